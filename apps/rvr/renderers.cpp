@@ -1,0 +1,18 @@
+#include "renderers.h"
+
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/raytrace/ray_tracer.h"
+
+namespace rvr {
+
+std::vector<std::string> renderer_names() { return {"raster", "raytrace"}; }
+
+Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name) {
+  if (name == "raster") return std::unique_ptr<Renderer>(std::make_unique<GlRasterizer>());
+  if (name == "raytrace") return std::unique_ptr<Renderer>(std::make_unique<RayTracer>());
+  std::string known;
+  for (const std::string& n : renderer_names()) known += (known.empty() ? "" : ", ") + n;
+  return bad_input("unknown renderer '" + name + "' (known: " + known + ")");
+}
+
+}  // namespace rvr

@@ -1,0 +1,38 @@
+// metrics.json and report.html of `rvr compare`.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "rvr/shared/compare.h"
+#include "rvr/shared/expected.h"
+
+namespace rvr {
+
+struct ReportRenderer {
+  std::string name;
+  std::string image_file;  // file name inside the output folder, e.g. "raster.png"
+  double seconds = 0.0;
+  std::vector<std::string> warnings;
+  std::map<std::string, double> stats;
+};
+
+struct ReportInput {
+  std::string scene;  // "builtin:cornell" or the file path
+  int width = 0, height = 0;
+  std::string mode;  // "local"
+  std::vector<ReportRenderer> renderers;  // the first two are the compared pair
+  ComparisonMetrics metrics;
+  float heat_map_scale = 0.1f;  // colour difference at the top of diff.png's colour map
+  std::string command_line;
+  std::string out_dir;  // holds the images named here plus diff.png and id_mismatch.png
+};
+
+// The metrics.json document (cli.md), as text.
+std::string metrics_json(const ReportInput& input);
+
+// A self-contained report.html: images from out_dir embedded as data URIs, no network.
+Expected<std::string> report_html(const ReportInput& input);
+
+}  // namespace rvr

@@ -1,0 +1,64 @@
+// How two renders of one scene differ: visibility (ids), depth and colour.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/image_io.h"
+
+namespace rvr {
+
+struct VisibilityMetrics {
+  size_t pixels = 0;
+  double id_agreement = 1.0;  // fraction of pixels with the same object AND primitive id
+  size_t mismatched_pixels = 0;
+  // Mismatched pixels none of whose 3x3 neighbourhood touches an object or primitive boundary
+  // in either id image: a silhouette may fall either way by a pixel, nothing else may.
+  size_t mismatched_off_edge = 0;
+};
+
+struct DepthMetrics {  // over pixels whose ids agree and are not background
+  double max_rel_error = 0.0;
+  double mean_rel_error = 0.0;
+};
+
+struct ColorMetrics {  // linear RGB, peak value 1 for PSNR and SSIM
+  double rmse = 0.0;
+  double psnr_db = 0.0;  // +inf when identical
+  double max_abs = 0.0;
+  double ssim = 1.0;     // luminance, 11x11 Gaussian window (sigma 1.5)
+};
+
+struct ComparisonMetrics {
+  VisibilityMetrics visibility;
+  DepthMetrics depth;
+  ColorMetrics color;
+};
+
+// Both buffers must have the same size.
+ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b);
+
+// A pixel whose (object, primitive) id differs from one of its 4 neighbours.
+std::vector<bool> id_boundaries(const FrameBuffers& fb);
+
+// Statistics of the difference of two images, like idiff.
+struct ImageDiff {
+  double mean_abs = 0.0;
+  double rmse = 0.0;
+  double psnr_db = 0.0;
+  double max_abs = 0.0;
+  int max_x = 0, max_y = 0, max_channel = 0;
+};
+// Errors (exit 2) when sizes or channel counts differ.
+Expected<ImageDiff> diff_images(const Image& a, const Image& b);
+
+// Colour heat map of the per-pixel max channel difference, scaled so `scale` maps to the top of
+// the colour map ("inferno").
+Image diff_heat_map(const Image& a, const Image& b, float scale);
+
+// Pixels whose object id differs in red over a grey version of a's colour.
+Image id_mismatch_image(const FrameBuffers& a, const FrameBuffers& b);
+
+}  // namespace rvr

@@ -1,0 +1,51 @@
+// Error values for library APIs: libraries return errors, only the CLI prints and exits.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <variant>
+
+namespace rvr {
+
+// Exit status the CLI uses for an error (see cli.md).
+enum class ErrorKind { BadInput = 2, Internal = 3 };
+
+struct Error {
+  // Without the "error: " prefix, e.g. "scenes/bad.json: objects[3].radius: must be > 0, got -1".
+  std::string message;
+  ErrorKind kind = ErrorKind::BadInput;
+};
+
+inline Error bad_input(std::string message) { return Error{std::move(message), ErrorKind::BadInput}; }
+inline Error internal_error(std::string message) {
+  return Error{std::move(message), ErrorKind::Internal};
+}
+
+// A value or an Error (std::expected is C++23).
+template <class T>
+class Expected {
+ public:
+  Expected(T value) : state_(std::move(value)) {}
+  Expected(Error error) : state_(std::move(error)) {}
+
+  bool ok() const { return state_.index() == 0; }
+  explicit operator bool() const { return ok(); }
+  T& value() & { return std::get<0>(state_); }
+  const T& value() const& { return std::get<0>(state_); }
+  T&& value() && { return std::get<0>(std::move(state_)); }
+  const Error& error() const { return std::get<1>(state_); }
+  T* operator->() { return &value(); }
+  const T* operator->() const { return &value(); }
+  T& operator*() { return value(); }
+  const T& operator*() const { return value(); }
+
+ private:
+  std::variant<T, Error> state_;
+};
+
+// For operations that produce nothing but may fail.
+struct Done {};
+using Status = Expected<Done>;
+inline Status ok_status() { return Done{}; }
+
+}  // namespace rvr

@@ -1,0 +1,49 @@
+// The interface every renderer implements; tests run one conformance suite over all of them.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/scene.h"
+
+namespace rvr {
+
+enum class RenderMode { Visibility, Local, Full };
+enum class SphereMode { Analytic, Mesh };
+enum class AccelKind { Bvh, None };
+enum class TriangleTest { MollerTrumbore, Chapter };
+
+const char* to_string(RenderMode mode);
+
+struct RenderOptions {
+  RenderMode mode = RenderMode::Local;
+  SphereMode spheres = SphereMode::Analytic;  // tracers: analytic or the raster's tessellation
+  int sphere_segments = 64;                   // tessellation: longitudes (rings = segments/2)
+  int threads = 0;                            // 0 = every core
+  int max_depth = 5;
+  uint64_t seed = 0;
+  AccelKind accel = AccelKind::Bvh;
+  TriangleTest triangle_test = TriangleTest::MollerTrumbore;
+};
+
+struct RenderOutput {
+  FrameBuffers buffers;
+  // Counters and phase times (seconds), e.g. "time.build", "rays.primary", "bvh.nodes_visited".
+  std::map<std::string, double> stats;
+  // What the renderer could not do for this scene (e.g. "csg objects skipped: 1").
+  std::vector<std::string> warnings;
+};
+
+class Renderer {
+ public:
+  virtual ~Renderer() = default;
+  virtual std::string name() const = 0;
+  virtual Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options) = 0;
+};
+
+}  // namespace rvr

@@ -1,0 +1,124 @@
+// The scene model shared by every renderer: what rvr-scene/1 describes, fully resolved
+// (materials by index, meshes in world space, defaults applied).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace rvr {
+
+struct Material {
+  std::string name;
+  glm::vec3 diffuse{0.8f};
+  glm::vec3 specular{0.0f};
+  glm::vec3 emission{0.0f};
+  float shininess = 32.0f;
+  float mirror = 0.0f;
+  float transparency = 0.0f;
+  float ior = 1.0f;
+};
+
+enum class LightType { Point, Area };
+
+struct Light {
+  LightType type = LightType::Point;
+  glm::vec3 position{0.0f};  // point
+  glm::vec3 corner{0.0f};    // area: parallelogram corner + edge_u + edge_v
+  glm::vec3 edge_u{0.0f};
+  glm::vec3 edge_v{0.0f};
+  glm::vec3 intensity{0.0f};  // total intensity (split over an area light's samples)
+  int samples = 4;            // area: n per side, n x n stratified
+};
+
+struct Camera {
+  glm::vec3 eye{0.0f, 0.0f, 1.0f};
+  glm::vec3 target{0.0f};
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
+  float fov_y_deg = 45.0f;
+  float near = 0.01f;
+  float far = 1000.0f;
+  float aperture_radius = 0.0f;
+  float focus_distance = 1.0f;
+};
+
+struct ImageSettings {
+  int width = 640;
+  int height = 480;
+  glm::vec3 background{0.0f};
+  int samples_per_pixel = 1;
+};
+
+struct Sphere {
+  glm::vec3 center{0.0f};
+  float radius = 1.0f;
+};
+
+// A square of side 2*half_size centred at point, facing normal (unit length).
+struct Plane {
+  glm::vec3 point{0.0f};
+  glm::vec3 normal{0.0f, 1.0f, 0.0f};
+  float half_size = 10.0f;
+};
+
+// Triangles in world space. normals is empty (flat shading: geometric normal) or holds one
+// unit normal per position (smooth shading: interpolated).
+struct TriangleMesh {
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::uvec3> triangles;
+
+  size_t triangle_count() const { return triangles.size(); }
+  bool smooth() const { return !normals.empty(); }
+};
+
+enum class CsgOp { Union, Intersection, Difference };
+
+// A CSG tree: leaves are spheres, inner nodes combine two solids.
+struct CsgNode {
+  bool is_leaf = true;
+  Sphere sphere;  // leaf
+  CsgOp op = CsgOp::Union;
+  std::shared_ptr<const CsgNode> a, b;  // inner node
+};
+
+enum class ObjectType { Sphere, Plane, Triangles, Csg };
+
+struct Object {
+  std::string name;
+  ObjectType type = ObjectType::Triangles;
+  uint32_t material = 0;  // index into Scene::materials
+  Sphere sphere;          // ObjectType::Sphere
+  Plane plane;            // ObjectType::Plane
+  TriangleMesh mesh;      // ObjectType::Triangles ("triangle" and "mesh" in the file)
+  std::shared_ptr<const CsgNode> csg;  // ObjectType::Csg
+};
+
+struct Scene {
+  std::string source;  // file path or "builtin:NAME", used in messages and reports
+  ImageSettings image;
+  Camera camera;
+  glm::vec3 ambient{0.0f};
+  std::vector<Material> materials;  // index 0 is the built-in grey default
+  std::vector<Light> lights;
+  std::vector<Object> objects;
+  std::vector<std::string> warnings;  // e.g. dropped degenerate triangles
+
+  size_t triangle_count() const;
+};
+
+// The built-in grey material used when an object names none.
+Material default_material();
+
+// One point light sample: a point light is one; an area light is n x n, at the centres of
+// its strata, each carrying intensity / (n*n).
+struct LightSample {
+  glm::vec3 position;
+  glm::vec3 intensity;
+};
+std::vector<LightSample> light_samples(const std::vector<Light>& lights);
+
+}  // namespace rvr

@@ -1,0 +1,28 @@
+// Triangle forms of the analytic shapes: the z-buffer draws these, and the tracer traces them
+// with --spheres mesh, so both loop orders can be compared on identical geometry.
+#pragma once
+
+#include <array>
+
+#include <glm/glm.hpp>
+
+#include "rvr/shared/scene.h"
+
+namespace rvr {
+
+// Two unit axes (u, v) spanning a plane with unit normal n, u x v = n. Both renderers use
+// these for the square's edges.
+std::array<glm::vec3, 2> plane_axes(const glm::vec3& n);
+
+// UV sphere: `segments` longitudes (>= 3), segments/2 rings (>= 2); vertices on the sphere,
+// smooth radial normals, counter-clockwise seen from outside.
+TriangleMesh tessellate_sphere(const Sphere& sphere, int segments);
+
+// The square as two triangles, counter-clockwise seen from the side the normal points to,
+// flat (no vertex normals).
+TriangleMesh tessellate_plane(const Plane& plane);
+
+// Segments for a sphere of about `triangles` triangles.
+int sphere_segments_for_triangles(size_t triangles);
+
+}  // namespace rvr
