@@ -1,1 +1,400 @@
-int main() { return 0; }
+// rvr: render one scene two ways and tell the truth about the difference. This program only
+// parses, calls the libraries and writes; errors come back as values and are printed here.
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "renderers.h"
+#include "report.h"
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/image_io.h"
+#include "rvr/shared/scene_loader.h"
+
+namespace {
+
+using namespace rvr;
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kVersion = "0.1.0";
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Thrown inside this program only, to leave with an exit status from any depth.
+struct Exit {
+  int status;
+};
+
+[[noreturn]] void fail(const Error& e) {
+  std::fprintf(stderr, "error: %s\n", e.message.c_str());
+  throw Exit{int(e.kind)};
+}
+
+template <class T>
+T take(Expected<T> result) {
+  if (!result) fail(result.error());
+  return std::move(result).value();
+}
+
+void check(const Status& status) {
+  if (!status) fail(status.error());
+}
+
+// Options shared by render and compare.
+struct CommonOptions {
+  std::string scene = "builtin:cornell";
+  std::string mode;
+  std::optional<int> width, height, spp;
+  int threads = 0;
+  std::string accel = "bvh";
+  std::string spheres = "analytic";
+  int sphere_segments = 64;
+  std::string triangle_test = "mt";
+  int max_depth = 5;
+  uint64_t seed = 0;
+  std::string gl = "osmesa";
+  bool quiet = false;
+};
+
+void add_common_options(CLI::App& cmd, CommonOptions& o) {
+  cmd.add_option("scene", o.scene, "scene file or builtin:NAME (default builtin:cornell)");
+  cmd.add_option("--mode", o.mode, "visibility | local | full")
+      ->check(CLI::IsMember({"visibility", "local", "full"}));
+  cmd.add_option("--width", o.width, "image width (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  cmd.add_option("--height", o.height, "image height (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  cmd.add_option("--spp", o.spp, "samples per pixel (overrides the scene)")
+      ->check(CLI::Range(1, 65536));
+  cmd.add_option("--threads", o.threads, "worker threads, 0 = every core")
+      ->check(CLI::Range(0, 1024));
+  cmd.add_option("--accel", o.accel, "tracer acceleration: bvh | none")
+      ->check(CLI::IsMember({"bvh", "none"}));
+  cmd.add_option("--spheres", o.spheres, "tracer spheres: analytic | mesh (the raster's tessellation)")
+      ->check(CLI::IsMember({"analytic", "mesh"}));
+  cmd.add_option("--sphere-segments", o.sphere_segments, "sphere tessellation: longitudes")
+      ->check(CLI::Range(3, 4096));
+  cmd.add_option("--triangle-test", o.triangle_test,
+                 "tracer ray-triangle test: mt (Moller-Trumbore) | chapter (plane, then edges)")
+      ->check(CLI::IsMember({"mt", "chapter"}));
+  cmd.add_option("--max-depth", o.max_depth, "recursion limit for bounce rays")
+      ->check(CLI::Range(0, 64));
+  cmd.add_option("--seed", o.seed, "seed of the per-pixel random streams");
+  cmd.add_option("--gl", o.gl, "GL back end: osmesa | egl")->check(CLI::IsMember({"osmesa", "egl"}));
+  cmd.add_flag("--quiet,-q", o.quiet, "no progress output");
+}
+
+RenderMode parse_mode(const std::string& s) {
+  if (s == "visibility") return RenderMode::Visibility;
+  if (s == "full") return RenderMode::Full;
+  return RenderMode::Local;
+}
+
+RenderOptions render_options(const CommonOptions& o, const std::string& default_mode) {
+  if (o.gl == "egl") fail(bad_input("--gl egl: the EGL back end is not available in this build; use --gl osmesa"));
+  RenderOptions r;
+  r.mode = parse_mode(o.mode.empty() ? default_mode : o.mode);
+  r.spheres = o.spheres == "mesh" ? SphereMode::Mesh : SphereMode::Analytic;
+  r.sphere_segments = o.sphere_segments;
+  r.threads = o.threads;
+  r.max_depth = o.max_depth;
+  r.seed = o.seed;
+  r.accel = o.accel == "none" ? AccelKind::None : AccelKind::Bvh;
+  r.triangle_test = o.triangle_test == "chapter" ? TriangleTest::Chapter : TriangleTest::MollerTrumbore;
+  return r;
+}
+
+Scene load(const CommonOptions& o, double& load_seconds) {
+  auto start = Clock::now();
+  Scene scene = take(load_scene(o.scene));
+  if (o.width) scene.image.width = *o.width;
+  if (o.height) scene.image.height = *o.height;
+  if (o.spp) scene.image.samples_per_pixel = *o.spp;
+  load_seconds = seconds_since(start);
+  return scene;
+}
+
+double peak_memory_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_maxrss) * 1024.0;
+}
+
+nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+
+// ---------------------------------------------------------------------------------- render
+
+struct RenderArgs {
+  CommonOptions common;
+  std::string renderer;
+  std::string out = "render.png";
+  std::vector<std::string> aovs;
+  std::string stats;
+};
+
+int run_render(const RenderArgs& a) {
+  RenderOptions options = render_options(a.common, "full");
+  double load_seconds = 0;
+  Scene scene = load(a.common, load_seconds);
+  std::unique_ptr<Renderer> renderer = take(make_renderer(a.renderer));
+  auto start = Clock::now();
+  RenderOutput out = take(renderer->render(scene, options));
+  double render_seconds = seconds_since(start);
+
+  auto write_start = Clock::now();
+  check(write_image(a.out, color_image(out.buffers)));
+  if (!a.aovs.empty()) check(write_aovs(a.out, out.buffers, a.aovs));
+  double write_seconds = seconds_since(write_start);
+
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const std::string& w : out.warnings) std::fprintf(stderr, "warning: %s: %s\n", a.renderer.c_str(), w.c_str());
+  if (!a.stats.empty()) {
+    nlohmann::json j;
+    j["renderer"] = a.renderer;
+    j["scene"] = scene.source;
+    j["width"] = scene.image.width;
+    j["height"] = scene.image.height;
+    j["mode"] = to_string(options.mode);
+    j["time"] = {{"load", load_seconds}, {"render", render_seconds}, {"write", write_seconds}};
+    nlohmann::json counters = nlohmann::json::object();
+    for (const auto& [k, v] : out.stats) counters[k] = finite_or_null(v);
+    j["stats"] = counters;
+    j["warnings"] = out.warnings;
+    j["peak_memory_bytes"] = peak_memory_bytes();
+    check(write_text_file(a.stats, j.dump(2) + "\n"));
+  }
+  if (!a.common.quiet) {
+    std::fprintf(stderr, "%s: %s %dx%d %s in %.3f s -> %s\n", a.renderer.c_str(),
+                 scene.source.c_str(), scene.image.width, scene.image.height,
+                 to_string(options.mode), render_seconds, a.out.c_str());
+  }
+  return 0;
+}
+
+// --------------------------------------------------------------------------------- compare
+
+struct CompareArgs {
+  CommonOptions common;
+  std::vector<std::string> renderers{"raster", "raytrace"};
+  std::string out_dir = "rvr-out";
+  std::optional<double> fail_below_agreement;
+};
+
+int run_compare(const CompareArgs& a, const std::string& command_line) {
+  if (a.renderers.size() < 2) fail(bad_input("--renderers: need at least two renderers to compare"));
+  RenderOptions options = render_options(a.common, "local");
+  double load_seconds = 0;
+  Scene scene = load(a.common, load_seconds);
+
+  std::vector<std::unique_ptr<Renderer>> renderers;
+  for (const std::string& name : a.renderers) renderers.push_back(take(make_renderer(name)));
+
+  ReportInput report;
+  report.scene = scene.source;
+  report.width = scene.image.width;
+  report.height = scene.image.height;
+  report.mode = to_string(options.mode);
+  report.command_line = command_line;
+  report.out_dir = a.out_dir;
+  std::vector<FrameBuffers> buffers;
+  for (size_t i = 0; i < renderers.size(); ++i) {
+    auto start = Clock::now();
+    RenderOutput out = take(renderers[i]->render(scene, options));
+    ReportRenderer r;
+    r.name = a.renderers[i];
+    r.image_file = r.name + ".png";
+    r.seconds = seconds_since(start);
+    r.warnings = out.warnings;
+    r.stats = out.stats;
+    r.stats["time.load"] = load_seconds;
+    report.renderers.push_back(r);
+    buffers.push_back(std::move(out.buffers));
+  }
+  report.metrics = compare_buffers(buffers[0], buffers[1]);
+
+  // Everything is computed before the first file is written.
+  std::vector<Image> images;
+  for (const FrameBuffers& fb : buffers) images.push_back(color_image(fb));
+  for (size_t i = 0; i < buffers.size(); ++i)
+    check(write_image(a.out_dir + "/" + report.renderers[i].image_file, images[i]));
+  check(write_image(a.out_dir + "/diff.png", diff_heat_map(images[0], images[1], report.heat_map_scale), false));
+  check(write_image(a.out_dir + "/id_mismatch.png", id_mismatch_image(buffers[0], buffers[1]), false));
+  check(write_text_file(a.out_dir + "/metrics.json", metrics_json(report)));
+  check(write_text_file(a.out_dir + "/report.html", take(report_html(report))));
+
+  const ComparisonMetrics& m = report.metrics;
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const ReportRenderer& r : report.renderers)
+    for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", r.name.c_str(), w.c_str());
+  std::printf("%s  %dx%d  mode %s\n", scene.source.c_str(), scene.image.width, scene.image.height,
+              report.mode.c_str());
+  for (const ReportRenderer& r : report.renderers)
+    std::printf("  %-12s %9.3f s\n", r.name.c_str(), r.seconds);
+  std::printf("  %s vs %s:\n", a.renderers[0].c_str(), a.renderers[1].c_str());
+  std::printf("  id agreement      %.5f  (%zu of %zu pixels differ, %zu off edges)\n",
+              m.visibility.id_agreement, m.visibility.mismatched_pixels, m.visibility.pixels,
+              m.visibility.mismatched_off_edge);
+  std::printf("  depth rel error   max %.3g  mean %.3g\n", m.depth.max_rel_error, m.depth.mean_rel_error);
+  std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
+              m.color.psnr_db, m.color.max_abs, m.color.ssim);
+  std::printf("  wrote %s/{%s.png,%s.png,diff.png,id_mismatch.png,metrics.json,report.html}\n",
+              a.out_dir.c_str(), a.renderers[0].c_str(), a.renderers[1].c_str());
+  if (a.fail_below_agreement && m.visibility.id_agreement < *a.fail_below_agreement) {
+    std::fprintf(stderr, "id agreement %.5f is below %.5f\n", m.visibility.id_agreement,
+                 *a.fail_below_agreement);
+    return 1;
+  }
+  return 0;
+}
+
+// ------------------------------------------------------------------------------------ diff
+
+struct DiffArgs {
+  std::string a, b, out;
+  std::optional<double> fail_above;
+};
+
+int run_diff(const DiffArgs& d) {
+  Image a = take(read_image(d.a));
+  Image b = take(read_image(d.b));
+  ImageDiff diff = take(diff_images(a, b));
+  if (!d.out.empty()) check(write_image(d.out, diff_heat_map(a, b, 0.1f), false));
+  std::printf("Comparing \"%s\" and \"%s\"\n", d.a.c_str(), d.b.c_str());
+  std::printf("  Mean error = %.6g\n  RMS error = %.6g\n  Peak SNR = %.6g\n", diff.mean_abs,
+              diff.rmse, diff.psnr_db);
+  std::printf("  Max error  = %.6g @ (%d, %d, channel %d)\n", diff.max_abs, diff.max_x,
+              diff.max_y, diff.max_channel);
+  if (d.fail_above && diff.rmse > *d.fail_above) {
+    std::printf("FAILURE: RMSE %.6g above %.6g\n", diff.rmse, *d.fail_above);
+    return 1;
+  }
+  std::printf("PASS\n");
+  return 0;
+}
+
+// ----------------------------------------------------------------------------- scenes/info
+
+int run_scenes() {
+  for (const BuiltinSceneInfo& s : builtin_scenes())
+    std::printf("builtin:%-14s %s\n", s.name.c_str(), s.description.c_str());
+  return 0;
+}
+
+std::string cpu_model() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("model name", 0) == 0) {
+      size_t colon = line.find(':');
+      if (colon != std::string::npos) return line.substr(colon + 2);
+    }
+  }
+  return "unknown";
+}
+
+int run_info() {
+  std::printf("rvr %s\n", kVersion);
+  std::printf("cpu: %s, %u hardware threads\n", cpu_model().c_str(), std::thread::hardware_concurrency());
+  std::printf("renderers: ");
+  for (const std::string& n : renderer_names()) std::printf("%s ", n.c_str());
+  std::printf("\n");
+  Expected<GlInfo> gl = query_gl_info();
+  if (!gl) fail(gl.error());
+  std::printf("gl backend: %s\nGL_VERSION: %s\nGL_RENDERER: %s\nGL_VENDOR: %s\nGLSL: %s\n",
+              gl->backend.c_str(), gl->version.c_str(), gl->renderer.c_str(), gl->vendor.c_str(),
+              gl->glsl_version.c_str());
+  return 0;
+}
+
+std::string join_args(int argc, char** argv) {
+  std::string s;
+  for (int i = 0; i < argc; ++i) {
+    std::string arg = argv[i];
+    bool quote = arg.find_first_of(" \t\"'$") != std::string::npos || arg.empty();
+    s += (i ? " " : "") + (quote ? "'" + arg + "'" : arg);
+  }
+  return s;
+}
+
+int run(int argc, char** argv) {
+  CLI::App app{"rvr: one scene, two loop orders (z-buffer rasterization vs ray tracing)"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", kVersion);
+
+  RenderArgs render;
+  CLI::App* render_cmd = app.add_subcommand("render", "render a scene with one renderer");
+  add_common_options(*render_cmd, render.common);
+  render_cmd->add_option("-r,--renderer", render.renderer, "raster | raytrace")->required();
+  render_cmd->add_option("-o,--output", render.out, "output image (.png, .exr)");
+  render_cmd->add_option("--aov", render.aovs, "extra outputs: depth,id,normal,cost")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"depth", "id", "normal", "cost"}));
+  render_cmd->add_option("--stats", render.stats, "write counters and phase times as JSON");
+
+  CompareArgs compare;
+  CLI::App* compare_cmd = app.add_subcommand("compare", "render with two renderers and compare");
+  add_common_options(*compare_cmd, compare.common);
+  compare_cmd->add_option("-r,--renderers", compare.renderers, "renderers, first two compared")
+      ->delimiter(',');
+  compare_cmd->add_option("-o,--output", compare.out_dir, "output folder (default rvr-out)");
+  compare_cmd->add_option("--fail-below-agreement", compare.fail_below_agreement,
+                          "exit 1 when the id agreement is below F")
+      ->check(CLI::Range(0.0, 1.0));
+
+  DiffArgs diff;
+  CLI::App* diff_cmd = app.add_subcommand("diff", "compare two image files, like idiff");
+  diff_cmd->add_option("image_a", diff.a, "first image")->required();
+  diff_cmd->add_option("image_b", diff.b, "second image")->required();
+  diff_cmd->add_option("-o,--output", diff.out, "heat map of the difference (.png)");
+  diff_cmd->add_option("--fail-above", diff.fail_above, "exit 1 when the RMSE is above this");
+
+  CLI::App* scenes_cmd = app.add_subcommand("scenes", "list the built-in scenes");
+  CLI::App* info_cmd = app.add_subcommand("info", "versions and machine facts for bug reports");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  }
+  if (render_cmd->parsed()) return run_render(render);
+  if (compare_cmd->parsed()) return run_compare(compare, join_args(argc, argv));
+  if (diff_cmd->parsed()) return run_diff(diff);
+  if (scenes_cmd->parsed()) return run_scenes();
+  if (info_cmd->parsed()) return run_info();
+  return 2;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const Exit& e) {
+    return e.status;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "error: out of memory\n");
+    return 3;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: internal: %s\n", e.what());
+    return 3;
+  }
+}

@@ -1,1 +1,165 @@
-// placeholder: being written
+// Binned SAH builder (as in pbrt-v4 and Embree): at each node, bin primitive centroids into
+// kBins slots per axis, sweep the bins for the split of least surface-area cost, and stop
+// when a leaf is cheaper than any split. Nodes come out in depth-first order.
+#include <algorithm>
+#include <chrono>
+
+#include "rvr/raytrace/bvh.h"
+
+namespace rvr {
+namespace {
+
+constexpr int kBins = 16;
+constexpr float kTraversalCost = 1.0f;
+constexpr float kIntersectCost = 1.0f;
+// Past this depth splits are object medians, so the depth (and the traversal stack) stays
+// bounded whatever the input.
+constexpr size_t kMedianDepth = 32;
+
+struct BuildTask {
+  uint32_t begin, end;  // range in the order array
+  uint32_t parent;      // node whose `offset` must point here (second children), or ~0
+  size_t depth;
+};
+
+struct Split {
+  int axis = -1;
+  int bin = 0;  // primitives in bins [0, bin] go left
+  float cost = INFINITY;
+};
+
+}  // namespace
+
+Bvh Bvh::build(const std::vector<Aabb>& bounds) {
+  auto start = std::chrono::steady_clock::now();
+  Bvh bvh;
+  const uint32_t n = uint32_t(bounds.size());
+  bvh.stats_.primitives = n;
+  if (n == 0) return bvh;
+
+  std::vector<glm::vec3> centroids(n);
+  for (uint32_t i = 0; i < n; ++i) centroids[i] = bounds[i].centroid();
+  bvh.order_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) bvh.order_[i] = i;
+  bvh.nodes_.reserve(size_t(n) / 2 + 1);
+
+  std::vector<BuildTask> tasks;
+  tasks.push_back({0, n, ~0u, 0});
+  float root_area = 0.0f;
+  while (!tasks.empty()) {
+    BuildTask task = tasks.back();
+    tasks.pop_back();
+    uint32_t index = uint32_t(bvh.nodes_.size());
+    if (task.parent != ~0u) bvh.nodes_[task.parent].offset = index;
+    bvh.nodes_.push_back({});
+
+    Aabb box, centroid_box;
+    for (uint32_t i = task.begin; i < task.end; ++i) {
+      box.grow(bounds[bvh.order_[i]]);
+      centroid_box.grow(centroids[bvh.order_[i]]);
+    }
+    if (index == 0) root_area = std::max(box.surface_area(), 1e-30f);
+    uint32_t count = task.end - task.begin;
+    bvh.stats_.max_depth = std::max(bvh.stats_.max_depth, task.depth);
+    float area_ratio = box.surface_area() / root_area;
+
+    auto make_leaf = [&]() {
+      BvhNode& node = bvh.nodes_[index];
+      node.lo = box.lo;
+      node.hi = box.hi;
+      node.offset = task.begin;
+      node.count = uint16_t(count);
+      node.axis = 0;
+      bvh.stats_.leaves++;
+      bvh.stats_.sah_cost += area_ratio * kIntersectCost * float(count);
+    };
+
+    float leaf_cost = kIntersectCost * float(count);
+    Split best;
+    glm::vec3 extent = centroid_box.hi - centroid_box.lo;
+    if (count > 1 && task.depth < kMedianDepth) {
+      Aabb bin_box[3][kBins];
+      uint32_t bin_count[3][kBins] = {};
+      for (uint32_t i = task.begin; i < task.end; ++i) {
+        uint32_t p = bvh.order_[i];
+        for (int a = 0; a < 3; ++a) {
+          if (extent[a] <= 0.0f) continue;
+          int b = std::min(kBins - 1, int((centroids[p][a] - centroid_box.lo[a]) *
+                                          (float(kBins) / extent[a])));
+          bin_count[a][b]++;
+          bin_box[a][b].grow(bounds[p]);
+        }
+      }
+      float inv_area = 1.0f / std::max(box.surface_area(), 1e-30f);
+      for (int a = 0; a < 3; ++a) {
+        if (extent[a] <= 0.0f) continue;
+        // Sweep from the right to get the area and count right of every split.
+        float right_area[kBins];
+        uint32_t right_count[kBins];
+        Aabb acc;
+        uint32_t cnt = 0;
+        for (int b = kBins - 1; b > 0; --b) {
+          acc.grow(bin_box[a][b]);
+          cnt += bin_count[a][b];
+          right_area[b] = acc.surface_area();
+          right_count[b] = cnt;
+        }
+        acc = Aabb();
+        cnt = 0;
+        for (int b = 0; b < kBins - 1; ++b) {
+          acc.grow(bin_box[a][b]);
+          cnt += bin_count[a][b];
+          if (cnt == 0 || right_count[b + 1] == 0) continue;
+          float cost = kTraversalCost + kIntersectCost * inv_area *
+                                            (acc.surface_area() * float(cnt) +
+                                             right_area[b + 1] * float(right_count[b + 1]));
+          if (cost < best.cost) best = {a, b, cost};
+        }
+      }
+    }
+
+    bool must_split = count > uint32_t(kMaxLeafSize);
+    if (count == 1 || (!must_split && !(best.cost < leaf_cost))) {
+      make_leaf();
+      continue;
+    }
+
+    uint32_t mid;
+    int axis;
+    if (best.axis >= 0) {
+      axis = best.axis;
+      float scale = float(kBins) / extent[axis];
+      float lo = centroid_box.lo[axis];
+      auto* first = bvh.order_.data() + task.begin;
+      auto* split = std::partition(first, bvh.order_.data() + task.end, [&](uint32_t p) {
+        return std::min(kBins - 1, int((centroids[p][axis] - lo) * scale)) <= best.bin;
+      });
+      mid = uint32_t(split - bvh.order_.data());
+    } else {
+      // No useful SAH split (all centroids equal, or too deep): split at the object median.
+      axis = int(std::max_element(&extent[0], &extent[0] + 3) - &extent[0]);
+      mid = task.begin + count / 2;
+      std::nth_element(bvh.order_.begin() + task.begin, bvh.order_.begin() + mid,
+                       bvh.order_.begin() + task.end, [&](uint32_t a, uint32_t b) {
+                         return centroids[a][axis] < centroids[b][axis];
+                       });
+    }
+
+    BvhNode& node = bvh.nodes_[index];
+    node.lo = box.lo;
+    node.hi = box.hi;
+    node.count = 0;
+    node.axis = uint8_t(axis);
+    bvh.stats_.sah_cost += area_ratio * kTraversalCost;
+    // Second child first onto the stack, so the first child is built next at index + 1.
+    tasks.push_back({mid, task.end, index, task.depth + 1});
+    tasks.push_back({task.begin, mid, ~0u, task.depth + 1});
+  }
+  bvh.nodes_.shrink_to_fit();
+  bvh.stats_.nodes = bvh.nodes_.size();
+  bvh.stats_.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return bvh;
+}
+
+}  // namespace rvr

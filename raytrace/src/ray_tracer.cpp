@@ -1,1 +1,256 @@
-// placeholder: being written
+// The ray tracer's frame loop: for each pixel (tiles in parallel), for each object (through
+// the BVH or the plain loop), shade the nearest hit with the shared shading function.
+#include "rvr/raytrace/ray_tracer.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "rvr/raytrace/trace_geometry.h"
+#include "rvr/shared/camera.h"
+#include "rvr/shared/shading.h"
+
+namespace rvr {
+namespace {
+
+constexpr int kTileSize = 16;
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// One random stream per pixel, seeded from (seed, x, y): the image does not depend on which
+// thread renders which tile.
+class PixelRng {
+ public:
+  PixelRng(uint64_t seed, int x, int y)
+      : state_(seed * 0x9E3779B97F4A7C15ull ^ (uint64_t(uint32_t(x)) << 32 | uint32_t(y))) {
+    next();
+  }
+  uint64_t next() {
+    uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  float uniform() { return float(next() >> 40) * (1.0f / 16777216.0f); }
+
+ private:
+  uint64_t state_;
+};
+
+struct RayCounters {
+  uint64_t primary = 0, shadow = 0, reflection = 0, refraction = 0;
+  TraversalCounters traversal;
+
+  void add(const RayCounters& o) {
+    primary += o.primary;
+    shadow += o.shadow;
+    reflection += o.reflection;
+    refraction += o.refraction;
+    traversal.nodes_visited += o.traversal.nodes_visited;
+    traversal.primitive_tests += o.traversal.primitive_tests;
+  }
+};
+
+// Offset for secondary ray origins: large enough to leave the surface at this position's
+// float precision, small enough not to skip thin geometry.
+float ray_epsilon(const glm::vec3& p) {
+  float m = std::max(std::max(std::abs(p.x), std::abs(p.y)), std::max(std::abs(p.z), 1.0f));
+  return 1e-4f * m;
+}
+
+class FrameTracer {
+ public:
+  FrameTracer(const Scene& scene, const RenderOptions& options, const TraceGeometry& geometry)
+      : scene_(scene),
+        options_(options),
+        geometry_(geometry),
+        lights_(light_samples(scene.lights)),
+        frame_(make_camera_frame(scene.camera, scene.image.width, scene.image.height)) {}
+
+  void render_pixel(int x, int y, FrameBuffers& fb, RayCounters& counters) const {
+    uint64_t work_before = counters.traversal.nodes_visited + counters.traversal.primitive_tests;
+    size_t i = fb.index(x, y);
+    // The AOVs come from the ray through the pixel centre, where OpenGL samples too.
+    Ray ray = primary_ray(float(x) + 0.5f, float(y) + 0.5f);
+    counters.primary++;
+    HitRecord hit;
+    glm::vec3 centre_colour = scene_.image.background;
+    if (geometry_.closest(ray, hit, counters.traversal)) {
+      SurfaceHit s = geometry_.surface(ray, hit);
+      glm::vec3 V = -glm::normalize(ray.dir);
+      glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
+      fb.depth[i] = s.t;  // the direction's forward component is 1: t is view depth
+      fb.object_id[i] = s.object;
+      fb.primitive_id[i] = s.primitive;
+      fb.normal[i] = N;
+      if (options_.mode != RenderMode::Visibility) centre_colour = shade(ray, s, N, V, 0, counters);
+    }
+    int spp = scene_.image.samples_per_pixel;
+    if (options_.mode == RenderMode::Visibility) {
+      fb.color[i] = scene_.image.background;
+    } else if (spp <= 1) {
+      fb.color[i] = centre_colour;
+    } else {
+      fb.color[i] = supersample(x, y, spp, counters);
+    }
+    fb.cost[i] = float(counters.traversal.nodes_visited + counters.traversal.primitive_tests -
+                       work_before);
+  }
+
+ private:
+  Ray primary_ray(float px, float py) const {
+    Ray r;
+    r.origin = frame_.eye;
+    r.dir = camera_ray_direction(frame_, px, py);
+    // t along a direction with forward component 1 is view depth: clip exactly as GL does.
+    r.tmin = scene_.camera.near;
+    r.tmax = scene_.camera.far;
+    return r;
+  }
+
+  // Stratified jitter: the pixel split into an m x m grid (m = floor(sqrt(spp))), one sample
+  // per cell, the rest uniformly placed.
+  glm::vec3 supersample(int x, int y, int spp, RayCounters& counters) const {
+    PixelRng rng(options_.seed, x, y);
+    int m = int(std::sqrt(double(spp)));
+    glm::vec3 sum(0.0f);
+    for (int k = 0; k < spp; ++k) {
+      float jx = rng.uniform(), jy = rng.uniform();
+      if (k < m * m) {
+        jx = (float(k % m) + jx) / float(m);
+        jy = (float(k / m) + jy) / float(m);
+      }
+      Ray ray = primary_ray(float(x) + jx, float(y) + jy);
+      counters.primary++;
+      sum += trace(ray, 0, counters);
+    }
+    return sum / float(spp);
+  }
+
+  glm::vec3 trace(const Ray& ray, int depth, RayCounters& counters) const {
+    HitRecord hit;
+    if (!geometry_.closest(ray, hit, counters.traversal)) return scene_.image.background;
+    SurfaceHit s = geometry_.surface(ray, hit);
+    glm::vec3 V = -glm::normalize(ray.dir);
+    return shade(ray, s, face_viewer(s.shading_normal, s.geometric_normal, V), V, depth, counters);
+  }
+
+  glm::vec3 shade(const Ray& ray, const SurfaceHit& s, const glm::vec3& N, const glm::vec3& V,
+                  int depth, RayCounters& counters) const {
+    const Material& m = scene_.materials[s.material];
+    if (options_.mode != RenderMode::Full) {
+      return shade_local(m, s.position, N, V, scene_.ambient, lights_);
+    }
+    float eps = ray_epsilon(s.position);
+    glm::vec3 above = s.position + eps * N;  // on the viewer's side of the surface
+    auto visibility = [&](size_t, const glm::vec3&, const glm::vec3& light) {
+      Ray shadow{above, light - above, 0.0f, 1.0f - 1e-4f};
+      counters.shadow++;
+      return geometry_.occluded(shadow, counters.traversal) ? 0.0f : 1.0f;
+    };
+    glm::vec3 local = shade_local(m, s.position, N, V, scene_.ambient, lights_, visibility);
+    glm::vec3 colour = (1.0f - m.mirror - m.transparency) * local;
+    if (depth >= options_.max_depth) return colour;
+    glm::vec3 d = glm::normalize(ray.dir);
+    if (m.mirror > 0.0f) {
+      counters.reflection++;
+      Ray r{above, glm::reflect(d, N), 0.0f, INFINITY};
+      colour += m.mirror * trace(r, depth + 1, counters);
+    }
+    if (m.transparency > 0.0f) {
+      glm::vec3 below = s.position - eps * N;
+      // Entering when the ray meets the outside of the surface as modelled.
+      bool entering = glm::dot(s.geometric_normal, d) < 0.0f;
+      float eta = entering ? 1.0f / m.ior : m.ior;
+      float cos_i = -glm::dot(d, N);
+      float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
+      Ray r;
+      if (k < 0.0f) {  // total internal reflection
+        counters.reflection++;
+        r = {above, glm::reflect(d, N), 0.0f, INFINITY};
+      } else {
+        counters.refraction++;
+        r = {below, eta * d + (eta * cos_i - std::sqrt(k)) * N, 0.0f, INFINITY};
+      }
+      colour += m.transparency * trace(r, depth + 1, counters);
+    }
+    return colour;
+  }
+
+  const Scene& scene_;
+  const RenderOptions& options_;
+  const TraceGeometry& geometry_;
+  std::vector<LightSample> lights_;
+  CameraFrame frame_;
+};
+
+}  // namespace
+
+Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& options) {
+  RenderOutput out;
+  const int w = scene.image.width, h = scene.image.height;
+  if (w <= 0 || h <= 0) return bad_input("image size must be positive");
+
+  auto t_build = Clock::now();
+  TraceGeometry geometry(scene, options.spheres, options.sphere_segments, options.accel,
+                         options.triangle_test);
+  out.stats["time.build"] = seconds_since(t_build);
+
+  auto t_render = Clock::now();
+  out.buffers.reset(w, h, scene.image.background);
+  FrameTracer tracer(scene, options, geometry);
+  tbb::combinable<RayCounters> counters;
+  const int tiles_x = (w + kTileSize - 1) / kTileSize;
+  const int tiles_y = (h + kTileSize - 1) / kTileSize;
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
+        [&](const tbb::blocked_range<int>& range) {
+          RayCounters& local = counters.local();
+          for (int tile = range.begin(); tile != range.end(); ++tile) {
+            int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
+            for (int y = y0; y < std::min(y0 + kTileSize, h); ++y)
+              for (int x = x0; x < std::min(x0 + kTileSize, w); ++x)
+                tracer.render_pixel(x, y, out.buffers, local);
+          }
+        },
+        tbb::simple_partitioner());
+  });
+  out.stats["time.render"] = seconds_since(t_render);
+
+  RayCounters total;
+  counters.combine_each([&](const RayCounters& c) { total.add(c); });
+  out.stats["rays.primary"] = double(total.primary);
+  out.stats["rays.shadow"] = double(total.shadow);
+  out.stats["rays.reflection"] = double(total.reflection);
+  out.stats["rays.refraction"] = double(total.refraction);
+  out.stats["bvh.nodes_visited"] = double(total.traversal.nodes_visited);
+  out.stats["primitive_tests"] = double(total.traversal.primitive_tests);
+  out.stats["primitives"] = double(geometry.primitive_count());
+  out.stats["triangles"] = double(geometry.triangle_count());
+  if (options.accel == AccelKind::Bvh) {
+    const BvhBuildStats& b = geometry.bvh().stats();
+    out.stats["bvh.nodes"] = double(b.nodes);
+    out.stats["bvh.leaves"] = double(b.leaves);
+    out.stats["bvh.max_depth"] = double(b.max_depth);
+    out.stats["bvh.sah_cost"] = b.sah_cost;
+    out.stats["bvh.bytes"] = double(geometry.acceleration_bytes());
+    out.stats["time.bvh_build"] = b.seconds;
+  }
+  if (options.mode == RenderMode::Full) {
+    if (scene.camera.aperture_radius > 0.0f)
+      out.warnings.push_back("depth of field is not implemented yet: rendered as a pinhole");
+  }
+  return out;
+}
+
+}  // namespace rvr

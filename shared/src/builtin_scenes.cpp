@@ -1,1 +1,249 @@
-// placeholder: being written
+// The built-in scenes: small, deterministic, and chosen to stress one axis each
+// (cornell: everything; spheres: analytic shapes; occluders: depth complexity; soup and
+// tessphere: triangle count).
+#include <charconv>
+#include <cstdint>
+#include <string>
+
+#include "rvr/shared/scene_loader.h"
+#include "rvr/shared/tessellate.h"
+
+namespace rvr {
+namespace {
+
+constexpr size_t kMaxBuiltinCount = 10'000'000;
+
+// splitmix64: a fixed generator, so soup:N is the same triangles on every platform.
+class SplitMix64 {
+ public:
+  explicit SplitMix64(uint64_t seed) : state_(seed) {}
+  uint64_t next() {
+    uint64_t z = (state_ += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  float uniform() { return float(next() >> 40) * (1.0f / 16777216.0f); }  // [0, 1)
+  float uniform(float lo, float hi) { return lo + (hi - lo) * uniform(); }
+
+ private:
+  uint64_t state_;
+};
+
+uint32_t add_material(Scene& s, const std::string& name, glm::vec3 diffuse,
+                      glm::vec3 specular = glm::vec3(0.0f), float shininess = 32.0f,
+                      glm::vec3 emission = glm::vec3(0.0f)) {
+  Material m;
+  m.name = name;
+  m.diffuse = diffuse;
+  m.specular = specular;
+  m.shininess = shininess;
+  m.emission = emission;
+  s.materials.push_back(m);
+  return uint32_t(s.materials.size() - 1);
+}
+
+Scene base_scene(const std::string& name) {
+  Scene s;
+  s.source = "builtin:" + name;
+  s.materials.push_back(default_material());
+  return s;
+}
+
+void look_at(Scene& s, glm::vec3 eye, glm::vec3 target, float fov, float near, float far) {
+  s.camera.eye = eye;
+  s.camera.target = target;
+  s.camera.up = {0, 1, 0};
+  s.camera.fov_y_deg = fov;
+  s.camera.near = near;
+  s.camera.far = far;
+  s.camera.focus_distance = glm::length(target - eye);
+}
+
+void add_point_light(Scene& s, glm::vec3 position, glm::vec3 intensity) {
+  Light l;
+  l.type = LightType::Point;
+  l.position = position;
+  l.intensity = intensity;
+  s.lights.push_back(l);
+}
+
+Object& add_object(Scene& s, const std::string& name, ObjectType type, uint32_t material) {
+  Object o;
+  o.name = name;
+  o.type = type;
+  o.material = material;
+  s.objects.push_back(std::move(o));
+  return s.objects.back();
+}
+
+// A quad v0 v1 v2 v3 (counter-clockwise seen from the front) as two flat triangles.
+void add_quad(Scene& s, const std::string& name, uint32_t material, glm::vec3 v0, glm::vec3 v1,
+              glm::vec3 v2, glm::vec3 v3) {
+  Object& o = add_object(s, name, ObjectType::Triangles, material);
+  o.mesh.positions = {v0, v1, v2, v3};
+  o.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+}
+
+void add_sphere(Scene& s, const std::string& name, uint32_t material, glm::vec3 c, float r) {
+  Object& o = add_object(s, name, ObjectType::Sphere, material);
+  o.sphere = {c, r};
+}
+
+// The Cornell box from its published geometry (Cornell University Program of Computer
+// Graphics), scaled from millimetres to decimetres, with two spheres in place of the blocks.
+// The published camera looks along +z, so +x is to the left: the red wall is on the left.
+Scene cornell() {
+  Scene s = base_scene("cornell");
+  const float k = 0.01f;
+  auto p = [k](float x, float y, float z) { return glm::vec3(x, y, z) * k; };
+  uint32_t white = add_material(s, "white", {0.73f, 0.73f, 0.73f});
+  uint32_t red = add_material(s, "red", {0.63f, 0.065f, 0.05f});
+  uint32_t green = add_material(s, "green", {0.14f, 0.45f, 0.091f});
+  uint32_t lamp = add_material(s, "lamp", {0.78f, 0.78f, 0.78f}, glm::vec3(0.0f), 32.0f,
+                               {4.0f, 4.0f, 4.0f});
+  uint32_t mirror = add_material(s, "mirror", {0.1f, 0.1f, 0.1f}, {0.9f, 0.9f, 0.9f}, 200.0f);
+  s.materials[mirror].mirror = 0.85f;
+  uint32_t glass = add_material(s, "glass", {0.05f, 0.05f, 0.05f}, {0.8f, 0.8f, 0.8f}, 300.0f);
+  s.materials[glass].transparency = 0.9f;
+  s.materials[glass].ior = 1.5f;
+
+  add_quad(s, "floor", white, p(552.8f, 0, 0), p(0, 0, 0), p(0, 0, 559.2f), p(549.6f, 0, 559.2f));
+  add_quad(s, "ceiling", white, p(556.0f, 548.8f, 0), p(556.0f, 548.8f, 559.2f),
+           p(0, 548.8f, 559.2f), p(0, 548.8f, 0));
+  add_quad(s, "back wall", white, p(549.6f, 0, 559.2f), p(0, 0, 559.2f), p(0, 548.8f, 559.2f),
+           p(556.0f, 548.8f, 559.2f));
+  add_quad(s, "green wall", green, p(0, 0, 559.2f), p(0, 0, 0), p(0, 548.8f, 0),
+           p(0, 548.8f, 559.2f));
+  add_quad(s, "red wall", red, p(552.8f, 0, 0), p(549.6f, 0, 559.2f), p(556.0f, 548.8f, 559.2f),
+           p(556.0f, 548.8f, 0));
+  // The lamp hangs 2 mm below the ceiling: coplanar with it, the two would tie in depth.
+  add_quad(s, "lamp", lamp, p(343.0f, 548.6f, 227.0f), p(343.0f, 548.6f, 332.0f),
+           p(213.0f, 548.6f, 332.0f), p(213.0f, 548.6f, 227.0f));
+  add_sphere(s, "mirror ball", mirror, p(370.0f, 100.0f, 370.0f), 1.0f);
+  add_sphere(s, "glass ball", glass, p(180.0f, 90.0f, 190.0f), 0.9f);
+
+  s.image.width = 640;
+  s.image.height = 480;
+  look_at(s, p(278.0f, 273.0f, -800.0f), p(278.0f, 273.0f, 0.0f), 39.3077f, 1.0f, 100.0f);
+  s.ambient = {0.03f, 0.03f, 0.03f};
+  add_point_light(s, p(278.0f, 530.0f, 279.5f), {12.0f, 12.0f, 12.0f});
+  return s;
+}
+
+Scene spheres() {
+  Scene s = base_scene("spheres");
+  uint32_t floor = add_material(s, "floor", {0.6f, 0.6f, 0.55f});
+  Object& plane = add_object(s, "floor", ObjectType::Plane, floor);
+  plane.plane = {{0, 0, 0}, {0, 1, 0}, 8.0f};
+  const int n = 5;
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      float hue = float(i * n + j) / float(n * n);
+      glm::vec3 colour(0.2f + 0.7f * hue, 0.3f + 0.5f * (1.0f - hue), 0.9f - 0.6f * hue);
+      uint32_t m = add_material(s, "ball" + std::to_string(i * n + j), colour,
+                                glm::vec3(0.4f), 16.0f + 8.0f * float(i));
+      add_sphere(s, "sphere " + std::to_string(i) + "," + std::to_string(j), m,
+                 {float(i - n / 2) * 1.1f, 0.45f, float(j - n / 2) * 1.1f}, 0.45f);
+    }
+  }
+  look_at(s, {0.0f, 4.0f, 7.5f}, {0.0f, 0.3f, 0.0f}, 45.0f, 0.1f, 100.0f);
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  add_point_light(s, {-3.0f, 6.0f, 4.0f}, {40.0f, 40.0f, 40.0f});
+  add_point_light(s, {4.0f, 3.0f, 2.0f}, {10.0f, 9.0f, 8.0f});
+  return s;
+}
+
+// N parallel quads facing the camera, one behind another; the rear ones are hidden by the
+// front one wherever it covers them, so the z-buffer shades N fragments there and the tracer 1.
+Scene occluders(size_t n) {
+  Scene s = base_scene("occluders:" + std::to_string(n));
+  const float spacing = 0.05f;
+  for (size_t i = 0; i < n; ++i) {
+    float t = n > 1 ? float(i) / float(n - 1) : 0.0f;
+    uint32_t m = add_material(s, "quad" + std::to_string(i), {0.9f - 0.6f * t, 0.3f, 0.2f + 0.7f * t});
+    Object& o = add_object(s, "quad " + std::to_string(i), ObjectType::Plane, m);
+    o.plane = {{0.0f, 0.0f, -float(i) * spacing}, {0, 0, 1}, 1.0f};
+  }
+  look_at(s, {0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 45.0f, 0.1f, 100.0f);
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  add_point_light(s, {1.0f, 1.5f, 3.0f}, {10.0f, 10.0f, 10.0f});
+  return s;
+}
+
+// N random triangles in a box. Triangle size shrinks as 1/sqrt(N), so the projected area (and
+// so the depth complexity) stays about the same as N grows: only the triangle count varies.
+Scene soup(size_t n) {
+  Scene s = base_scene("soup:" + std::to_string(n));
+  uint32_t m = add_material(s, "soup", {0.7f, 0.6f, 0.4f}, {0.3f, 0.3f, 0.3f}, 24.0f);
+  Object& o = add_object(s, "soup", ObjectType::Triangles, m);
+  SplitMix64 rng(0x5EEDull + n);
+  float size = std::min(0.5f, 0.25f * std::sqrt(1000.0f / float(n)));
+  o.mesh.positions.reserve(3 * n);
+  o.mesh.triangles.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
+    glm::vec3 c(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    uint32_t base = uint32_t(o.mesh.positions.size());
+    for (int k = 0; k < 3; ++k) {
+      o.mesh.positions.push_back(
+          c + size * glm::vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)));
+    }
+    o.mesh.triangles.push_back({base, base + 1, base + 2});
+  }
+  look_at(s, {0.0f, 0.0f, 3.5f}, {0.0f, 0.0f, 0.0f}, 45.0f, 0.1f, 100.0f);
+  s.ambient = {0.08f, 0.08f, 0.08f};
+  add_point_light(s, {2.0f, 3.0f, 4.0f}, {25.0f, 25.0f, 25.0f});
+  return s;
+}
+
+// One smooth sphere of about N triangles, as a mesh: primitive ids are triangle indices.
+Scene tessphere(size_t n) {
+  Scene s = base_scene("tessphere:" + std::to_string(n));
+  uint32_t m = add_material(s, "sphere", {0.3f, 0.5f, 0.8f}, {0.5f, 0.5f, 0.5f}, 48.0f);
+  Object& o = add_object(s, "sphere", ObjectType::Triangles, m);
+  o.mesh = tessellate_sphere({{0, 0, 0}, 1.0f}, sphere_segments_for_triangles(n));
+  look_at(s, {0.0f, 0.6f, 3.2f}, {0.0f, 0.0f, 0.0f}, 45.0f, 0.1f, 100.0f);
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  add_point_light(s, {2.0f, 3.0f, 3.0f}, {20.0f, 20.0f, 20.0f});
+  return s;
+}
+
+}  // namespace
+
+std::vector<BuiltinSceneInfo> builtin_scenes() {
+  return {
+      {"cornell", "the Cornell box (published geometry), a mirror and a glass sphere, a point light"},
+      {"spheres", "a 5x5 grid of analytic spheres on a square plane, two point lights"},
+      {"occluders:N", "N parallel quads one behind another facing the camera: depth complexity N (default 8)"},
+      {"soup:N", "N random triangles in a box, seeded, constant total area (default 1000)"},
+      {"tessphere:N", "one smooth sphere tessellated into about N triangles (default 10000)"},
+  };
+}
+
+Expected<Scene> make_builtin_scene(const std::string& spec) {
+  std::string name = spec;
+  size_t count = 0;
+  bool has_count = false;
+  if (size_t colon = spec.find(':'); colon != std::string::npos) {
+    name = spec.substr(0, colon);
+    std::string digits = spec.substr(colon + 1);
+    auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), count);
+    if (digits.empty() || ec != std::errc() || end != digits.data() + digits.size() ||
+        count < 1 || count > kMaxBuiltinCount) {
+      return bad_input("builtin:" + spec + ": N must be an integer in 1.." +
+                       std::to_string(kMaxBuiltinCount) + ", got '" + digits + "'");
+    }
+    has_count = true;
+  }
+  auto no_count = [&]() -> Expected<Scene> {
+    return bad_input("builtin:" + spec + ": scene '" + name + "' takes no ':N'");
+  };
+  if (name == "cornell") return has_count ? no_count() : Expected<Scene>(cornell());
+  if (name == "spheres") return has_count ? no_count() : Expected<Scene>(spheres());
+  if (name == "occluders") return occluders(has_count ? count : 8);
+  if (name == "soup") return soup(has_count ? count : 1000);
+  if (name == "tessphere") return tessphere(has_count ? count : 10000);
+  return bad_input("builtin:" + spec + ": no such built-in scene (see 'rvr scenes')");
+}
+
+}  // namespace rvr

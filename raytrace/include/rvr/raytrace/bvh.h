@@ -1,0 +1,143 @@
+// A bounding volume hierarchy: binned-SAH builder (bvh.cpp) apart from traversal (here, inline),
+// flattened into 32-byte nodes in depth-first order, traversed near child first with a fixed
+// stack. It knows only boxes; what a leaf's primitives are is the caller's business.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rvr/raytrace/intersect.h"
+
+namespace rvr {
+
+struct Aabb {
+  glm::vec3 lo{INFINITY};
+  glm::vec3 hi{-INFINITY};
+
+  void grow(const glm::vec3& p) {
+    lo = glm::min(lo, p);
+    hi = glm::max(hi, p);
+  }
+  void grow(const Aabb& b) {
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
+  bool empty() const { return lo.x > hi.x; }
+  glm::vec3 centroid() const { return 0.5f * (lo + hi); }
+  float surface_area() const {
+    if (empty()) return 0.0f;
+    glm::vec3 d = hi - lo;
+    return 2.0f * (d.x * d.y + d.y * d.z + d.z * d.x);
+  }
+};
+
+// Interior: count == 0, the first child follows at index + 1, the second is at `offset`.
+// Leaf: count > 0 primitives starting at `offset` in Bvh::primitive_order().
+struct alignas(32) BvhNode {
+  glm::vec3 lo;
+  uint32_t offset;
+  glm::vec3 hi;
+  uint16_t count;
+  uint8_t axis;  // split axis of an interior node: decides which child is near
+  uint8_t pad;
+};
+static_assert(sizeof(BvhNode) == 32, "BVH nodes are 32 bytes");
+
+struct BvhBuildStats {
+  size_t primitives = 0;
+  size_t nodes = 0;
+  size_t leaves = 0;
+  size_t max_depth = 0;
+  double sah_cost = 0.0;  // expected cost per ray: traversal 1, primitive test 1
+  double seconds = 0.0;
+};
+
+struct TraversalCounters {
+  uint64_t nodes_visited = 0;
+  uint64_t primitive_tests = 0;
+};
+
+class Bvh {
+ public:
+  static constexpr int kMaxLeafSize = 8;
+  static constexpr int kStackSize = 64;
+
+  // Builds over primitives given by their bounds; empty input gives an empty tree.
+  static Bvh build(const std::vector<Aabb>& primitive_bounds);
+
+  const std::vector<BvhNode>& nodes() const { return nodes_; }
+  // Leaf slots -> primitive index given to build().
+  const std::vector<uint32_t>& primitive_order() const { return order_; }
+  const BvhBuildStats& stats() const { return stats_; }
+  bool empty() const { return nodes_.empty(); }
+
+  // Visits the leaves whose boxes the ray enters before t_max, near child first.
+  // leaf(first_slot, count, t_max) tests the primitives in slots [first, first + count),
+  // may lower t_max to the nearest hit so far, and returns true to stop (any-hit queries).
+  template <class LeafFn>
+  void traverse(const Ray& ray, float& t_max, LeafFn&& leaf, TraversalCounters& counters) const;
+
+ private:
+  std::vector<BvhNode> nodes_;
+  std::vector<uint32_t> order_;
+  BvhBuildStats stats_;
+};
+
+// Slab test against a node box with precomputed reciprocal direction.
+struct RayBoxData {
+  glm::vec3 origin, inv_dir;
+  int neg[3];
+  explicit RayBoxData(const Ray& ray) : origin(ray.origin), inv_dir(1.0f / ray.dir) {
+    for (int a = 0; a < 3; ++a) neg[a] = inv_dir[a] < 0.0f;
+  }
+  bool hits(const BvhNode& n, float t_min, float t_max) const {
+    // Max/min order keeps a NaN (0 * inf, ray in a slab's plane) from rejecting the box.
+    const glm::vec3* b[2] = {&n.lo, &n.hi};
+    float tx0 = ((*b[neg[0]]).x - origin.x) * inv_dir.x;
+    float tx1 = ((*b[1 - neg[0]]).x - origin.x) * inv_dir.x;
+    float ty0 = ((*b[neg[1]]).y - origin.y) * inv_dir.y;
+    float ty1 = ((*b[1 - neg[1]]).y - origin.y) * inv_dir.y;
+    float tz0 = ((*b[neg[2]]).z - origin.z) * inv_dir.z;
+    float tz1 = ((*b[1 - neg[2]]).z - origin.z) * inv_dir.z;
+    // Widen the exit a little (pbrt's 1 + 2*gamma(3)) so rounding never loses a hit.
+    constexpr float kWiden = 1.0000004f;
+    float t0 = std::max(std::max(tx0, ty0), std::max(tz0, t_min));
+    float t1 = std::min(std::min(tx1, ty1), std::min(tz1, t_max)) * kWiden;
+    return t0 <= t1;
+  }
+};
+
+template <class LeafFn>
+void Bvh::traverse(const Ray& ray, float& t_max, LeafFn&& leaf,
+                   TraversalCounters& counters) const {
+  if (nodes_.empty()) return;
+  RayBoxData box(ray);
+  uint32_t stack[kStackSize];
+  int top = 0;
+  uint32_t current = 0;
+  for (;;) {
+    const BvhNode& node = nodes_[current];
+    ++counters.nodes_visited;
+    if (box.hits(node, ray.tmin, t_max)) {
+      if (node.count > 0) {
+        counters.primitive_tests += node.count;
+        if (leaf(node.offset, uint32_t(node.count), t_max)) return;
+        if (top == 0) return;
+        current = stack[--top];
+      } else if (box.neg[node.axis]) {  // second child is nearer
+        stack[top++] = current + 1;
+        current = node.offset;
+      } else {
+        stack[top++] = node.offset;
+        current = current + 1;
+      }
+    } else {
+      if (top == 0) return;
+      current = stack[--top];
+    }
+  }
+}
+
+}  // namespace rvr

@@ -1,0 +1,136 @@
+// Ray-primitive intersection: the tests of chapter 20 (ray-sphere, ray-plane, ray-triangle)
+// plus Moller-Trumbore. Each returns the hit parameter t in (ray.tmin, ray.tmax) and the
+// cheap data the closest-hit search needs; surface data is computed once, later.
+#pragma once
+
+#include <cmath>
+#include <utility>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "rvr/shared/scene.h"
+
+namespace rvr {
+
+struct Ray {
+  glm::vec3 origin;
+  glm::vec3 dir;  // need not be unit length; t is measured in units of |dir|
+  float tmin = 0.0f;
+  float tmax = INFINITY;
+};
+
+// A triangle precomputed as v0, e1 = v1 - v0, e2 = v2 - v0 (as Embree stores them).
+struct TrianglePrecomputed {
+  glm::vec3 v0, e1, e2;
+};
+
+inline TrianglePrecomputed precompute_triangle(const glm::vec3& a, const glm::vec3& b,
+                                               const glm::vec3& c) {
+  return {a, b - a, c - a};
+}
+
+// Barycentric hit: P = v0 + u e1 + v e2.
+struct TriangleHit {
+  float t, u, v;
+};
+
+// Moller-Trumbore: solves o + t d = v0 + u e1 + v e2 by Cramer's rule. Edges and vertices are
+// inside (u, v >= 0, u + v <= 1), so a ray through a shared edge hits at least one side.
+inline bool intersect_triangle_mt(const Ray& ray, const TrianglePrecomputed& tri,
+                                  TriangleHit& hit) {
+  glm::vec3 p = glm::cross(ray.dir, tri.e2);
+  float det = glm::dot(tri.e1, p);
+  if (det == 0.0f) return false;  // ray parallel to the triangle's plane (or degenerate)
+  float inv_det = 1.0f / det;
+  glm::vec3 s = ray.origin - tri.v0;
+  float u = glm::dot(s, p) * inv_det;
+  if (u < 0.0f || u > 1.0f) return false;
+  glm::vec3 q = glm::cross(s, tri.e1);
+  float v = glm::dot(ray.dir, q) * inv_det;
+  if (v < 0.0f || u + v > 1.0f) return false;
+  float t = glm::dot(tri.e2, q) * inv_det;
+  if (!(t > ray.tmin && t < ray.tmax)) return false;
+  hit = {t, u, v};
+  return true;
+}
+
+// The chapter's test: hit the triangle's plane, then check that the point lies on the inner
+// side of all three edges (the three sub-triangles P-v0-v1, P-v1-v2, P-v2-v0 have the same
+// orientation as the triangle).
+inline bool intersect_triangle_chapter(const Ray& ray, const TrianglePrecomputed& tri,
+                                       TriangleHit& hit) {
+  glm::vec3 n = glm::cross(tri.e1, tri.e2);
+  float denom = glm::dot(n, ray.dir);
+  if (denom == 0.0f) return false;  // parallel to the plane
+  float t = glm::dot(n, tri.v0 - ray.origin) / denom;
+  if (!(t > ray.tmin && t < ray.tmax)) return false;
+  glm::vec3 p = ray.origin + t * ray.dir - tri.v0;  // relative to v0
+  float n2 = glm::dot(n, n);
+  // Edge v0->v1: orientation of (v0, v1, P) is v * |n|^2.
+  float w_v = glm::dot(glm::cross(tri.e1, p), n);
+  if (w_v < 0.0f) return false;
+  // Edge v2->v0: orientation of (v2, v0, P) is u * |n|^2.
+  float w_u = glm::dot(glm::cross(p, tri.e2), n);
+  if (w_u < 0.0f) return false;
+  // Edge v1->v2: orientation of (v1, v2, P) is (1 - u - v) * |n|^2.
+  float w_w = glm::dot(glm::cross(tri.e2 - tri.e1, p - tri.e1), n);
+  if (w_w < 0.0f) return false;
+  hit = {t, w_u / n2, w_v / n2};
+  return true;
+}
+
+// Both roots t0 <= t1 of the ray-sphere quadratic |o + t d - c|^2 = r^2, in the form of
+// Ray Tracing Gems ch. 7, which keeps precision when the sphere is small or far away.
+// False when the line misses. CSG uses the interval [t0, t1] directly.
+inline bool sphere_interval(const Ray& ray, const Sphere& s, float& t0, float& t1) {
+  glm::vec3 f = ray.origin - s.center;
+  float a = glm::dot(ray.dir, ray.dir);
+  float b = -glm::dot(f, ray.dir);      // -b/2 of the textbook quadratic
+  glm::vec3 l = f + (b / a) * ray.dir;  // closest approach of the line to the centre
+  float disc = a * (s.radius * s.radius - glm::dot(l, l));
+  if (disc < 0.0f) return false;
+  float c = glm::dot(f, f) - s.radius * s.radius;
+  float q = b + std::copysign(std::sqrt(disc), b);
+  if (q == 0.0f) {  // origin on the sphere and ray tangent
+    t0 = t1 = 0.0f;
+    return true;
+  }
+  t0 = c / q;
+  t1 = q / a;
+  if (t0 > t1) std::swap(t0, t1);
+  return true;
+}
+
+// Ray-sphere: the nearest root in (tmin, tmax): the near one from outside, the far one from
+// inside.
+inline bool intersect_sphere(const Ray& ray, const Sphere& s, float& t_hit) {
+  float t0, t1;
+  if (!sphere_interval(ray, s, t0, t1)) return false;
+  if (t0 > ray.tmin && t0 < ray.tmax) {
+    t_hit = t0;
+    return true;
+  }
+  if (t1 > ray.tmin && t1 < ray.tmax) {
+    t_hit = t1;
+    return true;
+  }
+  return false;
+}
+
+// Ray-plane: the plane equation N.(P - point) = 0, then the square's bounds along the
+// plane's axes (u, v from plane_axes).
+inline bool intersect_square(const Ray& ray, const Plane& plane, const glm::vec3& u,
+                             const glm::vec3& v, float& t_hit) {
+  float denom = glm::dot(plane.normal, ray.dir);
+  if (denom == 0.0f) return false;  // parallel
+  float t = glm::dot(plane.normal, plane.point - ray.origin) / denom;
+  if (!(t > ray.tmin && t < ray.tmax)) return false;
+  glm::vec3 local = ray.origin + t * ray.dir - plane.point;
+  if (std::abs(glm::dot(local, u)) > plane.half_size) return false;
+  if (std::abs(glm::dot(local, v)) > plane.half_size) return false;
+  t_hit = t;
+  return true;
+}
+
+}  // namespace rvr

@@ -1,0 +1,317 @@
+#include "rvr/raytrace/trace_geometry.h"
+
+#include <algorithm>
+
+#include "rvr/shared/tessellate.h"
+
+namespace rvr {
+namespace {
+
+// CSG along one ray: every leaf sphere gives an interval of the whole line; a sweep over
+// the sorted boundaries tracks inside(A) and inside(B) per node and keeps the boundaries
+// where the node's inside changes. A subtracted solid's boundary is reversed: its outward
+// normal points into the result.
+struct CsgBoundary {
+  float t;
+  bool entering;  // the result is entered here
+  uint32_t leaf;  // depth-first leaf number
+  bool flip;      // normal = -(sphere's outward normal)
+};
+
+void collect_leaves(const CsgNode* node, std::vector<Sphere>& leaves) {
+  if (node->is_leaf) {
+    leaves.push_back(node->sphere);
+    return;
+  }
+  collect_leaves(node->a.get(), leaves);
+  collect_leaves(node->b.get(), leaves);
+}
+
+void csg_boundaries(const CsgNode* node, const Ray& ray, uint32_t& next_leaf,
+                    std::vector<CsgBoundary>& out) {
+  if (node->is_leaf) {
+    uint32_t leaf = next_leaf++;
+    float t0, t1;
+    if (sphere_interval(ray, node->sphere, t0, t1) && t0 < t1) {
+      out.push_back({t0, true, leaf, false});
+      out.push_back({t1, false, leaf, false});
+    }
+    return;
+  }
+  std::vector<CsgBoundary> a, b;
+  csg_boundaries(node->a.get(), ray, next_leaf, a);
+  csg_boundaries(node->b.get(), ray, next_leaf, b);
+  // Both lists are sorted and alternate enter/exit; merge them in t order.
+  bool in_a = false, in_b = false;
+  auto inside = [&](bool ia, bool ib) {
+    switch (node->op) {
+      case CsgOp::Union:
+        return ia || ib;
+      case CsgOp::Intersection:
+        return ia && ib;
+      case CsgOp::Difference:
+        return ia && !ib;
+    }
+    return false;
+  };
+  size_t i = 0, j = 0;
+  while (i < a.size() || j < b.size()) {
+    bool from_a = j >= b.size() || (i < a.size() && a[i].t <= b[j].t);
+    CsgBoundary e = from_a ? a[i++] : b[j++];
+    bool before = inside(in_a, in_b);
+    (from_a ? in_a : in_b) = e.entering;
+    bool after = inside(in_a, in_b);
+    if (before == after) continue;
+    if (!from_a && node->op == CsgOp::Difference) e.flip = !e.flip;
+    e.entering = after;
+    out.push_back(e);
+  }
+}
+
+}  // namespace
+
+TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_segments,
+                             AccelKind accel, TriangleTest triangle_test)
+    : accel_(accel), triangle_test_(triangle_test) {
+  size_t n_objects = scene.objects.size();
+  object_mesh_.assign(n_objects, nullptr);
+  object_material_.resize(n_objects);
+  size_t total_triangles = 0;
+  for (const Object& o : scene.objects) total_triangles += o.mesh.triangle_count();
+  triangles_.reserve(total_triangles);
+  triangle_object_.reserve(total_triangles);
+  triangle_id_.reserve(total_triangles);
+  triangle_in_mesh_.reserve(total_triangles);
+
+  auto add_mesh = [&](uint32_t object, const TriangleMesh& mesh, bool report_triangle_ids) {
+    object_mesh_[object] = &mesh;
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+      const glm::uvec3& t = mesh.triangles[i];
+      triangles_.push_back(
+          precompute_triangle(mesh.positions[t.x], mesh.positions[t.y], mesh.positions[t.z]));
+      triangle_object_.push_back(object);
+      triangle_id_.push_back(report_triangle_ids ? uint32_t(i) : 0u);
+      triangle_in_mesh_.push_back(uint32_t(i));
+    }
+  };
+
+  for (uint32_t id = 0; id < n_objects; ++id) {
+    const Object& o = scene.objects[id];
+    object_material_[id] = o.material;
+    switch (o.type) {
+      case ObjectType::Triangles:
+        add_mesh(id, o.mesh, true);
+        break;
+      case ObjectType::Sphere:
+        if (spheres == SphereMode::Mesh) {
+          owned_meshes_.push_back(
+              std::make_unique<TriangleMesh>(tessellate_sphere(o.sphere, sphere_segments)));
+          add_mesh(id, *owned_meshes_.back(), false);
+        } else {
+          analytic_.push_back({Kind::Sphere, id, o.sphere, {}, {}, {}, nullptr, {}});
+        }
+        break;
+      case ObjectType::Plane: {
+        auto [u, v] = plane_axes(o.plane.normal);
+        analytic_.push_back({Kind::Square, id, {}, o.plane, u, v, nullptr, {}});
+        break;
+      }
+      case ObjectType::Csg: {
+        std::vector<Sphere> leaves;
+        collect_leaves(o.csg.get(), leaves);
+        analytic_.push_back({Kind::Csg, id, {}, {}, {}, {}, o.csg.get(), std::move(leaves)});
+        break;
+      }
+    }
+  }
+
+  if (accel_ != AccelKind::Bvh) return;
+  std::vector<Aabb> bounds(primitive_count());
+  for (size_t i = 0; i < triangles_.size(); ++i) {
+    const TrianglePrecomputed& t = triangles_[i];
+    bounds[i].grow(t.v0);
+    bounds[i].grow(t.v0 + t.e1);
+    bounds[i].grow(t.v0 + t.e2);
+  }
+  for (size_t k = 0; k < analytic_.size(); ++k) {
+    const Analytic& a = analytic_[k];
+    Aabb& b = bounds[triangles_.size() + k];
+    if (a.kind == Kind::Sphere) {
+      b.grow(a.sphere.center - glm::vec3(a.sphere.radius));
+      b.grow(a.sphere.center + glm::vec3(a.sphere.radius));
+    } else if (a.kind == Kind::Square) {
+      float h = a.plane.half_size;
+      for (float su : {-h, h})
+        for (float sv : {-h, h}) b.grow(a.plane.point + su * a.axis_u + sv * a.axis_v);
+    } else {
+      // Any CSG result lies inside the union of its leaves.
+      for (const Sphere& s : a.csg_leaves) {
+        b.grow(s.center - glm::vec3(s.radius));
+        b.grow(s.center + glm::vec3(s.radius));
+      }
+    }
+  }
+  bvh_ = Bvh::build(bounds);
+  slot_primitive_ = bvh_.primitive_order();
+  slot_triangles_.resize(slot_primitive_.size());
+  for (size_t s = 0; s < slot_primitive_.size(); ++s) {
+    if (slot_primitive_[s] < triangles_.size()) slot_triangles_[s] = triangles_[slot_primitive_[s]];
+  }
+}
+
+size_t TraceGeometry::acceleration_bytes() const {
+  return bvh_.nodes().size() * sizeof(BvhNode) + slot_primitive_.size() * sizeof(uint32_t) +
+         slot_triangles_.size() * sizeof(TrianglePrecomputed);
+}
+
+bool TraceGeometry::hit_analytic(const Analytic& a, const Ray& ray, float t_max,
+                                 HitRecord& hit) const {
+  Ray r = ray;
+  r.tmax = t_max;
+  float t;
+  switch (a.kind) {
+    case Kind::Sphere:
+      if (!intersect_sphere(r, a.sphere, t)) return false;
+      hit.t = t;
+      return true;
+    case Kind::Square:
+      if (!intersect_square(r, a.plane, a.axis_u, a.axis_v, t)) return false;
+      hit.t = t;
+      return true;
+    case Kind::Csg: {
+      std::vector<CsgBoundary> boundaries;
+      uint32_t next_leaf = 0;
+      csg_boundaries(a.csg, r, next_leaf, boundaries);
+      for (const CsgBoundary& e : boundaries) {
+        if (e.t <= r.tmin) continue;
+        if (e.t >= r.tmax) return false;
+        hit.t = e.t;
+        hit.csg_leaf = e.leaf;
+        hit.csg_flip = e.flip;
+        return true;
+      }
+      return false;
+    }
+  }
+  return false;
+}
+
+struct MollerTrumboreTest {
+  bool operator()(const Ray& r, const TrianglePrecomputed& t, TriangleHit& h) const {
+    return intersect_triangle_mt(r, t, h);
+  }
+};
+struct ChapterTest {
+  bool operator()(const Ray& r, const TrianglePrecomputed& t, TriangleHit& h) const {
+    return intersect_triangle_chapter(r, t, h);
+  }
+};
+
+template <class TriangleTestFn, bool kAnyHit>
+bool TraceGeometry::query(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
+  TriangleTestFn test;
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  bool found = false;
+  float t_max = ray.tmax;
+  Ray r = ray;
+  // Tests primitive p (whose triangle, if it is one, is `tri`); true when it is a new nearest.
+  auto test_primitive = [&](uint32_t p, const TrianglePrecomputed& tri) {
+    if (p < n_triangles) {
+      r.tmax = t_max;
+      TriangleHit th;
+      if (!test(r, tri, th)) return false;
+      t_max = th.t;
+      hit.t = th.t;
+      hit.u = th.u;
+      hit.v = th.v;
+    } else {
+      HitRecord h;
+      if (!hit_analytic(analytic_[p - n_triangles], ray, t_max, h)) return false;
+      t_max = h.t;
+      hit = h;
+    }
+    hit.primitive = p;
+    found = true;
+    return true;
+  };
+
+  if (accel_ == AccelKind::None) {
+    // The chapter's loop: every object, keep the nearest.
+    uint32_t n = uint32_t(primitive_count());
+    static const TrianglePrecomputed kUnused{};
+    for (uint32_t p = 0; p < n; ++p) {
+      counters.primitive_tests++;
+      if (test_primitive(p, p < n_triangles ? triangles_[p] : kUnused) && kAnyHit) return true;
+    }
+    return found;
+  }
+  bvh_.traverse(
+      ray, t_max,
+      [&](uint32_t first, uint32_t count, float&) {
+        for (uint32_t s = first; s < first + count; ++s) {
+          if (test_primitive(slot_primitive_[s], slot_triangles_[s]) && kAnyHit) return true;
+        }
+        return false;
+      },
+      counters);
+  return found;
+}
+
+bool TraceGeometry::closest(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
+  if (triangle_test_ == TriangleTest::Chapter)
+    return query<ChapterTest, false>(ray, hit, counters);
+  return query<MollerTrumboreTest, false>(ray, hit, counters);
+}
+
+bool TraceGeometry::occluded(const Ray& ray, TraversalCounters& counters) const {
+  HitRecord hit;
+  if (triangle_test_ == TriangleTest::Chapter) return query<ChapterTest, true>(ray, hit, counters);
+  return query<MollerTrumboreTest, true>(ray, hit, counters);
+}
+
+SurfaceHit TraceGeometry::surface(const Ray& ray, const HitRecord& hit) const {
+  SurfaceHit s;
+  s.t = hit.t;
+  s.position = ray.origin + hit.t * ray.dir;
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  if (hit.primitive < n_triangles) {
+    uint32_t p = hit.primitive;
+    const TrianglePrecomputed& tri = triangles_[p];
+    s.object = triangle_object_[p];
+    s.primitive = triangle_id_[p];
+    s.geometric_normal = glm::normalize(glm::cross(tri.e1, tri.e2));
+    s.shading_normal = s.geometric_normal;
+    const TriangleMesh* mesh = object_mesh_[s.object];
+    if (mesh->smooth()) {
+      const glm::uvec3& v = mesh->triangles[triangle_in_mesh_[p]];
+      glm::vec3 n = (1.0f - hit.u - hit.v) * mesh->normals[v.x] + hit.u * mesh->normals[v.y] +
+                    hit.v * mesh->normals[v.z];
+      float len = glm::length(n);
+      if (len > 0.0f) s.shading_normal = n / len;
+    }
+  } else {
+    const Analytic& a = analytic_[hit.primitive - n_triangles];
+    s.object = a.object;
+    s.primitive = 0;
+    switch (a.kind) {
+      case Kind::Sphere:
+        s.geometric_normal = (s.position - a.sphere.center) / a.sphere.radius;
+        break;
+      case Kind::Square:
+        s.geometric_normal = a.plane.normal;
+        break;
+      case Kind::Csg: {
+        const Sphere& leaf = a.csg_leaves[hit.csg_leaf];
+        s.geometric_normal = (s.position - leaf.center) / leaf.radius;
+        if (hit.csg_flip) s.geometric_normal = -s.geometric_normal;
+        break;
+      }
+    }
+    s.geometric_normal = glm::normalize(s.geometric_normal);
+    s.shading_normal = s.geometric_normal;
+  }
+  s.material = object_material_[s.object];
+  return s;
+}
+
+}  // namespace rvr
