@@ -1,0 +1,148 @@
+// Conformance: every renderer x every built-in scene, in local mode with spheres traced as the
+// raster's tessellation, must agree with a renderer of the other loop order on what is seen.
+// A new renderer is one line in kRenderers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "renderers.h"
+#include "rvr/shared/camera.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/scene_loader.h"
+
+using namespace rvr;
+
+namespace {
+
+struct RendererCase {
+  const char* label;
+  const char* name;       // registry name
+  AccelKind accel;        // for tracers
+  const char* reference;  // a renderer of the other loop order
+  size_t max_triangles;   // skip scenes larger than this (brute force is O(pixels x triangles))
+};
+
+const RendererCase kRenderers[] = {
+    {"raster", "raster", AccelKind::Bvh, "raytrace", SIZE_MAX},
+    {"raytrace", "raytrace", AccelKind::Bvh, "raster", SIZE_MAX},
+    {"raytrace_none", "raytrace", AccelKind::None, "raster", 3000},
+};
+
+const char* kScenes[] = {"cornell", "spheres", "occluders:16", "soup:2000", "tessphere:20000"};
+
+// Thresholds (the contract, justified):
+// - id agreement >= 0.999 and no mismatch away from an id boundary: the loop orders sample the
+//   same pixel centres, so only ties on shared edges and silhouettes (a float rounding on
+//   either side of an edge) may differ.
+// - depth 1e-3 relative: GL interpolates eye-space z per fragment in float; the tracer
+//   intersects in float; both are ~1e-6 apart except at grazing angles.
+// - colour PSNR 40 dB: the same shading equation in GLSL and C++ on float inputs.
+constexpr double kMinAgreement = 0.999;
+constexpr double kMaxDepthRelError = 1e-3;
+constexpr double kMinPsnr = 40.0;
+constexpr int kSegments = 48;
+
+RenderOutput render_with(const char* name, AccelKind accel, const Scene& scene,
+                         SphereMode spheres, int segments) {
+  auto renderer = make_renderer(name);
+  EXPECT_TRUE(renderer.ok());
+  RenderOptions options;
+  options.mode = RenderMode::Local;
+  options.spheres = spheres;
+  options.sphere_segments = segments;
+  options.accel = accel;
+  Expected<RenderOutput> out = renderer.value()->render(scene, options);
+  EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().message);
+  return std::move(out).value();
+}
+
+class Conformance : public ::testing::TestWithParam<std::tuple<RendererCase, const char*>> {};
+
+}  // namespace
+
+TEST_P(Conformance, AgreesWithTheOtherLoopOrder) {
+  const auto& [r, scene_name] = GetParam();
+  Expected<Scene> scene = make_builtin_scene(scene_name);
+  ASSERT_TRUE(scene.ok());
+  if (scene->triangle_count() > r.max_triangles) GTEST_SKIP() << "too large for " << r.label;
+
+  RenderOutput a = render_with(r.name, r.accel, *scene, SphereMode::Mesh, kSegments);
+  RenderOutput b = render_with(r.reference, AccelKind::Bvh, *scene, SphereMode::Mesh, kSegments);
+  ComparisonMetrics m = compare_buffers(a.buffers, b.buffers);
+
+  // Something must be seen, or agreement means nothing.
+  size_t covered = 0;
+  for (uint32_t id : a.buffers.object_id) covered += id != kNoId;
+  EXPECT_GT(covered, a.buffers.pixel_count() / 10);
+
+  EXPECT_GE(m.visibility.id_agreement, kMinAgreement)
+      << m.visibility.mismatched_pixels << " mismatched pixels";
+  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
+  EXPECT_LE(m.depth.max_rel_error, kMaxDepthRelError);
+  EXPECT_GE(m.color.psnr_db, kMinPsnr);
+  RecordProperty("id_agreement", std::to_string(m.visibility.id_agreement));
+  RecordProperty("psnr_db", std::to_string(m.color.psnr_db));
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryRendererEveryScene, Conformance,
+    ::testing::Combine(::testing::ValuesIn(kRenderers), ::testing::ValuesIn(kScenes)),
+    [](const ::testing::TestParamInfo<Conformance::ParamType>& info) {
+      std::string s = std::string(std::get<0>(info.param).label) + "_" + std::get<1>(info.param);
+      for (char& c : s)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+      return s;
+    });
+
+// With analytic spheres the tracer sees the true silhouette and the z-buffer its polygon:
+// mismatches must lie on sphere silhouettes, within the tessellation's projected error, and
+// shrink as the segment count grows.
+TEST(AnalyticSpheres, MismatchesStayOnSilhouettesAndShrinkWithSegments) {
+  Expected<Scene> scene = make_builtin_scene("spheres");
+  ASSERT_TRUE(scene.ok());
+  const Scene& s = *scene;
+  CameraFrame frame = make_camera_frame(s.camera, s.image.width, s.image.height);
+  float focal_px = 0.5f * float(s.image.height) / frame.tan_half_fov_y;
+
+  size_t previous = SIZE_MAX;
+  for (int segments : {12, 24, 48, 96}) {
+    RenderOutput traced = render_with("raytrace", AccelKind::Bvh, s, SphereMode::Analytic, segments);
+    RenderOutput raster = render_with("raster", AccelKind::Bvh, s, SphereMode::Analytic, segments);
+    ComparisonMetrics m = compare_buffers(traced.buffers, raster.buffers);
+    size_t mismatched = m.visibility.mismatched_pixels;
+
+    // Largest gap between a sphere and its inscribed polygon (a quad spanning 2*pi/segments
+    // in both directions: its centre lies deepest), projected at the nearest sphere.
+    float worst_px = 0.0f;
+    for (const Object& o : s.objects) {
+      if (o.type != ObjectType::Sphere) continue;
+      float angle = 3.14159265f * std::sqrt(2.0f) / float(segments);
+      float gap = o.sphere.radius * (1.0f - std::cos(angle));
+      float distance = glm::length(o.sphere.center - s.camera.eye) - o.sphere.radius;
+      worst_px = std::max(worst_px, focal_px * gap / distance);
+    }
+    int reach = int(std::ceil(worst_px)) + 1;
+
+    std::vector<bool> edge = id_boundaries(traced.buffers);
+    const FrameBuffers& fa = traced.buffers;
+    const FrameBuffers& fb = raster.buffers;
+    size_t far_from_silhouette = 0;
+    for (int y = 0; y < fa.height; ++y) {
+      for (int x = 0; x < fa.width; ++x) {
+        size_t i = fa.index(x, y);
+        if (fa.object_id[i] == fb.object_id[i] && fa.primitive_id[i] == fb.primitive_id[i]) continue;
+        bool near_edge = false;
+        for (int dy = -reach; dy <= reach && !near_edge; ++dy)
+          for (int dx = -reach; dx <= reach && !near_edge; ++dx) {
+            int xx = x + dx, yy = y + dy;
+            if (xx >= 0 && yy >= 0 && xx < fa.width && yy < fa.height && edge[fa.index(xx, yy)])
+              near_edge = true;
+          }
+        far_from_silhouette += !near_edge;
+      }
+    }
+    EXPECT_EQ(far_from_silhouette, 0u) << segments << " segments, reach " << reach << " px";
+    EXPECT_LT(mismatched, previous) << segments << " segments";
+    previous = mismatched;
+  }
+}
