@@ -91,7 +91,8 @@ class FrameTracer {
       fb.object_id[i] = s.object;
       fb.primitive_id[i] = s.primitive;
       fb.normal[i] = N;
-      if (options_.mode != RenderMode::Visibility) centre_colour = shade(ray, s, N, V, 0, counters);
+      if (options_.mode != RenderMode::Visibility)
+        centre_colour = shade(ray, s, N, V, 0, counters, nullptr);
     }
     int spp = scene_.image.samples_per_pixel;
     if (options_.mode == RenderMode::Visibility) {
@@ -117,7 +118,8 @@ class FrameTracer {
   }
 
   // Stratified jitter: the pixel split into an m x m grid (m = floor(sqrt(spp))), one sample
-  // per cell, the rest uniformly placed.
+  // per cell, the rest uniformly placed. With an aperture, each sample also takes a point on
+  // the lens (a thin lens: every ray through one image point meets at the focus plane).
   glm::vec3 supersample(int x, int y, int spp, RayCounters& counters) const {
     PixelRng rng(options_.seed, x, y);
     int m = int(std::sqrt(double(spp)));
@@ -129,22 +131,44 @@ class FrameTracer {
         jy = (float(k / m) + jy) / float(m);
       }
       Ray ray = primary_ray(float(x) + jx, float(y) + jy);
+      if (options_.mode == RenderMode::Full && scene_.camera.aperture_radius > 0.0f) {
+        ray = through_lens(ray, k, spp, rng);
+      }
       counters.primary++;
-      sum += trace(ray, 0, counters);
+      sum += trace(ray, 0, counters, &rng);
     }
     return sum / float(spp);
   }
 
-  glm::vec3 trace(const Ray& ray, int depth, RayCounters& counters) const {
+  // Moves the ray's origin to a point on the lens disk (stratified in angle per sample, radius
+  // by the square root of a uniform number: uniform over the disk) and aims it at the point the
+  // pinhole ray meets at the focus distance. The direction keeps forward component 1, so t stays
+  // view depth and near/far clip as before.
+  Ray through_lens(const Ray& pinhole, int k, int spp, PixelRng& rng) const {
+    const float pi = 3.14159265358979f;
+    float radius = scene_.camera.aperture_radius * std::sqrt(rng.uniform());
+    float angle = 2.0f * pi * (float(k) + rng.uniform()) / float(spp);
+    glm::vec3 lens = frame_.eye + radius * (std::cos(angle) * frame_.right + std::sin(angle) * frame_.up);
+    glm::vec3 focus = frame_.eye + scene_.camera.focus_distance * pinhole.dir;
+    Ray r = pinhole;
+    r.origin = lens;
+    r.dir = (focus - lens) / scene_.camera.focus_distance;
+    return r;
+  }
+
+  glm::vec3 trace(const Ray& ray, int depth, RayCounters& counters, PixelRng* rng) const {
     HitRecord hit;
     if (!geometry_.closest(ray, hit, counters.traversal)) return scene_.image.background;
     SurfaceHit s = geometry_.surface(ray, hit);
     glm::vec3 V = -glm::normalize(ray.dir);
-    return shade(ray, s, face_viewer(s.shading_normal, s.geometric_normal, V), V, depth, counters);
+    return shade(ray, s, face_viewer(s.shading_normal, s.geometric_normal, V), V, depth, counters,
+                 rng);
   }
 
+  // rng is the pixel's stream when it takes several samples (area lights are then jittered
+  // inside their strata), null for one sample at the pixel centre.
   glm::vec3 shade(const Ray& ray, const SurfaceHit& s, const glm::vec3& N, const glm::vec3& V,
-                  int depth, RayCounters& counters) const {
+                  int depth, RayCounters& counters, PixelRng* rng) const {
     const Material& m = scene_.materials[s.material];
     if (options_.mode != RenderMode::Full) {
       return shade_local(m, s.position, N, V, scene_.ambient, lights_);
@@ -156,14 +180,15 @@ class FrameTracer {
       counters.shadow++;
       return geometry_.occluded(shadow, counters.traversal) ? 0.0f : 1.0f;
     };
-    glm::vec3 local = shade_local(m, s.position, N, V, scene_.ambient, lights_, visibility);
+    glm::vec3 local = shade_local(m, s.position, N, V, scene_.ambient,
+                                  rng ? light_samples(scene_.lights, [rng] { return rng->uniform(); }) : lights_, visibility);
     glm::vec3 colour = (1.0f - m.mirror - m.transparency) * local;
     if (depth >= options_.max_depth) return colour;
     glm::vec3 d = glm::normalize(ray.dir);
     if (m.mirror > 0.0f) {
       counters.reflection++;
       Ray r{above, glm::reflect(d, N), 0.0f, INFINITY};
-      colour += m.mirror * trace(r, depth + 1, counters);
+      colour += m.mirror * trace(r, depth + 1, counters, rng);
     }
     if (m.transparency > 0.0f) {
       glm::vec3 below = s.position - eps * N;
@@ -180,7 +205,7 @@ class FrameTracer {
         counters.refraction++;
         r = {below, eta * d + (eta * cos_i - std::sqrt(k)) * N, 0.0f, INFINITY};
       }
-      colour += m.transparency * trace(r, depth + 1, counters);
+      colour += m.transparency * trace(r, depth + 1, counters, rng);
     }
     return colour;
   }
@@ -246,9 +271,9 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
     out.stats["bvh.bytes"] = double(geometry.acceleration_bytes());
     out.stats["time.bvh_build"] = b.seconds;
   }
-  if (options.mode == RenderMode::Full) {
-    if (scene.camera.aperture_radius > 0.0f)
-      out.warnings.push_back("depth of field is not implemented yet: rendered as a pinhole");
+  if (options.mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f &&
+      scene.image.samples_per_pixel == 1) {
+    out.warnings.push_back("depth of field needs samples_per_pixel > 1: one sample is a pinhole");
   }
   return out;
 }

@@ -121,4 +121,27 @@ struct LightSample {
 };
 std::vector<LightSample> light_samples(const std::vector<Light>& lights);
 
+// The same, with each area-light sample placed at (i + jitter(), j + jitter()) / n inside its
+// stratum; jitter() returns numbers in [0, 1) (0.5 gives the centres).
+template <class Jitter>
+std::vector<LightSample> light_samples(const std::vector<Light>& lights, Jitter&& jitter) {
+  std::vector<LightSample> samples;
+  for (const Light& light : lights) {
+    if (light.type == LightType::Point) {
+      samples.push_back({light.position, light.intensity});
+      continue;
+    }
+    int n = light.samples;
+    glm::vec3 share = light.intensity / float(n * n);
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        float u = (float(i) + jitter()) / float(n);
+        float v = (float(j) + jitter()) / float(n);
+        samples.push_back({light.corner + u * light.edge_u + v * light.edge_v, share});
+      }
+    }
+  }
+  return samples;
+}
+
 }  // namespace rvr
