@@ -1,1 +1,309 @@
-// placeholder: being written
+// How two renders of one scene differ: visibility (ids), depth and colour. Everything here is
+// O(pixels): the SSIM window is separable and runs over a rolling buffer of rows.
+#include "rvr/shared/compare.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace rvr {
+
+namespace detail {
+// Defined in image_io.cpp: OpenImageIO's "inferno" map of values / scale, sRGB-encoded.
+Image inferno_display(const std::vector<float>& values, int width, int height, float scale);
+}  // namespace detail
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// The (object, primitive) id of a pixel; every background pixel has the same key whatever
+// primitive id a renderer left there.
+inline uint64_t id_key(const FrameBuffers& fb, size_t i) {
+  uint32_t obj = fb.object_id[i];
+  uint32_t prim = obj == kNoId ? kNoId : fb.primitive_id[i];
+  return (uint64_t(obj) << 32) | prim;
+}
+
+bool ids_sized(const FrameBuffers& fb) {
+  return fb.width >= 0 && fb.height >= 0 && fb.object_id.size() == fb.pixel_count() &&
+         fb.primitive_id.size() == fb.pixel_count();
+}
+
+// Marks every pixel whose 3x3 neighbourhood (itself included) holds a marked pixel of `mask`.
+std::vector<bool> dilate3x3(const std::vector<bool>& mask, int w, int h) {
+  std::vector<bool> rows(mask.size(), false), out(mask.size(), false);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      size_t i = size_t(y) * w + x;
+      rows[i] = mask[i] || (x > 0 && mask[i - 1]) || (x + 1 < w && mask[i + 1]);
+    }
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      size_t i = size_t(y) * w + x;
+      out[i] = rows[i] || (y > 0 && rows[i - w]) || (y + 1 < h && rows[i + w]);
+    }
+  return out;
+}
+
+float luminance(const glm::vec3& c) {
+  auto cl = [](float v) { return v > 0.0f ? std::min(v, 1.0f) : 0.0f; };  // NaN -> 0
+  return 0.2126f * cl(c.r) + 0.7152f * cl(c.g) + 0.0722f * cl(c.b);
+}
+
+float srgb_encode(float v) {
+  if (!(v > 0.0f)) return 0.0f;
+  if (v >= 1.0f) return 1.0f;
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+// Mean SSIM of two luminance images: 11x11 Gaussian window (sigma 1.5), C1 = 0.01^2,
+// C2 = 0.03^2, one value per pixel, averaged. Near the borders (and in images smaller than the
+// window) the window is cut to the image and renormalised, so every pixel has a value.
+double mean_ssim(const std::vector<float>& ya, const std::vector<float>& yb, int w, int h) {
+  if (w <= 0 || h <= 0) return 1.0;
+  constexpr int R = 5;
+  std::array<double, 2 * R + 1> g{};
+  for (int k = -R; k <= R; ++k) g[k + R] = std::exp(-double(k * k) / (2.0 * 1.5 * 1.5));
+
+  // Horizontal pass of the five moments (a, b, a^2, b^2, ab) of one row, into a ring of 11 rows.
+  constexpr int kMoments = 5;
+  const int ring = 2 * R + 1;
+  std::vector<double> hbuf(size_t(ring) * kMoments * w);
+  auto hrow = [&](int y) -> double* { return &hbuf[size_t(y % ring) * kMoments * w]; };
+  auto horizontal = [&](int y) {
+    double* out = hrow(y);
+    const float* ra = &ya[size_t(y) * w];
+    const float* rb = &yb[size_t(y) * w];
+    for (int x = 0; x < w; ++x) {
+      double s[kMoments] = {0, 0, 0, 0, 0}, wsum = 0;
+      int k0 = std::max(-R, -x), k1 = std::min(R, w - 1 - x);
+      for (int k = k0; k <= k1; ++k) {
+        double wt = g[k + R], a = ra[x + k], b = rb[x + k];
+        wsum += wt;
+        s[0] += wt * a;
+        s[1] += wt * b;
+        s[2] += wt * a * a;
+        s[3] += wt * b * b;
+        s[4] += wt * a * b;
+      }
+      for (int m = 0; m < kMoments; ++m) out[size_t(m) * w + x] = s[m] / wsum;
+    }
+  };
+
+  const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03;
+  double total = 0.0;
+  int done = 0;  // rows [0, done) have been filtered horizontally
+  std::vector<double> s(size_t(kMoments) * w);
+  for (int y = 0; y < h; ++y) {
+    while (done < std::min(h, y + R + 1)) horizontal(done++);
+    std::fill(s.begin(), s.end(), 0.0);
+    int k0 = std::max(-R, -y), k1 = std::min(R, h - 1 - y);
+    double wsum = 0;
+    for (int k = k0; k <= k1; ++k) {
+      double wt = g[k + R];
+      wsum += wt;
+      const double* row = hrow(y + k);
+      for (size_t i = 0; i < s.size(); ++i) s[i] += wt * row[i];
+    }
+    double row_total = 0.0;
+    for (int x = 0; x < w; ++x) {
+      double ma = s[x] / wsum, mb = s[size_t(w) + x] / wsum;
+      double va = std::max(0.0, s[2 * size_t(w) + x] / wsum - ma * ma);
+      double vb = std::max(0.0, s[3 * size_t(w) + x] / wsum - mb * mb);
+      double cov = s[4 * size_t(w) + x] / wsum - ma * mb;
+      row_total +=
+          ((2 * ma * mb + C1) * (2 * cov + C2)) / ((ma * ma + mb * mb + C1) * (va + vb + C2));
+    }
+    total += row_total;
+  }
+  return total / (double(w) * h);
+}
+
+double psnr_of(double rmse) {
+  return rmse > 0.0 ? 20.0 * std::log10(1.0 / rmse) : kInf;
+}
+
+}  // namespace
+
+std::vector<bool> id_boundaries(const FrameBuffers& fb) {
+  const int w = fb.width, h = fb.height;
+  std::vector<bool> edge(ids_sized(fb) ? fb.pixel_count() : 0, false);
+  if (edge.empty()) return edge;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      size_t i = fb.index(x, y);
+      uint64_t k = id_key(fb, i);
+      edge[i] = (x > 0 && id_key(fb, i - 1) != k) || (x + 1 < w && id_key(fb, i + 1) != k) ||
+                (y > 0 && id_key(fb, i - w) != k) || (y + 1 < h && id_key(fb, i + w) != k);
+    }
+  return edge;
+}
+
+ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) {
+  ComparisonMetrics m;
+  const size_t n = a.pixel_count();
+  m.visibility.pixels = n;
+  const bool same_size = a.width == b.width && a.height == b.height && ids_sized(a) &&
+                         ids_sized(b) && a.depth.size() == n && b.depth.size() == n &&
+                         a.color.size() == n && b.color.size() == n;
+  if (!same_size) {
+    // The caller broke the contract; report total disagreement rather than reading out of range.
+    m.visibility.id_agreement = 0.0;
+    m.visibility.mismatched_pixels = n;
+    m.visibility.mismatched_off_edge = n;
+    m.depth.max_rel_error = m.depth.mean_rel_error = 1.0;
+    m.color = ColorMetrics{1.0, 0.0, 1.0, 0.0};
+    return m;
+  }
+  if (n == 0) {
+    m.color.psnr_db = kInf;
+    return m;
+  }
+  const int w = a.width, h = a.height;
+
+  // Visibility. A mismatch counts as "on an edge" when both images have an id boundary within
+  // its 3x3 neighbourhood: a real silhouette or triangle edge is present in both renders, and a
+  // tie on it may fall either way by a pixel. A boundary present in only one image around the
+  // pixel is drawn by the mismatch itself (a speck or hole), which is what off-edge counts.
+  const std::vector<bool> near_a = dilate3x3(id_boundaries(a), w, h);
+  const std::vector<bool> near_b = dilate3x3(id_boundaries(b), w, h);
+  size_t mismatched = 0, off_edge = 0, depth_count = 0;
+  double depth_sum = 0.0, depth_max = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    if (id_key(a, i) != id_key(b, i)) {
+      ++mismatched;
+      if (!(near_a[i] && near_b[i])) ++off_edge;
+      continue;
+    }
+    if (a.object_id[i] == kNoId) continue;
+    double da = a.depth[i], db = b.depth[i], rel = 0.0;
+    if (da != db) {
+      double denom = std::max(std::fabs(da), std::fabs(db));
+      // Unequal infinite or NaN depth on a hit is as wrong as a depth can be.
+      rel = (std::isfinite(da) && std::isfinite(db)) ? (denom > 0 ? std::fabs(da - db) / denom : 0)
+                                                     : 1.0;
+    }
+    depth_sum += rel;
+    depth_max = std::max(depth_max, rel);
+    ++depth_count;
+  }
+  m.visibility.mismatched_pixels = mismatched;
+  m.visibility.mismatched_off_edge = off_edge;
+  m.visibility.id_agreement = double(n - mismatched) / double(n);
+  m.depth.max_rel_error = depth_max;
+  m.depth.mean_rel_error = depth_count ? depth_sum / double(depth_count) : 0.0;
+
+  // Colour, linear values, peak 1.
+  double sq = 0.0, max_abs = 0.0;
+  std::vector<float> ya(n), yb(n);
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      double d = std::fabs(double(a.color[i][c]) - double(b.color[i][c]));
+      if (std::isnan(d)) d = 1.0;  // a NaN colour is an error of at least full scale
+      sq += d * d;
+      max_abs = std::max(max_abs, d);
+    }
+    ya[i] = luminance(a.color[i]);
+    yb[i] = luminance(b.color[i]);
+  }
+  m.color.rmse = std::sqrt(sq / (3.0 * double(n)));
+  m.color.psnr_db = psnr_of(m.color.rmse);
+  m.color.max_abs = max_abs;
+  m.color.ssim = mean_ssim(ya, yb, w, h);
+  return m;
+}
+
+Expected<ImageDiff> diff_images(const Image& a, const Image& b) {
+  try {
+    if (a.width != b.width || a.height != b.height)
+      return bad_input("images differ in size: " + std::to_string(a.width) + "x" +
+                       std::to_string(a.height) + " vs " + std::to_string(b.width) + "x" +
+                       std::to_string(b.height));
+    if (a.channels != b.channels)
+      return bad_input("images differ in channel count: " + std::to_string(a.channels) + " vs " +
+                       std::to_string(b.channels));
+    const size_t count = size_t(a.width) * a.height * a.channels;
+    if (a.pixels.size() != count || b.pixels.size() != count)
+      return internal_error("image pixel buffers do not match their size");
+    ImageDiff d;
+    if (count == 0) {
+      d.psnr_db = kInf;
+      return d;
+    }
+    double sum = 0.0, sq = 0.0;
+    size_t worst = 0;
+    for (size_t i = 0; i < count; ++i) {
+      double e = std::fabs(double(a.pixels[i]) - double(b.pixels[i]));
+      if (std::isnan(e)) e = (std::isnan(a.pixels[i]) && std::isnan(b.pixels[i])) ? 0.0 : kInf;
+      sum += e;
+      sq += e * e;
+      if (e > d.max_abs) {
+        d.max_abs = e;
+        worst = i;
+      }
+    }
+    d.mean_abs = sum / double(count);
+    d.rmse = std::sqrt(sq / double(count));
+    d.psnr_db = psnr_of(d.rmse);
+    d.max_channel = int(worst % size_t(a.channels));
+    size_t pixel = worst / size_t(a.channels);
+    d.max_x = int(pixel % size_t(a.width));
+    d.max_y = int(pixel / size_t(a.width));
+    return d;
+  } catch (const std::exception& e) {
+    return internal_error(std::string("image diff failed: ") + e.what());
+  }
+}
+
+Image diff_heat_map(const Image& a, const Image& b, float scale) {
+  const int w = a.width, h = a.height;
+  const int channels = std::min(a.channels, b.channels);
+  std::vector<float> v(size_t(std::max(w, 0)) * std::max(h, 0), 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      float e = 0.0f;
+      if (x >= b.width || y >= b.height || a.channels != b.channels) {
+        e = std::numeric_limits<float>::infinity();  // no counterpart: top of the map
+      } else {
+        for (int c = 0; c < channels; ++c) {
+          float d = std::fabs(a.at(x, y, c) - b.at(x, y, c));
+          if (!(d <= e)) e = std::isnan(d) ? std::numeric_limits<float>::infinity() : d;
+        }
+      }
+      // scale <= 0: any difference at all is at the top of the map.
+      v[size_t(y) * w + x] = scale > 0.0f ? e / scale : (e > 0.0f ? 1.0f : 0.0f);
+    }
+  if (v.empty()) return Image{w, h, 3, {"R", "G", "B"}, {}};
+  return detail::inferno_display(v, w, h, 1.0f);
+}
+
+Image id_mismatch_image(const FrameBuffers& a, const FrameBuffers& b) {
+  Image img;
+  img.width = a.width;
+  img.height = a.height;
+  img.channels = 3;
+  img.channel_names = {"R", "G", "B"};
+  const size_t n = a.pixel_count();
+  img.pixels.assign(n * 3, 0.0f);
+  const bool comparable = a.width == b.width && a.height == b.height && a.object_id.size() == n &&
+                          b.object_id.size() == n;
+  for (size_t i = 0; i < n; ++i) {
+    float* p = &img.pixels[3 * i];
+    if (!comparable || a.object_id[i] != b.object_id[i]) {
+      p[0] = 1.0f;  // pure red, display referred
+      continue;
+    }
+    // Display-referred grey: the sRGB encoding of a's linear luminance.
+    float g = i < a.color.size() ? srgb_encode(luminance(a.color[i])) : 0.0f;
+    p[0] = p[1] = p[2] = g;
+  }
+  return img;
+}
+
+}  // namespace rvr

@@ -1,1 +1,346 @@
-// placeholder: being written
+// Image files through OpenImageIO, written atomically (temporary name in the same folder, then
+// rename). No codec is written by hand: OpenImageIO picks the format from the extension.
+#include "rvr/shared/image_io.h"
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <string>
+#include <system_error>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace rvr {
+namespace {
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  return s;
+}
+
+// Formats that keep float values as they are (scene-referred, linear). Every other format gets
+// 8 bits per channel, clamped, and the sRGB transfer when asked for.
+bool is_float_format(const std::string& ext) {
+  return ext == ".exr" || ext == ".hdr" || ext == ".pfm";
+}
+
+float srgb_encode(float v) {
+  if (!(v > 0.0f)) return 0.0f;  // also NaN
+  if (v >= 1.0f) return 1.0f;
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+// A name for the temporary file beside `path` that keeps its extension, because OpenImageIO
+// chooses the format by extension: "dir/.name.tmp-<pid>-<n>.ext". The counter only makes names
+// unique between threads of one process; it carries no other state.
+fs::path temp_path_for(const fs::path& path) {
+  static std::atomic<unsigned long> counter{0};
+  std::string name(1, '.');  // appended piecewise: GCC 12 warns falsely on "." + string
+  name += path.stem().string();
+  name += ".tmp-";
+  name += std::to_string(::getpid());
+  name += '-';
+  name += std::to_string(counter.fetch_add(1));
+  name += path.extension().string();
+  return path.parent_path() / name;
+}
+
+Error write_error(const std::string& path, const std::string& reason) {
+  return bad_input("cannot write '" + path + "': " + reason);
+}
+
+// Creates the parent folder of `path` when missing.
+bool make_parent(const fs::path& path, std::string& reason) {
+  fs::path parent = path.parent_path();
+  if (parent.empty()) return true;
+  std::error_code ec;
+  if (fs::is_directory(parent, ec)) return true;
+  fs::create_directories(parent, ec);
+  if (ec) {
+    reason = "cannot create folder '" + parent.string() + "': " + ec.message();
+    return false;
+  }
+  return true;
+}
+
+// Runs `write_temp(temp)`, then renames the temporary into place; removes it on any failure.
+template <class F>
+Status write_atomically(const std::string& path, F&& write_temp) {
+  try {
+    if (path.empty()) return write_error(path, "empty file name");
+    fs::path target(path);
+    std::string reason;
+    if (!make_parent(target, reason)) return write_error(path, reason);
+    fs::path temp = temp_path_for(target);
+    std::error_code ec;
+    if (!write_temp(temp, reason)) {
+      fs::remove(temp, ec);
+      return write_error(path, reason);
+    }
+    fs::rename(temp, target, ec);
+    if (ec) {
+      std::error_code ignored;
+      fs::remove(temp, ignored);
+      return write_error(path, ec.message());
+    }
+    return ok_status();
+  } catch (const std::exception& e) {
+    return write_error(path, e.what());
+  }
+}
+
+std::string first_line(std::string s) {
+  auto nl = s.find('\n');
+  if (nl != std::string::npos) s.resize(nl);
+  return s.empty() ? std::string("unknown error") : s;
+}
+
+bool write_pixels(const fs::path& temp, const Image& image, bool linear_to_srgb,
+                  std::string& reason) {
+  std::string ext = lower(fs::path(temp).extension().string());
+  auto out = OIIO::ImageOutput::create(temp.string());
+  if (!out) {
+    reason = first_line(OIIO::geterror());
+    if (reason == "unknown error") reason = "no image format for extension '" + ext + "'";
+    return false;
+  }
+  const bool as_float = is_float_format(ext);
+  OIIO::ImageSpec spec(image.width, image.height, image.channels,
+                       as_float ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+  if (image.channel_names.size() == size_t(image.channels)) {
+    spec.channelnames = image.channel_names;
+    // A lone "Z" channel is depth to OpenImageIO; do not let it take it for alpha.
+    spec.alpha_channel = -1;
+    for (int c = 0; c < image.channels; ++c) {
+      if (image.channel_names[c] == "A") spec.alpha_channel = c;
+      if (image.channel_names[c] == "Z") spec.z_channel = c;
+    }
+  }
+  // 8-bit files hold display (sRGB-encoded) values either way: encoded here from linear, or
+  // already display referred (heat maps).
+  spec.attribute("oiio:ColorSpace", as_float ? "Linear" : "sRGB");
+
+  bool ok = false;
+  if (!out->open(temp.string(), spec)) {
+    reason = first_line(out->geterror());
+    return false;
+  }
+  if (as_float) {
+    ok = out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
+  } else {
+    std::vector<uint8_t> bytes(image.pixels.size());
+    for (size_t i = 0; i < bytes.size(); ++i) {
+      float v = image.pixels[i];
+      v = linear_to_srgb ? srgb_encode(v) : (v > 0.0f ? std::min(v, 1.0f) : 0.0f);
+      bytes[i] = uint8_t(std::lround(v * 255.0f));
+    }
+    ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
+  }
+  if (!ok) reason = first_line(out->geterror());
+  if (!out->close() && ok) {
+    ok = false;
+    reason = first_line(out->geterror());
+  }
+  return ok;
+}
+
+// Linear inferno colours of `values` / `scale` (clamped to [0, 1]), through OpenImageIO.
+Image inferno_linear(const std::vector<float>& values, int width, int height, float scale) {
+  OIIO::ImageBuf src(OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::FLOAT));
+  std::vector<float> scaled(values.size());
+  const float inv = scale > 0.0f ? 1.0f / scale : 0.0f;
+  for (size_t i = 0; i < values.size(); ++i) {
+    float v = values[i] * inv;
+    scaled[i] = v > 0.0f ? std::min(v, 1.0f) : 0.0f;  // NaN -> 0
+  }
+  src.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, scaled.data());
+  OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, "inferno");
+  Image img;
+  img.width = width;
+  img.height = height;
+  img.channels = 3;
+  img.channel_names = {"R", "G", "B"};
+  img.pixels.assign(size_t(width) * height * 3, 0.0f);
+  if (mapped.initialized())
+    mapped.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, img.pixels.data());
+  return img;
+}
+
+}  // namespace
+
+namespace detail {
+// Also used by compare.cpp (which declares it): OpenImageIO's "inferno" colour map of
+// values / scale, clamped to [0, 1]. OpenImageIO's map is linear; this returns it sRGB-encoded
+// (display referred, the colours matplotlib shows), to be written with linear_to_srgb = false.
+Image inferno_display(const std::vector<float>& values, int width, int height, float scale) {
+  Image img = inferno_linear(values, width, height, scale);
+  for (float& v : img.pixels) v = srgb_encode(v);
+  return img;
+}
+}  // namespace detail
+
+Status write_image(const std::string& path, const Image& image, bool linear_to_srgb) {
+  if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
+      image.pixels.size() != size_t(image.width) * image.height * image.channels)
+    return write_error(path, "invalid image (" + std::to_string(image.width) + "x" +
+                                 std::to_string(image.height) + "x" +
+                                 std::to_string(image.channels) + ", " +
+                                 std::to_string(image.pixels.size()) + " values)");
+  return write_atomically(path, [&](const fs::path& temp, std::string& reason) {
+    return write_pixels(temp, image, linear_to_srgb, reason);
+  });
+}
+
+Expected<Image> read_image(const std::string& path) {
+  try {
+    auto fail = [&](const std::string& reason) {
+      return bad_input("cannot read '" + path + "': " + reason);
+    };
+    std::error_code ec;
+    if (!fs::exists(path, ec)) return fail("no such file");
+    if (fs::is_directory(path, ec)) return fail("is a folder");
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) return fail(first_line(OIIO::geterror()));
+    const OIIO::ImageSpec& spec = in->spec();
+    Image img;
+    img.width = spec.width;
+    img.height = spec.height;
+    img.channels = spec.nchannels;
+    img.channel_names = spec.channelnames;
+    if (img.width <= 0 || img.height <= 0 || img.channels <= 0) return fail("empty image");
+    img.pixels.resize(size_t(img.width) * img.height * img.channels);
+    if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data()))
+      return fail(first_line(in->geterror()));
+    in->close();
+    return img;
+  } catch (const std::exception& e) {
+    return bad_input("cannot read '" + path + "': " + e.what());
+  }
+}
+
+Image color_image(const FrameBuffers& fb) {
+  Image img;
+  img.width = fb.width;
+  img.height = fb.height;
+  img.channels = 3;
+  img.channel_names = {"R", "G", "B"};
+  img.pixels.resize(fb.pixel_count() * 3);
+  for (size_t i = 0; i < fb.pixel_count() && i < fb.color.size(); ++i) {
+    img.pixels[3 * i + 0] = fb.color[i].r;
+    img.pixels[3 * i + 1] = fb.color[i].g;
+    img.pixels[3 * i + 2] = fb.color[i].b;
+  }
+  return img;
+}
+
+namespace {
+
+Image aov_image(const FrameBuffers& fb, std::vector<std::string> names) {
+  Image img;
+  img.width = fb.width;
+  img.height = fb.height;
+  img.channels = int(names.size());
+  img.channel_names = std::move(names);
+  img.pixels.assign(fb.pixel_count() * img.channels, 0.0f);
+  return img;
+}
+
+float id_value(uint32_t id) {
+  return id == kNoId ? -1.0f : float(id);
+}
+
+// The value at the top of OUT.cost.png's colour map: the 99th percentile of the non-zero costs
+// (a few very expensive pixels would otherwise turn the rest black), at least 1.
+float cost_scale(const std::vector<float>& cost) {
+  std::vector<float> positive;
+  positive.reserve(cost.size());
+  for (float c : cost)
+    if (c > 0.0f && std::isfinite(c)) positive.push_back(c);
+  if (positive.empty()) return 1.0f;
+  size_t k = std::min(positive.size() - 1, size_t(std::ceil(0.99 * double(positive.size()))) - 1);
+  std::nth_element(positive.begin(), positive.begin() + k, positive.end());
+  return std::max(positive[k], 1.0f);
+}
+
+}  // namespace
+
+Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
+                  const std::vector<std::string>& aovs) {
+  try {
+    for (const auto& name : aovs)
+      if (name != "depth" && name != "id" && name != "normal" && name != "cost")
+        return bad_input("unknown aov '" + name + "' (known: depth, id, normal, cost)");
+    const size_t n = fb.pixel_count();
+    if (fb.depth.size() != n || fb.object_id.size() != n || fb.primitive_id.size() != n ||
+        fb.normal.size() != n || fb.cost.size() != n)
+      return internal_error("cannot write AOVs of '" + out_path + "': frame buffers of " +
+                            std::to_string(fb.width) + "x" + std::to_string(fb.height) +
+                            " are not fully sized");
+    const std::string base = fs::path(out_path).replace_extension().string();
+
+    for (const auto& name : aovs) {
+      Status st = ok_status();
+      if (name == "depth") {
+        Image img = aov_image(fb, {"Z"});
+        std::copy(fb.depth.begin(), fb.depth.end(), img.pixels.begin());
+        st = write_image(base + ".depth.exr", img, false);
+      } else if (name == "id") {
+        Image img = aov_image(fb, {"id", "prim"});
+        for (size_t i = 0; i < n; ++i) {
+          img.pixels[2 * i] = id_value(fb.object_id[i]);
+          img.pixels[2 * i + 1] = fb.object_id[i] == kNoId ? -1.0f : id_value(fb.primitive_id[i]);
+        }
+        st = write_image(base + ".id.exr", img, false);
+      } else if (name == "normal") {
+        Image img = aov_image(fb, {"R", "G", "B"});
+        for (size_t i = 0; i < n; ++i)
+          for (int c = 0; c < 3; ++c) img.pixels[3 * i + c] = fb.normal[i][c];
+        st = write_image(base + ".normal.exr", img, false);
+      } else if (name == "cost") {
+        Image img = aov_image(fb, {"cost"});
+        std::copy(fb.cost.begin(), fb.cost.end(), img.pixels.begin());
+        st = write_image(base + ".cost.exr", img, false);
+        if (st.ok()) {
+          Image png = detail::inferno_display(fb.cost, fb.width, fb.height, cost_scale(fb.cost));
+          st = write_image(base + ".cost.png", png, false);
+        }
+      }
+      if (!st.ok()) return st;
+    }
+    return ok_status();
+  } catch (const std::exception& e) {
+    return internal_error("cannot write AOVs of '" + out_path + "': " + e.what());
+  }
+}
+
+Status write_text_file(const std::string& path, const std::string& text) {
+  return write_atomically(path, [&](const fs::path& temp, std::string& reason) {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    if (!out) {
+      reason = "cannot create a temporary file in '" + temp.parent_path().string() + "'";
+      return false;
+    }
+    out.write(text.data(), std::streamsize(text.size()));
+    out.close();
+    if (!out) {
+      reason = "write failed";
+      return false;
+    }
+    return true;
+  });
+}
+
+}  // namespace rvr
