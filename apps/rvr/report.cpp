@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -168,10 +169,10 @@ footer{margin-top:30px;color:#7a8394;font-size:12px}
 const char* kScript = R"(
 (function () {
   var range = document.getElementById('flip-range');
-  var top = document.getElementById('flip-top');
+  var upper = document.getElementById('flip-top');
   var button = document.getElementById('flip-button');
-  if (!range || !top || !button) return;
-  function show(v) { top.style.clipPath = 'inset(0 0 0 ' + v + '%)'; }
+  if (!range || !upper || !button) return;
+  function show(v) { upper.style.clipPath = 'inset(0 0 0 ' + v + '%)'; }
   range.addEventListener('input', function () { show(range.value); });
   button.addEventListener('click', function () {
     range.value = Number(range.value) < 50 ? 100 : 0;
@@ -228,7 +229,10 @@ std::string metrics_json(const ReportInput& input) {
     // Extras.
     doc["compared"] = compared;
     doc["command"] = input.command_line;
-    doc["heat_map_scale"] = number(input.heat_map_scale);
+    // The float as it reads (0.1), not as its double widening prints (0.10000000149011612).
+    const double scale = input.heat_map_scale;
+    doc["heat_map_scale"] =
+        number(std::isfinite(scale) ? std::strtod(fmt("%.7g", scale).c_str(), nullptr) : scale);
     doc["files"] = {
         {"diff", "diff.png"}, {"id_mismatch", "id_mismatch.png"}, {"report", "report.html"}};
     // Invalid UTF-8 in a path or command line must not make dump() throw.
@@ -278,7 +282,7 @@ Expected<std::string> report_html(const ReportInput& input) {
     // Verdict badges.
     h << "<div class=\"badges\">"
       << "<span class=\"badge " << (vis.mismatched_off_edge == 0 ? "good" : "bad") << "\">"
-      << vis.mismatched_off_edge << " mismatched pixels off edges</span>"
+      << "mismatched off edges: " << vis.mismatched_off_edge << "</span>"
       << "<span class=\"badge neutral\">id agreement " << fmt("%.4f", vis.id_agreement * 100.0)
       << "%</span>"
       << "<span class=\"badge neutral\">PSNR "
