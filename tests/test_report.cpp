@@ -1,7 +1,5 @@
 // metrics.json and report.html of `rvr compare`.
 //
-// report.cpp belongs to the rvr executable, not to a library the tests link, so it is compiled
-// into this test directly (which also reaches its internal helpers, e.g. base64).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "../apps/rvr/report.cpp"
+#include "report.h"
 #include "rvr/shared/image_io.h"
 
 namespace fs = std::filesystem;
