@@ -78,9 +78,11 @@ std::string fmt_num(double v) {
 }
 
 std::string quote_json(const std::string& s) {
-  // JSON-escaped, cut short so a hostile string cannot flood the message.
+  // 'text', JSON-escaped inside, cut short so a hostile string cannot flood the message.
   std::string shown = s.size() > 60 ? s.substr(0, 57) + "..." : s;
-  return json(shown).dump(-1, ' ', false, json::error_handler_t::replace);
+  std::string q = json(shown).dump(-1, ' ', false, json::error_handler_t::replace);
+  q.front() = q.back() = '\'';
+  return q;
 }
 
 // What a JSON value is, for "must be X, got Y" messages.
@@ -128,23 +130,29 @@ std::string where(const std::string& path) {
   return path.empty() ? "top level" : path;
 }
 
+// Edit distance counting a swap of two neighbouring letters as one edit (optimal string
+// alignment), case-insensitive.
 size_t edit_distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  auto same = [](char x, char y) {
+    return std::tolower(static_cast<unsigned char>(x)) ==
+           std::tolower(static_cast<unsigned char>(y));
+  };
+  const size_t w = b.size() + 1;
+  std::vector<size_t> d((a.size() + 1) * w);
+  for (size_t i = 0; i <= a.size(); ++i) d[i * w] = i;
+  for (size_t j = 0; j <= b.size(); ++j) d[j] = j;
   for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diag = row[0];
-    row[0] = i;
     for (size_t j = 1; j <= b.size(); ++j) {
-      size_t up = row[j];
-      size_t cost = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
-                            std::tolower(static_cast<unsigned char>(b[j - 1]))
-                        ? 0
-                        : 1;
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + cost});
-      diag = up;
+      size_t cost = same(a[i - 1], b[j - 1]) ? 0 : 1;
+      size_t best =
+          std::min({d[(i - 1) * w + j] + 1, d[i * w + j - 1] + 1, d[(i - 1) * w + j - 1] + cost});
+      if (i > 1 && j > 1 && same(a[i - 1], b[j - 2]) && same(a[i - 2], b[j - 1])) {
+        best = std::min(best, d[(i - 2) * w + j - 2] + 1);
+      }
+      d[i * w + j] = best;
     }
   }
-  return row[b.size()];
+  return d[a.size() * w + b.size()];
 }
 
 // The closest allowed word, if it is close enough to be a likely typo.
@@ -758,7 +766,7 @@ class Reader {
     if (const json* f = find(root, "format")) {
       const std::string& s = string(*f, "format");
       if (s != kFormat) {
-        fail("format", fmt::format("must be \"{}\", got {}", kFormat, quote_json(s)));
+        fail("format", fmt::format("must be '{}', got {}", kFormat, quote_json(s)));
       }
     }
     if (const json* image = find(root, "image")) read_image(*image);
@@ -870,8 +878,9 @@ class Reader {
       m.transparency = real_in_unit(*t, key_path(path, "transparency"));
     }
     if (double(m.mirror) + double(m.transparency) > 1.0 + 1e-6) {
-      fail(path, fmt::format("mirror + transparency must be <= 1, got {} + {}", fmt_num(m.mirror),
-                             fmt_num(m.transparency)));
+      fail(path, fmt::format("mirror + transparency must be <= 1, got {} + {}",
+                             fmt_num(find(v, "mirror")->get<double>()),
+                             fmt_num(find(v, "transparency")->get<double>())));
     }
     if (const json* i = find(v, "ior")) {
       m.ior = real_at_least(*i, key_path(path, "ior"), 1, Bound::Closed);
@@ -1118,7 +1127,7 @@ class Reader {
       kind = string(*type, key_path(path, "type"));
       if (kind != "sphere" && kind != "csg") {
         fail(key_path(path, "type"),
-             "must be \"sphere\" or \"csg\" inside a csg tree, got " + quote_json(kind));
+             "must be 'sphere' or 'csg' inside a csg tree, got " + quote_json(kind));
       }
     } else {
       kind = find(v, "op") ? "csg" : "sphere";
