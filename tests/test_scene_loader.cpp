@@ -229,7 +229,7 @@ TEST_F(SceneLoader, EveryKeyParsesToTheRightValues) {
 }
 
 TEST_F(SceneLoader, DefaultsOfAMinimalScene) {
-  Scene s = parse_ok(R"({"camera": {"eye": [3, 4, 0], "target": [0, 0, 0], "up": [0, 1, 0]}})");
+  Scene s = parse_ok(R"({"camera": {"eye": [3, 4, 0], "target": [0, 0, 0], "up": [0, 3, 0]}})");
   EXPECT_EQ(s.image.width, 640);
   EXPECT_EQ(s.image.height, 480);
   EXPECT_TRUE(near3(s.image.background, glm::vec3(0.0f)));
@@ -239,6 +239,7 @@ TEST_F(SceneLoader, DefaultsOfAMinimalScene) {
   EXPECT_FLOAT_EQ(s.camera.far, 1000.0f);
   EXPECT_FLOAT_EQ(s.camera.aperture_radius, 0.0f);
   EXPECT_FLOAT_EQ(s.camera.focus_distance, 5.0f);  // distance(eye, target)
+  EXPECT_TRUE(near3(s.camera.up, {0, 1, 0}));      // only its direction matters
   EXPECT_TRUE(near3(s.ambient, glm::vec3(0.0f)));
   ASSERT_EQ(s.materials.size(), 1u);
   EXPECT_TRUE(s.lights.empty());
@@ -446,6 +447,9 @@ std::vector<BadCase> bad_cases() {
       {"zero up", camera(eye_target + R"("up": [0, 0, 0])"), "t.json: camera.up: must be non-zero"},
       {"eye equals target", camera(R"("eye": [1, 2, 3], "target": [1, 2, 3], "up": [0, 1, 0])"),
        "t.json: camera.target: must differ from camera.eye (both are [1, 2, 3])"},
+      {"eye too close to target",
+       camera(R"("eye": [0, 0, 0], "target": [1e-30, 0, 0], "up": [0, 1, 0])"),
+       "t.json: camera.target: is too far from or too close to camera.eye for 32-bit floats"},
       {"missing up", camera(eye_target.substr(0, eye_target.size() - 2)),
        "t.json: camera.up: is required"},
       {"negative shininess", material(R"("shininess": -1)"),
@@ -522,6 +526,8 @@ std::vector<BadCase> bad_cases() {
        "t.json: objects[0].file: 'flat.obj': all 2 triangles are degenerate (zero area)"},
       {"non-finite mesh vertex", one_object(R"({"type": "mesh", "file": "inf.obj"})"),
        "t.json: objects[0].file: 'inf.obj': vertex 0 of mesh 0 has a non-finite coordinate"},
+      {"NUL in a mesh path", one_object(R"({"type": "mesh", "file": "a\u0000b.obj"})"),
+       "t.json: objects[0].file: must not contain a NUL character"},
       {"mesh file is a folder", one_object(R"({"type": "mesh", "file": "."})"),
        "t.json: objects[0].file: cannot read '.': Is a directory"},
       // csg

@@ -684,6 +684,7 @@ std::string file_status(const fs::path& p) {
 TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
                          const std::string& path, bool smooth, size_t* skipped_primitives) {
   if (file.empty()) fail(path, "must not be empty");
+  if (file.find('\0') != std::string::npos) fail(path, "must not contain a NUL character");
   fs::path full = fs::path(file);
   if (full.is_relative()) full = fs::path(base_dir.empty() ? "." : base_dir) / full;
   std::string prefix = "cannot read " + quote_json(file) + ": ";
@@ -822,6 +823,8 @@ class Reader {
       fail("camera.up", "must not be parallel to target - eye, got up " + vec_text(c.up) +
                             " and target - eye " + vec_text(view_f));
     }
+    // Only its direction matters; unit length keeps float camera maths away from underflow.
+    c.up = glm::vec3(glm::normalize(up));
     if (const json* f = find(v, "fov_y_deg")) {
       c.fov_y_deg = real(*f, "camera.fov_y_deg");
       if (!(c.fov_y_deg > 0.0f && c.fov_y_deg < 180.0f)) {
