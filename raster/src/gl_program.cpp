@@ -1,0 +1,76 @@
+#include "gl_program.h"
+
+#include <fmt/format.h>
+
+#include <string>
+
+namespace rvr {
+
+namespace {
+
+std::string shader_log(GLuint shader) {
+  GLint length = 0;
+  glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+  std::string log(size_t(length > 0 ? length : 0), '\0');
+  if (length > 0) glGetShaderInfoLog(shader, length, nullptr, log.data());
+  while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
+  return log;
+}
+
+std::string program_log(GLuint program) {
+  GLint length = 0;
+  glGetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
+  std::string log(size_t(length > 0 ? length : 0), '\0');
+  if (length > 0) glGetProgramInfoLog(program, length, nullptr, log.data());
+  while (!log.empty() && (log.back() == '\0' || log.back() == '\n')) log.pop_back();
+  return log;
+}
+
+Expected<GLuint> compile(const char* name, GLenum stage, const char* source) {
+  GLuint shader = glCreateShader(stage);
+  if (shader == 0) return internal_error(fmt::format("{}: glCreateShader failed", name));
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = GL_FALSE;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (ok != GL_TRUE) {
+    std::string log = shader_log(shader);
+    glDeleteShader(shader);
+    return internal_error(fmt::format("{} {} shader does not compile: {}", name,
+                                      stage == GL_VERTEX_SHADER ? "vertex" : "fragment", log));
+  }
+  return shader;
+}
+
+}  // namespace
+
+Expected<GLuint> build_program(const char* name, const char* vertex_source,
+                               const char* fragment_source) {
+  auto vs = compile(name, GL_VERTEX_SHADER, vertex_source);
+  if (!vs) return vs.error();
+  auto fs = compile(name, GL_FRAGMENT_SHADER, fragment_source);
+  if (!fs) {
+    glDeleteShader(*vs);
+    return fs.error();
+  }
+  GLuint program = glCreateProgram();
+  glAttachShader(program, *vs);
+  glAttachShader(program, *fs);
+  glLinkProgram(program);
+  // The program keeps the compiled code; the shader objects are no longer needed.
+  glDetachShader(program, *vs);
+  glDetachShader(program, *fs);
+  glDeleteShader(*vs);
+  glDeleteShader(*fs);
+  GLint ok = GL_FALSE;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (ok != GL_TRUE) {
+    std::string log = program_log(program);
+    glDeleteProgram(program);
+    return internal_error(fmt::format("{} program does not link: {}", name, log));
+  }
+  RVR_GL_CHECK("building a shader program");
+  return program;
+}
+
+}  // namespace rvr

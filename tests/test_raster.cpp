@@ -1,0 +1,515 @@
+// GlRasterizer on hand-built scenes: ids, exact depth, shading equal to the C++ shade_local,
+// image orientation, tessellated shapes, skipped csg, stats and the driver checks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <glm/glm.hpp>
+#include <limits>
+#include <set>
+#include <string>
+
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/shared/camera.h"
+#include "rvr/shared/shading.h"
+#include "rvr/shared/tessellate.h"
+
+namespace rvr {
+namespace {
+
+constexpr int kW = 64, kH = 48;
+const float kInf = std::numeric_limits<float>::infinity();
+
+// Camera at z = 5 looking at the origin; one point light near the eye; a shiny material.
+Scene base_scene() {
+  Scene s;
+  s.source = "test";
+  s.image.width = kW;
+  s.image.height = kH;
+  s.image.background = {0.1f, 0.2f, 0.3f};
+  s.camera.eye = {0, 0, 5};
+  s.camera.target = {0, 0, 0};
+  s.camera.up = {0, 1, 0};
+  s.camera.fov_y_deg = 60;
+  s.camera.near = 0.1f;
+  s.camera.far = 100;
+  s.camera.focus_distance = 5;
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  s.materials.push_back(default_material());
+  Material m;
+  m.name = "shiny";
+  m.diffuse = {0.7f, 0.4f, 0.2f};
+  m.specular = {0.5f, 0.5f, 0.5f};
+  m.emission = {0.01f, 0.0f, 0.02f};
+  m.shininess = 20;
+  s.materials.push_back(m);
+  Light l;
+  l.type = LightType::Point;
+  l.position = {1, 2, 4};
+  l.intensity = {10, 9, 8};
+  s.lights.push_back(l);
+  return s;
+}
+
+Object triangle(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, uint32_t material = 1,
+                const std::string& name = "tri") {
+  Object o;
+  o.name = name;
+  o.type = ObjectType::Triangles;
+  o.material = material;
+  o.mesh.positions = {a, b, c};
+  o.mesh.triangles = {{0, 1, 2}};
+  return o;
+}
+
+// Axis-aligned square facing +z at depth z, as two triangles (prim 0 and 1).
+Object quad(float half, float z, const std::string& name = "quad") {
+  Object o;
+  o.name = name;
+  o.type = ObjectType::Triangles;
+  o.material = 1;
+  o.mesh.positions = {{-half, -half, z}, {half, -half, z}, {half, half, z}, {-half, half, z}};
+  o.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  return o;
+}
+
+RenderOutput render_ok(const Scene& s, RenderMode mode = RenderMode::Local,
+                       GlRasterizer* rasterizer = nullptr) {
+  GlRasterizer local;
+  GlRasterizer& r = rasterizer ? *rasterizer : local;
+  RenderOptions options;
+  options.mode = mode;
+  auto out = r.render(s, options);
+  EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().message);
+  if (!out.ok()) return RenderOutput{};
+  return std::move(out.value());
+}
+
+// The pixel containing the projection of world point p (y = 0 at the top).
+glm::ivec2 pixel_of(const Scene& s, const glm::vec3& p) {
+  glm::vec4 clip = projection_matrix(s.camera, s.image.width, s.image.height) *
+                   view_matrix(s.camera) * glm::vec4(p, 1.0f);
+  glm::vec3 ndc = glm::vec3(clip) / clip.w;
+  float px = (ndc.x * 0.5f + 0.5f) * float(s.image.width);
+  float py = (0.5f - ndc.y * 0.5f) * float(s.image.height);
+  return {int(std::floor(px)), int(std::floor(py))};
+}
+
+// Where the ray through pixel (x, y)'s centre meets the plane of triangle (a, b, c); t is the
+// view depth because the ray direction has unit component along the view axis.
+struct Hit {
+  float t;
+  glm::vec3 P, geometric_normal, V;
+};
+Hit hit_plane(const Scene& s, glm::ivec2 pixel, const glm::vec3& a, const glm::vec3& b,
+              const glm::vec3& c) {
+  CameraFrame f = make_camera_frame(s.camera, s.image.width, s.image.height);
+  glm::vec3 d = camera_ray_direction(f, float(pixel.x) + 0.5f, float(pixel.y) + 0.5f);
+  glm::vec3 g = glm::cross(b - a, c - a);
+  float t = glm::dot(a - f.eye, g) / glm::dot(d, g);
+  glm::vec3 P = f.eye + t * d;
+  return {t, P, g, glm::normalize(f.eye - P)};
+}
+
+void expect_vec_near(const glm::vec3& got, const glm::vec3& want, float tol,
+                     const std::string& what) {
+  EXPECT_NEAR(got.x, want.x, tol) << what;
+  EXPECT_NEAR(got.y, want.y, tol) << what;
+  EXPECT_NEAR(got.z, want.z, tol) << what;
+}
+
+TEST(GlRaster, SingleTriangleCentroidMatchesAnalyticDepthAndShading) {
+  Scene s = base_scene();
+  glm::vec3 a(-1.5f, -1.0f, -0.5f), b(1.5f, -1.2f, 0.3f), c(0.2f, 1.4f, -0.2f);
+  s.objects.push_back(triangle(a, b, c));
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  ASSERT_EQ(fb.width, kW);
+  ASSERT_EQ(fb.height, kH);
+  ASSERT_EQ(fb.color.size(), size_t(kW * kH));
+
+  glm::ivec2 px = pixel_of(s, (a + b + c) / 3.0f);
+  size_t i = fb.index(px.x, px.y);
+  EXPECT_EQ(fb.object_id[i], 0u);
+  EXPECT_EQ(fb.primitive_id[i], 0u);
+
+  Hit h = hit_plane(s, px, a, b, c);
+  EXPECT_NEAR(fb.depth[i], h.t, 1e-4f * h.t);
+  glm::vec3 N = face_viewer(glm::normalize(h.geometric_normal), h.geometric_normal, h.V);
+  expect_vec_near(fb.normal[i], N, 1e-4f, "normal");
+  glm::vec3 want = shade_local(s.materials[1], h.P, N, h.V, s.ambient, light_samples(s.lights));
+  expect_vec_near(fb.color[i], want, 1e-3f, "colour");
+}
+
+TEST(GlRaster, PixelsOutsideAreBackground) {
+  Scene s = base_scene();
+  s.objects.push_back(triangle({-0.5f, -0.5f, 0}, {0.5f, -0.5f, 0}, {0, 0.5f, 0}));
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  for (glm::ivec2 p : {glm::ivec2(0, 0), glm::ivec2(kW - 1, 0), glm::ivec2(0, kH - 1),
+                       glm::ivec2(kW - 1, kH - 1)}) {
+    size_t i = fb.index(p.x, p.y);
+    EXPECT_EQ(fb.object_id[i], kNoId);
+    EXPECT_EQ(fb.primitive_id[i], kNoId);
+    EXPECT_EQ(fb.depth[i], kInf);
+    EXPECT_EQ(fb.color[i], s.image.background);
+    EXPECT_EQ(fb.normal[i], glm::vec3(0.0f));
+    EXPECT_EQ(fb.cost[i], 0.0f);
+  }
+}
+
+TEST(GlRaster, QuadAtKnownDistanceHasExactDepthAndBothPrimitives) {
+  Scene s = base_scene();
+  s.objects.push_back(quad(1.0f, -3.0f));  // 8 units in front of the eye
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  size_t covered = 0;
+  std::set<uint32_t> prims;
+  for (size_t i = 0; i < fb.pixel_count(); ++i) {
+    if (fb.object_id[i] == kNoId) continue;
+    ++covered;
+    prims.insert(fb.primitive_id[i]);
+    EXPECT_NEAR(fb.depth[i], 8.0f, 8.0f * 1e-5f);
+    expect_vec_near(fb.normal[i], {0, 0, 1}, 1e-6f, "normal");
+  }
+  // Side 2 at distance 8 with a 60 degree fov covers about (2 / (2*8*tan30) * 48)^2 pixels.
+  EXPECT_GT(covered, 80u);
+  EXPECT_LT(covered, 140u);
+  EXPECT_EQ(prims, (std::set<uint32_t>{0, 1}));
+}
+
+TEST(GlRaster, NearerTriangleWinsWhateverTheOrder) {
+  for (bool near_first : {false, true}) {
+    Scene s = base_scene();
+    Object near_tri = triangle({-1, -1, 1}, {1, -1, 1}, {0, 1, 1}, 1, "near");
+    Object far_tri = triangle({-1.5f, -1.5f, -1}, {1.5f, -1.5f, -1}, {0, 1.5f, -1}, 1, "far");
+    if (near_first) {
+      s.objects = {near_tri, far_tri};
+    } else {
+      s.objects = {far_tri, near_tri};
+    }
+    uint32_t near_id = near_first ? 0u : 1u;
+    RenderOutput out = render_ok(s);
+    const FrameBuffers& fb = out.buffers;
+    size_t i = fb.index(kW / 2, kH / 2);
+    EXPECT_EQ(fb.object_id[i], near_id) << "near_first=" << near_first;
+    EXPECT_NEAR(fb.depth[i], 4.0f, 4e-4f);
+    EXPECT_EQ(fb.cost[i], 2.0f);  // both triangles generated a fragment here
+  }
+}
+
+TEST(GlRaster, RowZeroIsTheTop) {
+  Scene s = base_scene();
+  s.objects.push_back(triangle({-0.5f, 0.5f, 0}, {0.5f, 0.5f, 0}, {0, 1.5f, 0}));
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  size_t covered = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (fb.object_id[fb.index(x, y)] != kNoId) {
+        ++covered;
+        EXPECT_LT(y, kH / 2) << "covered pixel in the lower half at y=" << y;
+      }
+  EXPECT_GT(covered, 10u);
+  // The apex (y = 1.5) is nearer the top than the base (y = 0.5).
+  EXPECT_LT(pixel_of(s, {0, 1.4f, 0}).y, pixel_of(s, {0, 0.6f, 0}).y);
+  EXPECT_EQ(fb.object_id[fb.index(pixel_of(s, {0, 1.2f, 0}).x, pixel_of(s, {0, 1.2f, 0}).y)], 0u);
+}
+
+TEST(GlRaster, ObjectIdsFollowObjectOrder) {
+  Scene s = base_scene();
+  const float xs[3] = {-2.0f, 0.0f, 2.0f};
+  for (int k = 0; k < 3; ++k) {
+    float x = xs[k];
+    std::string name = "t";  // (not "t" + to_string: g++ 12 warns -Wrestrict falsely)
+    name += std::to_string(k);
+    s.objects.push_back(
+        triangle({x - 0.6f, -0.5f, 0}, {x + 0.6f, -0.5f, 0}, {x, 0.7f, 0}, 1, name));
+  }
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  for (int k = 0; k < 3; ++k) {
+    glm::ivec2 p = pixel_of(s, {xs[k], 0.0f, 0.0f});
+    EXPECT_EQ(fb.object_id[fb.index(p.x, p.y)], uint32_t(k));
+    EXPECT_EQ(fb.primitive_id[fb.index(p.x, p.y)], 0u);
+  }
+  EXPECT_EQ(out.stats.at("triangles.submitted"), 3.0);
+}
+
+TEST(GlRaster, PrimitiveIdRestartsPerObject) {
+  Scene s = base_scene();
+  s.objects.push_back(quad(0.8f, 0.0f, "left"));
+  for (glm::vec3& p : s.objects[0].mesh.positions) p.x -= 1.0f;
+  s.objects.push_back(quad(0.8f, 0.0f, "right"));
+  for (glm::vec3& p : s.objects[1].mesh.positions) p.x += 1.0f;
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  std::set<std::pair<uint32_t, uint32_t>> seen;
+  for (size_t i = 0; i < fb.pixel_count(); ++i)
+    if (fb.object_id[i] != kNoId) seen.insert({fb.object_id[i], fb.primitive_id[i]});
+  EXPECT_EQ(seen, (std::set<std::pair<uint32_t, uint32_t>>{{0, 0}, {0, 1}, {1, 0}, {1, 1}}));
+}
+
+TEST(GlRaster, SphereIsTessellatedWithPrimitiveIdZero) {
+  Scene s = base_scene();
+  Object o;
+  o.name = "ball";
+  o.type = ObjectType::Sphere;
+  o.material = 1;
+  o.sphere = {{0, 0, 0}, 1.0f};
+  s.objects.push_back(o);
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  size_t covered = 0;
+  for (size_t i = 0; i < fb.pixel_count(); ++i) {
+    if (fb.object_id[i] == kNoId) continue;
+    ++covered;
+    EXPECT_EQ(fb.object_id[i], 0u);
+    EXPECT_EQ(fb.primitive_id[i], 0u);
+    EXPECT_NEAR(glm::length(fb.normal[i]), 1.0f, 1e-4f);
+    EXPECT_GT(fb.normal[i].z, 0.0f);  // facing the viewer
+  }
+  EXPECT_GT(covered, 100u);
+  // The z-buffer draws the tessellation, so compare with the ray through the centre pixel
+  // hitting that same mesh (Moller-Trumbore over every triangle, nearest hit).
+  size_t c = fb.index(kW / 2, kH / 2);
+  CameraFrame f = make_camera_frame(s.camera, kW, kH);
+  glm::vec3 d = camera_ray_direction(f, kW / 2 + 0.5f, kH / 2 + 0.5f);
+  TriangleMesh mesh = tessellate_sphere(o.sphere, RenderOptions{}.sphere_segments);
+  float best = kInf;
+  glm::vec3 best_normal(0.0f);
+  for (const glm::uvec3& tri : mesh.triangles) {
+    glm::vec3 p0 = mesh.positions[tri.x], e1 = mesh.positions[tri.y] - p0,
+              e2 = mesh.positions[tri.z] - p0;
+    glm::vec3 pv = glm::cross(d, e2);
+    float det = glm::dot(e1, pv);
+    if (std::abs(det) < 1e-12f) continue;
+    glm::vec3 tv = f.eye - p0;
+    float u = glm::dot(tv, pv) / det;
+    glm::vec3 qv = glm::cross(tv, e1);
+    float v = glm::dot(d, qv) / det;
+    float t = glm::dot(e2, qv) / det;
+    if (u < 0 || v < 0 || u + v > 1 || t <= 0 || t >= best) continue;
+    best = t;
+    best_normal = glm::normalize((1 - u - v) * mesh.normals[tri.x] + u * mesh.normals[tri.y] +
+                                 v * mesh.normals[tri.z]);
+  }
+  ASSERT_LT(best, kInf);
+  EXPECT_NEAR(fb.depth[c], best, 1e-4f * best);
+  expect_vec_near(fb.normal[c], best_normal, 1e-4f, "centre normal");
+  RenderOptions defaults;
+  EXPECT_EQ(out.stats.at("triangles.submitted"),
+            double(tessellate_sphere(o.sphere, defaults.sphere_segments).triangle_count()));
+}
+
+TEST(GlRaster, PlaneIsTessellatedAndFacesTheViewer) {
+  for (float nz : {1.0f, -1.0f}) {
+    Scene s = base_scene();
+    Object o;
+    o.name = "floor";
+    o.type = ObjectType::Plane;
+    o.material = 1;
+    o.plane = {{0, 0, -1}, {0, 0, nz}, 1.0f};
+    s.objects.push_back(o);
+    RenderOutput out = render_ok(s);
+    const FrameBuffers& fb = out.buffers;
+    glm::ivec2 p = pixel_of(s, {0.3f, 0.2f, -1.0f});
+    size_t i = fb.index(p.x, p.y);
+    EXPECT_EQ(fb.object_id[i], 0u);
+    EXPECT_EQ(fb.primitive_id[i], 0u);
+    TriangleMesh m = tessellate_plane(o.plane);
+    Hit h = hit_plane(s, p, m.positions[0], m.positions[1], m.positions[2]);
+    EXPECT_NEAR(fb.depth[i], h.t, 1e-4f * h.t);
+    expect_vec_near(fb.normal[i], {0, 0, 1}, 1e-5f, "normal flipped to the viewer");
+    glm::vec3 N = face_viewer(o.plane.normal, o.plane.normal, h.V);
+    glm::vec3 want = shade_local(s.materials[1], h.P, N, h.V, s.ambient, light_samples(s.lights));
+    expect_vec_near(fb.color[i], want, 1e-3f, "colour");
+  }
+}
+
+TEST(GlRaster, SmoothNormalsFlipByTheGeometricNormal) {
+  Scene s = base_scene();
+  // Wound clockwise seen from the camera (face normal points away), vertex normals towards
+  // the camera: face_viewer must flip the interpolated normal because of the face normal.
+  Object o = triangle({-1, -1, 0}, {0, 1, 0}, {1, -1, 0});
+  glm::vec3 n = glm::normalize(glm::vec3(0.3f, 0.2f, 1.0f));
+  o.mesh.normals = {n, n, n};
+  s.objects.push_back(o);
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  glm::ivec2 p = pixel_of(s, {0, -0.3f, 0});
+  size_t i = fb.index(p.x, p.y);
+  ASSERT_EQ(fb.object_id[i], 0u);
+  expect_vec_near(fb.normal[i], -n, 1e-5f, "flipped smooth normal");
+  const glm::vec3 &a = o.mesh.positions[0], &b = o.mesh.positions[1], &c = o.mesh.positions[2];
+  Hit h = hit_plane(s, p, a, b, c);
+  glm::vec3 N = face_viewer(n, h.geometric_normal, h.V);
+  glm::vec3 want = shade_local(s.materials[1], h.P, N, h.V, s.ambient, light_samples(s.lights));
+  expect_vec_near(fb.color[i], want, 1e-3f, "colour");
+}
+
+TEST(GlRaster, ThousandsOfAreaLightSamplesMatchCpuShading) {
+  Scene s = base_scene();
+  Light area;
+  area.type = LightType::Area;
+  area.corner = {-2, 3, 1};
+  area.edge_u = {4, 0, 0};
+  area.edge_v = {0, 0, 3};
+  area.intensity = {30, 30, 30};
+  area.samples = 50;  // 2500 samples
+  s.lights.push_back(area);
+  glm::vec3 a(-2, -1.5f, -1), b(2, -1.5f, -1), c(0, 1.5f, 0);
+  s.objects.push_back(triangle(a, b, c));
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  glm::ivec2 p = pixel_of(s, (a + b + c) / 3.0f);
+  size_t i = fb.index(p.x, p.y);
+  ASSERT_EQ(fb.object_id[i], 0u);
+  Hit h = hit_plane(s, p, a, b, c);
+  glm::vec3 N = face_viewer(glm::normalize(h.geometric_normal), h.geometric_normal, h.V);
+  auto samples = light_samples(s.lights);
+  ASSERT_EQ(samples.size(), 2501u);
+  glm::vec3 want = shade_local(s.materials[1], h.P, N, h.V, s.ambient, samples);
+  expect_vec_near(fb.color[i], want, 1e-3f * std::max(1.0f, want.x), "colour");
+}
+
+TEST(GlRaster, CsgIsSkippedWithAWarning) {
+  Scene s = base_scene();
+  Object csg;
+  csg.name = "carved";
+  csg.type = ObjectType::Csg;
+  auto leaf = std::make_shared<CsgNode>();
+  leaf->sphere = {{0, 0, 0}, 1.0f};
+  csg.csg = leaf;
+  s.objects.push_back(csg);
+  s.objects.push_back(triangle({1, 1, 0}, {2, 1, 0}, {1.5f, 2, 0}));
+  RenderOutput out = render_ok(s);
+  const FrameBuffers& fb = out.buffers;
+  EXPECT_EQ(fb.object_id[fb.index(kW / 2, kH / 2)], kNoId);  // where the csg would be
+  glm::ivec2 p = pixel_of(s, {1.5f, 1.3f, 0});
+  EXPECT_EQ(fb.object_id[fb.index(p.x, p.y)], 1u);  // ids stay object indices
+  ASSERT_EQ(out.warnings.size(), 1u);
+  EXPECT_NE(out.warnings[0].find("csg"), std::string::npos);
+  EXPECT_NE(out.warnings[0].find("skipped 1"), std::string::npos);
+  EXPECT_NE(out.warnings[0].find("carved"), std::string::npos);
+}
+
+TEST(GlRaster, VisibilityModeKeepsBackgroundColour) {
+  Scene s = base_scene();
+  s.objects.push_back(quad(1.0f, 0.0f));
+  RenderOutput out = render_ok(s, RenderMode::Visibility);
+  const FrameBuffers& fb = out.buffers;
+  size_t i = fb.index(kW / 2, kH / 2);
+  EXPECT_EQ(fb.object_id[i], 0u);
+  EXPECT_NEAR(fb.depth[i], 5.0f, 5e-5f);
+  EXPECT_EQ(fb.color[i], s.image.background);
+  EXPECT_TRUE(out.warnings.empty());
+}
+
+TEST(GlRaster, FullModeAndMultisamplingWarn) {
+  Scene s = base_scene();
+  s.image.samples_per_pixel = 4;
+  s.objects.push_back(quad(1.0f, 0.0f));
+  RenderOutput full = render_ok(s, RenderMode::Full);
+  RenderOutput local = render_ok(s, RenderMode::Local);
+  ASSERT_EQ(full.warnings.size(), 2u);
+  EXPECT_NE(full.warnings[0].find("shadows"), std::string::npos);
+  EXPECT_NE(full.warnings[1].find("samples per pixel"), std::string::npos);
+  ASSERT_EQ(local.warnings.size(), 1u);
+  EXPECT_EQ(full.buffers.color, local.buffers.color);  // full is local shading for now
+}
+
+TEST(GlRaster, StatsAndCostAreConsistent) {
+  Scene s = base_scene();
+  s.objects.push_back(quad(1.0f, 0.0f, "front"));
+  s.objects.push_back(quad(2.0f, -1.0f, "back"));
+  RenderOutput out = render_ok(s);
+  for (const char* key : {"time.setup", "time.upload", "time.render", "time.cost", "time.readback",
+                          "triangles.submitted", "fragments.generated", "fragments.passed",
+                          "pixels.covered", "overdraw"})
+    EXPECT_TRUE(out.stats.count(key)) << key;
+  EXPECT_EQ(out.stats.at("triangles.submitted"), 4.0);
+  const FrameBuffers& fb = out.buffers;
+  double sum = 0.0, covered = 0.0;
+  for (size_t i = 0; i < fb.pixel_count(); ++i) {
+    sum += fb.cost[i];
+    if (fb.object_id[i] != kNoId) {
+      covered += 1.0;
+      EXPECT_GE(fb.cost[i], 1.0f);
+    }
+  }
+  EXPECT_EQ(out.stats.at("fragments.generated"), sum);
+  EXPECT_EQ(out.stats.at("pixels.covered"), covered);
+  EXPECT_EQ(fb.cost[fb.index(kW / 2, kH / 2)], 2.0f);
+  // Back quad drawn after the front one: its fragments behind it fail the depth test.
+  EXPECT_GE(out.stats.at("fragments.passed"), covered);
+  EXPECT_LT(out.stats.at("fragments.passed"), sum);
+}
+
+TEST(GlRaster, ReusesTheContextAcrossSizes) {
+  GlRasterizer r;
+  Scene s = base_scene();
+  s.objects.push_back(quad(1.0f, 0.0f));
+  RenderOutput a = render_ok(s, RenderMode::Local, &r);
+  s.image.width = 33;
+  s.image.height = 17;
+  RenderOutput b = render_ok(s, RenderMode::Local, &r);
+  RenderOutput c = render_ok(s, RenderMode::Local, &r);
+  EXPECT_EQ(a.buffers.width, kW);
+  EXPECT_EQ(b.buffers.width, 33);
+  EXPECT_EQ(b.buffers.height, 17);
+  EXPECT_EQ(b.buffers.color.size(), size_t(33 * 17));
+  EXPECT_EQ(b.buffers.object_id, c.buffers.object_id);
+  EXPECT_EQ(b.buffers.color, c.buffers.color);
+  EXPECT_EQ(b.buffers.object_id[b.buffers.index(16, 8)], 0u);
+}
+
+TEST(GlRaster, BadTriangleIndexIsBadInput) {
+  Scene s = base_scene();
+  Object o = triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0});
+  o.mesh.triangles = {{0, 1, 7}};
+  s.objects.push_back(o);
+  GlRasterizer r;
+  auto out = r.render(s, RenderOptions{});
+  ASSERT_FALSE(out.ok());
+  EXPECT_EQ(out.error().kind, ErrorKind::BadInput);
+}
+
+TEST(GlRaster, QueryGlInfoReportsLlvmpipe) {
+  auto info = query_gl_info();
+  ASSERT_TRUE(info.ok()) << info.error().message;
+  EXPECT_EQ(info->backend, "osmesa");
+  EXPECT_NE(info->renderer.find("llvmpipe"), std::string::npos) << info->renderer;
+  EXPECT_FALSE(info->version.empty());
+  EXPECT_NE(info->version.find("Core Profile"), std::string::npos) << info->version;
+  EXPECT_FALSE(info->vendor.empty());
+  EXPECT_FALSE(info->glsl_version.empty());
+}
+
+// Mesa picks its driver once per process, so the driver checks run in a fresh process
+// (the "threadsafe" death-test style re-executes this binary).
+int render_error_exit_code(const char* driver, const char* expected_text) {
+  setenv("GALLIUM_DRIVER", driver, 1);
+  Scene s = base_scene();
+  s.objects.push_back(quad(1.0f, 0.0f));
+  GlRasterizer r;
+  auto out = r.render(s, RenderOptions{});
+  if (out.ok()) return 1;
+  if (out.error().kind != ErrorKind::Internal) return 2;
+  if (out.error().message.find(expected_text) == std::string::npos) return 3;
+  return 0;
+}
+
+TEST(GlRasterDeathTest, RefusesSoftpipe) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(std::exit(render_error_exit_code("softpipe", "unset GALLIUM_DRIVER")),
+              ::testing::ExitedWithCode(0), "");
+}
+
+TEST(GlRasterDeathTest, RefusesZinkBeforeItCrashes) {
+  GTEST_FLAG_SET(death_test_style, "threadsafe");
+  EXPECT_EXIT(std::exit(render_error_exit_code("zink", "zink")), ::testing::ExitedWithCode(0), "");
+}
+
+}  // namespace
+}  // namespace rvr
