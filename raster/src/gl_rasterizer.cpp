@@ -7,11 +7,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <glm/glm.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <limits>
 #include <new>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "gl_check.h"
@@ -61,16 +63,6 @@ enum Target : int { kColour, kObjectId, kPrimitiveId, kViewDepth, kNormal, kCost
 
 constexpr std::array<GLenum, kTargetCount> kTargetFormats = {GL_RGBA32F, GL_R32UI,   GL_R32UI,
                                                              GL_R32F,    GL_RGBA32F, GL_R32F};
-
-// glReadPixels gives rows bottom-up; FrameBuffers wants y = 0 at the top.
-template <class T>
-void flip_rows(std::vector<T>& pixels, int width, int height) {
-  for (int y = 0; y < height / 2; ++y) {
-    auto top = pixels.begin() + ptrdiff_t(y) * width;
-    auto bottom = pixels.begin() + ptrdiff_t(height - 1 - y) * width;
-    std::swap_ranges(top, top + width, bottom);
-  }
-}
 
 Status append_mesh(const TriangleMesh& mesh, const std::string& name, std::vector<Vertex>& out) {
   const size_t n = mesh.positions.size();
@@ -132,7 +124,10 @@ struct GlRasterizer::Impl {
   GLuint scene_fbo = 0, cost_fbo = 0, depth_buffer = 0;
   std::array<GLuint, kTargetCount> targets{};
 
-  std::vector<Vertex> vertices;  // kept to reuse its capacity across renders
+  // Kept to reuse their capacity across renders.
+  std::vector<Vertex> vertices;
+  std::vector<uint32_t> scratch;  // one-channel readback
+  std::vector<glm::vec4> scratch_rgba;
 
   ~Impl() { release(); }
 
@@ -299,6 +294,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   // --- upload: expand every object to triangles, then one vertex buffer and one light buffer
   t = Clock::now();
   vertices.clear();
+  vertices.reserve(3 * scene.triangle_count());  // meshes; tessellated shapes add a little
   std::vector<DrawItem> draws;
   std::vector<std::string> skipped_csg;
   const Material fallback = default_material();
@@ -437,27 +433,39 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   fb.normal.resize(n);
   fb.cost.resize(n);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, scene_fbo);
-  auto read = [&](int attachment, GLenum format, GLenum type, void* dst) {
+  // Each attachment is read in its stored layout into reused scratch memory, then copied once
+  // into the FrameBuffers with rows flipped (GL rows are bottom-up, ours top-down).
+  auto read_scalar = [&](GLuint fbo, int attachment, GLenum format, GLenum type, auto& dst) {
+    using T = typename std::decay_t<decltype(dst)>::value_type;
+    static_assert(sizeof(T) == 4);
+    scratch.resize(n);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
     glReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + attachment));
-    glReadPixels(0, 0, w, h, format, type, dst);
+    glReadPixels(0, 0, w, h, format, type, scratch.data());
+    for (int y = 0; y < h; ++y)
+      std::memcpy(dst.data() + size_t(y) * size_t(w),
+                  scratch.data() + size_t(h - 1 - y) * size_t(w), size_t(w) * sizeof(T));
   };
-  read(kColour, GL_RGB, GL_FLOAT, fb.color.data());
-  read(kObjectId, GL_RED_INTEGER, GL_UNSIGNED_INT, fb.object_id.data());
-  read(kPrimitiveId, GL_RED_INTEGER, GL_UNSIGNED_INT, fb.primitive_id.data());
-  read(kViewDepth, GL_RED, GL_FLOAT, fb.depth.data());
-  read(kNormal, GL_RGB, GL_FLOAT, fb.normal.data());
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, cost_fbo);
-  read(0, GL_RED, GL_FLOAT, fb.cost.data());
+  auto read_rgb = [&](int attachment, std::vector<glm::vec3>& dst) {
+    scratch_rgba.resize(n);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, scene_fbo);
+    glReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + attachment));
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, scratch_rgba.data());
+    for (int y = 0; y < h; ++y) {
+      const glm::vec4* src = scratch_rgba.data() + size_t(h - 1 - y) * size_t(w);
+      glm::vec3* row = dst.data() + size_t(y) * size_t(w);
+      for (int x = 0; x < w; ++x) row[x] = glm::vec3(src[x]);
+    }
+  };
+  read_rgb(kColour, fb.color);
+  read_rgb(kNormal, fb.normal);
+  read_scalar(scene_fbo, kObjectId, GL_RED_INTEGER, GL_UNSIGNED_INT, fb.object_id);
+  read_scalar(scene_fbo, kPrimitiveId, GL_RED_INTEGER, GL_UNSIGNED_INT, fb.primitive_id);
+  read_scalar(scene_fbo, kViewDepth, GL_RED, GL_FLOAT, fb.depth);
+  read_scalar(cost_fbo, 0, GL_RED, GL_FLOAT, fb.cost);
   GLuint64 passed = 0;
   get_query_u64(query, GL_QUERY_RESULT, &passed);
   RVR_GL_CHECK("readback");
-  flip_rows(fb.color, w, h);
-  flip_rows(fb.object_id, w, h);
-  flip_rows(fb.primitive_id, w, h);
-  flip_rows(fb.depth, w, h);
-  flip_rows(fb.normal, w, h);
-  flip_rows(fb.cost, w, h);
   out.stats["time.readback"] = seconds_since(t);
 
   double generated = 0.0;
