@@ -133,6 +133,7 @@ struct GlRasterizer::Impl {
 
   // Context, programs and buffers: done once per GlRasterizer.
   Status init();
+  Status create_resources();
   Status resize(int w, int h);
   void release_targets();
   void release();
@@ -141,16 +142,18 @@ struct GlRasterizer::Impl {
 
 Status GlRasterizer::Impl::init() {
   if (context) return context->make_current();
+  Status s = create_resources();
+  if (!s) release();  // half-made state must not be reused by the next render
+  return s;
+}
+
+Status GlRasterizer::Impl::create_resources() {
   auto created = create_gl_context(1, 1);  // 1x1: every pixel we keep goes to an FBO
   if (!created) return created.error();
   context = std::move(created.value());
   auto strings = current_gl_strings();
   if (!strings) return strings.error();
-  if (Status s = check_gl_driver(*strings); !s) {
-    context->destroy();
-    context.reset();
-    return s.error();
-  }
+  RVR_TRY(check_gl_driver(*strings));
 
   auto scene = build_program("scene", shaders::kSceneVertex, shaders::kSceneFragment);
   if (!scene) return scene.error();
@@ -277,6 +280,13 @@ void GlRasterizer::Impl::release() {
   }
   context->destroy();
   context.reset();
+  // Names belong to the destroyed context: forget them so a later init() starts clean.
+  scene_program = cost_program = 0;
+  vao = vertex_buffer = light_buffer = light_texture = query = 0;
+  scene_fbo = cost_fbo = depth_buffer = 0;
+  targets.fill(0);
+  width = height = 0;
+  get_query_u64 = nullptr;
 }
 
 Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
