@@ -109,7 +109,7 @@ TEST_F(Cli, RasterRenders) {
 }
 
 TEST_F(Cli, BadSceneIsExit2WithOneErrorLineAndNoOutput) {
-  fs::path scene = write("bad.json", R"({"camera": {"eye": [0,0,5], "target": [0,0,0]},
+  fs::path scene = write("bad.json", R"({"camera": {"eye": [0,0,5], "target": [0,0,0], "up": [0,1,0]},
     "objects": [{"type": "sphere", "center": [0,0,0], "radius": -1}]})");
   RunResult r = run("render " + scene.string() + " -r raytrace -o " + (dir_ / "out.png").string());
   EXPECT_EQ(r.status, 2);

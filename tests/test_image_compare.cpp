@@ -338,15 +338,23 @@ TEST(Compare, IdenticalBuffersAgreeCompletely) {
   EXPECT_NEAR(m.color.ssim, 1.0, 1e-12);
 }
 
-TEST(Compare, IsolatedMismatchInAFlatRegionIsOffEdge) {
+TEST(Compare, LoneMismatchIsExcusedButAWrongRegionCountsItsInterior) {
   FrameBuffers a = flat(9, 9), b = flat(9, 9);
   b.primitive_id[b.index(4, 4)] = 3;  // same object, another primitive: still a mismatch
   auto m = compare_buffers(a, b);
   EXPECT_EQ(m.visibility.mismatched_pixels, 1u);
-  EXPECT_EQ(m.visibility.mismatched_off_edge, 1u);
+  // cli.md: its neighbours lie on the boundary it draws in b, so it is not off the edges.
+  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
   EXPECT_DOUBLE_EQ(m.visibility.id_agreement, 80.0 / 81.0);
+  // A 5x5 wrong region: only its centre has no boundary pixel among its 8 neighbours.
+  FrameBuffers c = flat(9, 9);
+  for (int y = 2; y <= 6; ++y)
+    for (int x = 2; x <= 6; ++x) c.object_id[c.index(x, y)] = 5;
+  auto m2 = compare_buffers(a, c);
+  EXPECT_EQ(m2.visibility.mismatched_pixels, 25u);
+  EXPECT_EQ(m2.visibility.mismatched_off_edge, 1u);
   // Either way round.
-  EXPECT_EQ(compare_buffers(b, a).visibility.mismatched_off_edge, 1u);
+  EXPECT_EQ(compare_buffers(c, a).visibility.mismatched_off_edge, 1u);
 }
 
 TEST(Compare, MismatchNextToABoundaryIsOnEdge) {
@@ -363,10 +371,13 @@ TEST(Compare, MismatchNextToABoundaryIsOnEdge) {
   auto m2 = compare_buffers(a, c);
   EXPECT_EQ(m2.visibility.mismatched_pixels, 1u);
   EXPECT_EQ(m2.visibility.mismatched_off_edge, 0u);
-  // Two pixels away it does not.
-  FrameBuffers d = a;
-  d.object_id[d.index(2, 2)] = 7;
-  EXPECT_EQ(compare_buffers(a, d).visibility.mismatched_off_edge, 1u);
+  // A wrong region well inside the left half counts its interior.
+  FrameBuffers d = two_halves(14, 9);
+  FrameBuffers e = d;
+  for (int y = 1; y <= 7; ++y)
+    for (int x = 0; x <= 4; ++x) e.object_id[e.index(x, y)] = 7;
+  // Rows 3..5 of columns 0..2 have no boundary (x = 4/5, y = 0/1 and 7/8) among neighbours.
+  EXPECT_EQ(compare_buffers(d, e).visibility.mismatched_off_edge, 9u);
 }
 
 TEST(Compare, SilhouetteShiftedByOnePixelIsAllOnEdge) {

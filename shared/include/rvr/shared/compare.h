@@ -14,10 +14,10 @@ struct VisibilityMetrics {
   size_t pixels = 0;
   double id_agreement = 1.0;  // fraction of pixels with the same object AND primitive id
   size_t mismatched_pixels = 0;
-  // Mismatched pixels away from every edge: a silhouette or shared edge may fall either way
-  // by a pixel, nothing else may. A mismatch counts as on an edge when BOTH id images have an
-  // object or primitive boundary in its 3x3 neighbourhood. (Taking "either image" literally
-  // would excuse every mismatch: a lone wrong pixel draws a boundary around itself.)
+  // Mismatched pixels none of whose 8 neighbours lies on an object or primitive boundary in
+  // either id image (cli.md): a silhouette or shared edge may fall either way by a pixel,
+  // nothing else may. A lone wrong pixel is excused (it draws a boundary around itself); a
+  // wrong region counts its interior.
   size_t mismatched_off_edge = 0;
 };
 
