@@ -28,7 +28,7 @@ void PrintTo(const RendererCase& r, std::ostream* os) { *os << r.label << " vs "
 const RendererCase kRenderers[] = {
     {"raster", "raster", AccelKind::Bvh, "raytrace", SIZE_MAX},
     {"raytrace", "raytrace", AccelKind::Bvh, "raster", SIZE_MAX},
-    {"raytrace_none", "raytrace", AccelKind::None, "raster", 3000},
+    {"raytrace_none", "raytrace", AccelKind::None, "raster", 5000},
 };
 
 const char* kScenes[] = {"cornell", "spheres", "occluders:16", "soup:2000", "tessphere:20000"};
