@@ -65,6 +65,9 @@ struct CommonOptions {
   int max_depth = 5;
   uint64_t seed = 0;
   std::string gl = "osmesa";
+  int shadow_map_size = 1024;
+  float shadow_bias = 0.01f;
+  bool shadow_pcf = false;
   bool quiet = false;
 };
 
@@ -93,6 +96,11 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
       ->check(CLI::Range(0, 64));
   cmd.add_option("--seed", o.seed, "seed of the per-pixel random streams");
   cmd.add_option("--gl", o.gl, "GL back end: osmesa | egl")->check(CLI::IsMember({"osmesa", "egl"}));
+  cmd.add_option("--shadow-map-size", o.shadow_map_size, "raster shadow maps: texels per side")
+      ->check(CLI::Range(16, 8192));
+  cmd.add_option("--shadow-bias", o.shadow_bias, "raster shadow maps: depth bias (scene units)")
+      ->check(CLI::Range(0.0f, 10.0f));
+  cmd.add_flag("--shadow-pcf", o.shadow_pcf, "raster shadow maps: 3x3 percentage-closer filtering");
   cmd.add_flag("--quiet,-q", o.quiet, "no progress output");
 }
 
@@ -113,6 +121,9 @@ RenderOptions render_options(const CommonOptions& o, const std::string& default_
   r.seed = o.seed;
   r.accel = o.accel == "none" ? AccelKind::None : AccelKind::Bvh;
   r.triangle_test = o.triangle_test == "chapter" ? TriangleTest::Chapter : TriangleTest::MollerTrumbore;
+  r.shadow_map_size = o.shadow_map_size;
+  r.shadow_bias = o.shadow_bias;
+  r.shadow_pcf = o.shadow_pcf;
   return r;
 }
 

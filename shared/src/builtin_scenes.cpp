@@ -2,6 +2,7 @@
 // (cornell: everything; spheres: analytic shapes; occluders: depth complexity; soup and
 // tessphere: triangle count).
 #include <charconv>
+#include <memory>
 #include <cstdint>
 #include <string>
 
@@ -127,7 +128,15 @@ Scene cornell() {
   s.image.height = 480;
   look_at(s, p(278.0f, 273.0f, -800.0f), p(278.0f, 273.0f, 0.0f), 39.3077f, 1.0f, 100.0f);
   s.ambient = {0.03f, 0.03f, 0.03f};
-  add_point_light(s, p(278.0f, 530.0f, 279.5f), {12.0f, 12.0f, 12.0f});
+  // The area light fills the lamp's opening, just below it, 4 x 4 samples.
+  Light lamp_light;
+  lamp_light.type = LightType::Area;
+  lamp_light.corner = p(343.0f, 548.0f, 227.0f);
+  lamp_light.edge_u = p(-130.0f, 0.0f, 0.0f);
+  lamp_light.edge_v = p(0.0f, 0.0f, 105.0f);
+  lamp_light.intensity = {14.0f, 14.0f, 14.0f};
+  lamp_light.samples = 4;
+  s.lights.push_back(lamp_light);
   return s;
 }
 
@@ -208,15 +217,135 @@ Scene tessphere(size_t n) {
   return s;
 }
 
+std::shared_ptr<CsgNode> csg_sphere(glm::vec3 c, float r) {
+  auto n = std::make_shared<CsgNode>();
+  n->sphere = {c, r};
+  return n;
+}
+
+std::shared_ptr<CsgNode> csg_op(CsgOp op, std::shared_ptr<const CsgNode> a,
+                                std::shared_ptr<const CsgNode> b) {
+  auto n = std::make_shared<CsgNode>();
+  n->is_leaf = false;
+  n->op = op;
+  n->a = std::move(a);
+  n->b = std::move(b);
+  return n;
+}
+
+void add_csg(Scene& s, const std::string& name, uint32_t material, std::shared_ptr<const CsgNode> tree) {
+  add_object(s, name, ObjectType::Csg, material).csg = std::move(tree);
+}
+
+// A closed box (outward, counter-clockwise faces) centred at c with half extents h.
+void add_box(Scene& s, const std::string& name, uint32_t material, glm::vec3 c, glm::vec3 h) {
+  Object& o = add_object(s, name, ObjectType::Triangles, material);
+  for (int i = 0; i < 8; ++i)
+    o.mesh.positions.push_back(c + glm::vec3(i & 1 ? h.x : -h.x, i & 2 ? h.y : -h.y, i & 4 ? h.z : -h.z));
+  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 4, 6, 2},
+                                {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}};
+  for (const auto& q : quads) {
+    o.mesh.triangles.push_back({q[0], q[1], q[2]});
+    o.mesh.triangles.push_back({q[0], q[2], q[3]});
+  }
+}
+
+// Every CSG operation on spheres, and a nested tree, on a floor.
+Scene csg() {
+  Scene s = base_scene("csg");
+  uint32_t floor = add_material(s, "floor", {0.6f, 0.6f, 0.6f});
+  Object& plane = add_object(s, "floor", ObjectType::Plane, floor);
+  plane.plane = {{0, 0, 0}, {0, 1, 0}, 6.0f};
+  uint32_t red = add_material(s, "red", {0.8f, 0.2f, 0.15f}, glm::vec3(0.3f), 32.0f);
+  uint32_t green = add_material(s, "green", {0.2f, 0.7f, 0.25f}, glm::vec3(0.3f), 32.0f);
+  uint32_t blue = add_material(s, "blue", {0.2f, 0.3f, 0.85f}, glm::vec3(0.3f), 32.0f);
+  uint32_t gold = add_material(s, "gold", {0.85f, 0.65f, 0.2f}, glm::vec3(0.4f), 64.0f);
+  add_csg(s, "union", red,
+          csg_op(CsgOp::Union, csg_sphere({-2.4f, 0.6f, 0}, 0.6f), csg_sphere({-2.0f, 0.9f, 0.2f}, 0.5f)));
+  add_csg(s, "intersection", green,
+          csg_op(CsgOp::Intersection, csg_sphere({-0.55f, 0.7f, 0}, 0.7f),
+                 csg_sphere({-0.05f, 0.7f, 0}, 0.7f)));
+  add_csg(s, "difference", blue,
+          csg_op(CsgOp::Difference, csg_sphere({1.0f, 0.7f, 0}, 0.7f),
+                 csg_sphere({1.3f, 1.0f, 0.5f}, 0.5f)));
+  // (A u B) - (C n D): a dumbbell with a lens-shaped bite.
+  auto dumbbell = csg_op(CsgOp::Union, csg_sphere({2.5f, 0.5f, -0.3f}, 0.5f),
+                         csg_sphere({2.9f, 0.5f, 0.4f}, 0.5f));
+  auto lens = csg_op(CsgOp::Intersection, csg_sphere({2.5f, 0.9f, 0.5f}, 0.5f),
+                     csg_sphere({2.9f, 0.9f, 0.3f}, 0.5f));
+  add_csg(s, "nested", gold, csg_op(CsgOp::Difference, dumbbell, lens));
+  look_at(s, {0.0f, 3.0f, 6.0f}, {0.2f, 0.5f, 0.0f}, 45.0f, 0.1f, 100.0f);
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  add_point_light(s, {-2.0f, 5.0f, 4.0f}, {40.0f, 40.0f, 40.0f});
+  return s;
+}
+
+// Spheres at several depths, the middle row in focus.
+Scene dof() {
+  Scene s = base_scene("dof");
+  uint32_t floor = add_material(s, "floor", {0.5f, 0.5f, 0.5f});
+  Object& plane = add_object(s, "floor", ObjectType::Plane, floor);
+  plane.plane = {{0, 0, -4}, {0, 1, 0}, 10.0f};
+  for (int i = 0; i < 7; ++i) {
+    float t = float(i) / 6.0f;
+    uint32_t m = add_material(s, "ball" + std::to_string(i), {0.9f - 0.7f * t, 0.4f, 0.2f + 0.7f * t},
+                              glm::vec3(0.5f), 64.0f);
+    add_sphere(s, "sphere " + std::to_string(i), m, {-2.4f + 0.8f * float(i), 0.35f, 1.5f - 1.5f * float(i)},
+               0.35f);
+  }
+  look_at(s, {0.0f, 1.2f, 4.0f}, {0.0f, 0.35f, -3.0f}, 40.0f, 0.1f, 100.0f);
+  s.camera.aperture_radius = 0.12f;
+  s.camera.focus_distance = glm::length(glm::vec3(-0.0f, 0.35f, -3.0f) - s.camera.eye);
+  s.image.samples_per_pixel = 16;
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  add_point_light(s, {2.0f, 5.0f, 3.0f}, {40.0f, 40.0f, 40.0f});
+  return s;
+}
+
+// A glass slab and a glass sphere in front of coloured quads: refraction bends their edges.
+Scene glass() {
+  Scene s = base_scene("glass");
+  uint32_t floor = add_material(s, "floor", {0.6f, 0.6f, 0.6f});
+  Object& plane = add_object(s, "floor", ObjectType::Plane, floor);
+  plane.plane = {{0, 0, 0}, {0, 1, 0}, 6.0f};
+  const glm::vec3 colours[4] = {{0.85f, 0.2f, 0.2f}, {0.2f, 0.75f, 0.25f}, {0.2f, 0.3f, 0.9f}, {0.9f, 0.8f, 0.2f}};
+  for (int i = 0; i < 4; ++i) {
+    for (int j = 0; j < 2; ++j) {
+      uint32_t m = add_material(s, "quad" + std::to_string(i) + std::to_string(j), colours[(i + j) % 4]);
+      float x0 = -2.0f + float(i), y0 = float(j);
+      add_quad(s, "wall " + std::to_string(i) + "," + std::to_string(j), m, {x0, y0, -1.5f},
+               {x0 + 1, y0, -1.5f}, {x0 + 1, y0 + 1, -1.5f}, {x0, y0 + 1, -1.5f});
+    }
+  }
+  Material glass_material;
+  glass_material.name = "glass";
+  glass_material.diffuse = glm::vec3(0.0f);
+  glass_material.specular = glm::vec3(0.8f);
+  glass_material.shininess = 200.0f;
+  glass_material.transparency = 0.95f;
+  glass_material.ior = 1.5f;
+  s.materials.push_back(glass_material);
+  uint32_t g = uint32_t(s.materials.size() - 1);
+  add_box(s, "slab", g, {-0.9f, 0.8f, 0.0f}, {0.6f, 0.7f, 0.15f});
+  add_sphere(s, "glass ball", g, {0.9f, 0.6f, 0.2f}, 0.6f);
+  look_at(s, {0.0f, 1.1f, 4.5f}, {0.0f, 0.8f, 0.0f}, 40.0f, 0.1f, 100.0f);
+  s.ambient = {0.08f, 0.08f, 0.08f};
+  add_point_light(s, {1.5f, 4.0f, 4.0f}, {30.0f, 30.0f, 30.0f});
+  return s;
+}
+
 }  // namespace
 
 std::vector<BuiltinSceneInfo> builtin_scenes() {
   return {
-      {"cornell", "the Cornell box (published geometry), a mirror and a glass sphere, a point light"},
+      {"cornell", "the Cornell box (published geometry), a mirror and a glass sphere, an area light"},
       {"spheres", "a 5x5 grid of analytic spheres on a square plane, two point lights"},
       {"occluders:N", "N parallel quads one behind another facing the camera: depth complexity N (default 8)"},
       {"soup:N", "N random triangles in a box, seeded, constant total area (default 1000)"},
       {"tessphere:N", "one smooth sphere tessellated into about N triangles (default 10000)"},
+      {"csg", "union, intersection, difference of spheres and a nested tree, on a floor"},
+      {"dof", "spheres at several depths, thin lens focused on the middle one, 16 samples"},
+      {"glass", "a glass slab and a glass sphere in front of coloured quads"},
   };
 }
 
@@ -243,6 +372,9 @@ Expected<Scene> make_builtin_scene(const std::string& spec) {
   if (name == "occluders") return occluders(has_count ? count : 8);
   if (name == "soup") return soup(has_count ? count : 1000);
   if (name == "tessphere") return tessphere(has_count ? count : 10000);
+  if (name == "csg") return has_count ? no_count() : Expected<Scene>(csg());
+  if (name == "dof") return has_count ? no_count() : Expected<Scene>(dof());
+  if (name == "glass") return has_count ? no_count() : Expected<Scene>(glass());
   return bad_input("builtin:" + spec + ": no such built-in scene (see 'rvr scenes')");
 }
 

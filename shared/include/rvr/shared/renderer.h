@@ -29,6 +29,12 @@ struct RenderOptions {
   uint64_t seed = 0;
   AccelKind accel = AccelKind::Bvh;
   TriangleTest triangle_test = TriangleTest::MollerTrumbore;
+  // Rasterizers, full mode: shadow maps (a cube map per point light, one map per area-light
+  // sample point). Resolution in texels per side; bias in units of view depth of the map,
+  // added to the stored depth before comparing; percentage-closer filtering over 3x3 texels.
+  int shadow_map_size = 1024;
+  float shadow_bias = 0.01f;
+  bool shadow_pcf = false;
 };
 
 struct RenderOutput {
