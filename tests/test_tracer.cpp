@@ -7,52 +7,17 @@
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/camera.h"
+#include "scene_builders.h"
 #include "rvr/shared/scene_loader.h"
 
 using namespace rvr;
+using namespace rvr::test;
 
 namespace {
 
-Scene empty_scene(int w, int h, glm::vec3 eye, glm::vec3 target, float fov) {
-  Scene s;
-  s.source = "test";
-  s.materials.push_back(default_material());
-  s.image.width = w;
-  s.image.height = h;
-  s.camera.eye = eye;
-  s.camera.target = target;
-  s.camera.fov_y_deg = fov;
-  s.camera.near = 0.01f;
-  s.camera.far = 100.0f;
-  s.camera.focus_distance = glm::length(target - eye);
-  return s;
-}
 
-uint32_t add_material(Scene& s, glm::vec3 diffuse, glm::vec3 emission = glm::vec3(0.0f),
-                      float mirror = 0.0f) {
-  Material m;
-  m.diffuse = diffuse;
-  m.emission = emission;
-  m.mirror = mirror;
-  s.materials.push_back(m);
-  return uint32_t(s.materials.size() - 1);
-}
 
-void add_plane(Scene& s, glm::vec3 point, glm::vec3 normal, float half, uint32_t material) {
-  Object o;
-  o.type = ObjectType::Plane;
-  o.plane = {point, glm::normalize(normal), half};
-  o.material = material;
-  s.objects.push_back(o);
-}
 
-void add_sphere(Scene& s, glm::vec3 c, float r, uint32_t material) {
-  Object o;
-  o.type = ObjectType::Sphere;
-  o.sphere = {c, r};
-  o.material = material;
-  s.objects.push_back(o);
-}
 
 RenderOutput trace(const Scene& s, RenderMode mode, int threads = 0) {
   RayTracer tracer;

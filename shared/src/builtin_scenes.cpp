@@ -86,6 +86,13 @@ void add_quad(Scene& s, const std::string& name, uint32_t material, glm::vec3 v0
   o.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
 }
 
+// A square floor facing +y, with its own diffuse material.
+void add_floor(Scene& s, glm::vec3 colour, glm::vec3 centre, float half_size) {
+  uint32_t m = add_material(s, "floor", colour);
+  Object& o = add_object(s, "floor", ObjectType::Plane, m);
+  o.plane = {centre, {0, 1, 0}, half_size};
+}
+
 void add_sphere(Scene& s, const std::string& name, uint32_t material, glm::vec3 c, float r) {
   Object& o = add_object(s, name, ObjectType::Sphere, material);
   o.sphere = {c, r};
@@ -142,9 +149,7 @@ Scene cornell() {
 
 Scene spheres() {
   Scene s = base_scene("spheres");
-  uint32_t floor = add_material(s, "floor", {0.6f, 0.6f, 0.55f});
-  Object& plane = add_object(s, "floor", ObjectType::Plane, floor);
-  plane.plane = {{0, 0, 0}, {0, 1, 0}, 8.0f};
+  add_floor(s, {0.6f, 0.6f, 0.55f}, {0, 0, 0}, 8.0f);
   const int n = 5;
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < n; ++i) {
@@ -253,9 +258,7 @@ void add_box(Scene& s, const std::string& name, uint32_t material, glm::vec3 c, 
 // Every CSG operation on spheres, and a nested tree, on a floor.
 Scene csg() {
   Scene s = base_scene("csg");
-  uint32_t floor = add_material(s, "floor", {0.6f, 0.6f, 0.6f});
-  Object& plane = add_object(s, "floor", ObjectType::Plane, floor);
-  plane.plane = {{0, 0, 0}, {0, 1, 0}, 6.0f};
+  add_floor(s, {0.6f, 0.6f, 0.6f}, {0, 0, 0}, 6.0f);
   uint32_t red = add_material(s, "red", {0.8f, 0.2f, 0.15f}, glm::vec3(0.3f), 32.0f);
   uint32_t green = add_material(s, "green", {0.2f, 0.7f, 0.25f}, glm::vec3(0.3f), 32.0f);
   uint32_t blue = add_material(s, "blue", {0.2f, 0.3f, 0.85f}, glm::vec3(0.3f), 32.0f);
@@ -283,9 +286,7 @@ Scene csg() {
 // Spheres at several depths, the middle row in focus.
 Scene dof() {
   Scene s = base_scene("dof");
-  uint32_t floor = add_material(s, "floor", {0.5f, 0.5f, 0.5f});
-  Object& plane = add_object(s, "floor", ObjectType::Plane, floor);
-  plane.plane = {{0, 0, -4}, {0, 1, 0}, 10.0f};
+  add_floor(s, {0.5f, 0.5f, 0.5f}, {0, 0, -4}, 10.0f);
   for (int i = 0; i < 7; ++i) {
     float t = float(i) / 6.0f;
     uint32_t m = add_material(s, "ball" + std::to_string(i), {0.9f - 0.7f * t, 0.4f, 0.2f + 0.7f * t},
@@ -305,9 +306,7 @@ Scene dof() {
 // A glass slab and a glass sphere in front of coloured quads: refraction bends their edges.
 Scene glass() {
   Scene s = base_scene("glass");
-  uint32_t floor = add_material(s, "floor", {0.6f, 0.6f, 0.6f});
-  Object& plane = add_object(s, "floor", ObjectType::Plane, floor);
-  plane.plane = {{0, 0, 0}, {0, 1, 0}, 6.0f};
+  add_floor(s, {0.6f, 0.6f, 0.6f}, {0, 0, 0}, 6.0f);
   const glm::vec3 colours[4] = {{0.85f, 0.2f, 0.2f}, {0.2f, 0.75f, 0.25f}, {0.2f, 0.3f, 0.9f}, {0.9f, 0.8f, 0.2f}};
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 2; ++j) {
