@@ -30,6 +30,7 @@ const RendererCase kRenderers[] = {
     {"raster", "raster", AccelKind::Bvh, "raytrace", SIZE_MAX},
     {"raytrace", "raytrace", AccelKind::Bvh, "raster", SIZE_MAX},
     {"raytrace_none", "raytrace", AccelKind::None, "raster", 5000},
+    {"embree", "embree", AccelKind::Embree, "raster", SIZE_MAX},
 };
 
 // Every built-in scene, sized for the test. `csg` is the one exception, by the format's rule:

@@ -5,11 +5,13 @@
 
 namespace rvr {
 
-std::vector<std::string> renderer_names() { return {"raster", "raytrace"}; }
+std::vector<std::string> renderer_names() { return {"raster", "raytrace", "embree"}; }
 
 Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name) {
   if (name == "raster") return std::unique_ptr<Renderer>(std::make_unique<GlRasterizer>());
   if (name == "raytrace") return std::unique_ptr<Renderer>(std::make_unique<RayTracer>());
+  if (name == "embree")
+    return std::unique_ptr<Renderer>(std::make_unique<RayTracer>(AccelKind::Embree));
   std::string known;
   for (const std::string& n : renderer_names()) known += (known.empty() ? "" : ", ") + n;
   return bad_input("unknown renderer '" + name + "' (known: " + known + ")");

@@ -219,7 +219,9 @@ class FrameTracer {
 
 }  // namespace
 
-Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& options) {
+Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& requested) {
+  RenderOptions options = requested;
+  if (has_forced_) options.accel = forced_;
   RenderOutput out;
   const int w = scene.image.width, h = scene.image.height;
   if (w <= 0 || h <= 0) return bad_input("image size must be positive");
@@ -228,6 +230,7 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
   TraceGeometry geometry(scene, options.spheres, options.sphere_segments, options.accel,
                          options.triangle_test);
   out.stats["time.build"] = seconds_since(t_build);
+  if (!geometry.error().empty()) return internal_error(geometry.error());
 
   auto t_render = Clock::now();
   out.buffers.reset(w, h, scene.image.background);
@@ -258,8 +261,12 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
   out.stats["rays.shadow"] = double(total.shadow);
   out.stats["rays.reflection"] = double(total.reflection);
   out.stats["rays.refraction"] = double(total.refraction);
-  out.stats["bvh.nodes_visited"] = double(total.traversal.nodes_visited);
-  out.stats["primitive_tests"] = double(total.traversal.primitive_tests);
+  if (options.accel != AccelKind::Embree) {  // Embree does not count its traversal steps
+    out.stats["bvh.nodes_visited"] = double(total.traversal.nodes_visited);
+    out.stats["primitive_tests"] = double(total.traversal.primitive_tests);
+  } else {
+    out.warnings.push_back("embree does not report traversal work: the cost AOV is 0");
+  }
   out.stats["primitives"] = double(geometry.primitive_count());
   out.stats["triangles"] = double(geometry.triangle_count());
   if (options.accel == AccelKind::Bvh) {

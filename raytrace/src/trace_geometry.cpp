@@ -1,5 +1,7 @@
 #include "rvr/raytrace/trace_geometry.h"
 
+#include "embree_backend.h"
+
 #include <algorithm>
 
 #include "rvr/shared/tessellate.h"
@@ -83,8 +85,10 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
   triangle_id_.reserve(total_triangles);
   triangle_in_mesh_.reserve(total_triangles);
 
+  object_first_triangle_.assign(n_objects, 0);
   auto add_mesh = [&](uint32_t object, const TriangleMesh& mesh, bool report_triangle_ids) {
     object_mesh_[object] = &mesh;
+    object_first_triangle_[object] = uint32_t(triangles_.size());
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
       const glm::uvec3& t = mesh.triangles[i];
       triangles_.push_back(
@@ -125,6 +129,10 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
     }
   }
 
+  if (accel_ == AccelKind::Embree) {
+    embree_.reset(make_embree_backend(*this, error_));
+    return;
+  }
   if (accel_ != AccelKind::Bvh) return;
   std::vector<Aabb> bounds(primitive_count());
   for (size_t i = 0; i < triangles_.size(); ++i) {
@@ -133,30 +141,40 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
     bounds[i].grow(t.v0 + t.e1);
     bounds[i].grow(t.v0 + t.e2);
   }
-  for (size_t k = 0; k < analytic_.size(); ++k) {
-    const Analytic& a = analytic_[k];
-    Aabb& b = bounds[triangles_.size() + k];
-    if (a.kind == Kind::Sphere) {
-      b.grow(a.sphere.center - glm::vec3(a.sphere.radius));
-      b.grow(a.sphere.center + glm::vec3(a.sphere.radius));
-    } else if (a.kind == Kind::Square) {
-      float h = a.plane.half_size;
-      for (float su : {-h, h})
-        for (float sv : {-h, h}) b.grow(a.plane.point + su * a.axis_u + sv * a.axis_v);
-    } else {
-      // Any CSG result lies inside the union of its leaves.
-      for (const Sphere& s : a.csg_leaves) {
-        b.grow(s.center - glm::vec3(s.radius));
-        b.grow(s.center + glm::vec3(s.radius));
-      }
-    }
-  }
+  for (size_t k = 0; k < analytic_.size(); ++k)
+    bounds[triangles_.size() + k] = analytic_bounds(analytic_[k]);
   bvh_ = Bvh::build(bounds);
   slot_primitive_ = bvh_.primitive_order();
   slot_triangles_.resize(slot_primitive_.size());
   for (size_t s = 0; s < slot_primitive_.size(); ++s) {
     if (slot_primitive_[s] < triangles_.size()) slot_triangles_[s] = triangles_[slot_primitive_[s]];
   }
+}
+
+TraceGeometry::~TraceGeometry() = default;
+
+Aabb TraceGeometry::analytic_bounds(const Analytic& a) {
+  Aabb b;
+  switch (a.kind) {
+    case Kind::Sphere:
+      b.grow(a.sphere.center - glm::vec3(a.sphere.radius));
+      b.grow(a.sphere.center + glm::vec3(a.sphere.radius));
+      break;
+    case Kind::Square: {
+      float h = a.plane.half_size;
+      for (float su : {-h, h})
+        for (float sv : {-h, h}) b.grow(a.plane.point + su * a.axis_u + sv * a.axis_v);
+      break;
+    }
+    case Kind::Csg:
+      // Any CSG result lies inside the union of its leaves.
+      for (const Sphere& s : a.csg_leaves) {
+        b.grow(s.center - glm::vec3(s.radius));
+        b.grow(s.center + glm::vec3(s.radius));
+      }
+      break;
+  }
+  return b;
 }
 
 size_t TraceGeometry::acceleration_bytes() const {
@@ -258,12 +276,14 @@ bool TraceGeometry::query(const Ray& ray, HitRecord& hit, TraversalCounters& cou
 }
 
 bool TraceGeometry::closest(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
+  if (embree_) return embree_closest(*embree_, ray, hit);
   if (triangle_test_ == TriangleTest::Chapter)
     return query<ChapterTest, false>(ray, hit, counters);
   return query<MollerTrumboreTest, false>(ray, hit, counters);
 }
 
 bool TraceGeometry::occluded(const Ray& ray, TraversalCounters& counters) const {
+  if (embree_) return embree_occluded(*embree_, ray);
   HitRecord hit;
   if (triangle_test_ == TriangleTest::Chapter) return query<ChapterTest, true>(ray, hit, counters);
   return query<MollerTrumboreTest, true>(ray, hit, counters);

@@ -9,8 +9,19 @@ namespace rvr {
 
 class RayTracer : public Renderer {
  public:
-  std::string name() const override { return "raytrace"; }
+  RayTracer() = default;
+  // The same tracer with its queries answered by one accelerator whatever the options say:
+  // AccelKind::Embree is the "embree" renderer, the yardstick for our BVH.
+  explicit RayTracer(AccelKind forced) : forced_(forced), has_forced_(true) {}
+
+  std::string name() const override {
+    return has_forced_ && forced_ == AccelKind::Embree ? "embree" : "raytrace";
+  }
   Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options) override;
+
+ private:
+  AccelKind forced_ = AccelKind::Bvh;
+  bool has_forced_ = false;
 };
 
 }  // namespace rvr

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "rvr/raytrace/bvh.h"
@@ -16,6 +17,13 @@
 namespace rvr {
 
 constexpr uint32_t kNoPrimitive = 0xFFFFFFFFu;
+
+// Embree's device and scene when Embree answers the queries (embree_backend.cpp); opaque here so
+// no Embree type leaks into this header.
+struct EmbreeBackend;
+struct EmbreeBackendDeleter {
+  void operator()(EmbreeBackend* backend) const;
+};
 
 // The cheap hit kept during traversal.
 struct HitRecord {
@@ -41,6 +49,10 @@ class TraceGeometry {
  public:
   TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_segments, AccelKind accel,
                 TriangleTest triangle_test = TriangleTest::MollerTrumbore);
+  ~TraceGeometry();
+
+  // Empty unless building failed (Embree could not make a device or scene).
+  const std::string& error() const { return error_; }
 
   // Closest hit in (ray.tmin, ray.tmax).
   bool closest(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
@@ -70,6 +82,9 @@ class TraceGeometry {
   template <class TriangleTestFn, bool kAnyHit>
   bool query(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
   bool hit_analytic(const Analytic& a, const Ray& ray, float t_max, HitRecord& hit) const;
+  static Aabb analytic_bounds(const Analytic& a);
+  friend struct EmbreeBackend;
+  friend bool embree_closest(const EmbreeBackend&, const Ray&, HitRecord&);
 
   AccelKind accel_;
   TriangleTest triangle_test_;
@@ -82,10 +97,13 @@ class TraceGeometry {
   std::vector<const TriangleMesh*> object_mesh_;             // per object, or null
   std::vector<std::unique_ptr<TriangleMesh>> owned_meshes_;  // tessellated spheres
   std::vector<uint32_t> object_material_;
+  std::vector<uint32_t> object_first_triangle_;  // unified index of each object's triangle 0
   // BVH leaf slots: primitive index and, for triangles, a copy in leaf order for locality.
   Bvh bvh_;
   std::vector<uint32_t> slot_primitive_;
   std::vector<TrianglePrecomputed> slot_triangles_;
+  std::unique_ptr<EmbreeBackend, EmbreeBackendDeleter> embree_;
+  std::string error_;
 };
 
 }  // namespace rvr

@@ -15,7 +15,7 @@ namespace rvr {
 
 enum class RenderMode { Visibility, Local, Full };
 enum class SphereMode { Analytic, Mesh };
-enum class AccelKind { Bvh, None };
+enum class AccelKind { Bvh, None, Embree };  // Embree: Intel Embree 3 answers the queries
 enum class TriangleTest { MollerTrumbore, Chapter };
 
 const char* to_string(RenderMode mode);
