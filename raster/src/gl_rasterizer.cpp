@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstring>
 #include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <limits>
 #include <new>
@@ -55,8 +56,60 @@ struct DrawItem {
 struct SceneUniforms {
   GLint view = -1, projection = -1, eye = -1, ambient = -1, background = -1, shade = -1,
         smooth = -1, use_primitive_id = -1, object_id = -1, diffuse = -1, specular = -1,
-        emission = -1, shininess = -1, lights = -1, light_count = -1;
+        emission = -1, shininess = -1, lights = -1, light_first = -1, light_end = -1, base = -1,
+        shadows = -1, shadow_maps = -1, face_rotation = -1, shadow_bias = -1, shadow_texel = -1,
+        shadow_pcf = -1;
 };
+
+// Texture units of the scene pass.
+constexpr GLint kLightUnit = 0;
+constexpr GLint kShadowUnit = 1;
+
+// Shadow maps (full mode). Every light sample (a point light, or one stratum centre of an area
+// light) gets a full cube: six 90 degree faces around the sample, stored as six layers of one
+// R32F 2D texture array (GL 3.3 has no cube-map arrays), each texel the linear distance |P - L|
+// of the nearest surface. A cube rather than one hemisphere map per area sample keeps one code
+// path for both kinds of light and leaves nothing outside the map (surfaces behind an area
+// light's plane still cast and receive correctly).
+//
+// Memory: the maps of all samples at once would be 6 * size^2 * 4 bytes each (24 MiB at 1024),
+// so the samples go in batches that fit kShadowBatchBytes; each batch renders its maps and then
+// adds its samples' light to the colour in an extra lighting pass (depth test GL_EQUAL against
+// the first pass's depth: same program, same vertices, so the depths are bit-identical).
+constexpr size_t kShadowBatchBytes = size_t(128) << 20;
+// Work: every face is cleared and rasterised, so the texels per frame grow with the sample
+// count. Above this budget (16 samples at 1024^2 fit) the side shrinks, with a warning.
+constexpr double kShadowTexelBudget = 6.0 * 16.0 * 1024.0 * 1024.0 * 1.25;
+constexpr int kShadowMinSize = 64;
+
+// Face f of every shadow cube looks along kFaceDirections[f] (0 +x, 1 -x, 2 +y, 3 -y, 4 +z,
+// 5 -z: cube_face() in the shader uses the same order).
+const std::array<glm::vec3, 6> kFaceDirections = {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0),
+                                                  glm::vec3(0, 1, 0), glm::vec3(0, -1, 0),
+                                                  glm::vec3(0, 0, 1), glm::vec3(0, 0, -1)};
+
+std::array<glm::mat3, 6> face_rotations() {
+  std::array<glm::mat3, 6> r;
+  for (size_t f = 0; f < 6; ++f) {
+    glm::vec3 up = std::abs(kFaceDirections[f].y) > 0.5f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+    r[f] = glm::mat3(glm::lookAt(glm::vec3(0.0f), kFaceDirections[f], up));
+  }
+  return r;
+}
+
+// "name1, name2" of the materials drawn by `draws` for which `uses` holds, each once.
+template <class Draws, class Pred>
+std::string material_names(const Draws& draws, Pred uses) {
+  std::vector<const Material*> seen;
+  std::string names;
+  for (const auto& d : draws) {
+    if (!uses(*d.material) || std::find(seen.begin(), seen.end(), d.material) != seen.end())
+      continue;
+    seen.push_back(d.material);
+    names += (names.empty() ? "" : ", ") + (d.material->name.empty() ? "?" : d.material->name);
+  }
+  return names;
+}
 
 // Colour attachments of the scene FBO, in fragment-output order (gl_shaders.h).
 enum Target : int { kColour, kObjectId, kPrimitiveId, kViewDepth, kNormal, kCost, kTargetCount };
@@ -112,17 +165,25 @@ Expected<GlInfo> query_gl_info() {
 
 struct GlRasterizer::Impl {
   std::unique_ptr<GlContext> context;
-  GLuint scene_program = 0, cost_program = 0;
+  GLuint scene_program = 0, cost_program = 0, shadow_program = 0;
   SceneUniforms su;
   GLint cost_view = -1, cost_projection = -1;
+  GLint shadow_light = -1, shadow_rotation = -1, shadow_projection = -1;
   GLuint vao = 0, vertex_buffer = 0, light_buffer = 0, light_texture = 0, query = 0;
   GLint max_size = 0;  // largest framebuffer side the driver accepts
+  GLint max_samples = 1, max_texture_size = 0, max_layers = 0;
   PFNGLGETQUERYOBJECTUI64VPROC get_query_u64 = nullptr;  // GL 3.3, not exported by libOSMesa
 
   // Render targets, re-made when the image size changes.
   int width = 0, height = 0;
   GLuint scene_fbo = 0, cost_fbo = 0, depth_buffer = 0;
   std::array<GLuint, kTargetCount> targets{};
+  // Multisampled colour + depth (spp > 1), re-made when size or sample count change.
+  GLuint msaa_fbo = 0, msaa_colour = 0, msaa_depth = 0;
+  int msaa_samples = 0;
+  // Shadow maps of one batch: size x size x layers (6 per sample).
+  GLuint shadow_fbo = 0, shadow_texture = 0;
+  int shadow_size = 0, shadow_layers = 0;
 
   // Kept to reuse their capacity across renders.
   std::vector<Vertex> vertices;
@@ -135,6 +196,12 @@ struct GlRasterizer::Impl {
   Status init();
   Status create_resources();
   Status resize(int w, int h);
+  Status ensure_msaa(int samples);
+  Status ensure_shadow_maps(int size, int layers);
+  Status render_shadow_maps(const std::vector<LightSample>& samples, size_t first, size_t end,
+                            const glm::mat4& projection, GLsizei vertex_count);
+  void release_msaa();
+  void release_shadow_maps();
   void release_targets();
   void release();
   Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options);
@@ -161,6 +228,12 @@ Status GlRasterizer::Impl::create_resources() {
   auto cost = build_program("cost", shaders::kCostVertex, shaders::kCostFragment);
   if (!cost) return cost.error();
   cost_program = *cost;
+  auto shadow = build_program("shadow", shaders::kShadowVertex, shaders::kShadowFragment);
+  if (!shadow) return shadow.error();
+  shadow_program = *shadow;
+  shadow_light = glGetUniformLocation(shadow_program, "u_light");
+  shadow_rotation = glGetUniformLocation(shadow_program, "u_rotation");
+  shadow_projection = glGetUniformLocation(shadow_program, "u_projection");
 
   auto loc = [&](const char* name) { return glGetUniformLocation(scene_program, name); };
   su.view = loc("u_view");
@@ -177,7 +250,15 @@ Status GlRasterizer::Impl::create_resources() {
   su.emission = loc("u_emission");
   su.shininess = loc("u_shininess");
   su.lights = loc("u_lights");
-  su.light_count = loc("u_light_count");
+  su.light_first = loc("u_light_first");
+  su.light_end = loc("u_light_end");
+  su.base = loc("u_base");
+  su.shadows = loc("u_shadows");
+  su.shadow_maps = loc("u_shadow_maps");
+  su.face_rotation = loc("u_face_rotation");
+  su.shadow_bias = loc("u_shadow_bias");
+  su.shadow_texel = loc("u_shadow_texel");
+  su.shadow_pcf = loc("u_shadow_pcf");
   cost_view = glGetUniformLocation(cost_program, "u_view");
   cost_projection = glGetUniformLocation(cost_program, "u_projection");
 
@@ -206,6 +287,10 @@ Status GlRasterizer::Impl::create_resources() {
   glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
   glGetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
   max_size = std::min({max_renderbuffer, max_viewport[0], max_viewport[1]});
+  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture_size);
+  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  max_samples = std::max(max_samples, 1);
   RVR_GL_CHECK("GL setup");
   return ok_status();
 }
@@ -255,7 +340,106 @@ Status GlRasterizer::Impl::resize(int w, int h) {
   return ok_status();
 }
 
+Status GlRasterizer::Impl::ensure_msaa(int samples) {
+  if (msaa_fbo != 0 && msaa_samples == samples) return ok_status();
+  release_msaa();
+  glGenRenderbuffers(1, &msaa_colour);
+  glBindRenderbuffer(GL_RENDERBUFFER, msaa_colour);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA32F, width, height);
+  glGenRenderbuffers(1, &msaa_depth);
+  glBindRenderbuffer(GL_RENDERBUFFER, msaa_depth);
+  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT32F, width, height);
+  glGenFramebuffers(1, &msaa_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, msaa_colour);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, msaa_depth);
+  GLenum colour_buffer = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &colour_buffer);
+  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  RVR_GL_CHECK("creating the multisampled framebuffer");
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    return internal_error(fmt::format("multisampled framebuffer ({} samples) incomplete (0x{:04x})",
+                                      samples, status));
+  msaa_samples = samples;
+  return ok_status();
+}
+
+void GlRasterizer::Impl::release_msaa() {
+  if (msaa_fbo) glDeleteFramebuffers(1, &msaa_fbo);
+  if (msaa_colour) glDeleteRenderbuffers(1, &msaa_colour);
+  if (msaa_depth) glDeleteRenderbuffers(1, &msaa_depth);
+  msaa_fbo = msaa_colour = msaa_depth = 0;
+  msaa_samples = 0;
+}
+
+Status GlRasterizer::Impl::ensure_shadow_maps(int size, int layers) {
+  if (shadow_texture != 0 && shadow_size == size && shadow_layers == layers) return ok_status();
+  release_shadow_maps();
+  glGenTextures(1, &shadow_texture);
+  glActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
+  glBindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
+  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, size, size, layers, 0, GL_RED, GL_FLOAT, nullptr);
+  // Read with texelFetch only; nearest, one level, so the texture is complete.
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
+  glActiveTexture(GL_TEXTURE0);
+  glGenFramebuffers(1, &shadow_fbo);
+  glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_texture, 0, 0);
+  GLenum colour_buffer = GL_COLOR_ATTACHMENT0;
+  glDrawBuffers(1, &colour_buffer);
+  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  RVR_GL_CHECK("allocating shadow maps");
+  if (status != GL_FRAMEBUFFER_COMPLETE)
+    return internal_error(fmt::format("shadow-map framebuffer incomplete (0x{:04x})", status));
+  shadow_size = size;
+  shadow_layers = layers;
+  return ok_status();
+}
+
+void GlRasterizer::Impl::release_shadow_maps() {
+  if (shadow_fbo) glDeleteFramebuffers(1, &shadow_fbo);
+  if (shadow_texture) glDeleteTextures(1, &shadow_texture);
+  shadow_fbo = shadow_texture = 0;
+  shadow_size = shadow_layers = 0;
+}
+
+// Renders the cubes of samples [first, end) into layers 0 .. 6 (end - first) - 1: every
+// triangle into every face, keeping the smallest distance per texel (GL_MIN blending).
+Status GlRasterizer::Impl::render_shadow_maps(const std::vector<LightSample>& samples, size_t first,
+                                              size_t end, const glm::mat4& projection,
+                                              GLsizei vertex_count) {
+  static const std::array<glm::mat3, 6> rotations = face_rotations();
+  glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+  glViewport(0, 0, shadow_size, shadow_size);
+  glDisable(GL_DEPTH_TEST);
+  glDepthMask(GL_FALSE);
+  glEnable(GL_BLEND);
+  glBlendEquation(GL_MIN);
+  glBlendFunc(GL_ONE, GL_ONE);
+  glUseProgram(shadow_program);
+  glUniformMatrix4fv(shadow_projection, 1, GL_FALSE, glm::value_ptr(projection));
+  const GLfloat nothing[4] = {std::numeric_limits<float>::max(), 0.0f, 0.0f, 0.0f};
+  for (size_t i = first; i < end; ++i) {
+    glUniform3fv(shadow_light, 1, glm::value_ptr(samples[i].position));
+    for (size_t f = 0; f < 6; ++f) {
+      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_texture, 0,
+                                GLint(6 * (i - first) + f));
+      glClearBufferfv(GL_COLOR, 0, nothing);
+      glUniformMatrix3fv(shadow_rotation, 1, GL_FALSE, glm::value_ptr(rotations[f]));
+      if (vertex_count > 0) glDrawArrays(GL_TRIANGLES, 0, vertex_count);
+    }
+  }
+  glBlendEquation(GL_FUNC_ADD);
+  glDisable(GL_BLEND);
+  glDepthMask(GL_TRUE);
+  RVR_GL_CHECK("shadow maps");
+  return ok_status();
+}
+
 void GlRasterizer::Impl::release_targets() {
+  release_msaa();
   if (scene_fbo) glDeleteFramebuffers(1, &scene_fbo);
   if (cost_fbo) glDeleteFramebuffers(1, &cost_fbo);
   if (depth_buffer) glDeleteRenderbuffers(1, &depth_buffer);
@@ -272,6 +456,8 @@ void GlRasterizer::Impl::release() {
     release_targets();
     if (scene_program) glDeleteProgram(scene_program);
     if (cost_program) glDeleteProgram(cost_program);
+    if (shadow_program) glDeleteProgram(shadow_program);
+    release_shadow_maps();
     if (vao) glDeleteVertexArrays(1, &vao);
     if (vertex_buffer) glDeleteBuffers(1, &vertex_buffer);
     if (light_buffer) glDeleteBuffers(1, &light_buffer);
@@ -281,7 +467,11 @@ void GlRasterizer::Impl::release() {
   context->destroy();
   context.reset();
   // Names belong to the destroyed context: forget them so a later init() starts clean.
-  scene_program = cost_program = 0;
+  scene_program = cost_program = shadow_program = 0;
+  msaa_fbo = msaa_colour = msaa_depth = 0;
+  msaa_samples = 0;
+  shadow_fbo = shadow_texture = 0;
+  shadow_size = shadow_layers = 0;
   vao = vertex_buffer = light_buffer = light_texture = query = 0;
   scene_fbo = cost_fbo = depth_buffer = 0;
   targets.fill(0);
@@ -359,60 +549,197 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   glBindBuffer(GL_TEXTURE_BUFFER, light_buffer);
   glBufferData(GL_TEXTURE_BUFFER, GLsizeiptr(light_texels.size() * sizeof(glm::vec4)),
                light_texels.data(), GL_STATIC_DRAW);
-  glActiveTexture(GL_TEXTURE0);
+  glActiveTexture(GLenum(GL_TEXTURE0 + kLightUnit));
   glBindTexture(GL_TEXTURE_BUFFER, light_texture);
   glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, light_buffer);
   RVR_GL_CHECK("uploading geometry and lights");
   out.stats["time.upload"] = seconds_since(t);
 
-  // --- scene pass: z-buffer visibility, ids, depth, normal, local shading
+  // --- shadow-map plan (full mode): resolution, batches, light-space projection
+  const bool shade = options.mode != RenderMode::Visibility;
+  const bool shadows = options.mode == RenderMode::Full && !samples.empty();
+  int map_size = 0;
+  size_t batch = std::max<size_t>(samples.size(), 1);
+  glm::mat4 light_projection(1.0f);
+  if (shadows) {
+    if (options.shadow_map_size < 1)
+      return bad_input(fmt::format("shadow map size {} must be positive", options.shadow_map_size));
+    if (!(options.shadow_bias >= 0.0f) || !std::isfinite(options.shadow_bias))
+      return bad_input(fmt::format("shadow bias {} must be >= 0", options.shadow_bias));
+    map_size = std::min(options.shadow_map_size, max_texture_size);
+    const double texels = 6.0 * double(samples.size()) * double(map_size) * double(map_size);
+    if (texels > kShadowTexelBudget) {
+      const int fit = int(std::sqrt(kShadowTexelBudget / (6.0 * double(samples.size()))));
+      map_size = std::max(std::min(map_size, kShadowMinSize), fit);
+    }
+    if (map_size < options.shadow_map_size)
+      out.warnings.push_back(
+          fmt::format("shadow maps of {} texels per side for {} light samples ({} requested)",
+                      map_size, samples.size(), options.shadow_map_size));
+    const size_t per_sample = 6 * size_t(map_size) * size_t(map_size) * sizeof(float);
+    batch = std::clamp<size_t>(kShadowBatchBytes / per_sample, 1, samples.size());
+    batch = std::min(batch, size_t(std::max(max_layers / 6, 1)));
+    // Near and far only clip: distances are stored exactly and nearest-kept by GL_MIN, so a
+    // near plane far below any feature size (1e-6 of the scene) costs no precision.
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const Vertex& v : vertices) {
+      lo = glm::min(lo, v.position);
+      hi = glm::max(hi, v.position);
+    }
+    float reach = 0.0f;
+    for (const LightSample& ls : samples)
+      reach = std::max(
+          reach, glm::length(glm::max(glm::abs(ls.position - lo), glm::abs(ls.position - hi))));
+    if (vertices.empty()) reach = 1.0f;
+    reach = std::max(reach, 1e-3f);
+    light_projection = glm::perspective(glm::radians(90.0f), 1.0f, 1e-6f * reach, 2.0f * reach);
+    RVR_TRY(ensure_shadow_maps(map_size, int(6 * batch)));
+  }
+
+  // --- multisampling: colour into a multisampled FBO, resolved into the colour target
+  int msaa = 1;
+  if (shade && scene.image.samples_per_pixel > 1) {
+    msaa = std::min(scene.image.samples_per_pixel, int(max_samples));
+    if (msaa < scene.image.samples_per_pixel)
+      out.warnings.push_back(
+          fmt::format("{} samples per pixel requested; the GL allows {}, rendered {}",
+                      scene.image.samples_per_pixel, max_samples, msaa));
+    RVR_TRY(ensure_msaa(msaa));
+  }
+
+  // --- scene passes: z-buffer visibility, ids, depth, normal, shading
+  double shadow_time = 0.0;
   t = Clock::now();
   const glm::mat4 view = view_matrix(scene.camera);
   const glm::mat4 projection = projection_matrix(scene.camera, w, h);
-  glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
-  glViewport(0, 0, w, h);
-  glDisable(GL_CULL_FACE);  // two-sided, like the tracer
-  glDisable(GL_BLEND);
-  glEnable(GL_DEPTH_TEST);
-  glDepthFunc(GL_LESS);
-  glDepthMask(GL_TRUE);
   const float inf = std::numeric_limits<float>::infinity();
   const glm::vec4 background(scene.image.background, 1.0f);
   const glm::vec4 zero(0.0f);
   const GLuint no_id[4] = {kNoId, kNoId, kNoId, kNoId};
   const GLfloat far_view[4] = {inf, 0.0f, 0.0f, 0.0f};
   const GLfloat depth_one = 1.0f;
-  glClearBufferfv(GL_COLOR, kColour, glm::value_ptr(background));
-  glClearBufferuiv(GL_COLOR, kObjectId, no_id);
-  glClearBufferuiv(GL_COLOR, kPrimitiveId, no_id);
-  glClearBufferfv(GL_COLOR, kViewDepth, far_view);
-  glClearBufferfv(GL_COLOR, kNormal, glm::value_ptr(zero));
-  glClearBufferfv(GL_DEPTH, 0, &depth_one);
+  const GLenum colour_only = GL_COLOR_ATTACHMENT0;
+  std::array<GLenum, kCost> all_outputs{};
+  for (int i = 0; i < kCost; ++i) all_outputs[size_t(i)] = GLenum(GL_COLOR_ATTACHMENT0 + i);
+  static const std::array<glm::mat3, 6> rotations = face_rotations();
 
-  glUseProgram(scene_program);
-  glUniformMatrix4fv(su.view, 1, GL_FALSE, glm::value_ptr(view));
-  glUniformMatrix4fv(su.projection, 1, GL_FALSE, glm::value_ptr(projection));
-  glUniform3fv(su.eye, 1, glm::value_ptr(scene.camera.eye));
-  glUniform3fv(su.ambient, 1, glm::value_ptr(scene.ambient));
-  glUniform3fv(su.background, 1, glm::value_ptr(scene.image.background));
-  glUniform1i(su.shade, options.mode == RenderMode::Visibility ? 0 : 1);
-  glUniform1i(su.lights, 0);
-  glUniform1i(su.light_count, GLint(samples.size()));
-  glBeginQuery(GL_SAMPLES_PASSED, query);
-  for (const DrawItem& d : draws) {
-    glUniform1ui(su.object_id, d.object);
-    glUniform1i(su.smooth, d.smooth ? 1 : 0);
-    glUniform1i(su.use_primitive_id, d.use_primitive_id ? 1 : 0);
-    glUniform3fv(su.diffuse, 1, glm::value_ptr(d.material->diffuse));
-    glUniform3fv(su.specular, 1, glm::value_ptr(d.material->specular));
-    glUniform3fv(su.emission, 1, glm::value_ptr(d.material->emission));
-    glUniform1f(su.shininess, d.material->shininess);
-    glDrawArrays(GL_TRIANGLES, d.first, d.count);
+  // One draw of every object with the scene program; the caller sets the pass's state.
+  auto draw_scene = [&](bool shade_pass, size_t first, size_t end, bool base) {
+    glUseProgram(scene_program);
+    glUniformMatrix4fv(su.view, 1, GL_FALSE, glm::value_ptr(view));
+    glUniformMatrix4fv(su.projection, 1, GL_FALSE, glm::value_ptr(projection));
+    glUniform3fv(su.eye, 1, glm::value_ptr(scene.camera.eye));
+    glUniform3fv(su.ambient, 1, glm::value_ptr(scene.ambient));
+    glUniform3fv(su.background, 1, glm::value_ptr(scene.image.background));
+    glUniform1i(su.shade, shade_pass ? 1 : 0);
+    glUniform1i(su.lights, kLightUnit);
+    glUniform1i(su.light_first, GLint(first));
+    glUniform1i(su.light_end, GLint(end));
+    glUniform1i(su.base, base ? 1 : 0);
+    glUniform1i(su.shadows, shadows ? 1 : 0);
+    glUniform1i(su.shadow_maps, kShadowUnit);
+    glUniformMatrix3fv(su.face_rotation, 6, GL_FALSE, glm::value_ptr(rotations[0]));
+    glUniform1f(su.shadow_bias, options.shadow_bias);
+    // A texel spans at most 2/size in tan units (at a face centre): normal offset and slope bias
+    // are measured in it (gl_shaders.h, shadow_visibility).
+    glUniform1f(su.shadow_texel, map_size > 0 ? 2.0f / float(map_size) : 0.0f);
+    glUniform1i(su.shadow_pcf, options.shadow_pcf ? 1 : 0);
+    for (const DrawItem& d : draws) {
+      glUniform1ui(su.object_id, d.object);
+      glUniform1i(su.smooth, d.smooth ? 1 : 0);
+      glUniform1i(su.use_primitive_id, d.use_primitive_id ? 1 : 0);
+      glUniform3fv(su.diffuse, 1, glm::value_ptr(d.material->diffuse));
+      glUniform3fv(su.specular, 1, glm::value_ptr(d.material->specular));
+      glUniform3fv(su.emission, 1, glm::value_ptr(d.material->emission));
+      glUniform1f(su.shininess, d.material->shininess);
+      glDrawArrays(GL_TRIANGLES, d.first, d.count);
+    }
+  };
+  auto clear_scene_targets = [&] {
+    glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+    glDrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
+    glClearBufferfv(GL_COLOR, kColour, glm::value_ptr(background));
+    glClearBufferuiv(GL_COLOR, kObjectId, no_id);
+    glClearBufferuiv(GL_COLOR, kPrimitiveId, no_id);
+    glClearBufferfv(GL_COLOR, kViewDepth, far_view);
+    glClearBufferfv(GL_COLOR, kNormal, glm::value_ptr(zero));
+    glClearBufferfv(GL_DEPTH, 0, &depth_one);
+  };
+
+  glDisable(GL_CULL_FACE);  // two-sided, like the tracer
+  glDisable(GL_BLEND);
+  glActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
+  glBindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
+  glActiveTexture(GL_TEXTURE0);
+  const size_t batches = shadows ? (samples.size() + batch - 1) / batch : 1;
+  for (size_t b = 0; b < batches; ++b) {
+    const size_t first = b * batch, end = std::min(samples.size(), first + batch);
+    if (shadows) {
+      auto ts = Clock::now();
+      RVR_TRY(render_shadow_maps(samples, first, end, light_projection, GLsizei(vertices.size())));
+      glFinish();
+      shadow_time += seconds_since(ts);
+    }
+    glViewport(0, 0, w, h);
+    glEnable(GL_DEPTH_TEST);
+    if (b == 0) {
+      // Base pass: emission, ambient and the first batch of lights; ids etc. when single-sampled.
+      glDepthFunc(GL_LESS);
+      glDepthMask(GL_TRUE);
+      if (msaa > 1) {
+        glBindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
+        glClearBufferfv(GL_COLOR, 0, glm::value_ptr(background));
+        glClearBufferfv(GL_DEPTH, 0, &depth_one);
+      } else {
+        clear_scene_targets();
+        glBeginQuery(GL_SAMPLES_PASSED, query);
+      }
+      draw_scene(shade, first, end, true);
+      if (msaa == 1) glEndQuery(GL_SAMPLES_PASSED);
+    } else {
+      // Additive pass for this batch's lights, on exactly the surfaces the base pass kept.
+      glBindFramebuffer(GL_FRAMEBUFFER, msaa > 1 ? msaa_fbo : scene_fbo);
+      glDrawBuffers(1, &colour_only);
+      glDepthFunc(GL_EQUAL);
+      glDepthMask(GL_FALSE);
+      glEnable(GL_BLEND);
+      glBlendFunc(GL_ONE, GL_ONE);
+      draw_scene(true, first, end, false);
+      glDisable(GL_BLEND);
+      glDepthMask(GL_TRUE);
+      glDepthFunc(GL_LESS);
+    }
   }
-  glEndQuery(GL_SAMPLES_PASSED);
+  if (msaa > 1) {
+    // The per-pixel AOVs (ids, depth, normal) come from one sample at the pixel centre; the
+    // colour is the multisampled one, resolved (averaged) over each pixel's samples.
+    clear_scene_targets();
+    glBeginQuery(GL_SAMPLES_PASSED, query);
+    draw_scene(false, 0, 0, true);
+    glEndQuery(GL_SAMPLES_PASSED);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, scene_fbo);
+    glDrawBuffers(1, &colour_only);
+    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+    glDrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
+  } else {
+    glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+    glDrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
+  }
   glFinish();
   RVR_GL_CHECK("scene pass");
-  out.stats["time.render"] = seconds_since(t);
+  out.stats["time.render"] = seconds_since(t) - shadow_time;
+  if (shadows) {
+    out.stats["time.shadow_maps"] = shadow_time;
+    out.stats["shadow_map.maps"] = double(samples.size());
+    out.stats["shadow_map.faces"] = 6.0 * double(samples.size());
+    out.stats["shadow_map.size"] = double(map_size);
+    out.stats["shadow_map.texels"] =
+        6.0 * double(map_size) * double(map_size) * double(samples.size());
+    out.stats["shadow_map.batches"] = double(batches);
+  }
 
   // --- cost pass: every fragment generated, whatever the depth test would say
   t = Clock::now();
@@ -496,14 +823,20 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
     out.warnings.push_back(fmt::format("csg objects have no z-buffer form: skipped {} ({})",
                                        skipped_csg.size(), names));
   }
-  if (options.mode == RenderMode::Full)
-    out.warnings.push_back(
-        "raster: shadows, reflection, refraction and depth of field are not implemented; full "
-        "mode rendered local shading");
-  if (scene.image.samples_per_pixel > 1)
-    out.warnings.push_back(fmt::format(
-        "raster: {} samples per pixel requested; multisampling is not implemented, rendered 1",
-        scene.image.samples_per_pixel));
+  if (options.mode == RenderMode::Full) {
+    // What a z-buffer cannot do, named for this scene only (shadows it does, with shadow maps).
+    std::string mirrors = material_names(draws, [](const Material& m) { return m.mirror > 0.0f; });
+    if (!mirrors.empty())
+      out.warnings.push_back(
+          fmt::format("reflection (mirror materials: {}) not rendered by a z-buffer", mirrors));
+    std::string clear =
+        material_names(draws, [](const Material& m) { return m.transparency > 0.0f; });
+    if (!clear.empty())
+      out.warnings.push_back(
+          fmt::format("refraction/transparency (materials: {}) not rendered", clear));
+    if (scene.camera.aperture_radius > 0.0f)
+      out.warnings.push_back("depth of field (aperture_radius > 0) not rendered: pinhole");
+  }
   return out;
 }
 

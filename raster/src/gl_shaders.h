@@ -62,7 +62,22 @@ uniform float u_shininess;
 // Light sample i: texel 2i = position, texel 2i+1 = intensity. A buffer texture holds
 // millions of texels, where a uniform array would stop at a few hundred samples.
 uniform samplerBuffer u_lights;
-uniform int u_light_count;
+// This pass shades light samples [u_light_first, u_light_end) and adds emission + ambient only
+// when u_base is set: full mode renders the shadow maps in batches and adds one lighting pass
+// per batch (gl_rasterizer.cpp).
+uniform int u_light_first;
+uniform int u_light_end;
+uniform bool u_base;
+
+// Shadow maps (full mode): sample i of this batch owns layers 6(i - u_light_first) + face of
+// u_shadow_maps, each holding |P - L| of the nearest surface (+huge where none) seen through
+// the face's 90 degree frustum; u_face_rotation[face] turns P - L into that face's eye space.
+uniform bool u_shadows;
+uniform sampler2DArray u_shadow_maps;
+uniform mat3 u_face_rotation[6];
+uniform float u_shadow_bias;       // constant part, world units
+uniform float u_shadow_texel;      // 2 / map size: a texel's largest extent in tan units
+uniform bool u_shadow_pcf;
 
 layout(location = 0) out vec4 o_colour;
 layout(location = 1) out uint o_object_id;
@@ -80,9 +95,56 @@ float specular_power(float x, float s) {
   return pow(x, s);
 }
 
-vec3 shade_local(vec3 P, vec3 N, vec3 V) {
-  vec3 colour = u_emission + u_ambient * u_diffuse;
-  for (int i = 0; i < u_light_count; ++i) {
+// Cube face of direction d (0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z): the major axis; ties go to
+// the first, which is fine because the faces' frusta overlap on their shared edges.
+int cube_face(vec3 d) {
+  vec3 a = abs(d);
+  if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0 ? 0 : 1;
+  if (a.y >= a.z) return d.y >= 0.0 ? 2 : 3;
+  return d.z >= 0.0 ? 4 : 5;
+}
+
+// vis_l of DESIGN.md from sample i's shadow cube: 1 when |P - L| - bias <= the stored distance
+// of P's texel, else 0; with PCF the mean of that test over the 3x3 texels around it (clamped
+// to the face: no filtering across cube edges).
+float shadow_visibility(int i, vec3 P, vec3 L, vec3 geometric_normal) {
+  vec3 n = normalize(geometric_normal);
+  float true_dist = length(P - L);
+  if (dot(n, L - P) < 0.0) n = -n;  // the side of the surface the light is on
+  // Normal offset: look up from P moved off its own surface, towards the light, by one texel's
+  // footprint at this distance (a texel spans at most u_shadow_texel = 2/size in tan units),
+  // so grazing surfaces stop reading their own neighbouring texels (acne).
+  vec3 d = P + n * (u_shadow_texel * true_dist) - L;
+  float dist = length(d);
+  int face = cube_face(d);
+  vec3 e = u_face_rotation[face] * d;  // eye space of the face, looking down -z
+  vec2 uv = e.xy / max(-e.z, 1e-30) * 0.5 + 0.5;
+  int size = textureSize(u_shadow_maps, 0).x;
+  ivec2 texel = clamp(ivec2(floor(uv * float(size))), ivec2(0), ivec2(size - 1));
+  int layer = 6 * (i - u_light_first) + face;
+  // Slope-scaled term: the map holds the distance at its texel centre, up to ~0.7 texel away
+  // from the lookup direction; on a surface at angle theta to the light ray that changes the
+  // distance by about dist * 0.7 * texel * tan(theta). Capped so grazing surfaces keep shadows.
+  float cos_theta = abs(dot(n, d / max(dist, 1e-30)));
+  float tan_theta = min(sqrt(max(0.0, 1.0 - cos_theta * cos_theta)) / max(cos_theta, 1e-6), 8.0);
+  float bias = u_shadow_bias + 0.75 * u_shadow_texel * dist * tan_theta;
+  if (!u_shadow_pcf) {
+    float stored = texelFetch(u_shadow_maps, ivec3(texel, layer), 0).r;
+    return dist - bias <= stored ? 1.0 : 0.0;
+  }
+  float lit = 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      ivec2 t = clamp(texel + ivec2(dx, dy), ivec2(0), ivec2(size - 1));
+      float stored = texelFetch(u_shadow_maps, ivec3(t, layer), 0).r;
+      lit += dist - bias <= stored ? 1.0 : 0.0;
+    }
+  return lit / 9.0;
+}
+
+vec3 shade_local(vec3 P, vec3 N, vec3 V, vec3 geometric_normal) {
+  vec3 colour = u_base ? u_emission + u_ambient * u_diffuse : vec3(0.0);
+  for (int i = u_light_first; i < u_light_end; ++i) {
     vec3 light_position = texelFetch(u_lights, 2 * i).xyz;
     vec3 light_intensity = texelFetch(u_lights, 2 * i + 1).xyz;
     vec3 to_light = light_position - P;
@@ -94,7 +156,7 @@ vec3 shade_local(vec3 P, vec3 N, vec3 V) {
     float n_dot_h = max(0.0, dot(N, H));
     vec3 brdf = u_diffuse * n_dot_l + u_specular * specular_power(n_dot_h, u_shininess);
     if (brdf == vec3(0.0)) continue;
-    float vis = 1.0;  // shadow maps come later
+    float vis = u_shadows ? shadow_visibility(i, P, light_position, geometric_normal) : 1.0;
     colour += vis * brdf * light_intensity / dist2;
   }
   return colour;
@@ -106,12 +168,36 @@ void main() {
   vec3 shading_normal = u_smooth ? normalize(v_normal) : normalize(v_geometric_normal);
   vec3 N = face_viewer(shading_normal, v_geometric_normal, V);
 
-  o_colour = vec4(u_shade ? shade_local(P, N, V) : u_background, 1.0);
+  // Alpha 1 in the base pass, 0 in additive passes (blended ONE, ONE).
+  o_colour = vec4(u_shade ? shade_local(P, N, V, v_geometric_normal) : u_background,
+                  u_base ? 1.0 : 0.0);
   o_object_id = u_object_id;
   o_primitive_id = u_use_primitive_id ? uint(gl_PrimitiveID) : 0u;
   o_view_depth = v_view_depth;
   o_normal = vec4(N, 0.0);
 }
+)glsl";
+
+// Shadow maps: one cube face of one light sample. Positions are taken relative to the light
+// and turned into the face's eye space; the fragment stores |P - L| (linear distance, exact in
+// float whatever the near plane) and the target keeps the minimum (GL_MIN blending), so no
+// depth buffer and no depth-precision trade-off is needed.
+inline constexpr const char* kShadowVertex = R"glsl(#version 330 core
+layout(location = 0) in vec3 a_position;
+uniform vec3 u_light;
+uniform mat3 u_rotation;
+uniform mat4 u_projection;
+out vec3 v_offset;
+void main() {
+  v_offset = a_position - u_light;
+  gl_Position = u_projection * vec4(u_rotation * v_offset, 1.0);
+}
+)glsl";
+
+inline constexpr const char* kShadowFragment = R"glsl(#version 330 core
+in vec3 v_offset;
+layout(location = 0) out float o_distance;
+void main() { o_distance = length(v_offset); }
 )glsl";
 
 // The overdraw pass: every generated fragment adds 1 to its pixel (additive blending, no depth
