@@ -1,0 +1,227 @@
+// rvr_bench: what each loop order costs. Names are stable (bench/README.md documents them):
+//   BM_Frame/<renderer>/<scene>/<n>/<width>   a whole frame, height = width * 3/4
+//   BM_DepthComplexity/<renderer>/<N>          occluders:N at 512x384
+//   BM_Effects/<effect>                        the tracer on cornell, one effect at a time
+//   BM_Trace/<accel>/<rays>/<scene>/<n>        one thread, rays only, no shading
+//   BM_Build/<accel>/<n>                       acceleration structure build
+// Scenes and acceleration structures are built outside the timed loops.
+#include <benchmark/benchmark.h>
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <string>
+
+#include <tbb/global_control.h>
+
+#include "renderers.h"
+#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/raytrace/trace_geometry.h"
+#include "rvr/shared/camera.h"
+#include "rvr/shared/scene_loader.h"
+
+using namespace rvr;
+
+namespace {
+
+// Built scenes are cached: soup:1000000 takes a while to make.
+const Scene& builtin(const std::string& name) {
+  static std::mutex mutex;
+  static std::map<std::string, std::unique_ptr<Scene>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[name];
+  if (!slot) slot = std::make_unique<Scene>(make_builtin_scene(name).value());
+  return *slot;
+}
+
+void add_counters(benchmark::State& state, const RenderOutput& out, double pixels) {
+  auto get = [&](const char* k) {
+    auto it = out.stats.find(k);
+    return it == out.stats.end() ? 0.0 : it->second;
+  };
+  double rays = get("rays.primary") + get("rays.shadow") + get("rays.reflection") + get("rays.refraction");
+  using C = benchmark::Counter;
+  if (rays > 0) state.counters["rays/s"] = C(rays, C::kIsIterationInvariantRate);
+  double tris = get("triangles.submitted") > 0 ? get("triangles.submitted") : get("triangles");
+  state.counters["triangles/s"] = C(tris, C::kIsIterationInvariantRate);
+  state.counters["pixels/s"] = C(pixels, C::kIsIterationInvariantRate);
+}
+
+// A whole frame with one renderer. The first frame (GL shader JIT, TBB threads) is not timed.
+void BM_Frame(benchmark::State& state, std::string renderer_name, std::string scene_name) {
+  Scene scene = builtin(scene_name + ":" + std::to_string(state.range(0)));
+  scene.image.width = int(state.range(1));
+  scene.image.height = int(state.range(1) * 3 / 4);
+  auto renderer = make_renderer(renderer_name == "raytrace_none" ? "raytrace" : renderer_name);
+  RenderOptions options;
+  options.mode = RenderMode::Local;
+  if (renderer_name == "raytrace_none") options.accel = AccelKind::None;
+  RenderOutput out = renderer.value()->render(scene, options).value();
+  for (auto _ : state) {
+    out = renderer.value()->render(scene, options).value();
+    benchmark::DoNotOptimize(out.buffers.color.data());
+  }
+  add_counters(state, out, double(scene.image.width) * scene.image.height);
+}
+
+void BM_DepthComplexity(benchmark::State& state, std::string renderer_name) {
+  Scene scene = builtin("occluders:" + std::to_string(state.range(0)));
+  scene.image.width = 512;
+  scene.image.height = 384;
+  auto renderer = make_renderer(renderer_name);
+  RenderOptions options;
+  options.mode = RenderMode::Local;
+  RenderOutput out = renderer.value()->render(scene, options).value();
+  for (auto _ : state) {
+    out = renderer.value()->render(scene, options).value();
+    benchmark::DoNotOptimize(out.buffers.color.data());
+  }
+  add_counters(state, out, 512.0 * 384.0);
+}
+
+// The tracer on cornell with exactly one effect switched on.
+void BM_Effects(benchmark::State& state, std::string effect) {
+  Scene scene = builtin("cornell");
+  for (Material& m : scene.materials) m.mirror = m.transparency = 0.0f;
+  Light point{LightType::Point, {2.78f, 5.3f, 2.795f}, {}, {}, {}, glm::vec3(12.0f), 1};
+  Light area = scene.lights[0];
+  scene.lights = {point};
+  RenderOptions options;
+  options.mode = RenderMode::Full;
+  if (effect == "primary") {
+    options.mode = RenderMode::Local;
+  } else if (effect == "area_light_4x4") {
+    scene.lights = {area};
+  } else if (effect.rfind("mirror_depth_", 0) == 0) {
+    options.max_depth = std::stoi(effect.substr(13));
+    for (Material& m : scene.materials) if (m.name == "mirror") m.mirror = 0.85f;
+    // A second mirror facing the first one: depth matters only between mirrors.
+    for (Object& o : scene.objects) if (o.name == "back wall") o.material = scene.objects[6].material;
+  } else if (effect == "glass") {
+    for (Material& m : scene.materials) if (m.name == "glass") m.transparency = 0.9f;
+  } else if (effect == "dof_16") {
+    scene.camera.aperture_radius = 0.08f;
+    scene.camera.focus_distance = 9.5f;
+    scene.image.samples_per_pixel = 16;
+  }  // "hard_shadows": the point light in full mode
+  RayTracer tracer;
+  RenderOutput out = tracer.render(scene, options).value();
+  for (auto _ : state) {
+    out = tracer.render(scene, options).value();
+    benchmark::DoNotOptimize(out.buffers.color.data());
+  }
+  add_counters(state, out, double(scene.image.width) * scene.image.height);
+}
+
+std::vector<Ray> make_rays(const Scene& scene, const std::string& kind) {
+  std::vector<Ray> rays;
+  rays.reserve(1024 * 768);
+  if (kind == "primary") {  // coherent: through every pixel centre of a 1024x768 frame
+    CameraFrame f = make_camera_frame(scene.camera, 1024, 768);
+    for (int y = 0; y < 768; ++y)
+      for (int x = 0; x < 1024; ++x)
+        rays.push_back({f.eye, camera_ray_direction(f, x + 0.5f, y + 0.5f), scene.camera.near, scene.camera.far});
+    return rays;
+  }
+  std::mt19937 rng(42);  // incoherent: random origins in the scene's box, random directions
+  std::uniform_real_distribution<float> U(-1.0f, 1.0f);
+  for (int i = 0; i < 1024 * 768; ++i) {
+    glm::vec3 d(U(rng), U(rng), U(rng));
+    if (glm::dot(d, d) < 1e-6f) d = {0, 0, 1};
+    rays.push_back({{U(rng), U(rng), U(rng)}, d, 0.0f, INFINITY});
+  }
+  return rays;
+}
+
+// Rays only, one thread: our BVH's closest-hit query against Embree's rtcIntersect1.
+void BM_Trace(benchmark::State& state, std::string accel, std::string rays_kind, std::string scene_name) {
+  const Scene& scene = builtin(scene_name + ":" + std::to_string(state.range(0)));
+  TraceGeometry geometry(scene, SphereMode::Analytic, 64, accel == "embree" ? AccelKind::Embree : AccelKind::Bvh);
+  std::vector<Ray> rays = make_rays(scene, rays_kind);
+  tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  TraversalCounters counters;
+  size_t hits = 0;
+  for (auto _ : state) {
+    counters = {};
+    for (const Ray& r : rays) {
+      HitRecord h;
+      hits += geometry.closest(r, h, counters);
+    }
+  }
+  benchmark::DoNotOptimize(hits);
+  using C = benchmark::Counter;
+  state.counters["rays/s"] = C(double(rays.size()), C::kIsIterationInvariantRate);
+  if (accel == "bvh") {
+    state.counters["nodes/ray"] = double(counters.nodes_visited) / double(rays.size());
+    state.counters["tests/ray"] = double(counters.primitive_tests) / double(rays.size());
+  }
+}
+
+// Acceleration structure build, one thread for both (Embree builds with TBB too).
+void BM_Build(benchmark::State& state, std::string accel) {
+  tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+  const Scene& scene = builtin("soup:" + std::to_string(state.range(0)));
+  double nodes = 0, sah = 0, bytes = 0;
+  for (auto _ : state) {
+    TraceGeometry g(scene, SphereMode::Analytic, 64, accel == "embree" ? AccelKind::Embree : AccelKind::Bvh);
+    if (accel == "bvh") {
+      nodes = double(g.bvh().stats().nodes);
+      sah = g.bvh().stats().sah_cost;
+      bytes = double(g.acceleration_bytes());
+    }
+    benchmark::DoNotOptimize(&g);
+  }
+  using C = benchmark::Counter;
+  state.counters["prims/s"] = C(double(state.range(0)), C::kIsIterationInvariantRate);
+  if (accel == "bvh") {
+    state.counters["nodes"] = nodes;
+    state.counters["sah_cost"] = sah;
+    state.counters["bytes/tri"] = bytes / double(state.range(0));
+  }
+}
+
+void register_all() {
+  for (std::string r : {"raster", "raytrace", "raytrace_none", "embree"}) {
+    for (std::string s : {"tessphere", "soup"}) {
+      for (long n : {100L, 1000L, 10000L, 100000L, 1000000L}) {
+        if (r == "raytrace_none" && n > 1000) continue;  // O(pixels x triangles)
+        for (long w : {256L, 1024L, 2048L}) {
+          benchmark::RegisterBenchmark(("BM_Frame/" + r + "/" + s).c_str(), BM_Frame, r, s)
+              ->Args({n, w})
+              ->Unit(benchmark::kMillisecond)
+              ->UseRealTime();
+        }
+      }
+    }
+  }
+  for (std::string r : {"raster", "raytrace", "embree"})
+    for (long n : {1L, 2L, 4L, 8L, 16L, 32L, 64L, 128L, 256L})
+      benchmark::RegisterBenchmark(("BM_DepthComplexity/" + r).c_str(), BM_DepthComplexity, r)
+          ->Arg(n)->Unit(benchmark::kMillisecond)->UseRealTime();
+  for (std::string e : {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1", "mirror_depth_2",
+                        "mirror_depth_3", "mirror_depth_4", "mirror_depth_5", "glass", "dof_16"})
+    benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)->Unit(benchmark::kMillisecond)->UseRealTime();
+  for (std::string a : {"bvh", "embree"})
+    for (std::string rays : {"primary", "random"}) {
+      benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/tessphere").c_str(), BM_Trace, a, rays,
+                                   std::string("tessphere"))->Arg(100000)->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/soup").c_str(), BM_Trace, a, rays,
+                                   std::string("soup"))->Arg(1000000)->Unit(benchmark::kMillisecond);
+    }
+  for (std::string a : {"bvh", "embree"})
+    for (long n : {10000L, 100000L, 1000000L})
+      benchmark::RegisterBenchmark(("BM_Build/" + a).c_str(), BM_Build, a)
+          ->Arg(n)->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  register_all();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}
