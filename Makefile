@@ -5,7 +5,7 @@ PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-d
 	openimageio-tools libbenchmark-dev libgtest-dev libembree-dev libtbb-dev \
 	nlohmann-json3-dev libcli11-dev libfmt-dev libassimp-dev python3-matplotlib
 
-.PHONY: all deps build demo test clean format
+.PHONY: all deps build demo test bench clean format
 
 all: build
 
@@ -25,6 +25,14 @@ demo: build
 
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# A sweep of a few minutes: JSON into bench/results/, charts into bench/charts/.
+BENCH_FILTER ?= BM_Frame/(raster|raytrace|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_DepthComplexity|BM_Effects|BM_Trace|BM_Build
+bench: build
+	mkdir -p bench/results bench/charts
+	$(BUILD_DIR)/bin/rvr_bench --benchmark_filter='$(BENCH_FILTER)' --benchmark_min_time=0.2 \
+		--benchmark_out=bench/results/latest.json --benchmark_out_format=json
+	/usr/bin/python3 bench/plot.py bench/results/latest.json bench/charts
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')
