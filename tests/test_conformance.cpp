@@ -28,6 +28,7 @@ void PrintTo(const RendererCase& r, std::ostream* os) { *os << r.label << " vs "
 
 const RendererCase kRenderers[] = {
     {"raster", "raster", AccelKind::Bvh, "raytrace", SIZE_MAX},
+    {"softraster", "softraster", AccelKind::Bvh, "raytrace", SIZE_MAX},
     {"raytrace", "raytrace", AccelKind::Bvh, "raster", SIZE_MAX},
     {"raytrace_none", "raytrace", AccelKind::None, "raster", 5000},
     {"embree", "embree", AccelKind::Embree, "raster", SIZE_MAX},

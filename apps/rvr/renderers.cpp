@@ -1,14 +1,18 @@
 #include "renderers.h"
 
 #include "rvr/raster/gl_rasterizer.h"
+#include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
 
 namespace rvr {
 
-std::vector<std::string> renderer_names() { return {"raster", "raytrace", "embree"}; }
+std::vector<std::string> renderer_names() {
+  return {"raster", "softraster", "raytrace", "embree"};
+}
 
 Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name) {
   if (name == "raster") return std::unique_ptr<Renderer>(std::make_unique<GlRasterizer>());
+  if (name == "softraster") return std::unique_ptr<Renderer>(std::make_unique<SoftRasterizer>());
   if (name == "raytrace") return std::unique_ptr<Renderer>(std::make_unique<RayTracer>());
   if (name == "embree")
     return std::unique_ptr<Renderer>(std::make_unique<RayTracer>(AccelKind::Embree));

@@ -1,0 +1,20 @@
+// Our own CPU z-buffer renderer: "for each triangle, for each covered pixel", with no GL.
+// Triangles are transformed, near-clipped and binned to 64x64 screen tiles; tiles are
+// rasterized in parallel (fixed-point edge functions, top-left fill rule, strict-less z-test
+// in submission order), then each visible pixel is shaded once with rvr::shade_local.
+#pragma once
+
+#include <string>
+
+#include "rvr/shared/expected.h"
+#include "rvr/shared/renderer.h"
+
+namespace rvr {
+
+class SoftRasterizer : public Renderer {
+ public:
+  std::string name() const override { return "softraster"; }
+  Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options) override;
+};
+
+}  // namespace rvr
