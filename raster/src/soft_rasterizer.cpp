@@ -30,11 +30,13 @@ double seconds_since(Clock::time_point start) {
 }
 
 constexpr int kTile = 64;
-constexpr int kSubBits = 8;  // sub-pixel precision of the edge functions, as in GL rasterizers
+// Sub-pixel precision of the edge functions: finer than GL's usual 8 bits, so that snapping
+// an edge-on sliver (a sphere's silhouette) rarely makes it cover a centre it does not.
+constexpr int kSubBits = 12;
 constexpr int64_t kSub = int64_t(1) << kSubBits;
-// Screen coordinates stay within +-2^18 pixels (guard-band clipping), so fixed-point edge
-// functions (products of 28-bit differences) never overflow int64.
-constexpr double kGuardPixels = double(1 << 18);
+// Guard-band clipping keeps screen coordinates within +-(2^15 + 2^14) pixels, i.e. 28-bit
+// fixed point, so edge functions (products of 29-bit differences) never overflow int64.
+constexpr double kGuardPixels = double(1 << 16);
 constexpr int kMaxImageSide = 1 << 15;
 
 // What shading needs per object; tessellated shapes point into SoftRasterizer-owned meshes.
@@ -51,7 +53,8 @@ struct SetupTriangle {
   std::array<bool, 3> top_left;  // edge i runs from vertex i to vertex i+1
   // q_j(p) = q0[j] + qa[j]*(px - ox) + qb[j]*(py - oy) = (barycentric j of the ORIGINAL
   // triangle) / w: linear in screen space, so sum_j q_j = 1/w = 1/view depth, and q_j/sum is
-  // the perspective-correct barycentric. Unsnapped doubles, for accurate depth.
+  // the perspective-correct barycentric. From the unsnapped vertices, in double: P must be
+  // exact where 1/|L - P|^2 is steep (surfaces next to a light).
   std::array<double, 3> q0, qa, qb;
   double ox = 0, oy = 0;
   int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // pixel bounding box, inclusive, on screen
@@ -60,7 +63,9 @@ struct SetupTriangle {
   double inv_w(double px, double py, std::array<double, 3>& q) const {
     double s = 0;
     for (int j = 0; j < 3; ++j) {
-      q[j] = q0[j] + qa[j] * (px - ox) + qb[j] * (py - oy);
+      // Clamped: a sliver may cover a centre just outside itself (snapping); it is then seen
+      // at its nearest edge point instead of extrapolating depth.
+      q[j] = std::max(0.0, q0[j] + qa[j] * (px - ox) + qb[j] * (py - oy));
       s += q[j];
     }
     return s;
@@ -166,7 +171,6 @@ struct Setup {
       // y points down: with positive area, top edges run right and left edges run up.
       t.top_left[i] = (dy == 0 && dx > 0) || dy < 0;
     }
-    // Attribute planes from the unsnapped positions.
     double dx1 = sx[1] - sx[0], dy1 = sy[1] - sy[0], dx2 = sx[2] - sx[0], dy2 = sy[2] - sy[0];
     double det = dx1 * dy2 - dx2 * dy1;
     if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return;
