@@ -1,18 +1,17 @@
 // rvr: render one scene two ways and tell the truth about the difference. This program only
 // parses, calls the libraries and writes; errors come back as values and are printed here.
+#include <fmt/format.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <thread>
-
-#include <CLI/CLI.hpp>
-#include <fmt/format.h>
-#include <nlohmann/json.hpp>
 
 #include "renderers.h"
 #include "report.h"
@@ -85,7 +84,8 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
       ->check(CLI::Range(0, 1024));
   cmd.add_option("--accel", o.accel, "tracer acceleration: bvh | none")
       ->check(CLI::IsMember({"bvh", "none"}));
-  cmd.add_option("--spheres", o.spheres, "tracer spheres: analytic | mesh (the raster's tessellation)")
+  cmd.add_option("--spheres", o.spheres,
+                 "tracer spheres: analytic | mesh (the raster's tessellation)")
       ->check(CLI::IsMember({"analytic", "mesh"}));
   cmd.add_option("--sphere-segments", o.sphere_segments, "sphere tessellation: longitudes")
       ->check(CLI::Range(3, 4096));
@@ -95,7 +95,8 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--max-depth", o.max_depth, "recursion limit for bounce rays")
       ->check(CLI::Range(0, 64));
   cmd.add_option("--seed", o.seed, "seed of the per-pixel random streams");
-  cmd.add_option("--gl", o.gl, "GL back end: osmesa | egl")->check(CLI::IsMember({"osmesa", "egl"}));
+  cmd.add_option("--gl", o.gl, "GL back end: osmesa | egl")
+      ->check(CLI::IsMember({"osmesa", "egl"}));
   cmd.add_option("--shadow-map-size", o.shadow_map_size, "raster shadow maps: texels per side")
       ->check(CLI::Range(16, 8192));
   cmd.add_option("--shadow-bias", o.shadow_bias, "raster shadow maps: depth bias (scene units)")
@@ -111,7 +112,8 @@ RenderMode parse_mode(const std::string& s) {
 }
 
 RenderOptions render_options(const CommonOptions& o, const std::string& default_mode) {
-  if (o.gl == "egl") fail(bad_input("--gl egl: the EGL back end is not available in this build; use --gl osmesa"));
+  if (o.gl == "egl")
+    fail(bad_input("--gl egl: the EGL back end is not available in this build; use --gl osmesa"));
   RenderOptions r;
   r.mode = parse_mode(o.mode.empty() ? default_mode : o.mode);
   r.spheres = o.spheres == "mesh" ? SphereMode::Mesh : SphereMode::Analytic;
@@ -120,7 +122,8 @@ RenderOptions render_options(const CommonOptions& o, const std::string& default_
   r.max_depth = o.max_depth;
   r.seed = o.seed;
   r.accel = o.accel == "none" ? AccelKind::None : AccelKind::Bvh;
-  r.triangle_test = o.triangle_test == "chapter" ? TriangleTest::Chapter : TriangleTest::MollerTrumbore;
+  r.triangle_test =
+      o.triangle_test == "chapter" ? TriangleTest::Chapter : TriangleTest::MollerTrumbore;
   r.shadow_map_size = o.shadow_map_size;
   r.shadow_bias = o.shadow_bias;
   r.shadow_pcf = o.shadow_pcf;
@@ -143,7 +146,9 @@ double peak_memory_bytes() {
   return double(usage.ru_maxrss) * 1024.0;
 }
 
-nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
+nlohmann::json finite_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
 
 // ---------------------------------------------------------------------------------- render
 
@@ -170,7 +175,8 @@ int run_render(const RenderArgs& a) {
   double write_seconds = seconds_since(write_start);
 
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-  for (const std::string& w : out.warnings) std::fprintf(stderr, "warning: %s: %s\n", a.renderer.c_str(), w.c_str());
+  for (const std::string& w : out.warnings)
+    std::fprintf(stderr, "warning: %s: %s\n", a.renderer.c_str(), w.c_str());
   if (!a.stats.empty()) {
     nlohmann::json j;
     j["renderer"] = a.renderer;
@@ -204,7 +210,8 @@ struct CompareArgs {
 };
 
 int run_compare(const CompareArgs& a, const std::string& command_line) {
-  if (a.renderers.size() < 2) fail(bad_input("--renderers: need at least two renderers to compare"));
+  if (a.renderers.size() < 2)
+    fail(bad_input("--renderers: need at least two renderers to compare"));
   RenderOptions options = render_options(a.common, "local");
   double load_seconds = 0;
   Scene scene = load(a.common, load_seconds);
@@ -240,15 +247,18 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   for (const FrameBuffers& fb : buffers) images.push_back(color_image(fb));
   for (size_t i = 0; i < buffers.size(); ++i)
     check(write_image(a.out_dir + "/" + report.renderers[i].image_file, images[i]));
-  check(write_image(a.out_dir + "/diff.png", diff_heat_map(images[0], images[1], report.heat_map_scale), false));
-  check(write_image(a.out_dir + "/id_mismatch.png", id_mismatch_image(buffers[0], buffers[1]), false));
+  check(write_image(a.out_dir + "/diff.png",
+                    diff_heat_map(images[0], images[1], report.heat_map_scale), false));
+  check(write_image(a.out_dir + "/id_mismatch.png", id_mismatch_image(buffers[0], buffers[1]),
+                    false));
   check(write_text_file(a.out_dir + "/metrics.json", metrics_json(report)));
   check(write_text_file(a.out_dir + "/report.html", take(report_html(report))));
 
   const ComparisonMetrics& m = report.metrics;
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   for (const ReportRenderer& r : report.renderers)
-    for (const std::string& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", r.name.c_str(), w.c_str());
+    for (const std::string& w : r.warnings)
+      std::fprintf(stderr, "warning: %s: %s\n", r.name.c_str(), w.c_str());
   std::printf("%s  %dx%d  mode %s\n", scene.source.c_str(), scene.image.width, scene.image.height,
               report.mode.c_str());
   for (const ReportRenderer& r : report.renderers)
@@ -257,7 +267,8 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   std::printf("  id agreement      %.5f  (%zu of %zu pixels differ, %zu off edges)\n",
               m.visibility.id_agreement, m.visibility.mismatched_pixels, m.visibility.pixels,
               m.visibility.mismatched_off_edge);
-  std::printf("  depth rel error   max %.3g  mean %.3g\n", m.depth.max_rel_error, m.depth.mean_rel_error);
+  std::printf("  depth rel error   max %.3g  mean %.3g\n", m.depth.max_rel_error,
+              m.depth.mean_rel_error);
   std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
               m.color.psnr_db, m.color.max_abs, m.color.ssim);
   std::printf("  wrote %s/{%s.png,%s.png,diff.png,id_mismatch.png,metrics.json,report.html}\n",
@@ -285,8 +296,8 @@ int run_diff(const DiffArgs& d) {
   std::printf("Comparing \"%s\" and \"%s\"\n", d.a.c_str(), d.b.c_str());
   std::printf("  Mean error = %.6g\n  RMS error = %.6g\n  Peak SNR = %.6g\n", diff.mean_abs,
               diff.rmse, diff.psnr_db);
-  std::printf("  Max error  = %.6g @ (%d, %d, channel %d)\n", diff.max_abs, diff.max_x,
-              diff.max_y, diff.max_channel);
+  std::printf("  Max error  = %.6g @ (%d, %d, channel %d)\n", diff.max_abs, diff.max_x, diff.max_y,
+              diff.max_channel);
   if (d.fail_above && diff.rmse > *d.fail_above) {
     std::printf("FAILURE: RMSE %.6g above %.6g\n", diff.rmse, *d.fail_above);
     return 1;
@@ -317,7 +328,8 @@ std::string cpu_model() {
 
 int run_info() {
   std::printf("rvr %s\n", kVersion);
-  std::printf("cpu: %s, %u hardware threads\n", cpu_model().c_str(), std::thread::hardware_concurrency());
+  std::printf("cpu: %s, %u hardware threads\n", cpu_model().c_str(),
+              std::thread::hardware_concurrency());
   std::printf("renderers: ");
   for (const std::string& n : renderer_names()) std::printf("%s ", n.c_str());
   std::printf("\n");
@@ -347,7 +359,10 @@ int run(int argc, char** argv) {
   RenderArgs render;
   CLI::App* render_cmd = app.add_subcommand("render", "render a scene with one renderer");
   add_common_options(*render_cmd, render.common);
-  render_cmd->add_option("-r,--renderer", render.renderer, "raster | raytrace")->required();
+  std::string renderer_list;
+  for (const std::string& name : renderer_names())
+    renderer_list += (renderer_list.empty() ? "" : " | ") + name;
+  render_cmd->add_option("-r,--renderer", render.renderer, renderer_list)->required();
   render_cmd->add_option("-o,--output", render.out, "output image (.png, .exr)");
   render_cmd->add_option("--aov", render.aovs, "extra outputs: depth,id,normal,cost")
       ->delimiter(',')
@@ -360,8 +375,9 @@ int run(int argc, char** argv) {
   compare_cmd->add_option("-r,--renderers", compare.renderers, "renderers, first two compared")
       ->delimiter(',');
   compare_cmd->add_option("-o,--output", compare.out_dir, "output folder (default rvr-out)");
-  compare_cmd->add_option("--fail-below-agreement", compare.fail_below_agreement,
-                          "exit 1 when the id agreement is below F")
+  compare_cmd
+      ->add_option("--fail-below-agreement", compare.fail_below_agreement,
+                   "exit 1 when the id agreement is below F")
       ->check(CLI::Range(0.0, 1.0));
 
   DiffArgs diff;
