@@ -32,12 +32,16 @@ ReportInput sample_input(const std::string& out_dir) {
   in.mode = "local";
   in.out_dir = out_dir;
   in.command_line = "rvr compare builtin:cornell -o out --renderers raster,raytrace";
-  ReportRenderer a{"raster", "raster.png", 0.12, {}, {{"time.render", 0.1}, {"fragments", 99}}};
+  ReportRenderer a{"raster", "raster.png", 0.12, {}, {{"time.render", 0.1}, {"fragments", 99}},
+                   "",       0.0,          0.0};
   ReportRenderer b{"raytrace",
                    "raytrace.png",
                    0.4,
                    {"csg objects skipped: <1> & \"more\""},
-                   {{"time.build", 0.01}, {"time.render", 0.38}, {"rays.primary", 48}}};
+                   {{"time.build", 0.01}, {"time.render", 0.38}, {"rays.primary", 48}},
+                   "raytrace.cost.png",
+                   31.0,
+                   12.5};
   in.renderers = {a, b};
   in.metrics.visibility = {48, 47.0 / 48.0, 1, 0};
   in.metrics.depth = {0.0004, 0.00001};
@@ -58,7 +62,8 @@ class ReportDir : public ::testing::Test {
     img.height = 6;
     img.channels = 3;
     img.pixels.assign(8 * 6 * 3, 0.5f);
-    for (const char* name : {"raster.png", "raytrace.png", "diff.png", "id_mismatch.png"})
+    for (const char* name :
+         {"raster.png", "raytrace.png", "raytrace.cost.png", "diff.png", "id_mismatch.png"})
       ASSERT_TRUE(write_image((dir_ / name).string(), img).ok());
   }
   void TearDown() override {
@@ -110,6 +115,11 @@ TEST(MetricsJson, HasEveryRequiredField) {
   EXPECT_DOUBLE_EQ(doc["color"]["psnr_db"].get<double>(), 47.9);
   EXPECT_EQ(doc["command"], "rvr compare builtin:cornell -o out --renderers raster,raytrace");
   EXPECT_EQ(doc["heat_map_scale"].get<double>(), 0.1);
+  // The work-per-pixel picture, only for a renderer that reports work.
+  EXPECT_FALSE(doc["renderers"]["raster"].contains("cost"));
+  EXPECT_EQ(doc["renderers"]["raytrace"]["cost"]["image"], "raytrace.cost.png");
+  EXPECT_EQ(doc["renderers"]["raytrace"]["cost"]["mean"], 12.5);
+  EXPECT_EQ(doc["renderers"]["raytrace"]["cost"]["scale"], 31.0);
 }
 
 TEST(MetricsJson, InfiniteAndNanValuesStayValidJson) {
@@ -139,8 +149,13 @@ TEST_F(ReportDir, HtmlIsSelfContained) {
   ASSERT_TRUE(html.ok()) << html.error().message;
   const std::string& h = html.value();
   EXPECT_EQ(h.rfind("<!DOCTYPE html>", 0), 0u);
-  // Both renders (side by side and in the flip view), diff.png and id_mismatch.png.
-  EXPECT_GE(count_of(h, "data:image/png;base64,"), 6u);
+  // Both renders (side by side and in the flip view), diff.png, id_mismatch.png and the
+  // cost picture of the renderer that has one.
+  EXPECT_EQ(count_of(h, "data:image/png;base64,"), 7u);
+  EXPECT_NE(h.find("raytrace.cost.png</b>: BVH nodes visited + primitive tests per pixel; mean "
+                   "12.5, yellow-white &ge; 31"),
+            std::string::npos);
+  EXPECT_NE(h.find("<b>raster</b>: no per-pixel work reported"), std::string::npos);
   EXPECT_EQ(h.find("http"), std::string::npos);
   EXPECT_EQ(h.find("<link"), std::string::npos);
   EXPECT_EQ(h.find("<script src"), std::string::npos);

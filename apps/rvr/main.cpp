@@ -243,10 +243,26 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   report.metrics = compare_buffers(buffers[0], buffers[1]);
 
   // Everything is computed before the first file is written.
-  std::vector<Image> images;
-  for (const FrameBuffers& fb : buffers) images.push_back(color_image(fb));
-  for (size_t i = 0; i < buffers.size(); ++i)
+  std::vector<Image> images, cost_images;
+  for (size_t i = 0; i < buffers.size(); ++i) {
+    const FrameBuffers& fb = buffers[i];
+    ReportRenderer& r = report.renderers[i];
+    images.push_back(color_image(fb));
+    double total = 0;
+    for (float c : fb.cost) total += c;
+    float scale = 0;
+    cost_images.push_back(cost_image(fb, &scale));
+    if (total > 0) {
+      r.cost_file = r.name + ".cost.png";
+      r.cost_scale = scale;
+      r.cost_mean = total / double(std::max<size_t>(1, fb.pixel_count()));
+    }
+  }
+  for (size_t i = 0; i < buffers.size(); ++i) {
     check(write_image(a.out_dir + "/" + report.renderers[i].image_file, images[i]));
+    if (!report.renderers[i].cost_file.empty())
+      check(write_image(a.out_dir + "/" + report.renderers[i].cost_file, cost_images[i], false));
+  }
   check(write_image(a.out_dir + "/diff.png",
                     diff_heat_map(images[0], images[1], report.heat_map_scale), false));
   check(write_image(a.out_dir + "/id_mismatch.png", id_mismatch_image(buffers[0], buffers[1]),

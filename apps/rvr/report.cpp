@@ -66,7 +66,6 @@ std::string escape_html(const std::string& s) {
   return out;
 }
 
-
 std::string mime_type(const std::string& file) {
   std::string ext = std::filesystem::path(file).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -209,6 +208,9 @@ std::string metrics_json(const ReportInput& input) {
                         {"warnings", r.warnings},
                         {"stats", stats},
                         {"image", r.image_file}};
+      if (!r.cost_file.empty())
+        renderers[key]["cost"] = {
+            {"image", r.cost_file}, {"mean", number(r.cost_mean)}, {"scale", number(r.cost_scale)}};
       if (compared.size() < 2) compared.push_back(key);
     }
     doc["renderers"] = renderers;
@@ -259,6 +261,16 @@ Expected<std::string> report_html(const ReportInput& input) {
       auto uri = data_uri(input.out_dir, r.image_file);
       if (!uri) return uri.error();
       render_uris.push_back(std::move(uri.value()));
+    }
+    std::vector<std::string> cost_uris;
+    for (const auto& r : input.renderers) {
+      if (r.cost_file.empty()) {
+        cost_uris.emplace_back();
+        continue;
+      }
+      auto uri = data_uri(input.out_dir, r.cost_file);
+      if (!uri) return uri.error();
+      cost_uris.push_back(std::move(uri.value()));
     }
     auto diff_uri = data_uri(input.out_dir, "diff.png");
     if (!diff_uri) return diff_uri.error();
@@ -338,6 +350,24 @@ Expected<std::string> report_html(const ReportInput& input) {
       << "\" alt=\"object id mismatches\"><figcaption><b>id_mismatch.png</b>: pixels whose "
          "object id differs, in red, over a grey version of "
       << escape_html(name_a) << ".</figcaption></figure>\n</div>\n";
+
+    // Work per pixel: what each loop order pays where.
+    h << "<h2>Work per pixel</h2>\n<div class=\"grid\">\n";
+    for (size_t i = 0; i < input.renderers.size(); ++i) {
+      const auto& r = input.renderers[i];
+      if (r.cost_file.empty()) {
+        h << "<figure><figcaption><b>" << escape_html(r.name)
+          << "</b>: no per-pixel work reported.</figcaption></figure>\n";
+        continue;
+      }
+      h << "<figure><img src=\"" << cost_uris[i] << "\" alt=\"" << escape_html(r.name)
+        << " work per pixel\"><figcaption><b>" << escape_html(r.cost_file) << "</b>: "
+        << (r.stats.count("fragments.generated") ? "fragments generated per pixel (overdraw)"
+                                                 : "BVH nodes visited + primitive tests per pixel")
+        << "; mean " << fmt("%.3g", r.cost_mean) << ", yellow-white &ge; "
+        << fmt("%g", r.cost_scale) << " (the 99th percentile).</figcaption></figure>\n";
+    }
+    h << "</div>\n";
 
     // Metrics.
     const bool identical = std::isinf(col.psnr_db) && col.psnr_db > 0;

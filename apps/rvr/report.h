@@ -16,12 +16,16 @@ struct ReportRenderer {
   double seconds = 0.0;
   std::vector<std::string> warnings;
   std::map<std::string, double> stats;
+  // Work per pixel (cost AOV) picture in the output folder, or empty when the renderer
+  // reports none (embree); the cost at the top of its colour map; the mean over pixels.
+  std::string cost_file;
+  double cost_scale = 0.0, cost_mean = 0.0;
 };
 
 struct ReportInput {
   std::string scene;  // "builtin:cornell" or the file path
   int width = 0, height = 0;
-  std::string mode;  // "local"
+  std::string mode;                       // "local"
   std::vector<ReportRenderer> renderers;  // the first two are the compared pair
   ComparisonMetrics metrics;
   float heat_map_scale = 0.1f;  // colour difference at the top of diff.png's colour map

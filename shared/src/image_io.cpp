@@ -277,6 +277,12 @@ float cost_scale(const std::vector<float>& cost) {
 
 }  // namespace
 
+Image cost_image(const FrameBuffers& fb, float* scale) {
+  float top = cost_scale(fb.cost);
+  if (scale) *scale = top;
+  return detail::inferno_display(fb.cost, fb.width, fb.height, top);
+}
+
 Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
                   const std::vector<std::string>& aovs) {
   try {
@@ -314,8 +320,7 @@ Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
         std::copy(fb.cost.begin(), fb.cost.end(), img.pixels.begin());
         st = write_image(base + ".cost.exr", img, false);
         if (st.ok()) {
-          Image png = detail::inferno_display(fb.cost, fb.width, fb.height, cost_scale(fb.cost));
-          st = write_image(base + ".cost.png", png, false);
+          st = write_image(base + ".cost.png", cost_image(fb), false);
         }
       }
       if (!st.ok()) return st;

@@ -33,6 +33,10 @@ Expected<Image> read_image(const std::string& path);
 // Linear colour of a render as a 3-channel image.
 Image color_image(const FrameBuffers& fb);
 
+// The cost AOV on the inferno colour map (display-referred). `scale`, the cost at the top of
+// the map, is the 99th percentile of the non-zero costs (at least 1) and is returned too.
+Image cost_image(const FrameBuffers& fb, float* scale = nullptr);
+
 // Writes the AOVs named in `aovs` ("depth", "id", "normal", "cost") beside `out_path`:
 // OUT.depth.exr, OUT.id.exr (channels id, prim; background -1), OUT.normal.exr,
 // OUT.cost.exr and a colour-mapped OUT.cost.png. OUT is out_path without its extension.
