@@ -3,9 +3,10 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
 	openimageio-tools libbenchmark-dev libgtest-dev libembree-dev libtbb-dev \
-	nlohmann-json3-dev libcli11-dev libfmt-dev libassimp-dev python3-matplotlib
+	nlohmann-json3-dev libcli11-dev libfmt-dev libassimp-dev python3-matplotlib \
+	clang-14 libclang-rt-14-dev
 
-.PHONY: all deps build demo test bench clean format
+.PHONY: all deps build demo test sanitize fuzz bench clean format
 
 all: build
 
@@ -26,6 +27,37 @@ demo: build
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
+# The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer (any UB fails the
+# test), in its own build folder. Leaks inside Mesa/llvmpipe are suppressed by
+# tests/sanitize/lsan.supp (third-party code only); slow tests are left out by SANITIZE_EXCLUDE.
+SANITIZE_DIR ?= build-asan
+SANITIZE_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+# Brute-force conformance renders every scene with no acceleration structure: minutes natively,
+# far too long under ASan. It is the same code the other conformance tests run with a BVH.
+SANITIZE_EXCLUDE ?= BruteForce
+sanitize: deps
+	cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+		-DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
+		-DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)"
+	cmake --build $(SANITIZE_DIR) -j $(JOBS)
+	cd $(SANITIZE_DIR) && \
+		ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1 \
+		LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp:print_suppressions=0 \
+		UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+		ctest --output-on-failure -j $(JOBS) -E '$(SANITIZE_EXCLUDE)'
+
+# libFuzzer (clang 14) on the scene loader and the mesh importer path, FUZZ_SECONDS per
+# harness; see tests/fuzz/run.sh and notes in tests/fuzz/README.md.
+FUZZ_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZ_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+fuzz: deps
+	cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
+		-DRVR_BUILD_FUZZERS=ON -DRVR_BUILD_TESTS=OFF -DCMAKE_CXX_FLAGS="$(FUZZ_FLAGS)" \
+		-DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
+	cmake --build $(FUZZ_DIR) -j $(JOBS) --target fuzz_scene fuzz_mesh
+	FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run.sh $(FUZZ_DIR)
+
 # A sweep of a few minutes: JSON into bench/results/, charts into bench/charts/.
 BENCH_FILTER ?= BM_Frame/(raster|raytrace|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_DepthComplexity|BM_Effects|BM_Trace|BM_Build
 bench: build
@@ -38,4 +70,4 @@ format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')
 
 clean:
-	rm -rf $(BUILD_DIR) rvr-out
+	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) rvr-out

@@ -691,8 +691,12 @@ TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
   if (std::string problem = file_status(full); !problem.empty()) fail(path, prefix + problem);
 
   Assimp::Importer importer;
-  unsigned flags =
-      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
+  // ValidateDataStructure first: Assimp's readers can produce broken data from broken files
+  // (e.g. an OFF face whose vertex count is garbage gives faces with no indices), and the other
+  // post-processing steps assert on it, which aborts the process. Validation turns that into
+  // an import error instead (found by fuzzing; tests/fuzz/regressions/mesh).
+  unsigned flags = aiProcess_ValidateDataStructure | aiProcess_Triangulate |
+                   aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
   if (smooth) flags |= aiProcess_GenSmoothNormals;  // ignored where the file has normals
   const aiScene* ai = importer.ReadFile(full.string(), flags);
   if (!ai) {
