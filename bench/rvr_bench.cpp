@@ -4,16 +4,16 @@
 //   BM_Effects/<effect>                        the tracer on cornell, one effect at a time
 //   BM_Trace/<accel>/<rays>/<scene>/<n>        one thread, rays only, no shading
 //   BM_Build/<accel>/<n>                       acceleration structure build
+//   BM_Threads/<renderer>/<threads>            tessphere:100000 at 1024x768 on 1 or 2 threads
 // Scenes and acceleration structures are built outside the timed loops.
 #include <benchmark/benchmark.h>
+#include <tbb/global_control.h>
 
 #include <map>
 #include <memory>
 #include <mutex>
 #include <random>
 #include <string>
-
-#include <tbb/global_control.h>
 
 #include "renderers.h"
 #include "rvr/raytrace/ray_tracer.h"
@@ -40,7 +40,8 @@ void add_counters(benchmark::State& state, const RenderOutput& out, double pixel
     auto it = out.stats.find(k);
     return it == out.stats.end() ? 0.0 : it->second;
   };
-  double rays = get("rays.primary") + get("rays.shadow") + get("rays.reflection") + get("rays.refraction");
+  double rays =
+      get("rays.primary") + get("rays.shadow") + get("rays.reflection") + get("rays.refraction");
   using C = benchmark::Counter;
   if (rays > 0) state.counters["rays/s"] = C(rays, C::kIsIterationInvariantRate);
   double tris = get("triangles.submitted") > 0 ? get("triangles.submitted") : get("triangles");
@@ -63,6 +64,23 @@ void BM_Frame(benchmark::State& state, std::string renderer_name, std::string sc
     benchmark::DoNotOptimize(out.buffers.color.data());
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
+}
+
+// Parallel scaling of our own loops: the same frame with 1 and with 2 worker threads.
+void BM_Threads(benchmark::State& state, std::string renderer_name) {
+  Scene scene = builtin("tessphere:100000");
+  scene.image.width = 1024;
+  scene.image.height = 768;
+  auto renderer = make_renderer(renderer_name);
+  RenderOptions options;
+  options.mode = RenderMode::Local;
+  options.threads = int(state.range(0));
+  RenderOutput out = renderer.value()->render(scene, options).value();
+  for (auto _ : state) {
+    out = renderer.value()->render(scene, options).value();
+    benchmark::DoNotOptimize(out.buffers.color.data());
+  }
+  add_counters(state, out, 1024.0 * 768.0);
 }
 
 void BM_DepthComplexity(benchmark::State& state, std::string renderer_name) {
@@ -95,11 +113,14 @@ void BM_Effects(benchmark::State& state, std::string effect) {
     scene.lights = {area};
   } else if (effect.rfind("mirror_depth_", 0) == 0) {
     options.max_depth = std::stoi(effect.substr(13));
-    for (Material& m : scene.materials) if (m.name == "mirror") m.mirror = 0.85f;
+    for (Material& m : scene.materials)
+      if (m.name == "mirror") m.mirror = 0.85f;
     // A second mirror facing the first one: depth matters only between mirrors.
-    for (Object& o : scene.objects) if (o.name == "back wall") o.material = scene.objects[6].material;
+    for (Object& o : scene.objects)
+      if (o.name == "back wall") o.material = scene.objects[6].material;
   } else if (effect == "glass") {
-    for (Material& m : scene.materials) if (m.name == "glass") m.transparency = 0.9f;
+    for (Material& m : scene.materials)
+      if (m.name == "glass") m.transparency = 0.9f;
   } else if (effect == "dof_16") {
     scene.camera.aperture_radius = 0.08f;
     scene.camera.focus_distance = 9.5f;
@@ -121,7 +142,8 @@ std::vector<Ray> make_rays(const Scene& scene, const std::string& kind) {
     CameraFrame f = make_camera_frame(scene.camera, 1024, 768);
     for (int y = 0; y < 768; ++y)
       for (int x = 0; x < 1024; ++x)
-        rays.push_back({f.eye, camera_ray_direction(f, x + 0.5f, y + 0.5f), scene.camera.near, scene.camera.far});
+        rays.push_back({f.eye, camera_ray_direction(f, x + 0.5f, y + 0.5f), scene.camera.near,
+                        scene.camera.far});
     return rays;
   }
   std::mt19937 rng(42);  // incoherent: random origins in the scene's box, random directions
@@ -135,9 +157,11 @@ std::vector<Ray> make_rays(const Scene& scene, const std::string& kind) {
 }
 
 // Rays only, one thread: our BVH's closest-hit query against Embree's rtcIntersect1.
-void BM_Trace(benchmark::State& state, std::string accel, std::string rays_kind, std::string scene_name) {
+void BM_Trace(benchmark::State& state, std::string accel, std::string rays_kind,
+              std::string scene_name) {
   const Scene& scene = builtin(scene_name + ":" + std::to_string(state.range(0)));
-  TraceGeometry geometry(scene, SphereMode::Analytic, 64, accel == "embree" ? AccelKind::Embree : AccelKind::Bvh);
+  TraceGeometry geometry(scene, SphereMode::Analytic, 64,
+                         accel == "embree" ? AccelKind::Embree : AccelKind::Bvh);
   std::vector<Ray> rays = make_rays(scene, rays_kind);
   tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   TraversalCounters counters;
@@ -164,7 +188,8 @@ void BM_Build(benchmark::State& state, std::string accel) {
   const Scene& scene = builtin("soup:" + std::to_string(state.range(0)));
   double nodes = 0, sah = 0, bytes = 0;
   for (auto _ : state) {
-    TraceGeometry g(scene, SphereMode::Analytic, 64, accel == "embree" ? AccelKind::Embree : AccelKind::Bvh);
+    TraceGeometry g(scene, SphereMode::Analytic, 64,
+                    accel == "embree" ? AccelKind::Embree : AccelKind::Bvh);
     if (accel == "bvh") {
       nodes = double(g.bvh().stats().nodes);
       sah = g.bvh().stats().sah_cost;
@@ -182,7 +207,7 @@ void BM_Build(benchmark::State& state, std::string accel) {
 }
 
 void register_all() {
-  for (std::string r : {"raster", "raytrace", "raytrace_none", "embree"}) {
+  for (std::string r : {"raster", "softraster", "raytrace", "raytrace_none", "embree"}) {
     for (std::string s : {"tessphere", "soup"}) {
       for (long n : {100L, 1000L, 10000L, 100000L, 1000000L}) {
         if (r == "raytrace_none" && n > 1000) continue;  // O(pixels x triangles)
@@ -195,24 +220,41 @@ void register_all() {
       }
     }
   }
-  for (std::string r : {"raster", "raytrace", "embree"})
+  for (std::string r : {"raster", "softraster", "raytrace", "embree"})
     for (long n : {1L, 2L, 4L, 8L, 16L, 32L, 64L, 128L, 256L})
       benchmark::RegisterBenchmark(("BM_DepthComplexity/" + r).c_str(), BM_DepthComplexity, r)
-          ->Arg(n)->Unit(benchmark::kMillisecond)->UseRealTime();
-  for (std::string e : {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1", "mirror_depth_2",
-                        "mirror_depth_3", "mirror_depth_4", "mirror_depth_5", "glass", "dof_16"})
-    benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)->Unit(benchmark::kMillisecond)->UseRealTime();
+          ->Arg(n)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+  for (std::string e :
+       {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1", "mirror_depth_2",
+        "mirror_depth_3", "mirror_depth_4", "mirror_depth_5", "glass", "dof_16"})
+    benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   for (std::string a : {"bvh", "embree"})
     for (std::string rays : {"primary", "random"}) {
-      benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/tessphere").c_str(), BM_Trace, a, rays,
-                                   std::string("tessphere"))->Arg(100000)->Unit(benchmark::kMillisecond);
-      benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/soup").c_str(), BM_Trace, a, rays,
-                                   std::string("soup"))->Arg(1000000)->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/tessphere").c_str(), BM_Trace,
+                                   a, rays, std::string("tessphere"))
+          ->Arg(100000)
+          ->Unit(benchmark::kMillisecond);
+      benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/soup").c_str(), BM_Trace, a,
+                                   rays, std::string("soup"))
+          ->Arg(1000000)
+          ->Unit(benchmark::kMillisecond);
     }
+  for (std::string r : {"raytrace", "softraster"})
+    for (long threads : {1L, 2L})
+      benchmark::RegisterBenchmark(("BM_Threads/" + r).c_str(), BM_Threads, r)
+          ->Arg(threads)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
   for (std::string a : {"bvh", "embree"})
     for (long n : {10000L, 100000L, 1000000L})
       benchmark::RegisterBenchmark(("BM_Build/" + a).c_str(), BM_Build, a)
-          ->Arg(n)->Unit(benchmark::kMillisecond)->UseRealTime();
+          ->Arg(n)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
 }
 
 }  // namespace
