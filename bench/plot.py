@@ -2,7 +2,8 @@
 """Charts from an rvr_bench JSON file (Google Benchmark's --benchmark_out format).
 
 usage: plot.py RESULTS.json OUT_DIR
-Writes frame_vs_triangles.png, depth_complexity.png, effects.png, ours_vs_embree.png.
+Writes frame_vs_triangles.png, depth_complexity.png, effects.png, ours_vs_embree.png,
+threads.png and targets.md (issue 4's ratios, measured in this one run), and prints the ratios.
 """
 import json
 import sys
@@ -123,13 +124,75 @@ def ours_vs_embree(rows, context, out):
     fig.savefig(out / "ours_vs_embree.png", dpi=100)
 
 
+def threads(rows, context, out):
+    series = defaultdict(dict)
+    for b in rows:
+        p = parts(b)
+        if p[0] == "BM_Threads":
+            series[p[1]][int(p[2])] = ms(b)
+    if not series:
+        return
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    names = sorted(series)
+    for i, name in enumerate(names):
+        t1 = series[name].get(1)
+        counts = sorted(series[name])
+        ax.bar([c + 0.35 * i for c in counts], [t1 / series[name][c] if t1 else 0 for c in counts], 0.35,
+               label=name)
+    ax.axhline(1.8, color="grey", linestyle="--", label="target 1.8x at 2 threads")
+    ax.set_xticks([1.175, 2.175], ["1 thread", "2 threads"])
+    ax.set_ylabel("speed-up over one thread")
+    ax.set_title("Parallel scaling, tessphere:100000 at 1024x768\n" + subtitle(context))
+    ax.legend()
+    ax.grid(True, axis="y", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(out / "threads.png", dpi=100)
+
+
+def targets(rows, context, out):
+    """Issue 4's performance targets as ratios of figures from this one run."""
+    by_name = {b["name"].replace("/real_time", ""): b for b in rows}
+
+    def value(name, key=None):
+        b = by_name.get(name)
+        if b is None:
+            return None
+        return b.get(key) if key else ms(b)
+
+    def ratio(a, b):
+        return a / b if a and b else None
+
+    checks = []
+    for scene in ["tessphere/100000", "soup/1000000"]:
+        r = ratio(value(f"BM_Trace/bvh/primary/{scene}", "rays/s"), value(f"BM_Trace/embree/primary/{scene}", "rays/s"))
+        checks.append((f"BM_Trace primary {scene}: our BVH rays/s / Embree rtcIntersect1", r, ">= 0.7", r and r >= 0.7))
+    for n in ["100000", "1000000"]:
+        r = ratio(value(f"BM_Build/bvh/{n}", "prims/s"), value(f"BM_Build/embree/{n}", "prims/s"))
+        checks.append((f"BM_Build {n}: our build prims/s / Embree's", r, ">= 0.5", r and r >= 0.5))
+        b = value(f"BM_Build/bvh/{n}", "bytes/tri")
+        checks.append((f"BM_Build {n}: our BVH bytes per triangle", b, "<= 64", b and b <= 64))
+    r = ratio(value("BM_Frame/softraster/tessphere/100000/1024"), value("BM_Frame/raster/tessphere/100000/1024"))
+    checks.append(("BM_Frame tessphere/100000/1024: softraster time / raster (llvmpipe) time", r, "<= 1.5",
+                   r and r <= 1.5))
+    for name in ["raytrace", "softraster"]:
+        r = ratio(value(f"BM_Threads/{name}/1"), value(f"BM_Threads/{name}/2"))
+        checks.append((f"BM_Threads/{name}: speed-up with 2 threads", r, ">= 1.8", r and r >= 1.8))
+    lines = ["| target | measured | wanted | met |", "|---|---|---|---|"]
+    for what, v, want, ok in checks:
+        shown = "not run" if v is None else f"{v:.3g}"
+        lines.append(f"| {what} | {shown} | {want} | {'yes' if ok else 'no' if v is not None else '-'} |")
+    text = "\n".join(lines) + "\n"
+    (out / "targets.md").write_text(text)
+    print(text)
+
+
 def main():
     if len(sys.argv) != 3:
         sys.exit(__doc__)
     context, rows = load(sys.argv[1])
     out = Path(sys.argv[2])
     out.mkdir(parents=True, exist_ok=True)
-    for chart in (frame_vs_triangles, depth_complexity, effects, ours_vs_embree):
+    for chart in (frame_vs_triangles, depth_complexity, effects, ours_vs_embree, threads, targets):
         chart(rows, context, out)
     print(f"wrote charts to {out}/")
 
