@@ -5,7 +5,7 @@
 //   BM_Trace/<accel>/<rays>/<scene>/<n>        one thread, rays only, no shading
 //   BM_Build/<accel>/<n>                       acceleration structure build
 //   BM_Threads/<renderer>/<threads>            tessphere:100000 at 1024x768 on 1 or 2 threads
-// Scenes and acceleration structures are built outside the timed loops.
+// Scenes and acceleration structures are built outside the timed loops (FrameRenderer).
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
@@ -49,18 +49,47 @@ void add_counters(benchmark::State& state, const RenderOutput& out, double pixel
   state.counters["pixels/s"] = C(pixels, C::kIsIterationInvariantRate);
 }
 
+// Renders frames of one scene with one renderer. For the tracers the scene's geometry and BVH
+// are built once, here, outside the timed loop; rasterizers have nothing to build beforehand.
+class FrameRenderer {
+ public:
+  FrameRenderer(const std::string& name, const Scene& scene, const RenderOptions& options)
+      : scene_(scene), options_(options) {
+    bool tracer = name == "raytrace" || name == "raytrace_none" || name == "embree";
+    if (!tracer) {
+      renderer_ = std::move(make_renderer(name).value());
+      return;
+    }
+    AccelKind accel = name == "embree"          ? AccelKind::Embree
+                      : name == "raytrace_none" ? AccelKind::None
+                                                : AccelKind::Bvh;
+    geometry_ = std::make_unique<TraceGeometry>(scene, options.spheres, options.sphere_segments,
+                                                accel, options.triangle_test);
+  }
+  RenderOutput frame() {
+    if (geometry_) return tracer_.render(scene_, options_, *geometry_).value();
+    return renderer_->render(scene_, options_).value();
+  }
+
+ private:
+  const Scene& scene_;
+  RenderOptions options_;
+  std::unique_ptr<Renderer> renderer_;
+  RayTracer tracer_;
+  std::unique_ptr<TraceGeometry> geometry_;
+};
+
 // A whole frame with one renderer. The first frame (GL shader JIT, TBB threads) is not timed.
 void BM_Frame(benchmark::State& state, std::string renderer_name, std::string scene_name) {
   Scene scene = builtin(scene_name + ":" + std::to_string(state.range(0)));
   scene.image.width = int(state.range(1));
   scene.image.height = int(state.range(1) * 3 / 4);
-  auto renderer = make_renderer(renderer_name == "raytrace_none" ? "raytrace" : renderer_name);
   RenderOptions options;
   options.mode = RenderMode::Local;
-  if (renderer_name == "raytrace_none") options.accel = AccelKind::None;
-  RenderOutput out = renderer.value()->render(scene, options).value();
+  FrameRenderer renderer(renderer_name, scene, options);
+  RenderOutput out = renderer.frame();
   for (auto _ : state) {
-    out = renderer.value()->render(scene, options).value();
+    out = renderer.frame();
     benchmark::DoNotOptimize(out.buffers.color.data());
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
@@ -71,13 +100,13 @@ void BM_Threads(benchmark::State& state, std::string renderer_name) {
   Scene scene = builtin("tessphere:100000");
   scene.image.width = 1024;
   scene.image.height = 768;
-  auto renderer = make_renderer(renderer_name);
   RenderOptions options;
   options.mode = RenderMode::Local;
   options.threads = int(state.range(0));
-  RenderOutput out = renderer.value()->render(scene, options).value();
+  FrameRenderer renderer(renderer_name, scene, options);
+  RenderOutput out = renderer.frame();
   for (auto _ : state) {
-    out = renderer.value()->render(scene, options).value();
+    out = renderer.frame();
     benchmark::DoNotOptimize(out.buffers.color.data());
   }
   add_counters(state, out, 1024.0 * 768.0);
@@ -87,12 +116,12 @@ void BM_DepthComplexity(benchmark::State& state, std::string renderer_name) {
   Scene scene = builtin("occluders:" + std::to_string(state.range(0)));
   scene.image.width = 512;
   scene.image.height = 384;
-  auto renderer = make_renderer(renderer_name);
   RenderOptions options;
   options.mode = RenderMode::Local;
-  RenderOutput out = renderer.value()->render(scene, options).value();
+  FrameRenderer renderer(renderer_name, scene, options);
+  RenderOutput out = renderer.frame();
   for (auto _ : state) {
-    out = renderer.value()->render(scene, options).value();
+    out = renderer.frame();
     benchmark::DoNotOptimize(out.buffers.color.data());
   }
   add_counters(state, out, 512.0 * 384.0);

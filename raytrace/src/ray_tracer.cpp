@@ -2,14 +2,14 @@
 // the BVH or the plain loop), shade the nearest hit with the shared shading function.
 #include "rvr/raytrace/ray_tracer.h"
 
-#include <atomic>
-#include <chrono>
-#include <cmath>
-
 #include <tbb/blocked_range.h>
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
 
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/shared/camera.h"
@@ -102,8 +102,8 @@ class FrameTracer {
     } else {
       fb.color[i] = supersample(x, y, spp, counters);
     }
-    fb.cost[i] = float(counters.traversal.nodes_visited + counters.traversal.primitive_tests -
-                       work_before);
+    fb.cost[i] =
+        float(counters.traversal.nodes_visited + counters.traversal.primitive_tests - work_before);
   }
 
  private:
@@ -148,7 +148,8 @@ class FrameTracer {
     const float pi = 3.14159265358979f;
     float radius = scene_.camera.aperture_radius * std::sqrt(rng.uniform());
     float angle = 2.0f * pi * (float(k) + rng.uniform()) / float(spp);
-    glm::vec3 lens = frame_.eye + radius * (std::cos(angle) * frame_.right + std::sin(angle) * frame_.up);
+    glm::vec3 lens =
+        frame_.eye + radius * (std::cos(angle) * frame_.right + std::sin(angle) * frame_.up);
     glm::vec3 focus = frame_.eye + scene_.camera.focus_distance * pinhole.dir;
     Ray r = pinhole;
     r.origin = lens;
@@ -180,8 +181,9 @@ class FrameTracer {
       counters.shadow++;
       return geometry_.occluded(shadow, counters.traversal) ? 0.0f : 1.0f;
     };
-    glm::vec3 local = shade_local(m, s.position, N, V, scene_.ambient,
-                                  rng ? light_samples(scene_.lights, [rng] { return rng->uniform(); }) : lights_, visibility);
+    glm::vec3 local = shade_local(
+        m, s.position, N, V, scene_.ambient,
+        rng ? light_samples(scene_.lights, [rng] { return rng->uniform(); }) : lights_, visibility);
     glm::vec3 colour = (1.0f - m.mirror - m.transparency) * local;
     if (depth >= options_.max_depth) return colour;
     glm::vec3 d = glm::normalize(ray.dir);
@@ -222,15 +224,26 @@ class FrameTracer {
 Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& requested) {
   RenderOptions options = requested;
   if (has_forced_) options.accel = forced_;
-  RenderOutput out;
-  const int w = scene.image.width, h = scene.image.height;
-  if (w <= 0 || h <= 0) return bad_input("image size must be positive");
+  if (scene.image.width <= 0 || scene.image.height <= 0)
+    return bad_input("image size must be positive");
 
   auto t_build = Clock::now();
   TraceGeometry geometry(scene, options.spheres, options.sphere_segments, options.accel,
                          options.triangle_test);
-  out.stats["time.build"] = seconds_since(t_build);
+  double build_seconds = seconds_since(t_build);
   if (!geometry.error().empty()) return internal_error(geometry.error());
+  Expected<RenderOutput> out = render(scene, options, geometry);
+  if (out.ok()) out.value().stats["time.build"] = build_seconds;
+  return out;
+}
+
+Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& requested,
+                                         const TraceGeometry& geometry) {
+  RenderOptions options = requested;
+  options.accel = geometry.accel();
+  RenderOutput out;
+  const int w = scene.image.width, h = scene.image.height;
+  if (w <= 0 || h <= 0) return bad_input("image size must be positive");
 
   auto t_render = Clock::now();
   out.buffers.reset(w, h, scene.image.background);

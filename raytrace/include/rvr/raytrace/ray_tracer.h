@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "rvr/raytrace/trace_geometry.h"
 #include "rvr/shared/renderer.h"
 
 namespace rvr {
@@ -18,6 +19,10 @@ class RayTracer : public Renderer {
     return has_forced_ && forced_ == AccelKind::Embree ? "embree" : "raytrace";
   }
   Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options) override;
+  // A frame over geometry built beforehand from the same scene (benchmarks build once and time
+  // frames only); its accelerator and sphere mode win over the options'.
+  Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options,
+                                const TraceGeometry& geometry);
 
  private:
   AccelKind forced_ = AccelKind::Bvh;
