@@ -62,7 +62,7 @@ fuzz: deps
 	FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run.sh $(FUZZ_DIR)
 
 # A sweep of a few minutes: JSON into bench/results/, charts into bench/charts/.
-BENCH_FILTER ?= BM_Frame/(raster|raytrace|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_DepthComplexity|BM_Effects|BM_Trace|BM_Build
+BENCH_FILTER ?= BM_Frame/(raster|softraster|raytrace|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_DepthComplexity|BM_Effects|BM_Trace|BM_Build|BM_Threads
 bench: build
 	mkdir -p bench/results bench/charts
 	$(BUILD_DIR)/bin/rvr_bench --benchmark_filter='$(BENCH_FILTER)' --benchmark_min_time=0.2 \

@@ -1,12 +1,26 @@
 // Binned SAH builder (as in pbrt-v4 and Embree): at each node, bin primitive centroids into
 // kBins slots per axis, sweep the bins for the split of least surface-area cost, and stop
 // when a leaf is cheaper than any split. Nodes come out in depth-first order.
+#include "rvr/raytrace/bvh.h"
+
 #include <algorithm>
 #include <chrono>
 
-#include "rvr/raytrace/bvh.h"
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 namespace rvr {
+
+void advise_huge_pages(void* p, size_t bytes) {
+#ifdef MADV_HUGEPAGE
+  madvise(p, bytes, MADV_HUGEPAGE);
+#else
+  (void)p;
+  (void)bytes;
+#endif
+}
+
 namespace {
 
 constexpr int kBins = 16;
@@ -88,8 +102,8 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds) {
         uint32_t p = bvh.order_[i];
         for (int a = 0; a < 3; ++a) {
           if (extent[a] <= 0.0f) continue;
-          int b = std::min(kBins - 1, int((centroids[p][a] - centroid_box.lo[a]) *
-                                          (float(kBins) / extent[a])));
+          int b = std::min(
+              kBins - 1, int((centroids[p][a] - centroid_box.lo[a]) * (float(kBins) / extent[a])));
           bin_count[a][b]++;
           bin_box[a][b].grow(bounds[p]);
         }
@@ -143,10 +157,9 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds) {
       // No useful SAH split (all centroids equal, or too deep): split at the object median.
       axis = int(std::max_element(&extent[0], &extent[0] + 3) - &extent[0]);
       mid = task.begin + count / 2;
-      std::nth_element(bvh.order_.begin() + task.begin, bvh.order_.begin() + mid,
-                       bvh.order_.begin() + task.end, [&](uint32_t a, uint32_t b) {
-                         return centroids[a][axis] < centroids[b][axis];
-                       });
+      std::nth_element(
+          bvh.order_.begin() + task.begin, bvh.order_.begin() + mid, bvh.order_.begin() + task.end,
+          [&](uint32_t a, uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
     }
 
     BvhNode& node = bvh.nodes_[index];

@@ -1,9 +1,8 @@
 #include "rvr/raytrace/trace_geometry.h"
 
-#include "embree_backend.h"
-
 #include <algorithm>
 
+#include "embree_backend.h"
 #include "rvr/shared/tessellate.h"
 
 namespace rvr {
@@ -144,7 +143,7 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
   for (size_t k = 0; k < analytic_.size(); ++k)
     bounds[triangles_.size() + k] = analytic_bounds(analytic_[k]);
   bvh_ = Bvh::build(bounds);
-  slot_primitive_ = bvh_.primitive_order();
+  slot_primitive_.assign(bvh_.primitive_order().begin(), bvh_.primitive_order().end());
   slot_triangles_.resize(slot_primitive_.size());
   for (size_t s = 0; s < slot_primitive_.size(); ++s) {
     if (slot_primitive_[s] < triangles_.size()) slot_triangles_[s] = triangles_[slot_primitive_[s]];
@@ -277,8 +276,7 @@ bool TraceGeometry::query(const Ray& ray, HitRecord& hit, TraversalCounters& cou
 
 bool TraceGeometry::closest(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
   if (embree_) return embree_closest(*embree_, ray, hit);
-  if (triangle_test_ == TriangleTest::Chapter)
-    return query<ChapterTest, false>(ray, hit, counters);
+  if (triangle_test_ == TriangleTest::Chapter) return query<ChapterTest, false>(ray, hit, counters);
   return query<MollerTrumboreTest, false>(ray, hit, counters);
 }
 

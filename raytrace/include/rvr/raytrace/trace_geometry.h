@@ -91,7 +91,7 @@ class TraceGeometry {
   // Unified primitive index: [0, T) triangles, [T, T + A) analytic shapes.
   std::vector<TrianglePrecomputed> triangles_;
   std::vector<uint32_t> triangle_object_;
-  std::vector<uint32_t> triangle_id_;  // primitive id reported (0 for tessellated spheres)
+  std::vector<uint32_t> triangle_id_;       // primitive id reported (0 for tessellated spheres)
   std::vector<uint32_t> triangle_in_mesh_;  // index into the mesh's triangles (normals)
   std::vector<Analytic> analytic_;
   std::vector<const TriangleMesh*> object_mesh_;             // per object, or null
@@ -100,8 +100,8 @@ class TraceGeometry {
   std::vector<uint32_t> object_first_triangle_;  // unified index of each object's triangle 0
   // BVH leaf slots: primitive index and, for triangles, a copy in leaf order for locality.
   Bvh bvh_;
-  std::vector<uint32_t> slot_primitive_;
-  std::vector<TrianglePrecomputed> slot_triangles_;
+  TraversalVector<uint32_t> slot_primitive_;
+  TraversalVector<TrianglePrecomputed> slot_triangles_;
   std::unique_ptr<EmbreeBackend, EmbreeBackendDeleter> embree_;
   std::string error_;
 };
