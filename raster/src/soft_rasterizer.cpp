@@ -319,35 +319,67 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     transparency |= d.material->transparency > 0.0f;
   }
 
-  Setup setup{
-      w,
-      h,
-      glm::dmat4(projection_matrix(scene.camera, w, h)) * glm::dmat4(view_matrix(scene.camera)),
-      {},
-      0,
-      {},
-      {}};
-  size_t submitted = 0;
-  for (size_t i = 0; i < objects.size(); ++i) {
-    const TriangleMesh* m = objects[i].mesh;
-    if (!m) continue;
-    setup.triangles.reserve(setup.triangles.size() + m->triangles.size());
-    for (size_t k = 0; k < m->triangles.size(); ++k) {
-      const glm::uvec3& tri = m->triangles[k];
-      setup.add({m->positions[tri.x], m->positions[tri.y], m->positions[tri.z]}, uint32_t(i),
-                uint32_t(k));
-    }
-    submitted += m->triangles.size();
-  }
-  const std::vector<SetupTriangle>& tris = setup.triangles;
+  // Setup in parallel over fixed chunks of the submission order, each chunk transforming,
+  // clipping and binning its own triangles; chunks are joined in order, so the triangle list and
+  // every bin come out exactly as a serial pass would make them, whatever the thread count.
+  const glm::dmat4 view_projection =
+      glm::dmat4(projection_matrix(scene.camera, w, h)) * glm::dmat4(view_matrix(scene.camera));
+  struct Submitted {
+    uint32_t object, primitive;
+  };
+  std::vector<Submitted> order;
+  for (size_t i = 0; i < objects.size(); ++i)
+    if (const TriangleMesh* m = objects[i].mesh)
+      for (size_t k = 0; k < m->triangles.size(); ++k) order.push_back({uint32_t(i), uint32_t(k)});
+  const size_t submitted = order.size();
   const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-  std::vector<std::vector<uint32_t>> bins(size_t(tiles_x) * size_t(tiles_y));
-  for (size_t i = 0; i < tris.size(); ++i) {
-    const SetupTriangle& s = tris[i];
-    for (int ty = s.y0 / kTile; ty <= s.y1 / kTile; ++ty)
-      for (int tx = s.x0 / kTile; tx <= s.x1 / kTile; ++tx)
-        bins[size_t(ty) * size_t(tiles_x) + size_t(tx)].push_back(uint32_t(i));
+  const size_t tile_count = size_t(tiles_x) * size_t(tiles_y);
+  constexpr size_t kChunk = 8192;
+  const size_t chunk_count = (order.size() + kChunk - 1) / kChunk;
+  std::vector<Setup> chunks(chunk_count, Setup{w, h, view_projection, {}, 0, {}, {}});
+  std::vector<std::vector<std::vector<uint32_t>>> chunk_bins(chunk_count);
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), chunk_count, [&](size_t c) {
+      Setup& setup = chunks[c];
+      const size_t end = std::min(order.size(), (c + 1) * kChunk);
+      setup.triangles.reserve(end - c * kChunk);
+      for (size_t j = c * kChunk; j < end; ++j) {
+        const TriangleMesh& m = *objects[order[j].object].mesh;
+        const glm::uvec3& tri = m.triangles[order[j].primitive];
+        setup.add({m.positions[tri.x], m.positions[tri.y], m.positions[tri.z]}, order[j].object,
+                  order[j].primitive);
+      }
+      auto& bins = chunk_bins[c];
+      bins.resize(tile_count);
+      for (size_t i = 0; i < setup.triangles.size(); ++i) {
+        const SetupTriangle& st = setup.triangles[i];
+        for (int ty = st.y0 / kTile; ty <= st.y1 / kTile; ++ty)
+          for (int tx = st.x0 / kTile; tx <= st.x1 / kTile; ++tx)
+            bins[size_t(ty) * size_t(tiles_x) + size_t(tx)].push_back(uint32_t(i));
+      }
+    });
+  });
+  // Offsets of each chunk's triangles in the joined list.
+  std::vector<uint32_t> first(chunk_count + 1, 0);
+  size_t clipped = 0;
+  for (size_t c = 0; c < chunk_count; ++c) {
+    first[c + 1] = first[c] + uint32_t(chunks[c].triangles.size());
+    clipped += chunks[c].clipped;
   }
+  std::vector<SetupTriangle> tris(first[chunk_count]);
+  std::vector<std::vector<uint32_t>> bins(tile_count);
+  arena.execute([&] {
+    tbb::parallel_for(size_t(0), chunk_count, [&](size_t c) {
+      std::copy(chunks[c].triangles.begin(), chunks[c].triangles.end(), tris.begin() + first[c]);
+    });
+    tbb::parallel_for(size_t(0), tile_count, [&](size_t b) {
+      size_t n = 0;
+      for (size_t c = 0; c < chunk_count; ++c) n += chunk_bins[c][b].size();
+      bins[b].reserve(n);
+      for (size_t c = 0; c < chunk_count; ++c)
+        for (uint32_t i : chunk_bins[c][b]) bins[b].push_back(first[c] + i);
+    });
+  });
   out.stats["time.setup"] = seconds_since(t);
 
   // --- raster: tiles in parallel, each independent of the others
@@ -410,7 +442,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   for (const TileCounters& c : counters) generated += c.generated;
   for (uint32_t v : visible) covered += v != kNoId ? 1 : 0;
   out.stats["triangles.submitted"] = double(submitted);
-  out.stats["triangles.clipped"] = double(setup.clipped);
+  out.stats["triangles.clipped"] = double(clipped);
   out.stats["triangles.setup"] = double(tris.size());
   out.stats["fragments.generated"] = double(generated);
   out.stats["fragments.shaded"] = double(covered);
