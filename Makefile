@@ -61,11 +61,14 @@ fuzz: deps
 	cmake --build $(FUZZ_DIR) -j $(JOBS) --target fuzz_scene fuzz_mesh
 	FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run.sh $(FUZZ_DIR)
 
-# A sweep of a few minutes: JSON into bench/results/, charts into bench/charts/.
+# A sweep of a few minutes: JSON into bench/results/, charts into bench/charts/. Three
+# repetitions in random order, medians kept: on 2 shared cores the machine speed drifts by 2x
+# over minutes, and interleaving spreads the drift over every benchmark alike.
 BENCH_FILTER ?= BM_Frame/(raster|softraster|raytrace|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_DepthComplexity|BM_Effects|BM_Trace|BM_Build|BM_Threads
 bench: build
 	mkdir -p bench/results bench/charts
 	$(BUILD_DIR)/bin/rvr_bench --benchmark_filter='$(BENCH_FILTER)' --benchmark_min_time=0.2 \
+		--benchmark_repetitions=3 --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true \
 		--benchmark_out=bench/results/latest.json --benchmark_out_format=json
 	/usr/bin/python3 bench/plot.py bench/results/latest.json bench/charts
 

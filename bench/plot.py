@@ -18,6 +18,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 def load(path):
     data = json.loads(Path(path).read_text())
+    medians = [dict(b, name=b["run_name"]) for b in data["benchmarks"]
+               if b.get("run_type") == "aggregate" and b.get("aggregate_name") == "median"]
+    if medians:  # --benchmark_repetitions: the median of each benchmark
+        return data.get("context", {}), medians
     rows = [b for b in data["benchmarks"] if b.get("run_type", "iteration") == "iteration"]
     return data.get("context", {}), rows
 
