@@ -79,13 +79,13 @@ class FrameRenderer {
   std::unique_ptr<TraceGeometry> geometry_;
 };
 
-// A whole frame with one renderer. The first frame (GL shader JIT, TBB threads) is not timed.
-void BM_Frame(benchmark::State& state, std::string renderer_name, std::string scene_name) {
-  Scene scene = builtin(scene_name + ":" + std::to_string(state.range(0)));
-  scene.image.width = int(state.range(1));
-  scene.image.height = int(state.range(1) * 3 / 4);
+// Times whole frames of `scene` (already sized) in local mode. The first frame (GL shader JIT,
+// TBB threads) is not timed.
+void time_frames(benchmark::State& state, const std::string& renderer_name, const Scene& scene,
+                 int threads = 0) {
   RenderOptions options;
   options.mode = RenderMode::Local;
+  options.threads = threads;
   FrameRenderer renderer(renderer_name, scene, options);
   RenderOutput out = renderer.frame();
   for (auto _ : state) {
@@ -95,36 +95,27 @@ void BM_Frame(benchmark::State& state, std::string renderer_name, std::string sc
   add_counters(state, out, double(scene.image.width) * scene.image.height);
 }
 
+// A whole frame with one renderer.
+void BM_Frame(benchmark::State& state, std::string renderer_name, std::string scene_name) {
+  Scene scene = builtin(scene_name + ":" + std::to_string(state.range(0)));
+  scene.image.width = int(state.range(1));
+  scene.image.height = int(state.range(1) * 3 / 4);
+  time_frames(state, renderer_name, scene);
+}
+
 // Parallel scaling of our own loops: the same frame with 1 and with 2 worker threads.
 void BM_Threads(benchmark::State& state, std::string renderer_name) {
   Scene scene = builtin("tessphere:100000");
   scene.image.width = 1024;
   scene.image.height = 768;
-  RenderOptions options;
-  options.mode = RenderMode::Local;
-  options.threads = int(state.range(0));
-  FrameRenderer renderer(renderer_name, scene, options);
-  RenderOutput out = renderer.frame();
-  for (auto _ : state) {
-    out = renderer.frame();
-    benchmark::DoNotOptimize(out.buffers.color.data());
-  }
-  add_counters(state, out, 1024.0 * 768.0);
+  time_frames(state, renderer_name, scene, int(state.range(0)));
 }
 
 void BM_DepthComplexity(benchmark::State& state, std::string renderer_name) {
   Scene scene = builtin("occluders:" + std::to_string(state.range(0)));
   scene.image.width = 512;
   scene.image.height = 384;
-  RenderOptions options;
-  options.mode = RenderMode::Local;
-  FrameRenderer renderer(renderer_name, scene, options);
-  RenderOutput out = renderer.frame();
-  for (auto _ : state) {
-    out = renderer.frame();
-    benchmark::DoNotOptimize(out.buffers.color.data());
-  }
-  add_counters(state, out, 512.0 * 384.0);
+  time_frames(state, renderer_name, scene);
 }
 
 // The tracer on cornell with exactly one effect switched on.
