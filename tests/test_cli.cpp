@@ -7,9 +7,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -30,9 +29,10 @@ std::string slurp(const fs::path& p) {
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("rvr_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
-            "_" + std::to_string(::getpid()));
+    dir_ =
+        fs::temp_directory_path() /
+        ("rvr_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) +
+         "_" + std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -85,12 +85,12 @@ TEST_F(Cli, ScenesListsEveryBuiltin) {
 
 TEST_F(Cli, RenderWritesImageAovsAndStats) {
   fs::path out = dir_ / "sub" / "img.png";
-  RunResult r = run("render builtin:cornell -r raytrace " + std::string(kSmall) + " -o " +
-                    out.string() + " --aov depth,id,normal,cost --stats " +
-                    (dir_ / "stats.json").string());
+  RunResult r =
+      run("render builtin:cornell -r raytrace " + std::string(kSmall) + " -o " + out.string() +
+          " --aov depth,id,normal,cost --stats " + (dir_ / "stats.json").string());
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* f : {"img.png", "img.depth.exr", "img.id.exr", "img.normal.exr",
-                        "img.cost.exr", "img.cost.png"})
+  for (const char* f :
+       {"img.png", "img.depth.exr", "img.id.exr", "img.normal.exr", "img.cost.exr", "img.cost.png"})
     EXPECT_TRUE(fs::exists(dir_ / "sub" / f)) << f;
   nlohmann::json stats = nlohmann::json::parse(slurp(dir_ / "stats.json"));
   EXPECT_EQ(stats["renderer"], "raytrace");
@@ -109,7 +109,8 @@ TEST_F(Cli, RasterRenders) {
 }
 
 TEST_F(Cli, BadSceneIsExit2WithOneErrorLineAndNoOutput) {
-  fs::path scene = write("bad.json", R"({"camera": {"eye": [0,0,5], "target": [0,0,0], "up": [0,1,0]},
+  fs::path scene =
+      write("bad.json", R"({"camera": {"eye": [0,0,5], "target": [0,0,0], "up": [0,1,0]},
     "objects": [{"type": "sphere", "center": [0,0,0], "radius": -1}]})");
   RunResult r = run("render " + scene.string() + " -r raytrace -o " + (dir_ / "out.png").string());
   EXPECT_EQ(r.status, 2);
@@ -121,7 +122,8 @@ TEST_F(Cli, BadSceneIsExit2WithOneErrorLineAndNoOutput) {
 }
 
 TEST_F(Cli, SyntaxErrorNamesLineAndColumn) {
-  fs::path scene = write("syntax.json", "{\n  \"camera\": {\n    \"eye\": [0, 0, 5]\n    \"target\": [0,0,0]\n}\n");
+  fs::path scene = write(
+      "syntax.json", "{\n  \"camera\": {\n    \"eye\": [0, 0, 5]\n    \"target\": [0,0,0]\n}\n");
   RunResult r = run("compare " + scene.string() + " -o " + (dir_ / "cmp").string());
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("syntax.json:4:"), std::string::npos) << r.err;
@@ -153,29 +155,40 @@ TEST_F(Cli, CompareWritesEverythingAndThresholdGivesExit1) {
   fs::path out = dir_ / "cmp";
   RunResult r = run("compare builtin:soup:3000 --width 160 --height 120 -o " + out.string());
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* f : {"raster.png", "raytrace.png", "diff.png", "id_mismatch.png",
-                        "metrics.json", "report.html"})
+  for (const char* f :
+       {"raster.png", "raytrace.png", "diff.png", "id_mismatch.png", "metrics.json", "report.html"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   nlohmann::json m = nlohmann::json::parse(slurp(out / "metrics.json"));
-  for (const char* key : {"scene", "width", "height", "mode", "renderers", "visibility", "depth", "color"})
+  for (const char* key :
+       {"scene", "width", "height", "mode", "renderers", "visibility", "depth", "color"})
     EXPECT_TRUE(m.contains(key)) << key;
   double agreement = m["visibility"]["id_agreement"].get<double>();
   EXPECT_GT(agreement, 0.99);
   EXPECT_NE(r.out.find("id agreement"), std::string::npos);
   // A threshold above what was measured is crossed: exit 1.
   if (agreement < 1.0) {
-    EXPECT_EQ(run("compare builtin:soup:3000 --width 160 --height 120 --fail-below-agreement 1 -o " +
-                  out.string())
-                  .status,
-              1);
+    EXPECT_EQ(
+        run("compare builtin:soup:3000 --width 160 --height 120 --fail-below-agreement 1 -o " +
+            out.string())
+            .status,
+        1);
   }
 }
 
 TEST_F(Cli, DiffReportsAndFailsAboveThreshold) {
   fs::path a = dir_ / "a.png", b = dir_ / "b.png", c = dir_ / "c.png";
-  ASSERT_EQ(run("render builtin:cornell -r raytrace --mode local " + std::string(kSmall) + " -o " + a.string()).status, 0);
-  ASSERT_EQ(run("render builtin:spheres -r raytrace --mode local " + std::string(kSmall) + " -o " + b.string()).status, 0);
-  ASSERT_EQ(run("render builtin:cornell -r raytrace --mode local --width 40 --height 30 -o " + c.string()).status, 0);
+  ASSERT_EQ(run("render builtin:cornell -r raytrace --mode local " + std::string(kSmall) + " -o " +
+                a.string())
+                .status,
+            0);
+  ASSERT_EQ(run("render builtin:spheres -r raytrace --mode local " + std::string(kSmall) + " -o " +
+                b.string())
+                .status,
+            0);
+  ASSERT_EQ(
+      run("render builtin:cornell -r raytrace --mode local --width 40 --height 30 -o " + c.string())
+          .status,
+      0);
   RunResult same = run("diff " + a.string() + " " + a.string());
   EXPECT_EQ(same.status, 0) << same.err;
   RunResult differ = run("diff " + a.string() + " " + b.string() + " --fail-above 0.001 -o " +
@@ -195,4 +208,175 @@ TEST_F(Cli, DefaultCompareFinishesInUnderAMinute) {
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_LT(seconds, 60.0);
   EXPECT_TRUE(fs::exists(dir_ / "rvr-out" / "report.html"));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input, as a user meets it on the command line: every row is exit 2, exactly one line on
+// stderr, starting "error: FILE:" and naming the JSON path (or the file's problem), and no file
+// written. The loader's own table (test_scene_loader) checks the full messages.
+
+namespace {
+
+struct CliBadInput {
+  const char* label;
+  std::string scene;     // the scene file's text (written as bad.json), or empty
+  std::string expected;  // substring of the one error line, after "error: "
+};
+
+std::string with_camera(const std::string& rest) {
+  return R"({"camera": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0]})" +
+         (rest.empty() ? std::string() : ", " + rest) + "}";
+}
+std::string with_object(const std::string& object) {
+  return with_camera(R"("objects": [)" + object + "]");
+}
+std::string with_sphere(const std::string& extra) {
+  return with_object(R"({"type": "sphere", "center": [0, 0, 0], "radius": 1)" + extra + "}");
+}
+
+std::vector<CliBadInput> cli_bad_inputs() {
+  return {
+      {"syntax", "{\"camera\": {} \"objects\": []}", "bad.json:1:15: JSON syntax"},
+      {"truncated", "{\"camera\": {\"eye\": [0, 0", "bad.json:1:25: JSON syntax"},
+      {"empty", "", "bad.json:1:1: JSON syntax"},
+      {"binary garbage", std::string("\x89PNG\r\n\x1a\n\0\0\0", 11), "bad.json:1:1: JSON syntax"},
+      {"NaN literal", with_object(R"({"type": "sphere", "center": [0, 0, 0], "radius": NaN})"),
+       "bad.json:1:"},
+      {"root not an object", "[1, 2, 3]", "bad.json: top level: must be an object"},
+      {"unknown top-level key", with_camera(R"("objets": [])"),
+       "bad.json: top level: unknown key 'objets'"},
+      {"wrong format", with_camera(R"("format": "rvr-scene/9")"), "bad.json: format:"},
+      {"missing camera", R"({"objects": []})", "bad.json: camera: is required"},
+      {"short eye", R"({"camera": {"eye": [0, 0], "target": [0, 0, 0], "up": [0, 1, 0]}})",
+       "bad.json: camera.eye:"},
+      {"up parallel to view",
+       R"({"camera": {"eye": [0, 5, 0], "target": [0, 0, 0], "up": [0, 1, 0]}})",
+       "bad.json: camera.up:"},
+      {"eye equals target",
+       R"({"camera": {"eye": [0, 0, 0], "target": [0, 0, 0], "up": [0, 1, 0]}})",
+       "bad.json: camera"},
+      {"fov out of range",
+       R"({"camera": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 180}})",
+       "bad.json: camera.fov_y_deg:"},
+      {"zero width", with_camera(R"("image": {"width": 0})"), "bad.json: image.width:"},
+      {"zero samples", with_camera(R"("image": {"samples_per_pixel": 0})"),
+       "bad.json: image.samples_per_pixel:"},
+      {"fractional height", with_camera(R"("image": {"height": 10.5})"), "bad.json: image.height:"},
+      {"negative radius", with_sphere(R"(, "radius": -1)"), "bad.json: objects[0].radius:"},
+      {"duplicate key", with_sphere(R"(, "radius": 2)"),
+       "bad.json: objects[0].radius: duplicate key"},
+      {"radius as a string",
+       with_object(R"({"type": "sphere", "center": [0, 0, 0], "radius": "1"})"),
+       "bad.json: objects[0].radius:"},
+      {"overflowing number",
+       with_object(R"({"type": "sphere", "center": [0, 1e999, 0], "radius": 1})"),
+       "bad.json: objects[0].center[1]:"},
+      {"unknown object type", with_object(R"({"type": "cube"})"), "bad.json: objects[0].type:"},
+      {"zero plane normal",
+       with_object(R"({"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 0]})"),
+       "bad.json: objects[0].normal:"},
+      {"degenerate lone triangle",
+       with_object(R"({"type": "triangle", "vertices": [[0, 0, 0], [1, 1, 1], [2, 2, 2]]})"),
+       "bad.json: objects[0]"},
+      {"undefined material", with_sphere(R"(, "material": "gold")"),
+       "bad.json: objects[0].material:"},
+      {"negative diffuse", with_camera(R"("materials": {"m": {"diffuse": [-0.5, 0, 0]}})"),
+       "bad.json: materials.m.diffuse"},
+      {"ior zero", with_camera(R"("materials": {"m": {"ior": 0}})"), "bad.json: materials.m.ior:"},
+      {"negative light intensity",
+       with_camera(
+           R"("lights": [{"type": "point", "position": [0, 1, 0], "intensity": [-1, 1, 1]}])"),
+       "bad.json: lights[0].intensity"},
+      {"zero-area light",
+       with_camera(
+           R"("lights": [{"type": "area", "corner": [0, 1, 0], "edge_u": [1, 0, 0], "edge_v": [2, 0, 0], "intensity": [1, 1, 1]}])"),
+       "bad.json: lights[0]"},
+      {"missing mesh file", with_object(R"({"type": "mesh", "file": "no-such.obj"})"),
+       "bad.json: objects[0].file:"},
+      {"garbage mesh", with_object(R"({"type": "mesh", "file": "garbage.obj"})"),
+       "bad.json: objects[0].file:"},
+      {"mesh is a folder", with_object(R"({"type": "mesh", "file": "folder.obj"})"),
+       "bad.json: objects[0].file:"},
+      {"csg without b",
+       with_object(
+           R"({"type": "csg", "op": "union", "a": {"type": "sphere", "center": [0, 0, 0], "radius": 1}})"),
+       "bad.json: objects[0].b:"},
+      {"unknown csg op",
+       with_object(
+           R"({"type": "csg", "op": "xor", "a": {"type": "sphere", "center": [0, 0, 0], "radius": 1}, "b": {"type": "sphere", "center": [0, 0, 0], "radius": 1}})"),
+       "bad.json: objects[0].op:"},
+      {"zero scale", with_sphere(R"(, "transform": {"scale": [1, 0, 1]})"),
+       "bad.json: objects[0].transform.scale"},
+  };
+}
+
+}  // namespace
+
+TEST_F(Cli, EveryBadInputIsExit2WithOneNamedErrorLineAndNoOutput) {
+  auto cases = cli_bad_inputs();
+  ASSERT_GE(cases.size(), 30u);
+  // Inputs the mesh rows refer to.
+  write("garbage.obj", std::string("\x01\x02 not a mesh \xff\xfe\n v 1 2\n f 9 9 9\n", 32));
+  fs::create_directories(dir_ / "folder.obj");
+  for (size_t k = 0; k < cases.size(); ++k) {
+    const CliBadInput& c = cases[k];
+    SCOPED_TRACE(c.label);
+    write("bad.json", c.scene);
+    std::vector<std::string> commands{"render " + (dir_ / "bad.json").string() +
+                                      " -r raytrace -o " + (dir_ / "out.png").string() +
+                                      " --aov depth --stats " + (dir_ / "stats.json").string()};
+    // compare loads through the same path: every fourth row is enough (each run starts Mesa).
+    if (k % 4 == 0)
+      commands.push_back("compare " + (dir_ / "bad.json").string() + " -o " +
+                         (dir_ / "cmp").string());
+    for (const std::string& cmd : commands) {
+      RunResult r = run(cmd);
+      EXPECT_EQ(r.status, 2) << r.err;
+      // Exactly one line, and it is the error.
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_EQ(r.err.rfind("error: " + (dir_ / "bad.json").string(), 0), 0u) << r.err;
+      EXPECT_NE(r.err.find(c.expected.substr(std::string("bad.json").size())), std::string::npos)
+          << "expected '" << c.expected << "' in: " << r.err;
+      EXPECT_TRUE(outputs({"bad.json", "garbage.obj", "folder.obj"}).empty());
+      for (const char* f : {"out.png", "out.depth.exr", "stats.json", "cmp"})
+        fs::remove_all(dir_ / f);
+    }
+  }
+}
+
+TEST_F(Cli, MissingSceneFileAndFolderAsSceneAreExit2) {
+  for (const std::string& scene : {(dir_ / "nope.json").string(), dir_.string()}) {
+    RunResult r = run("render " + scene + " -r raytrace -o " + (dir_ / "x.png").string());
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("error: " + scene, 0), 0u) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "x.png"));
+  }
+}
+
+TEST_F(Cli, OutputsGoIntoNewFoldersButNeverOverAnInput) {
+  // -o into a missing folder creates it.
+  RunResult ok = run("render builtin:spheres -r raytrace " + std::string(kSmall) + " -o " +
+                     (dir_ / "new/sub/img.png").string());
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_TRUE(fs::exists(dir_ / "new/sub/img.png"));
+  // An output equal to an input is refused, and the input is untouched.
+  fs::path scene = write("scene.json", with_sphere(""));
+  std::string before = slurp(scene);
+  RunResult same =
+      run("render " + scene.string() + " -r raytrace " + kSmall + " -o " + scene.string());
+  EXPECT_EQ(same.status, 2) << same.err;
+  EXPECT_NE(same.err.find("error: " + scene.string()), std::string::npos) << same.err;
+  EXPECT_EQ(slurp(scene), before);
+  RunResult stats = run("render " + scene.string() + " -r raytrace " + kSmall + " -o " +
+                        (dir_ / "a.png").string() + " --stats " + scene.string());
+  EXPECT_EQ(stats.status, 2) << stats.err;
+  EXPECT_EQ(slurp(scene), before);
+  EXPECT_FALSE(fs::exists(dir_ / "a.png"));
+  // An unwritable place is exit 2 with the path in the message.
+  fs::path blocked = write("blocked", "a file, not a folder");
+  RunResult unwritable = run("render " + scene.string() + " -r raytrace " + kSmall + " -o " +
+                             (blocked / "img.png").string());
+  EXPECT_EQ(unwritable.status, 2) << unwritable.err;
+  EXPECT_NE(unwritable.err.find((blocked / "img.png").string()), std::string::npos)
+      << unwritable.err;
 }

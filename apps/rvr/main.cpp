@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -160,7 +161,26 @@ struct RenderArgs {
   std::string stats;
 };
 
+// Refuses, before any work, an output that would overwrite one of the inputs.
+void refuse_overwriting_inputs(const std::vector<std::string>& inputs,
+                               const std::vector<std::string>& outputs) {
+  for (const std::string& out : outputs) {
+    for (const std::string& in : inputs) {
+      std::error_code ec;
+      if (in.rfind("builtin:", 0) == 0 || !std::filesystem::exists(out, ec)) continue;
+      if (std::filesystem::equivalent(out, in, ec))
+        fail(bad_input(out + ": is also an input; writing it would destroy it"));
+    }
+  }
+}
+
 int run_render(const RenderArgs& a) {
+  std::vector<std::string> outputs{a.out, a.stats};
+  const std::string base = std::filesystem::path(a.out).replace_extension().string();
+  for (const std::string& aov : a.aovs)
+    outputs.push_back(base + "." + aov + (aov == "cost" ? ".png" : ".exr"));
+  if (std::count(a.aovs.begin(), a.aovs.end(), "cost")) outputs.push_back(base + ".cost.exr");
+  refuse_overwriting_inputs({a.common.scene}, outputs);
   RenderOptions options = render_options(a.common, "full");
   double load_seconds = 0;
   Scene scene = load(a.common, load_seconds);
@@ -212,6 +232,8 @@ struct CompareArgs {
 int run_compare(const CompareArgs& a, const std::string& command_line) {
   if (a.renderers.size() < 2)
     fail(bad_input("--renderers: need at least two renderers to compare"));
+  refuse_overwriting_inputs({a.common.scene},
+                            {a.out_dir + "/metrics.json", a.out_dir + "/report.html"});
   RenderOptions options = render_options(a.common, "local");
   double load_seconds = 0;
   Scene scene = load(a.common, load_seconds);
@@ -305,6 +327,7 @@ struct DiffArgs {
 };
 
 int run_diff(const DiffArgs& d) {
+  if (!d.out.empty()) refuse_overwriting_inputs({d.a, d.b}, {d.out});
   Image a = take(read_image(d.a));
   Image b = take(read_image(d.b));
   ImageDiff diff = take(diff_images(a, b));
