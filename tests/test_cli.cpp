@@ -2,13 +2,16 @@
 // written when the input is bad.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <thread>
 
 namespace fs = std::filesystem;
 
@@ -379,4 +382,28 @@ TEST_F(Cli, OutputsGoIntoNewFoldersButNeverOverAnInput) {
   EXPECT_EQ(unwritable.status, 2) << unwritable.err;
   EXPECT_NE(unwritable.err.find((blocked / "img.png").string()), std::string::npos)
       << unwritable.err;
+}
+
+TEST_F(Cli, CtrlCStopsPromptlyAndLeavesNoFile) {
+  // A render of many seconds, interrupted after 2 s (the handler is set once main runs; the
+  // dynamic loading of Mesa and LLVM before it takes ~0.5 s).
+  fs::path out = dir_ / "long.png";
+  pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    std::freopen("/dev/null", "w", stderr);
+    ::execl(RVR_BINARY, RVR_BINARY, "render", "builtin:dof", "-r", "raytrace", "--spp", "4096",
+            "--width", "1024", "--height", "768", "-o", out.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+  auto sent = std::chrono::steady_clock::now();
+  ASSERT_EQ(::kill(pid, SIGINT), 0);
+  int status = 0;
+  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  EXPECT_LT(seconds, 2.0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  EXPECT_TRUE(outputs({}).empty());
 }

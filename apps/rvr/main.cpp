@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -451,7 +452,21 @@ int run(int argc, char** argv) {
 
 }  // namespace
 
+// Ctrl-C (or a kill): stop at once, delete the file being written, if any (finished files are
+// complete, having been renamed into place), and exit 130 as shells expect.
+extern "C" void on_interrupt(int signal_number) {
+  rvr::remove_unfinished_output();
+  const char message[] = "error: interrupted\n";
+  ssize_t ignored = ::write(2, message, sizeof(message) - 1);
+  (void)ignored;
+  ::_exit(128 + signal_number);
+}
+
 int main(int argc, char** argv) {
+  struct sigaction action {};
+  action.sa_handler = on_interrupt;
+  sigemptyset(&action.sa_mask);
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaction(s, &action, nullptr);
   try {
     return run(argc, argv);
   } catch (const Exit& e) {

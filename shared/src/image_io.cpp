@@ -11,6 +11,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -77,6 +78,20 @@ bool make_parent(const fs::path& path, std::string& reason) {
 }
 
 // Runs `write_temp(temp)`, then renames the temporary into place; removes it on any failure.
+// The temporary file being written, for remove_unfinished_output() in a signal handler: a
+// fixed buffer and a lock-free flag, nothing a handler cannot touch.
+char g_unfinished_path[4096];
+std::atomic<bool> g_unfinished{false};
+
+struct UnfinishedOutput {
+  explicit UnfinishedOutput(const std::string& temp) {
+    if (temp.size() >= sizeof(g_unfinished_path)) return;
+    std::memcpy(g_unfinished_path, temp.c_str(), temp.size() + 1);
+    g_unfinished.store(true);
+  }
+  ~UnfinishedOutput() { g_unfinished.store(false); }
+};
+
 template <class F>
 Status write_atomically(const std::string& path, F&& write_temp) {
   try {
@@ -85,6 +100,7 @@ Status write_atomically(const std::string& path, F&& write_temp) {
     std::string reason;
     if (!make_parent(target, reason)) return write_error(path, reason);
     fs::path temp = temp_path_for(target);
+    UnfinishedOutput unfinished(temp.string());
     std::error_code ec;
     if (!write_temp(temp, reason)) {
       fs::remove(temp, ec);
@@ -329,6 +345,10 @@ Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
   } catch (const std::exception& e) {
     return internal_error("cannot write AOVs of '" + out_path + "': " + e.what());
   }
+}
+
+void remove_unfinished_output() noexcept {
+  if (g_unfinished.load()) ::unlink(g_unfinished_path);
 }
 
 Status write_text_file(const std::string& path, const std::string& text) {

@@ -43,6 +43,10 @@ Image cost_image(const FrameBuffers& fb, float* scale = nullptr);
 Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
                   const std::vector<std::string>& aovs);
 
+// Deletes the temporary file of a write in progress, if any. Async-signal-safe: for a SIGINT
+// handler, so an interrupted run leaves no half-written file behind.
+void remove_unfinished_output() noexcept;
+
 // Writes `text` to `path` atomically (temporary name, then rename); creates missing folders.
 Status write_text_file(const std::string& path, const std::string& text);
 
