@@ -407,3 +407,31 @@ TEST_F(Cli, CtrlCStopsPromptlyAndLeavesNoFile) {
   EXPECT_EQ(WEXITSTATUS(status), 130);
   EXPECT_TRUE(outputs({}).empty());
 }
+
+TEST_F(Cli, LimitsRefuseHugeWorkBeforeAnyAllocationAndFlagsRaiseThem) {
+  struct Row {
+    std::string args, expected;
+  };
+  const Row rows[] = {
+      {"builtin:cornell --width 16384 --height 16384 --spp 64",
+       "error: builtin:cornell: image: 16384x16384 pixels x 64 samples = 17179869184 samples, "
+       "over the limit of 1073741824 (raise it with --max-samples)"},
+      {"builtin:tessphere:100000 --max-triangles 1000",
+       "error: builtin:tessphere:100000: objects: 99538 triangles"},
+      {"builtin:cornell --width 4096 --height 4096 --max-memory-mb 100",
+       "error: builtin:cornell: image, objects: about"},
+  };
+  for (const Row& row : rows) {
+    auto start = std::chrono::steady_clock::now();
+    RunResult r = run("render " + row.args + " -r raytrace -o " + (dir_ / "x.png").string());
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.err.rfind(row.expected, 0), 0u) << r.err;
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+              10.0);
+    EXPECT_TRUE(outputs({}).empty());
+  }
+  // Raised, the same small render goes through.
+  RunResult ok = run("render builtin:tessphere:100000 -r raytrace --max-triangles 200000 " +
+                     std::string(kSmall) + " -o " + (dir_ / "x.png").string());
+  EXPECT_EQ(ok.status, 0) << ok.err;
+}

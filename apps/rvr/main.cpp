@@ -20,6 +20,7 @@
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/limits.h"
 #include "rvr/shared/scene_loader.h"
 
 namespace {
@@ -70,6 +71,8 @@ struct CommonOptions {
   float shadow_bias = 0.01f;
   bool shadow_pcf = false;
   bool quiet = false;
+  Limits limits;
+  uint64_t max_memory_mb = 0;
 };
 
 void add_common_options(CLI::App& cmd, CommonOptions& o) {
@@ -105,6 +108,15 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
       ->check(CLI::Range(0.0f, 10.0f));
   cmd.add_flag("--shadow-pcf", o.shadow_pcf, "raster shadow maps: 3x3 percentage-closer filtering");
   cmd.add_flag("--quiet,-q", o.quiet, "no progress output");
+  cmd.add_option("--max-samples", o.limits.max_samples,
+                 "refuse more than N pixels x samples (default 2^30)")
+      ->check(CLI::PositiveNumber);
+  cmd.add_option("--max-triangles", o.limits.max_triangles,
+                 "refuse more than N triangles, tessellation included (default 50000000)")
+      ->check(CLI::PositiveNumber);
+  cmd.add_option("--max-memory-mb", o.max_memory_mb,
+                 "refuse renders estimated to need more MiB (default 3/4 of physical memory)")
+      ->check(CLI::PositiveNumber);
 }
 
 RenderMode parse_mode(const std::string& s) {
@@ -132,13 +144,16 @@ RenderOptions render_options(const CommonOptions& o, const std::string& default_
   return r;
 }
 
-Scene load(const CommonOptions& o, double& load_seconds) {
+Scene load(const CommonOptions& o, const RenderOptions& options, double& load_seconds) {
   auto start = Clock::now();
   Scene scene = take(load_scene(o.scene));
   if (o.width) scene.image.width = *o.width;
   if (o.height) scene.image.height = *o.height;
   if (o.spp) scene.image.samples_per_pixel = *o.spp;
   load_seconds = seconds_since(start);
+  Limits limits = o.limits;
+  limits.max_memory_bytes = std::min<uint64_t>(o.max_memory_mb, uint64_t(1) << 40) << 20;
+  check(check_limits(scene, options, limits));
   return scene;
 }
 
@@ -184,7 +199,7 @@ int run_render(const RenderArgs& a) {
   refuse_overwriting_inputs({a.common.scene}, outputs);
   RenderOptions options = render_options(a.common, "full");
   double load_seconds = 0;
-  Scene scene = load(a.common, load_seconds);
+  Scene scene = load(a.common, options, load_seconds);
   std::unique_ptr<Renderer> renderer = take(make_renderer(a.renderer));
   auto start = Clock::now();
   RenderOutput out = take(renderer->render(scene, options));
@@ -237,7 +252,7 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
                             {a.out_dir + "/metrics.json", a.out_dir + "/report.html"});
   RenderOptions options = render_options(a.common, "local");
   double load_seconds = 0;
-  Scene scene = load(a.common, load_seconds);
+  Scene scene = load(a.common, options, load_seconds);
 
   std::vector<std::unique_ptr<Renderer>> renderers;
   for (const std::string& name : a.renderers) renderers.push_back(take(make_renderer(name)));
