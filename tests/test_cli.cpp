@@ -435,3 +435,14 @@ TEST_F(Cli, LimitsRefuseHugeWorkBeforeAnyAllocationAndFlagsRaiseThem) {
                      std::string(kSmall) + " -o " + (dir_ / "x.png").string());
   EXPECT_EQ(ok.status, 0) << ok.err;
 }
+
+TEST_F(Cli, EndlessOrHugeSceneFileIsRefused) {
+  auto start = std::chrono::steady_clock::now();
+  RunResult r = run("render /dev/zero -r raytrace -o " + (dir_ / "x.png").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err,
+            "error: /dev/zero: the scene file is over 256 MiB (meshes belong in mesh files)\n");
+  // No hang: it stops after 256 MiB (seconds natively, longer under AddressSanitizer).
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 90.0);
+  EXPECT_TRUE(outputs({}).empty());
+}

@@ -48,6 +48,7 @@ using json = nlohmann::json;
 namespace fs = std::filesystem;
 
 constexpr int kMaxJsonDepth = 512;
+constexpr size_t kMaxSceneFileBytes = size_t(256) << 20;
 constexpr int kMaxCsgDepth = 64;
 constexpr int kMaxImageSize = 16384;
 constexpr int kMaxSamplesPerPixel = 4096;
@@ -1409,7 +1410,16 @@ Expected<Scene> load_scene_file(const std::string& path) {
     std::string text;
     char buffer[1 << 16];
     size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) text.append(buffer, n);
+    while ((n = std::fread(buffer, 1, sizeof buffer, f)) > 0) {
+      text.append(buffer, n);
+      if (text.size() > kMaxSceneFileBytes) {  // also ends endless inputs such as /dev/zero
+        std::fclose(f);
+        return bad_input(
+            fmt::format("{}: the scene file is over {} MiB (meshes belong in mesh "
+                        "files)",
+                        path, kMaxSceneFileBytes >> 20));
+      }
+    }
     int read_error = std::ferror(f) ? errno : 0;
     std::fclose(f);
     if (read_error) return bad_input(path + ": cannot read: " + std::strerror(read_error));
