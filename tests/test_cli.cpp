@@ -392,7 +392,7 @@ TEST_F(Cli, CtrlCStopsPromptlyAndLeavesNoFile) {
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     std::freopen("/dev/null", "w", stderr);
-    ::execl(RVR_BINARY, RVR_BINARY, "render", "builtin:dof", "-r", "raytrace", "--spp", "4096",
+    ::execl(RVR_BINARY, RVR_BINARY, "render", "builtin:dof", "-r", "raytrace", "--spp", "1024",
             "--width", "1024", "--height", "768", "-o", out.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
