@@ -446,3 +446,13 @@ TEST_F(Cli, EndlessOrHugeSceneFileIsRefused) {
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 90.0);
   EXPECT_TRUE(outputs({}).empty());
 }
+
+TEST_F(Cli, InfoHasWhatABugReportNeeds) {
+  RunResult r = run("info");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* field :
+       {"rvr ", "cpu: ", "hardware threads", "renderers: raster softraster", "simd: built for ",
+        "embree: 3.", "openimageio: ", "tbb: ", "gl backend: osmesa",
+        "GL_VERSION: ", "GL_RENDERER: llvmpipe", "llvmpipe threads: "})
+    EXPECT_NE(r.out.find(field), std::string::npos) << field << " missing in:\n" << r.out;
+}

@@ -18,6 +18,7 @@
 #include "renderers.h"
 #include "report.h"
 #include "rvr/raster/gl_rasterizer.h"
+#include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/limits.h"
@@ -381,6 +382,35 @@ std::string cpu_model() {
   return "unknown";
 }
 
+// The widest vector instructions this build of rvr uses (Embree picks its own at run time).
+const char* built_simd() {
+#if defined(__AVX512F__)
+  return "AVX-512 (512-bit)";
+#elif defined(__AVX2__)
+  return "AVX2 (256-bit)";
+#elif defined(__AVX__)
+  return "AVX (256-bit)";
+#else
+  return "SSE2 (128-bit)";
+#endif
+}
+
+// Vector extensions the CPU reports in /proc/cpuinfo.
+std::string cpu_simd() {
+  std::ifstream in("/proc/cpuinfo");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind("flags", 0) != 0) continue;
+    std::string found;
+    for (const char* f : {"sse4_2", "avx", "avx2", "avx512f"}) {
+      if ((" " + line + " ").find(std::string(" ") + f + " ") != std::string::npos)
+        found += (found.empty() ? "" : ", ") + std::string(f);
+    }
+    return found.empty() ? "none of SSE4.2, AVX, AVX2, AVX-512" : found;
+  }
+  return "unknown (no /proc/cpuinfo)";
+}
+
 int run_info() {
   std::printf("rvr %s\n", kVersion);
   std::printf("cpu: %s, %u hardware threads\n", cpu_model().c_str(),
@@ -388,11 +418,17 @@ int run_info() {
   std::printf("renderers: ");
   for (const std::string& n : renderer_names()) std::printf("%s ", n.c_str());
   std::printf("\n");
+  std::printf("simd: built for %s; the CPU has %s\n", built_simd(), cpu_simd().c_str());
+  std::printf("embree: %s\nopenimageio: %s\ntbb: %s\n", embree_version().c_str(),
+              openimageio_version().c_str(), tbb_version().c_str());
   Expected<GlInfo> gl = query_gl_info();
   if (!gl) fail(gl.error());
   std::printf("gl backend: %s\nGL_VERSION: %s\nGL_RENDERER: %s\nGL_VENDOR: %s\nGLSL: %s\n",
               gl->backend.c_str(), gl->version.c_str(), gl->renderer.c_str(), gl->vendor.c_str(),
               gl->glsl_version.c_str());
+  const char* lp_threads = std::getenv("LP_NUM_THREADS");
+  std::printf("llvmpipe threads: %s\n",
+              lp_threads ? lp_threads : "every core (LP_NUM_THREADS not set)");
   return 0;
 }
 

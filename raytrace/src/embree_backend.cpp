@@ -1,10 +1,10 @@
 #include "embree_backend.h"
 
+#include <embree3/rtcore.h>
+
 #include <cstring>
 #include <limits>
 #include <vector>
-
-#include <embree3/rtcore.h>
 
 namespace rvr {
 
@@ -27,7 +27,9 @@ struct EmbreeBackend {
   static void occluded(const RTCOccludedFunctionNArguments* args);
 };
 
-void EmbreeBackendDeleter::operator()(EmbreeBackend* backend) const { delete backend; }
+void EmbreeBackendDeleter::operator()(EmbreeBackend* backend) const {
+  delete backend;
+}
 
 namespace {
 
@@ -98,7 +100,8 @@ EmbreeBackend* EmbreeBackend::create(const TraceGeometry& g, std::string& error)
   backend->owner = &g;
   backend->device = rtcNewDevice(nullptr);
   if (!backend->device) {
-    error = "Embree: cannot create a device (error " + std::to_string(int(rtcGetDeviceError(nullptr))) + ")";
+    error = "Embree: cannot create a device (error " +
+            std::to_string(int(rtcGetDeviceError(nullptr))) + ")";
     return nullptr;
   }
   backend->scene = rtcNewScene(backend->device);
@@ -108,13 +111,16 @@ EmbreeBackend* EmbreeBackend::create(const TraceGeometry& g, std::string& error)
     if (!mesh || mesh->triangles.empty()) continue;
     RTCGeometry geom = rtcNewGeometry(backend->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     // Embree's own buffers carry the padding its SIMD loads need after the last vertex.
-    auto* vertices = static_cast<float*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh->positions.size()));
-    auto* indices = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), mesh->triangles.size()));
+    auto* vertices = static_cast<float*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                3 * sizeof(float), mesh->positions.size()));
+    auto* indices = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                3 * sizeof(uint32_t), mesh->triangles.size()));
     if (!vertices || !indices) {
       rtcReleaseGeometry(geom);
-      error = "Embree: out of memory for a mesh of " + std::to_string(mesh->triangles.size()) + " triangles";
+      error = "Embree: out of memory for a mesh of " + std::to_string(mesh->triangles.size()) +
+              " triangles";
       return nullptr;
     }
     std::memcpy(vertices, mesh->positions.data(), mesh->positions.size() * 3 * sizeof(float));
@@ -175,6 +181,10 @@ bool embree_occluded(const EmbreeBackend& backend, const Ray& ray) {
   set_ray(r, ray);
   rtcOccluded1(backend.scene, &context, &r);
   return r.tfar < 0.0f;
+}
+
+std::string embree_version() {
+  return RTC_VERSION_STRING;
 }
 
 }  // namespace rvr

@@ -6,6 +6,7 @@
 #include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
+#include <tbb/version.h>
 
 #include <atomic>
 #include <chrono>
@@ -296,6 +297,10 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
     out.warnings.push_back("depth of field needs samples_per_pixel > 1: one sample is a pinhole");
   }
   return out;
+}
+
+std::string tbb_version() {
+  return std::string(TBB_VERSION_STRING) + " (runtime " + TBB_runtime_version() + ")";
 }
 
 }  // namespace rvr

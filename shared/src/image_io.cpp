@@ -347,6 +347,10 @@ Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
   }
 }
 
+std::string openimageio_version() {
+  return OIIO_VERSION_STRING;
+}
+
 void remove_unfinished_output() noexcept {
   if (g_unfinished.load()) ::unlink(g_unfinished_path);
 }

@@ -8,6 +8,10 @@
 
 namespace rvr {
 
+// Versions of the libraries the tracer runs on, for `rvr info`.
+std::string embree_version();
+std::string tbb_version();
+
 class RayTracer : public Renderer {
  public:
   RayTracer() = default;

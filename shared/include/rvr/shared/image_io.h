@@ -43,6 +43,9 @@ Image cost_image(const FrameBuffers& fb, float* scale = nullptr);
 Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
                   const std::vector<std::string>& aovs);
 
+// OpenImageIO's version, for `rvr info`.
+std::string openimageio_version();
+
 // Deletes the temporary file of a write in progress, if any. Async-signal-safe: for a SIGINT
 // handler, so an interrupted run leaves no half-written file behind.
 void remove_unfinished_output() noexcept;
