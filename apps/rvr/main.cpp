@@ -67,7 +67,7 @@ struct CommonOptions {
   std::string triangle_test = "mt";
   int max_depth = 5;
   uint64_t seed = 0;
-  std::string gl = "osmesa";
+  std::string gl;  // empty: osmesa, falling back to egl when OSMesa is missing
   int shadow_map_size = 1024;
   float shadow_bias = 0.01f;
   bool shadow_pcf = false;
@@ -101,7 +101,8 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--max-depth", o.max_depth, "recursion limit for bounce rays")
       ->check(CLI::Range(0, 64));
   cmd.add_option("--seed", o.seed, "seed of the per-pixel random streams");
-  cmd.add_option("--gl", o.gl, "GL back end: osmesa | egl")
+  cmd.add_option("--gl", o.gl,
+                 "raster GL back end: osmesa | egl (default osmesa, egl when OSMesa is missing)")
       ->check(CLI::IsMember({"osmesa", "egl"}));
   cmd.add_option("--shadow-map-size", o.shadow_map_size, "raster shadow maps: texels per side")
       ->check(CLI::Range(16, 8192));
@@ -120,6 +121,12 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
       ->check(CLI::PositiveNumber);
 }
 
+GlBackend gl_backend(const CommonOptions& o) {
+  if (o.gl == "osmesa") return GlBackend::OsMesa;
+  if (o.gl == "egl") return GlBackend::Egl;
+  return GlBackend::Default;
+}
+
 RenderMode parse_mode(const std::string& s) {
   if (s == "visibility") return RenderMode::Visibility;
   if (s == "full") return RenderMode::Full;
@@ -127,8 +134,6 @@ RenderMode parse_mode(const std::string& s) {
 }
 
 RenderOptions render_options(const CommonOptions& o, const std::string& default_mode) {
-  if (o.gl == "egl")
-    fail(bad_input("--gl egl: the EGL back end is not available in this build; use --gl osmesa"));
   RenderOptions r;
   r.mode = parse_mode(o.mode.empty() ? default_mode : o.mode);
   r.spheres = o.spheres == "mesh" ? SphereMode::Mesh : SphereMode::Analytic;
@@ -201,7 +206,7 @@ int run_render(const RenderArgs& a) {
   RenderOptions options = render_options(a.common, "full");
   double load_seconds = 0;
   Scene scene = load(a.common, options, load_seconds);
-  std::unique_ptr<Renderer> renderer = take(make_renderer(a.renderer));
+  std::unique_ptr<Renderer> renderer = take(make_renderer(a.renderer, gl_backend(a.common)));
   auto start = Clock::now();
   RenderOutput out = take(renderer->render(scene, options));
   double render_seconds = seconds_since(start);
@@ -256,7 +261,7 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   Scene scene = load(a.common, options, load_seconds);
 
   std::vector<std::unique_ptr<Renderer>> renderers;
-  for (const std::string& name : a.renderers) renderers.push_back(take(make_renderer(name)));
+  for (const std::string& name : a.renderers) renderers.push_back(take(make_renderer(name, gl_backend(a.common))));
 
   ReportInput report;
   report.scene = scene.source;
@@ -411,7 +416,7 @@ std::string cpu_simd() {
   return "unknown (no /proc/cpuinfo)";
 }
 
-int run_info() {
+int run_info(const std::string& gl_name) {
   std::printf("rvr %s\n", kVersion);
   std::printf("cpu: %s, %u hardware threads\n", cpu_model().c_str(),
               std::thread::hardware_concurrency());
@@ -421,8 +426,11 @@ int run_info() {
   std::printf("simd: built for %s; the CPU has %s\n", built_simd(), cpu_simd().c_str());
   std::printf("embree: %s\nopenimageio: %s\ntbb: %s\n", embree_version().c_str(),
               openimageio_version().c_str(), tbb_version().c_str());
-  Expected<GlInfo> gl = query_gl_info();
+  CommonOptions gl_choice;
+  gl_choice.gl = gl_name;
+  Expected<GlInfo> gl = query_gl_info(gl_backend(gl_choice));
   if (!gl) fail(gl.error());
+  for (const std::string& w : gl->warnings) std::printf("gl warning: %s\n", w.c_str());
   std::printf("gl backend: %s\nGL_VERSION: %s\nGL_RENDERER: %s\nGL_VENDOR: %s\nGLSL: %s\n",
               gl->backend.c_str(), gl->version.c_str(), gl->renderer.c_str(), gl->vendor.c_str(),
               gl->glsl_version.c_str());
@@ -480,6 +488,9 @@ int run(int argc, char** argv) {
 
   CLI::App* scenes_cmd = app.add_subcommand("scenes", "list the built-in scenes");
   CLI::App* info_cmd = app.add_subcommand("info", "versions and machine facts for bug reports");
+  std::string info_gl;
+  info_cmd->add_option("--gl", info_gl, "GL back end to describe: osmesa | egl (default as render)")
+      ->check(CLI::IsMember({"osmesa", "egl"}));
 
   try {
     app.parse(argc, argv);
@@ -497,7 +508,7 @@ int run(int argc, char** argv) {
   if (compare_cmd->parsed()) return run_compare(compare, join_args(argc, argv));
   if (diff_cmd->parsed()) return run_diff(diff);
   if (scenes_cmd->parsed()) return run_scenes();
-  if (info_cmd->parsed()) return run_info();
+  if (info_cmd->parsed()) return run_info(info_gl);
   return 2;
 }
 

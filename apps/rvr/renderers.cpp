@@ -10,8 +10,8 @@ std::vector<std::string> renderer_names() {
   return {"raster", "softraster", "raytrace", "embree"};
 }
 
-Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name) {
-  if (name == "raster") return std::unique_ptr<Renderer>(std::make_unique<GlRasterizer>());
+Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name, GlBackend gl) {
+  if (name == "raster") return std::unique_ptr<Renderer>(std::make_unique<GlRasterizer>(gl));
   if (name == "softraster") return std::unique_ptr<Renderer>(std::make_unique<SoftRasterizer>());
   if (name == "raytrace") return std::unique_ptr<Renderer>(std::make_unique<RayTracer>());
   if (name == "embree")

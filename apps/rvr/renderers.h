@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "rvr/raster/gl_rasterizer.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/renderer.h"
 
@@ -13,7 +14,8 @@ namespace rvr {
 // In the order they are documented: "raster", "raytrace".
 std::vector<std::string> renderer_names();
 
-// A bad name is a BadInput error listing the known ones.
-Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name);
+// A bad name is a BadInput error listing the known ones. `gl` picks the raster's GL back end.
+Expected<std::unique_ptr<Renderer>> make_renderer(const std::string& name,
+                                                  GlBackend gl = GlBackend::Default);
 
 }  // namespace rvr

@@ -87,7 +87,10 @@ void* OsMesaContext::proc_address(const char* name) const {
   return reinterpret_cast<void*>(OSMesaGetProcAddress(name));
 }
 
-Expected<std::unique_ptr<GlContext>> create_gl_context(int width, int height) {
+Expected<std::unique_ptr<GlContext>> create_gl_context(GlBackend backend, int width, int height,
+                                                       std::vector<std::string>& warnings) {
+  (void)warnings;
+  if (backend == GlBackend::Egl) return internal_error("the EGL back end is not built yet");
   auto ctx = OsMesaContext::create(width, height);
   if (!ctx) return ctx.error();
   return std::unique_ptr<GlContext>(std::move(ctx.value()));

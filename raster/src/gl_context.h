@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "rvr/raster/gl_rasterizer.h"
 #include "rvr/shared/expected.h"
 
 struct osmesa_context;  // OSMesa's handle; its header stays in gl_context.cpp
@@ -57,7 +58,9 @@ class OsMesaContext final : public GlContext {
   std::vector<unsigned char> buffer_;  // the default framebuffer OSMesa insists on
 };
 
-// The context the renderer uses; today always OSMesa.
-Expected<std::unique_ptr<GlContext>> create_gl_context(int width, int height);
+// A context of the chosen back end, made current. Default: OSMesa, or EGL when OSMesa cannot
+// be loaded; the fallback is appended to `warnings`.
+Expected<std::unique_ptr<GlContext>> create_gl_context(GlBackend backend, int width, int height,
+                                                       std::vector<std::string>& warnings);
 
 }  // namespace rvr

@@ -158,11 +158,23 @@ std::string object_label(const Object& o, size_t index) {
 
 }  // namespace
 
-Expected<GlInfo> query_gl_info() {
-  auto context = create_gl_context(1, 1);
+const char* to_string(GlBackend backend) {
+  switch (backend) {
+    case GlBackend::OsMesa:
+      return "osmesa";
+    case GlBackend::Egl:
+      return "egl";
+    case GlBackend::Default:
+      break;
+  }
+  return "default";
+}
+
+Expected<GlInfo> query_gl_info(GlBackend backend) {
+  GlInfo info;
+  auto context = create_gl_context(backend, 1, 1, info.warnings);
   if (!context) return context.error();
   auto strings = current_gl_strings();
-  GlInfo info;
   info.backend = (*context)->backend();
   (*context)->destroy();
   if (!strings) return strings.error();
@@ -174,7 +186,9 @@ Expected<GlInfo> query_gl_info() {
 }
 
 struct GlRasterizer::Impl {
+  GlBackend backend = GlBackend::Default;
   std::unique_ptr<GlContext> context;
+  std::vector<std::string> context_warnings;  // e.g. the default fell back to EGL
   GLuint scene_program = 0, cost_program = 0, shadow_program = 0;
   SceneUniforms su;
   GLint cost_view = -1, cost_projection = -1;
@@ -225,7 +239,8 @@ Status GlRasterizer::Impl::init() {
 }
 
 Status GlRasterizer::Impl::create_resources() {
-  auto created = create_gl_context(1, 1);  // 1x1: every pixel we keep goes to an FBO
+  context_warnings.clear();
+  auto created = create_gl_context(backend, 1, 1, context_warnings);  // 1x1: every pixel we keep goes to an FBO
   if (!created) return created.error();
   context = std::move(created.value());
   auto strings = current_gl_strings();
@@ -498,6 +513,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   // --- setup: context, programs (first call only), render targets (on size change)
   auto t = Clock::now();
   RVR_TRY(init());
+  out.warnings = context_warnings;
   RVR_TRY(resize(w, h));
   out.stats["time.setup"] = seconds_since(t);
 
@@ -850,7 +866,9 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   return out;
 }
 
-GlRasterizer::GlRasterizer() : impl_(std::make_unique<Impl>()) {}
+GlRasterizer::GlRasterizer(GlBackend backend) : impl_(std::make_unique<Impl>()) {
+  impl_->backend = backend;
+}
 
 GlRasterizer::~GlRasterizer() = default;
 
