@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <set>
 
 #include "renderers.h"
@@ -22,6 +23,7 @@ struct RendererCase {
   const char* reference;  // a renderer of the other loop order
   double max_work;        // pixels x triangles; beyond it both images shrink (brute force is
                           // O(pixels x triangles), and the agreement rules hold at any size)
+  GlBackend gl = GlBackend::Default;  // for the raster: where its GL context comes from
 };
 
 // Test names in ctest: "raster vs raytrace".
@@ -30,7 +32,8 @@ void PrintTo(const RendererCase& r, std::ostream* os) {
 }
 
 const RendererCase kRenderers[] = {
-    {"raster", "raster", AccelKind::Bvh, "raytrace", 0},
+    {"raster", "raster", AccelKind::Bvh, "raytrace", 0, GlBackend::OsMesa},
+    {"raster_egl", "raster", AccelKind::Bvh, "raytrace", 0, GlBackend::Egl},
     {"softraster", "softraster", AccelKind::Bvh, "raytrace", 0},
     {"raytrace", "raytrace", AccelKind::Bvh, "raster", 0},
     {"raytrace_none", "raytrace", AccelKind::None, "raster", 1.6e9},
@@ -66,11 +69,12 @@ constexpr double kMinPsnr = 40.0;
 constexpr int kSegments = 48;
 
 RenderOutput render_with(const char* name, AccelKind accel, const Scene& scene, SphereMode spheres,
-                         int segments) {
-  auto renderer = make_renderer(name);
+                         int segments, GlBackend gl = GlBackend::Default,
+                         RenderMode mode = RenderMode::Local) {
+  auto renderer = make_renderer(name, gl);
   EXPECT_TRUE(renderer.ok());
   RenderOptions options;
-  options.mode = RenderMode::Local;
+  options.mode = mode;
   options.spheres = spheres;
   options.sphere_segments = segments;
   options.accel = accel;
@@ -119,7 +123,7 @@ TEST_P(Conformance, AgreesWithTheOtherLoopOrder) {
     scene->image.height = std::max(1, int(scene->image.height * scale));
   }
 
-  RenderOutput a = render_with(r.name, r.accel, *scene, SphereMode::Mesh, kSegments);
+  RenderOutput a = render_with(r.name, r.accel, *scene, SphereMode::Mesh, kSegments, r.gl);
   RenderOutput b = render_with(r.reference, AccelKind::Bvh, *scene, SphereMode::Mesh, kSegments);
   ComparisonMetrics m = compare_buffers(a.buffers, b.buffers);
 
@@ -143,6 +147,45 @@ INSTANTIATE_TEST_SUITE_P(EveryRendererEveryScene, Conformance,
                          [](const ::testing::TestParamInfo<Conformance::ParamType>& info) {
                            std::string s = std::string(std::get<0>(info.param).label) + "_" +
                                            std::get<1>(info.param);
+                           for (char& c : s)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return s;
+                         });
+
+// The two GL back ends (OSMesa and EGL surfaceless) differ only in how the context is made;
+// both run the same Mesa release's llvmpipe, which is deterministic, so every buffer must be
+// bit-identical. Full mode, so shadow maps (layered depth textures, geometry shader) and
+// multisampling are covered too, not only the visibility pass.
+class GlBackends : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(GlBackends, OsMesaAndEglRenderIdenticalBuffers) {
+  Expected<Scene> scene = make_builtin_scene(GetParam());
+  ASSERT_TRUE(scene.ok());
+  RenderOutput osmesa = render_with("raster", AccelKind::Bvh, *scene, SphereMode::Mesh, kSegments,
+                                    GlBackend::OsMesa, RenderMode::Full);
+  RenderOutput egl = render_with("raster", AccelKind::Bvh, *scene, SphereMode::Mesh, kSegments,
+                                 GlBackend::Egl, RenderMode::Full);
+  const FrameBuffers& a = osmesa.buffers;
+  const FrameBuffers& b = egl.buffers;
+  ASSERT_EQ(a.pixel_count(), b.pixel_count());
+  size_t differing = 0;
+  for (size_t i = 0; i < a.pixel_count(); ++i) {
+    bool same = a.object_id[i] == b.object_id[i] && a.primitive_id[i] == b.primitive_id[i] &&
+                std::memcmp(&a.depth[i], &b.depth[i], sizeof(float)) == 0 &&
+                std::memcmp(&a.color[i], &b.color[i], sizeof(a.color[i])) == 0 &&
+                std::memcmp(&a.normal[i], &b.normal[i], sizeof(a.normal[i])) == 0;
+    differing += !same;
+  }
+  EXPECT_EQ(differing, 0u) << "of " << a.pixel_count() << " pixels";
+  EXPECT_EQ(osmesa.warnings, egl.warnings);
+  EXPECT_GT(osmesa.stats.at("fragments.generated"), 0.0);
+  EXPECT_EQ(osmesa.stats.at("fragments.generated"), egl.stats.at("fragments.generated"));
+  EXPECT_EQ(osmesa.stats.at("fragments.passed"), egl.stats.at("fragments.passed"));
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryScene, GlBackends, ::testing::ValuesIn(kScenes),
+                         [](const ::testing::TestParamInfo<const char*>& info) {
+                           std::string s = info.param;
                            for (char& c : s)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return s;

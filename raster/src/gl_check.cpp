@@ -32,7 +32,7 @@ Status gl_check(const char* what, const char* file, int line) {
   // glGetError reports one flag per call; a bounded loop also survives a lost context, which
   // keeps returning an error forever.
   for (int i = 0; i < 16; ++i) {
-    GLenum e = glGetError();
+    GLenum e = gl().GetError();
     if (e == GL_NO_ERROR) break;
     if (!codes.empty()) codes += ", ";
     codes += fmt::format("{} (0x{:04x})", gl_error_name(e), unsigned(e));

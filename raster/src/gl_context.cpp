@@ -1,8 +1,8 @@
 #include "gl_context.h"
 
-#include <GL/osmesa.h>
 #include <fmt/format.h>
 
+#include <cassert>
 #include <cstdlib>
 #include <string_view>
 
@@ -10,17 +10,58 @@
 
 namespace rvr {
 
+namespace {
+
+// GL keeps one current context per thread; so do we, for its entry points.
+thread_local const GladGLContext* t_current_entry_points = nullptr;
+
+}  // namespace
+
+const GladGLContext& gl() {
+  assert(t_current_entry_points && "GL call with no current GlContext on this thread");
+  return *t_current_entry_points;
+}
+
+GlContext::~GlContext() = default;
+
+Status GlContext::make_current() {
+  if (!loaded_) return internal_error(fmt::format("{} GL context used after destroy()", backend()));
+  RVR_TRY(bind());
+  t_current_entry_points = &entry_points_;
+  return ok_status();
+}
+
+void GlContext::destroy() {
+  if (!loaded_) return;
+  release_native();
+  if (t_current_entry_points == &entry_points_) t_current_entry_points = nullptr;
+  loaded_ = false;
+}
+
+Status GlContext::finish_creation() {
+  RVR_TRY(bind());
+  auto load = [](void* self, const char* name) -> GLADapiproc {
+    return reinterpret_cast<GLADapiproc>(static_cast<GlContext*>(self)->proc_address(name));
+  };
+  const int version = gladLoadGLContextUserPtr(&entry_points_, load, this);
+  if (version == 0 || !entry_points_.VERSION_3_3)
+    return internal_error(
+        fmt::format("{}: the context does not offer OpenGL 3.3 core (loader saw version {}.{})",
+                    backend(), GLAD_VERSION_MAJOR(version), GLAD_VERSION_MINOR(version)));
+  loaded_ = true;
+  t_current_entry_points = &entry_points_;
+  return ok_status();
+}
+
 Expected<GlStrings> current_gl_strings() {
   auto get = [](GLenum name) -> std::string {
-    const GLubyte* s = glGetString(name);
+    const GLubyte* s = gl().GetString(name);
     return s ? std::string(reinterpret_cast<const char*>(s)) : std::string();
   };
   GlStrings strings{get(GL_VERSION), get(GL_RENDERER), get(GL_VENDOR),
                     get(GL_SHADING_LANGUAGE_VERSION)};
   if (strings.version.empty() || strings.renderer.empty())
-    return internal_error(
-        "glGetString returned nothing: the GL entry points are not OSMesa's (is libGL linked "
-        "before libOSMesa?)");
+    return internal_error("glGetString returned nothing for GL_VERSION or GL_RENDERER");
   RVR_GL_CHECK("glGetString");
   return strings;
 }
@@ -34,66 +75,33 @@ Status check_gl_driver(const GlStrings& strings) {
   return ok_status();
 }
 
-Expected<std::unique_ptr<OsMesaContext>> OsMesaContext::create(int width, int height) {
-  // zink and swr crash inside OSMesa context creation rather than failing, so they are refused
+Status check_gallium_driver_variable() {
+  // zink and swr crash inside context creation rather than failing, so they are refused
   // before we get there.
   if (const char* driver = std::getenv("GALLIUM_DRIVER")) {
     std::string_view d(driver);
     if (d == "zink" || d == "swr")
       return internal_error(fmt::format(
-          "GALLIUM_DRIVER={} crashes OSMesa context creation; unset GALLIUM_DRIVER to use "
-          "llvmpipe",
+          "GALLIUM_DRIVER={} crashes GL context creation; unset GALLIUM_DRIVER to use llvmpipe",
           d));
   }
-  if (width < 1 || height < 1)
-    return internal_error(fmt::format("GL context size {}x{} is invalid", width, height));
-
-  const int attribs[] = {OSMESA_FORMAT,
-                         OSMESA_RGBA,
-                         OSMESA_DEPTH_BITS,
-                         0,  // every render goes to an FBO with its own depth buffer
-                         OSMESA_PROFILE,
-                         OSMESA_CORE_PROFILE,
-                         OSMESA_CONTEXT_MAJOR_VERSION,
-                         3,
-                         OSMESA_CONTEXT_MINOR_VERSION,
-                         3,
-                         0};
-  std::unique_ptr<OsMesaContext> ctx(new OsMesaContext());
-  ctx->context_ = OSMesaCreateContextAttribs(attribs, nullptr);
-  if (!ctx->context_) return internal_error("could not create an OSMesa OpenGL 3.3 core context");
-  ctx->width_ = width;
-  ctx->height_ = height;
-  ctx->buffer_.assign(size_t(width) * size_t(height) * 4, 0);
-  RVR_TRY(ctx->make_current());
-  return ctx;
-}
-
-Status OsMesaContext::make_current() {
-  if (!context_) return internal_error("OSMesa context used after destroy()");
-  if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width_, height_))
-    return internal_error("OSMesaMakeCurrent failed");
   return ok_status();
 }
 
-void OsMesaContext::destroy() {
-  if (!context_) return;
-  OSMesaDestroyContext(context_);
-  context_ = nullptr;
-  buffer_.clear();
-}
-
-void* OsMesaContext::proc_address(const char* name) const {
-  return reinterpret_cast<void*>(OSMesaGetProcAddress(name));
-}
-
-Expected<std::unique_ptr<GlContext>> create_gl_context(GlBackend backend, int width, int height,
+Expected<std::unique_ptr<GlContext>> create_gl_context(GlBackend backend,
                                                        std::vector<std::string>& warnings) {
-  (void)warnings;
-  if (backend == GlBackend::Egl) return internal_error("the EGL back end is not built yet");
-  auto ctx = OsMesaContext::create(width, height);
-  if (!ctx) return ctx.error();
-  return std::unique_ptr<GlContext>(std::move(ctx.value()));
+  RVR_TRY(check_gallium_driver_variable());
+  if (backend == GlBackend::OsMesa) return create_osmesa_context();
+  if (backend == GlBackend::Egl) return create_egl_context();
+  auto osmesa = create_osmesa_context();
+  if (osmesa) return osmesa;
+  auto egl = create_egl_context();
+  if (!egl)
+    return internal_error(
+        fmt::format("no GL context: {}; and {}", osmesa.error().message, egl.error().message));
+  warnings.push_back(fmt::format("OSMesa unavailable ({}); using EGL surfaceless instead",
+                                 osmesa.error().message));
+  return egl;
 }
 
 }  // namespace rvr

@@ -1,7 +1,11 @@
 // A headless OpenGL 3.3 core context. Rendering goes into FBOs, so the context only has to
-// exist and be current; GlContext is all the renderer sees, so an EGL surfaceless context can
-// later replace OSMesa without touching the renderer.
+// exist and be current. GlContext is all the renderer sees; two back ends make one:
+//  - OSMesa (libOSMesa, loaded at run time so rvr still starts where it is missing),
+//  - EGL surfaceless (EGL_PLATFORM_SURFACELESS_MESA), the way forward now that newer Mesa
+//    releases have dropped OSMesa.
 #pragma once
+
+#include <glad/gl.h>
 
 #include <memory>
 #include <string>
@@ -10,24 +14,36 @@
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/shared/expected.h"
 
-struct osmesa_context;  // OSMesa's handle; its header stays in gl_context.cpp
-
 namespace rvr {
 
 class GlContext {
  public:
-  virtual ~GlContext() = default;
-  // Binds the context to the calling thread; GL calls go to it until another is made current.
-  virtual Status make_current() = 0;
-  virtual void destroy() = 0;
-  virtual const char* backend() const = 0;  // "osmesa"
-  // Entry points libOSMesa does not export (e.g. glGetQueryObjectui64v). Never null-checks
-  // reliably: OSMesa returns non-null for unknown names, so ask only for what the version has.
+  virtual ~GlContext();
+  GlContext(const GlContext&) = delete;
+  GlContext& operator=(const GlContext&) = delete;
+
+  // Binds the context to the calling thread; gl() then returns its entry points.
+  Status make_current();
+  // Releases the context (idempotent); gl() on this thread is unusable afterwards.
+  void destroy();
+  virtual const char* backend() const = 0;  // "osmesa" or "egl"
+
+ protected:
+  GlContext() = default;
+  // Makes the native context current on the calling thread.
+  virtual Status bind() = 0;
+  virtual void release_native() = 0;
+  // The back end's GetProcAddress: what glad loads the entry points with.
   virtual void* proc_address(const char* name) const = 0;
+  // Binds, loads the entry points and checks the version; the back ends' create() ends here.
+  Status finish_creation();
+
+ private:
+  GladGLContext entry_points_{};
+  bool loaded_ = false;
 };
 
-// GL_VERSION etc. of the current context; an Internal error when the strings are missing
-// (e.g. libGL linked before libOSMesa).
+// GL_VERSION etc. of the current context; an Internal error when the strings are missing.
 struct GlStrings {
   std::string version, renderer, vendor, glsl_version;
 };
@@ -36,31 +52,17 @@ Expected<GlStrings> current_gl_strings();
 // Internal error for drivers that cannot render correctly (softpipe draws black).
 Status check_gl_driver(const GlStrings& strings);
 
-class OsMesaContext final : public GlContext {
- public:
-  // A core 3.3 context (Mesa gives 4.5) with a width x height RGBA default buffer, made current.
-  // Refuses GALLIUM_DRIVER values known to crash inside context creation.
-  static Expected<std::unique_ptr<OsMesaContext>> create(int width, int height);
+// Internal error for GALLIUM_DRIVER values known to crash inside context creation.
+Status check_gallium_driver_variable();
 
-  ~OsMesaContext() override { destroy(); }
-  OsMesaContext(const OsMesaContext&) = delete;
-  OsMesaContext& operator=(const OsMesaContext&) = delete;
-
-  Status make_current() override;
-  void destroy() override;
-  const char* backend() const override { return "osmesa"; }
-  void* proc_address(const char* name) const override;
-
- private:
-  OsMesaContext() = default;
-  osmesa_context* context_ = nullptr;
-  int width_ = 0, height_ = 0;
-  std::vector<unsigned char> buffer_;  // the default framebuffer OSMesa insists on
-};
+// The back ends. Each returns a context that is already current, or an Internal error saying
+// why none could be made (library missing, no 3.3 core context, ...).
+Expected<std::unique_ptr<GlContext>> create_osmesa_context();
+Expected<std::unique_ptr<GlContext>> create_egl_context();
 
 // A context of the chosen back end, made current. Default: OSMesa, or EGL when OSMesa cannot
-// be loaded; the fallback is appended to `warnings`.
-Expected<std::unique_ptr<GlContext>> create_gl_context(GlBackend backend, int width, int height,
+// be used; the fallback and its reason are appended to `warnings`.
+Expected<std::unique_ptr<GlContext>> create_gl_context(GlBackend backend,
                                                        std::vector<std::string>& warnings);
 
 }  // namespace rvr

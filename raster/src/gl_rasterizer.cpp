@@ -172,7 +172,7 @@ const char* to_string(GlBackend backend) {
 
 Expected<GlInfo> query_gl_info(GlBackend backend) {
   GlInfo info;
-  auto context = create_gl_context(backend, 1, 1, info.warnings);
+  auto context = create_gl_context(backend, info.warnings);
   if (!context) return context.error();
   auto strings = current_gl_strings();
   info.backend = (*context)->backend();
@@ -196,7 +196,6 @@ struct GlRasterizer::Impl {
   GLuint vao = 0, vertex_buffer = 0, light_buffer = 0, light_texture = 0, query = 0;
   GLint max_size = 0;  // largest framebuffer side the driver accepts
   GLint max_samples = 1, max_texture_size = 0, max_layers = 0;
-  PFNGLGETQUERYOBJECTUI64VPROC get_query_u64 = nullptr;  // GL 3.3, not exported by libOSMesa
 
   // Render targets, re-made when the image size changes.
   int width = 0, height = 0;
@@ -240,7 +239,8 @@ Status GlRasterizer::Impl::init() {
 
 Status GlRasterizer::Impl::create_resources() {
   context_warnings.clear();
-  auto created = create_gl_context(backend, 1, 1, context_warnings);  // 1x1: every pixel we keep goes to an FBO
+  auto created =
+      create_gl_context(backend, context_warnings);  // 1x1: every pixel we keep goes to an FBO
   if (!created) return created.error();
   context = std::move(created.value());
   auto strings = current_gl_strings();
@@ -256,11 +256,11 @@ Status GlRasterizer::Impl::create_resources() {
   auto shadow = build_program("shadow", shaders::kShadowVertex, shaders::kShadowFragment);
   if (!shadow) return shadow.error();
   shadow_program = *shadow;
-  shadow_light = glGetUniformLocation(shadow_program, "u_light");
-  shadow_rotation = glGetUniformLocation(shadow_program, "u_rotation");
-  shadow_projection = glGetUniformLocation(shadow_program, "u_projection");
+  shadow_light = gl().GetUniformLocation(shadow_program, "u_light");
+  shadow_rotation = gl().GetUniformLocation(shadow_program, "u_rotation");
+  shadow_projection = gl().GetUniformLocation(shadow_program, "u_projection");
 
-  auto loc = [&](const char* name) { return glGetUniformLocation(scene_program, name); };
+  auto loc = [&](const char* name) { return gl().GetUniformLocation(scene_program, name); };
   su.view = loc("u_view");
   su.projection = loc("u_projection");
   su.eye = loc("u_eye");
@@ -284,37 +284,34 @@ Status GlRasterizer::Impl::create_resources() {
   su.shadow_bias = loc("u_shadow_bias");
   su.shadow_texel = loc("u_shadow_texel");
   su.shadow_pcf = loc("u_shadow_pcf");
-  cost_view = glGetUniformLocation(cost_program, "u_view");
-  cost_projection = glGetUniformLocation(cost_program, "u_projection");
+  cost_view = gl().GetUniformLocation(cost_program, "u_view");
+  cost_projection = gl().GetUniformLocation(cost_program, "u_projection");
 
-  glGenVertexArrays(1, &vao);
-  glGenBuffers(1, &vertex_buffer);
-  glBindVertexArray(vao);
-  glBindBuffer(GL_ARRAY_BUFFER, vertex_buffer);
+  gl().GenVertexArrays(1, &vao);
+  gl().GenBuffers(1, &vertex_buffer);
+  gl().BindVertexArray(vao);
+  gl().BindBuffer(GL_ARRAY_BUFFER, vertex_buffer);
   auto attrib = [](GLuint index, size_t offset) {
-    glEnableVertexAttribArray(index);
-    glVertexAttribPointer(index, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex),
-                          reinterpret_cast<const void*>(offset));
+    gl().EnableVertexAttribArray(index);
+    gl().VertexAttribPointer(index, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex),
+                             reinterpret_cast<const void*>(offset));
   };
   attrib(shaders::kAttribPosition, offsetof(Vertex, position));
   attrib(shaders::kAttribNormal, offsetof(Vertex, normal));
   attrib(shaders::kAttribGeometricNormal, offsetof(Vertex, geometric_normal));
 
-  glGenBuffers(1, &light_buffer);
-  glGenTextures(1, &light_texture);
-  glGenQueries(1, &query);
-  get_query_u64 = reinterpret_cast<PFNGLGETQUERYOBJECTUI64VPROC>(
-      context->proc_address("glGetQueryObjectui64v"));
-  if (!get_query_u64) return internal_error("the GL has no glGetQueryObjectui64v");
+  gl().GenBuffers(1, &light_buffer);
+  gl().GenTextures(1, &light_texture);
+  gl().GenQueries(1, &query);
 
   GLint max_renderbuffer = 0;
   GLint max_viewport[2] = {0, 0};
-  glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
-  glGetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
+  gl().GetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
+  gl().GetIntegerv(GL_MAX_VIEWPORT_DIMS, max_viewport);
   max_size = std::min({max_renderbuffer, max_viewport[0], max_viewport[1]});
-  glGetIntegerv(GL_MAX_SAMPLES, &max_samples);
-  glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture_size);
-  glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
+  gl().GetIntegerv(GL_MAX_SAMPLES, &max_samples);
+  gl().GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture_size);
+  gl().GetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
   max_samples = std::max(max_samples, 1);
   RVR_GL_CHECK("GL setup");
   return ok_status();
@@ -326,37 +323,38 @@ Status GlRasterizer::Impl::resize(int w, int h) {
     return internal_error(fmt::format(
         "image {}x{} exceeds the GL driver's largest framebuffer ({} per side)", w, h, max_size));
   release_targets();
-  glGenRenderbuffers(kTargetCount, targets.data());
+  gl().GenRenderbuffers(kTargetCount, targets.data());
   for (int i = 0; i < kTargetCount; ++i) {
-    glBindRenderbuffer(GL_RENDERBUFFER, targets[size_t(i)]);
-    glRenderbufferStorage(GL_RENDERBUFFER, kTargetFormats[size_t(i)], w, h);
+    gl().BindRenderbuffer(GL_RENDERBUFFER, targets[size_t(i)]);
+    gl().RenderbufferStorage(GL_RENDERBUFFER, kTargetFormats[size_t(i)], w, h);
   }
-  glGenRenderbuffers(1, &depth_buffer);
-  glBindRenderbuffer(GL_RENDERBUFFER, depth_buffer);
-  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+  gl().GenRenderbuffers(1, &depth_buffer);
+  gl().BindRenderbuffer(GL_RENDERBUFFER, depth_buffer);
+  gl().RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
   RVR_GL_CHECK("allocating render targets");
 
-  glGenFramebuffers(1, &scene_fbo);
-  glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+  gl().GenFramebuffers(1, &scene_fbo);
+  gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
   std::array<GLenum, kCost> draw_buffers{};
   for (int i = 0; i < kCost; ++i) {
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GLenum(GL_COLOR_ATTACHMENT0 + i), GL_RENDERBUFFER,
-                              targets[size_t(i)]);
+    gl().FramebufferRenderbuffer(GL_FRAMEBUFFER, GLenum(GL_COLOR_ATTACHMENT0 + i), GL_RENDERBUFFER,
+                                 targets[size_t(i)]);
     draw_buffers[size_t(i)] = GLenum(GL_COLOR_ATTACHMENT0 + i);
   }
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_buffer);
-  glDrawBuffers(GLsizei(draw_buffers.size()), draw_buffers.data());
-  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  gl().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_buffer);
+  gl().DrawBuffers(GLsizei(draw_buffers.size()), draw_buffers.data());
+  GLenum status = gl().CheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE)
     return internal_error(fmt::format("scene framebuffer incomplete (0x{:04x})", status));
 
   // The overdraw pass has its own FBO: it blends and ignores depth.
-  glGenFramebuffers(1, &cost_fbo);
-  glBindFramebuffer(GL_FRAMEBUFFER, cost_fbo);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, targets[kCost]);
+  gl().GenFramebuffers(1, &cost_fbo);
+  gl().BindFramebuffer(GL_FRAMEBUFFER, cost_fbo);
+  gl().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                               targets[kCost]);
   GLenum cost_buffer = GL_COLOR_ATTACHMENT0;
-  glDrawBuffers(1, &cost_buffer);
-  status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  gl().DrawBuffers(1, &cost_buffer);
+  status = gl().CheckFramebufferStatus(GL_FRAMEBUFFER);
   if (status != GL_FRAMEBUFFER_COMPLETE)
     return internal_error(fmt::format("cost framebuffer incomplete (0x{:04x})", status));
   RVR_GL_CHECK("creating framebuffers");
@@ -368,19 +366,20 @@ Status GlRasterizer::Impl::resize(int w, int h) {
 Status GlRasterizer::Impl::ensure_msaa(int samples) {
   if (msaa_fbo != 0 && msaa_samples == samples) return ok_status();
   release_msaa();
-  glGenRenderbuffers(1, &msaa_colour);
-  glBindRenderbuffer(GL_RENDERBUFFER, msaa_colour);
-  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA32F, width, height);
-  glGenRenderbuffers(1, &msaa_depth);
-  glBindRenderbuffer(GL_RENDERBUFFER, msaa_depth);
-  glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT32F, width, height);
-  glGenFramebuffers(1, &msaa_fbo);
-  glBindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, msaa_colour);
-  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, msaa_depth);
+  gl().GenRenderbuffers(1, &msaa_colour);
+  gl().BindRenderbuffer(GL_RENDERBUFFER, msaa_colour);
+  gl().RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA32F, width, height);
+  gl().GenRenderbuffers(1, &msaa_depth);
+  gl().BindRenderbuffer(GL_RENDERBUFFER, msaa_depth);
+  gl().RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT32F, width,
+                                      height);
+  gl().GenFramebuffers(1, &msaa_fbo);
+  gl().BindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
+  gl().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, msaa_colour);
+  gl().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, msaa_depth);
   GLenum colour_buffer = GL_COLOR_ATTACHMENT0;
-  glDrawBuffers(1, &colour_buffer);
-  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  gl().DrawBuffers(1, &colour_buffer);
+  GLenum status = gl().CheckFramebufferStatus(GL_FRAMEBUFFER);
   RVR_GL_CHECK("creating the multisampled framebuffer");
   if (status != GL_FRAMEBUFFER_COMPLETE)
     return internal_error(fmt::format("multisampled framebuffer ({} samples) incomplete (0x{:04x})",
@@ -390,9 +389,9 @@ Status GlRasterizer::Impl::ensure_msaa(int samples) {
 }
 
 void GlRasterizer::Impl::release_msaa() {
-  if (msaa_fbo) glDeleteFramebuffers(1, &msaa_fbo);
-  if (msaa_colour) glDeleteRenderbuffers(1, &msaa_colour);
-  if (msaa_depth) glDeleteRenderbuffers(1, &msaa_depth);
+  if (msaa_fbo) gl().DeleteFramebuffers(1, &msaa_fbo);
+  if (msaa_colour) gl().DeleteRenderbuffers(1, &msaa_colour);
+  if (msaa_depth) gl().DeleteRenderbuffers(1, &msaa_depth);
   msaa_fbo = msaa_colour = msaa_depth = 0;
   msaa_samples = 0;
 }
@@ -400,21 +399,22 @@ void GlRasterizer::Impl::release_msaa() {
 Status GlRasterizer::Impl::ensure_shadow_maps(int size, int layers) {
   if (shadow_texture != 0 && shadow_size == size && shadow_layers == layers) return ok_status();
   release_shadow_maps();
-  glGenTextures(1, &shadow_texture);
-  glActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
-  glBindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
-  glTexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, size, size, layers, 0, GL_RED, GL_FLOAT, nullptr);
+  gl().GenTextures(1, &shadow_texture);
+  gl().ActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
+  gl().BindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
+  gl().TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, size, size, layers, 0, GL_RED, GL_FLOAT,
+                  nullptr);
   // Read with texelFetch only; nearest, one level, so the texture is complete.
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glTexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
-  glActiveTexture(GL_TEXTURE0);
-  glGenFramebuffers(1, &shadow_fbo);
-  glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
-  glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_texture, 0, 0);
+  gl().TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  gl().TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  gl().TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
+  gl().ActiveTexture(GL_TEXTURE0);
+  gl().GenFramebuffers(1, &shadow_fbo);
+  gl().BindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+  gl().FramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_texture, 0, 0);
   GLenum colour_buffer = GL_COLOR_ATTACHMENT0;
-  glDrawBuffers(1, &colour_buffer);
-  GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  gl().DrawBuffers(1, &colour_buffer);
+  GLenum status = gl().CheckFramebufferStatus(GL_FRAMEBUFFER);
   RVR_GL_CHECK("allocating shadow maps");
   if (status != GL_FRAMEBUFFER_COMPLETE)
     return internal_error(fmt::format("shadow-map framebuffer incomplete (0x{:04x})", status));
@@ -424,8 +424,8 @@ Status GlRasterizer::Impl::ensure_shadow_maps(int size, int layers) {
 }
 
 void GlRasterizer::Impl::release_shadow_maps() {
-  if (shadow_fbo) glDeleteFramebuffers(1, &shadow_fbo);
-  if (shadow_texture) glDeleteTextures(1, &shadow_texture);
+  if (shadow_fbo) gl().DeleteFramebuffers(1, &shadow_fbo);
+  if (shadow_texture) gl().DeleteTextures(1, &shadow_texture);
   shadow_fbo = shadow_texture = 0;
   shadow_size = shadow_layers = 0;
 }
@@ -436,39 +436,39 @@ Status GlRasterizer::Impl::render_shadow_maps(const std::vector<LightSample>& sa
                                               size_t end, const glm::mat4& projection,
                                               GLsizei vertex_count) {
   static const std::array<glm::mat3, 6> rotations = face_rotations();
-  glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
-  glViewport(0, 0, shadow_size, shadow_size);
-  glDisable(GL_DEPTH_TEST);
-  glDepthMask(GL_FALSE);
-  glEnable(GL_BLEND);
-  glBlendEquation(GL_MIN);
-  glBlendFunc(GL_ONE, GL_ONE);
-  glUseProgram(shadow_program);
-  glUniformMatrix4fv(shadow_projection, 1, GL_FALSE, glm::value_ptr(projection));
+  gl().BindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+  gl().Viewport(0, 0, shadow_size, shadow_size);
+  gl().Disable(GL_DEPTH_TEST);
+  gl().DepthMask(GL_FALSE);
+  gl().Enable(GL_BLEND);
+  gl().BlendEquation(GL_MIN);
+  gl().BlendFunc(GL_ONE, GL_ONE);
+  gl().UseProgram(shadow_program);
+  gl().UniformMatrix4fv(shadow_projection, 1, GL_FALSE, glm::value_ptr(projection));
   const GLfloat nothing[4] = {std::numeric_limits<float>::max(), 0.0f, 0.0f, 0.0f};
   for (size_t i = first; i < end; ++i) {
-    glUniform3fv(shadow_light, 1, glm::value_ptr(samples[i].position));
+    gl().Uniform3fv(shadow_light, 1, glm::value_ptr(samples[i].position));
     for (size_t f = 0; f < 6; ++f) {
-      glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_texture, 0,
-                                GLint(6 * (i - first) + f));
-      glClearBufferfv(GL_COLOR, 0, nothing);
-      glUniformMatrix3fv(shadow_rotation, 1, GL_FALSE, glm::value_ptr(rotations[f]));
-      if (vertex_count > 0) glDrawArrays(GL_TRIANGLES, 0, vertex_count);
+      gl().FramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_texture, 0,
+                                   GLint(6 * (i - first) + f));
+      gl().ClearBufferfv(GL_COLOR, 0, nothing);
+      gl().UniformMatrix3fv(shadow_rotation, 1, GL_FALSE, glm::value_ptr(rotations[f]));
+      if (vertex_count > 0) gl().DrawArrays(GL_TRIANGLES, 0, vertex_count);
     }
   }
-  glBlendEquation(GL_FUNC_ADD);
-  glDisable(GL_BLEND);
-  glDepthMask(GL_TRUE);
+  gl().BlendEquation(GL_FUNC_ADD);
+  gl().Disable(GL_BLEND);
+  gl().DepthMask(GL_TRUE);
   RVR_GL_CHECK("shadow maps");
   return ok_status();
 }
 
 void GlRasterizer::Impl::release_targets() {
   release_msaa();
-  if (scene_fbo) glDeleteFramebuffers(1, &scene_fbo);
-  if (cost_fbo) glDeleteFramebuffers(1, &cost_fbo);
-  if (depth_buffer) glDeleteRenderbuffers(1, &depth_buffer);
-  if (targets[0]) glDeleteRenderbuffers(kTargetCount, targets.data());
+  if (scene_fbo) gl().DeleteFramebuffers(1, &scene_fbo);
+  if (cost_fbo) gl().DeleteFramebuffers(1, &cost_fbo);
+  if (depth_buffer) gl().DeleteRenderbuffers(1, &depth_buffer);
+  if (targets[0]) gl().DeleteRenderbuffers(kTargetCount, targets.data());
   scene_fbo = cost_fbo = depth_buffer = 0;
   targets.fill(0);
   width = height = 0;
@@ -479,15 +479,15 @@ void GlRasterizer::Impl::release() {
   // Deleting needs the context current; if that fails, destroying the context frees it all.
   if (context->make_current()) {
     release_targets();
-    if (scene_program) glDeleteProgram(scene_program);
-    if (cost_program) glDeleteProgram(cost_program);
-    if (shadow_program) glDeleteProgram(shadow_program);
+    if (scene_program) gl().DeleteProgram(scene_program);
+    if (cost_program) gl().DeleteProgram(cost_program);
+    if (shadow_program) gl().DeleteProgram(shadow_program);
     release_shadow_maps();
-    if (vao) glDeleteVertexArrays(1, &vao);
-    if (vertex_buffer) glDeleteBuffers(1, &vertex_buffer);
-    if (light_buffer) glDeleteBuffers(1, &light_buffer);
-    if (light_texture) glDeleteTextures(1, &light_texture);
-    if (query) glDeleteQueries(1, &query);
+    if (vao) gl().DeleteVertexArrays(1, &vao);
+    if (vertex_buffer) gl().DeleteBuffers(1, &vertex_buffer);
+    if (light_buffer) gl().DeleteBuffers(1, &light_buffer);
+    if (light_texture) gl().DeleteTextures(1, &light_texture);
+    if (query) gl().DeleteQueries(1, &query);
   }
   context->destroy();
   context.reset();
@@ -501,7 +501,6 @@ void GlRasterizer::Impl::release() {
   scene_fbo = cost_fbo = depth_buffer = 0;
   targets.fill(0);
   width = height = 0;
-  get_query_u64 = nullptr;
 }
 
 Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
@@ -557,10 +556,10 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
     d.count = GLsizei(GLint(vertices.size()) - d.first);
     if (d.count > 0) draws.push_back(d);
   }
-  glBindVertexArray(vao);
-  glBindBuffer(GL_ARRAY_BUFFER, vertex_buffer);
-  glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)), vertices.data(),
-               GL_STATIC_DRAW);
+  gl().BindVertexArray(vao);
+  gl().BindBuffer(GL_ARRAY_BUFFER, vertex_buffer);
+  gl().BufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)), vertices.data(),
+                  GL_STATIC_DRAW);
 
   const std::vector<LightSample> samples = options.mode == RenderMode::Visibility
                                                ? std::vector<LightSample>{}
@@ -572,12 +571,12 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
     light_texels.emplace_back(s.intensity, 0.0f);
   }
   if (light_texels.empty()) light_texels.resize(2, glm::vec4(0.0f));  // never an empty buffer
-  glBindBuffer(GL_TEXTURE_BUFFER, light_buffer);
-  glBufferData(GL_TEXTURE_BUFFER, GLsizeiptr(light_texels.size() * sizeof(glm::vec4)),
-               light_texels.data(), GL_STATIC_DRAW);
-  glActiveTexture(GLenum(GL_TEXTURE0 + kLightUnit));
-  glBindTexture(GL_TEXTURE_BUFFER, light_texture);
-  glTexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, light_buffer);
+  gl().BindBuffer(GL_TEXTURE_BUFFER, light_buffer);
+  gl().BufferData(GL_TEXTURE_BUFFER, GLsizeiptr(light_texels.size() * sizeof(glm::vec4)),
+                  light_texels.data(), GL_STATIC_DRAW);
+  gl().ActiveTexture(GLenum(GL_TEXTURE0 + kLightUnit));
+  gl().BindTexture(GL_TEXTURE_BUFFER, light_texture);
+  gl().TexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, light_buffer);
   RVR_GL_CHECK("uploading geometry and lights");
   out.stats["time.upload"] = seconds_since(t);
 
@@ -651,110 +650,110 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
 
   // One draw of every object with the scene program; the caller sets the pass's state.
   auto draw_scene = [&](bool shade_pass, size_t first, size_t end, bool base) {
-    glUseProgram(scene_program);
-    glUniformMatrix4fv(su.view, 1, GL_FALSE, glm::value_ptr(view));
-    glUniformMatrix4fv(su.projection, 1, GL_FALSE, glm::value_ptr(projection));
-    glUniform3fv(su.eye, 1, glm::value_ptr(scene.camera.eye));
-    glUniform3fv(su.ambient, 1, glm::value_ptr(scene.ambient));
-    glUniform3fv(su.background, 1, glm::value_ptr(scene.image.background));
-    glUniform1i(su.shade, shade_pass ? 1 : 0);
-    glUniform1i(su.lights, kLightUnit);
-    glUniform1i(su.light_first, GLint(first));
-    glUniform1i(su.light_end, GLint(end));
-    glUniform1i(su.base, base ? 1 : 0);
-    glUniform1i(su.shadows, shadows ? 1 : 0);
-    glUniform1i(su.shadow_maps, kShadowUnit);
-    glUniformMatrix3fv(su.face_rotation, 6, GL_FALSE, glm::value_ptr(rotations[0]));
-    glUniform1f(su.shadow_bias, options.shadow_bias);
+    gl().UseProgram(scene_program);
+    gl().UniformMatrix4fv(su.view, 1, GL_FALSE, glm::value_ptr(view));
+    gl().UniformMatrix4fv(su.projection, 1, GL_FALSE, glm::value_ptr(projection));
+    gl().Uniform3fv(su.eye, 1, glm::value_ptr(scene.camera.eye));
+    gl().Uniform3fv(su.ambient, 1, glm::value_ptr(scene.ambient));
+    gl().Uniform3fv(su.background, 1, glm::value_ptr(scene.image.background));
+    gl().Uniform1i(su.shade, shade_pass ? 1 : 0);
+    gl().Uniform1i(su.lights, kLightUnit);
+    gl().Uniform1i(su.light_first, GLint(first));
+    gl().Uniform1i(su.light_end, GLint(end));
+    gl().Uniform1i(su.base, base ? 1 : 0);
+    gl().Uniform1i(su.shadows, shadows ? 1 : 0);
+    gl().Uniform1i(su.shadow_maps, kShadowUnit);
+    gl().UniformMatrix3fv(su.face_rotation, 6, GL_FALSE, glm::value_ptr(rotations[0]));
+    gl().Uniform1f(su.shadow_bias, options.shadow_bias);
     // A texel spans at most 2/size in tan units (at a face centre): normal offset and slope bias
     // are measured in it (gl_shaders.h, shadow_visibility).
-    glUniform1f(su.shadow_texel, map_size > 0 ? 2.0f / float(map_size) : 0.0f);
-    glUniform1i(su.shadow_pcf, options.shadow_pcf ? 1 : 0);
+    gl().Uniform1f(su.shadow_texel, map_size > 0 ? 2.0f / float(map_size) : 0.0f);
+    gl().Uniform1i(su.shadow_pcf, options.shadow_pcf ? 1 : 0);
     for (const DrawItem& d : draws) {
-      glUniform1ui(su.object_id, d.object);
-      glUniform1i(su.smooth, d.smooth ? 1 : 0);
-      glUniform1i(su.use_primitive_id, d.use_primitive_id ? 1 : 0);
-      glUniform3fv(su.diffuse, 1, glm::value_ptr(d.material->diffuse));
-      glUniform3fv(su.specular, 1, glm::value_ptr(d.material->specular));
-      glUniform3fv(su.emission, 1, glm::value_ptr(d.material->emission));
-      glUniform1f(su.shininess, d.material->shininess);
-      glDrawArrays(GL_TRIANGLES, d.first, d.count);
+      gl().Uniform1ui(su.object_id, d.object);
+      gl().Uniform1i(su.smooth, d.smooth ? 1 : 0);
+      gl().Uniform1i(su.use_primitive_id, d.use_primitive_id ? 1 : 0);
+      gl().Uniform3fv(su.diffuse, 1, glm::value_ptr(d.material->diffuse));
+      gl().Uniform3fv(su.specular, 1, glm::value_ptr(d.material->specular));
+      gl().Uniform3fv(su.emission, 1, glm::value_ptr(d.material->emission));
+      gl().Uniform1f(su.shininess, d.material->shininess);
+      gl().DrawArrays(GL_TRIANGLES, d.first, d.count);
     }
   };
   auto clear_scene_targets = [&] {
-    glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
-    glDrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
-    glClearBufferfv(GL_COLOR, kColour, glm::value_ptr(background));
-    glClearBufferuiv(GL_COLOR, kObjectId, no_id);
-    glClearBufferuiv(GL_COLOR, kPrimitiveId, no_id);
-    glClearBufferfv(GL_COLOR, kViewDepth, far_view);
-    glClearBufferfv(GL_COLOR, kNormal, glm::value_ptr(zero));
-    glClearBufferfv(GL_DEPTH, 0, &depth_one);
+    gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+    gl().DrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
+    gl().ClearBufferfv(GL_COLOR, kColour, glm::value_ptr(background));
+    gl().ClearBufferuiv(GL_COLOR, kObjectId, no_id);
+    gl().ClearBufferuiv(GL_COLOR, kPrimitiveId, no_id);
+    gl().ClearBufferfv(GL_COLOR, kViewDepth, far_view);
+    gl().ClearBufferfv(GL_COLOR, kNormal, glm::value_ptr(zero));
+    gl().ClearBufferfv(GL_DEPTH, 0, &depth_one);
   };
 
-  glDisable(GL_CULL_FACE);  // two-sided, like the tracer
-  glDisable(GL_BLEND);
-  glActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
-  glBindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
-  glActiveTexture(GL_TEXTURE0);
+  gl().Disable(GL_CULL_FACE);  // two-sided, like the tracer
+  gl().Disable(GL_BLEND);
+  gl().ActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
+  gl().BindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
+  gl().ActiveTexture(GL_TEXTURE0);
   const size_t batches = shadows ? (samples.size() + batch - 1) / batch : 1;
   for (size_t b = 0; b < batches; ++b) {
     const size_t first = b * batch, end = std::min(samples.size(), first + batch);
     if (shadows) {
       auto ts = Clock::now();
       RVR_TRY(render_shadow_maps(samples, first, end, light_projection, GLsizei(vertices.size())));
-      glFinish();
+      gl().Finish();
       shadow_time += seconds_since(ts);
     }
-    glViewport(0, 0, w, h);
-    glEnable(GL_DEPTH_TEST);
+    gl().Viewport(0, 0, w, h);
+    gl().Enable(GL_DEPTH_TEST);
     if (b == 0) {
       // Base pass: emission, ambient and the first batch of lights; ids etc. when single-sampled.
-      glDepthFunc(GL_LESS);
-      glDepthMask(GL_TRUE);
+      gl().DepthFunc(GL_LESS);
+      gl().DepthMask(GL_TRUE);
       if (msaa > 1) {
-        glBindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
-        glClearBufferfv(GL_COLOR, 0, glm::value_ptr(background));
-        glClearBufferfv(GL_DEPTH, 0, &depth_one);
+        gl().BindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
+        gl().ClearBufferfv(GL_COLOR, 0, glm::value_ptr(background));
+        gl().ClearBufferfv(GL_DEPTH, 0, &depth_one);
       } else {
         clear_scene_targets();
-        glBeginQuery(GL_SAMPLES_PASSED, query);
+        gl().BeginQuery(GL_SAMPLES_PASSED, query);
       }
       draw_scene(shade, first, end, true);
-      if (msaa == 1) glEndQuery(GL_SAMPLES_PASSED);
+      if (msaa == 1) gl().EndQuery(GL_SAMPLES_PASSED);
     } else {
       // Additive pass for this batch's lights, on exactly the surfaces the base pass kept.
-      glBindFramebuffer(GL_FRAMEBUFFER, msaa > 1 ? msaa_fbo : scene_fbo);
-      glDrawBuffers(1, &colour_only);
-      glDepthFunc(GL_EQUAL);
-      glDepthMask(GL_FALSE);
-      glEnable(GL_BLEND);
-      glBlendFunc(GL_ONE, GL_ONE);
+      gl().BindFramebuffer(GL_FRAMEBUFFER, msaa > 1 ? msaa_fbo : scene_fbo);
+      gl().DrawBuffers(1, &colour_only);
+      gl().DepthFunc(GL_EQUAL);
+      gl().DepthMask(GL_FALSE);
+      gl().Enable(GL_BLEND);
+      gl().BlendFunc(GL_ONE, GL_ONE);
       draw_scene(true, first, end, false);
-      glDisable(GL_BLEND);
-      glDepthMask(GL_TRUE);
-      glDepthFunc(GL_LESS);
+      gl().Disable(GL_BLEND);
+      gl().DepthMask(GL_TRUE);
+      gl().DepthFunc(GL_LESS);
     }
   }
   if (msaa > 1) {
     // The per-pixel AOVs (ids, depth, normal) come from one sample at the pixel centre; the
     // colour is the multisampled one, resolved (averaged) over each pixel's samples.
     clear_scene_targets();
-    glBeginQuery(GL_SAMPLES_PASSED, query);
+    gl().BeginQuery(GL_SAMPLES_PASSED, query);
     draw_scene(false, 0, 0, true);
-    glEndQuery(GL_SAMPLES_PASSED);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo);
-    glReadBuffer(GL_COLOR_ATTACHMENT0);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, scene_fbo);
-    glDrawBuffers(1, &colour_only);
-    glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
-    glDrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
+    gl().EndQuery(GL_SAMPLES_PASSED);
+    gl().BindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo);
+    gl().ReadBuffer(GL_COLOR_ATTACHMENT0);
+    gl().BindFramebuffer(GL_DRAW_FRAMEBUFFER, scene_fbo);
+    gl().DrawBuffers(1, &colour_only);
+    gl().BlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+    gl().DrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
   } else {
-    glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
-    glDrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
+    gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+    gl().DrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
   }
-  glFinish();
+  gl().Finish();
   RVR_GL_CHECK("scene pass");
   out.stats["time.render"] = seconds_since(t) - shadow_time;
   if (shadows) {
@@ -769,17 +768,17 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
 
   // --- cost pass: every fragment generated, whatever the depth test would say
   t = Clock::now();
-  glBindFramebuffer(GL_FRAMEBUFFER, cost_fbo);
-  glClearBufferfv(GL_COLOR, 0, glm::value_ptr(zero));
-  glDisable(GL_DEPTH_TEST);
-  glEnable(GL_BLEND);
-  glBlendFunc(GL_ONE, GL_ONE);
-  glUseProgram(cost_program);
-  glUniformMatrix4fv(cost_view, 1, GL_FALSE, glm::value_ptr(view));
-  glUniformMatrix4fv(cost_projection, 1, GL_FALSE, glm::value_ptr(projection));
-  if (!vertices.empty()) glDrawArrays(GL_TRIANGLES, 0, GLsizei(vertices.size()));
-  glDisable(GL_BLEND);
-  glFinish();
+  gl().BindFramebuffer(GL_FRAMEBUFFER, cost_fbo);
+  gl().ClearBufferfv(GL_COLOR, 0, glm::value_ptr(zero));
+  gl().Disable(GL_DEPTH_TEST);
+  gl().Enable(GL_BLEND);
+  gl().BlendFunc(GL_ONE, GL_ONE);
+  gl().UseProgram(cost_program);
+  gl().UniformMatrix4fv(cost_view, 1, GL_FALSE, glm::value_ptr(view));
+  gl().UniformMatrix4fv(cost_projection, 1, GL_FALSE, glm::value_ptr(projection));
+  if (!vertices.empty()) gl().DrawArrays(GL_TRIANGLES, 0, GLsizei(vertices.size()));
+  gl().Disable(GL_BLEND);
+  gl().Finish();
   RVR_GL_CHECK("cost pass");
   out.stats["time.cost"] = seconds_since(t);
 
@@ -795,25 +794,25 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   fb.primitive_id.resize(n);
   fb.normal.resize(n);
   fb.cost.resize(n);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  gl().PixelStorei(GL_PACK_ALIGNMENT, 1);
   // Each attachment is read in its stored layout into reused scratch memory, then copied once
   // into the FrameBuffers with rows flipped (GL rows are bottom-up, ours top-down).
   auto read_scalar = [&](GLuint fbo, int attachment, GLenum format, GLenum type, auto& dst) {
     using T = typename std::decay_t<decltype(dst)>::value_type;
     static_assert(sizeof(T) == 4);
     scratch.resize(n);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
-    glReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + attachment));
-    glReadPixels(0, 0, w, h, format, type, scratch.data());
+    gl().BindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    gl().ReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + attachment));
+    gl().ReadPixels(0, 0, w, h, format, type, scratch.data());
     for (int y = 0; y < h; ++y)
       std::memcpy(dst.data() + size_t(y) * size_t(w),
                   scratch.data() + size_t(h - 1 - y) * size_t(w), size_t(w) * sizeof(T));
   };
   auto read_rgb = [&](int attachment, std::vector<glm::vec3>& dst) {
     scratch_rgba.resize(n);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, scene_fbo);
-    glReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + attachment));
-    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, scratch_rgba.data());
+    gl().BindFramebuffer(GL_READ_FRAMEBUFFER, scene_fbo);
+    gl().ReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + attachment));
+    gl().ReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, scratch_rgba.data());
     for (int y = 0; y < h; ++y) {
       const glm::vec4* src = scratch_rgba.data() + size_t(h - 1 - y) * size_t(w);
       glm::vec3* row = dst.data() + size_t(y) * size_t(w);
@@ -827,7 +826,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   read_scalar(scene_fbo, kViewDepth, GL_RED, GL_FLOAT, fb.depth);
   read_scalar(cost_fbo, 0, GL_RED, GL_FLOAT, fb.cost);
   GLuint64 passed = 0;
-  get_query_u64(query, GL_QUERY_RESULT, &passed);
+  gl().GetQueryObjectui64v(query, GL_QUERY_RESULT, &passed);
   RVR_GL_CHECK("readback");
   out.stats["time.readback"] = seconds_since(t);
 
