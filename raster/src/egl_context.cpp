@@ -10,7 +10,7 @@
 #include <EGL/eglext.h>
 #include <dlfcn.h>
 #include <fmt/format.h>
-#include <glad/gl.h>  // before the EGL headers, which must not pull in the system GL/gl.h
+#include <glad/gl.h>
 
 #include <cstdlib>
 #include <string>

@@ -1,10 +1,13 @@
 // OSMesa: Mesa's off-screen interface. libOSMesa is opened at run time (not linked), so that
 // rvr starts and falls back to EGL on systems whose Mesa no longer ships it. Its entry points
 // then come only through OSMesaGetProcAddress, never from the library's exported gl* symbols.
+// glad's gl.h first, in a block of its own: osmesa.h would otherwise pull in the system
+// GL/gl.h, which glad refuses to follow.
+#include <glad/gl.h>
+// (keeps clang-format from sorting across the line above)
 #include <GL/osmesa.h>
 #include <dlfcn.h>
 #include <fmt/format.h>
-#include <glad/gl.h>  // before osmesa.h, which would otherwise pull in the system GL/gl.h
 
 #include <cstdlib>
 #include <string>
