@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
@@ -455,4 +456,37 @@ TEST_F(Cli, InfoHasWhatABugReportNeeds) {
         "embree: 3.", "openimageio: ", "tbb: ", "gl backend: osmesa",
         "GL_VERSION: ", "GL_RENDERER: llvmpipe", "llvmpipe threads: "})
     EXPECT_NE(r.out.find(field), std::string::npos) << field << " missing in:\n" << r.out;
+}
+
+// --gl picks the raster's GL back end; by default OSMesa, falling back to EGL (and saying so)
+// when libOSMesa cannot be loaded, which RVR_OSMESA_LIBRARY simulates.
+TEST_F(Cli, GlBackendsAndTheFallbackToEgl) {
+  RunResult egl = run("info --gl egl");
+  ASSERT_EQ(egl.status, 0) << egl.err;
+  EXPECT_NE(egl.out.find("gl backend: egl\n"), std::string::npos) << egl.out;
+  EXPECT_NE(egl.out.find("GL_RENDERER: llvmpipe"), std::string::npos) << egl.out;
+
+  const std::string args = "render builtin:cornell -r raster --width 64 --height 48 -o ";
+  RunResult a = run(args + (dir_ / "osmesa.png").string() + " --gl osmesa");
+  ASSERT_EQ(a.status, 0) << a.err;
+  RunResult b = run(args + (dir_ / "egl.png").string() + " --gl egl");
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_EQ(slurp(dir_ / "osmesa.png"), slurp(dir_ / "egl.png"));
+
+  const std::string missing = "RVR_OSMESA_LIBRARY=/nonexistent/libOSMesa.so.8";
+  RunResult fallback = run(args + (dir_ / "fallback.png").string(), missing);
+  ASSERT_EQ(fallback.status, 0) << fallback.err;
+  EXPECT_NE(fallback.err.find("warning: raster: OSMesa unavailable (cannot load "
+                              "/nonexistent/libOSMesa.so.8"),
+            std::string::npos)
+      << fallback.err;
+  EXPECT_NE(fallback.err.find("using EGL surfaceless instead"), std::string::npos);
+  EXPECT_EQ(slurp(dir_ / "osmesa.png"), slurp(dir_ / "fallback.png"));
+
+  // Asked for by name, OSMesa does not fall back: an internal failure (exit 3), one line.
+  RunResult refused = run(args + (dir_ / "refused.png").string() + " --gl osmesa", missing);
+  EXPECT_EQ(refused.status, 3);
+  EXPECT_EQ(refused.err.rfind("error: ", 0), 0u) << refused.err;
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  EXPECT_FALSE(fs::exists(dir_ / "refused.png"));
 }
