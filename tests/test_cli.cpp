@@ -159,8 +159,8 @@ TEST_F(Cli, CompareWritesEverythingAndThresholdGivesExit1) {
   fs::path out = dir_ / "cmp";
   RunResult r = run("compare builtin:soup:3000 --width 160 --height 120 -o " + out.string());
   ASSERT_EQ(r.status, 0) << r.err;
-  for (const char* f :
-       {"raster.png", "raytrace.png", "diff.png", "id_mismatch.png", "metrics.json", "report.html"})
+  for (const char* f : {"raster.png", "raytrace.png", "diff.png", "id_mismatch.png",
+                        "depth_diff.png", "metrics.json", "report.html"})
     EXPECT_TRUE(fs::exists(out / f)) << f;
   nlohmann::json m = nlohmann::json::parse(slurp(out / "metrics.json"));
   for (const char* key :

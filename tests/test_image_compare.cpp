@@ -569,3 +569,53 @@ TEST(IdMismatchImage, RedWhereObjectsDifferGreyElsewhere) {
   EXPECT_EQ(img.at(3, 1, 0), img.at(3, 1, 1));
   EXPECT_EQ(img.at(3, 1, 1), img.at(3, 1, 2));
 }
+
+TEST(DepthDiffImage, LogScaleAndBackgroundColours) {
+  FrameBuffers a = flat(8, 1), b = flat(8, 1);
+  for (int x = 0; x < 8; ++x) a.depth[x] = b.depth[x] = 1.0f;
+  // x=0: same depth -> black. x=1: rel 10^-3.5, half way up 1e-6..1e-1 in log10 -> inferno(0.5).
+  b.depth[1] = 1.0f - std::pow(10.0f, -3.5f);
+  b.depth[2] = 0.9f;                        // rel 0.1: the top of the map
+  a.depth[3] = 2.0f;                        // rel 0.5: clamped to the top
+  a.object_id[4] = b.object_id[4] = kNoId;  // background in both
+  b.object_id[5] = kNoId;                   // hit vs background, both ways
+  a.object_id[6] = kNoId;
+  b.object_id[7] = 3;  // different object: still a depth difference (here 0)
+  Image img = depth_diff_image(a, b);
+  ASSERT_EQ(img.width, 8);
+  ASSERT_EQ(img.height, 1);
+  ASSERT_EQ(img.channels, 3);
+  auto pixel = [&](int x) { return glm::vec3(img.at(x, 0, 0), img.at(x, 0, 1), img.at(x, 0, 2)); };
+  EXPECT_LT(pixel(0).r + pixel(0).g + pixel(0).b, 0.05f);
+  EXPECT_NEAR(pixel(1).r, 0.735f, 0.03f);
+  EXPECT_NEAR(pixel(1).g, 0.216f, 0.03f);
+  EXPECT_NEAR(pixel(1).b, 0.330f, 0.03f);
+  EXPECT_NEAR(pixel(2).r, 0.988f, 0.02f);
+  EXPECT_NEAR(pixel(2).g, 0.998f, 0.02f);
+  EXPECT_NEAR(pixel(2).b, 0.645f, 0.03f);
+  EXPECT_EQ(pixel(3), pixel(2));
+  EXPECT_EQ(pixel(4), glm::vec3(0.5f));
+  EXPECT_EQ(pixel(5), glm::vec3(0.0f, 1.0f, 1.0f));
+  EXPECT_EQ(pixel(6), glm::vec3(0.0f, 1.0f, 1.0f));
+  EXPECT_EQ(pixel(7), pixel(0));
+}
+
+TEST(DepthDiffImage, ScaleIsAParameterAndBadInputStillGivesAPicture) {
+  FrameBuffers a = flat(2, 1), b = flat(2, 1);
+  b.depth[0] = 5.0f * (1.0f - 1e-3f);
+  b.depth[1] = std::numeric_limits<float>::quiet_NaN();  // a hit with no depth: worst
+  // With the top of the map at 1e-3 the first pixel is at the top too.
+  Image img = depth_diff_image(a, b, {1e-5f, 1e-3f});
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(img.at(0, 0, c), img.at(1, 0, c), 0.02f);
+    EXPECT_GT(img.at(0, 0, c), 0.6f);
+  }
+  // A smaller b: its missing pixels are hit vs background; a nonsense scale does not crash.
+  FrameBuffers small = flat(1, 1);
+  Image partial = depth_diff_image(a, small, {-1.0f, 0.0f});
+  ASSERT_EQ(partial.width, 2);
+  EXPECT_EQ(partial.at(1, 0, 0), 0.0f);
+  EXPECT_EQ(partial.at(1, 0, 1), 1.0f);
+  EXPECT_EQ(partial.at(1, 0, 2), 1.0f);
+  for (float v : partial.pixels) EXPECT_TRUE(std::isfinite(v));
+}

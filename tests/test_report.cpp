@@ -62,8 +62,8 @@ class ReportDir : public ::testing::Test {
     img.height = 6;
     img.channels = 3;
     img.pixels.assign(8 * 6 * 3, 0.5f);
-    for (const char* name :
-         {"raster.png", "raytrace.png", "raytrace.cost.png", "diff.png", "id_mismatch.png"})
+    for (const char* name : {"raster.png", "raytrace.png", "raytrace.cost.png", "diff.png",
+                             "id_mismatch.png", "depth_diff.png"})
       ASSERT_TRUE(write_image((dir_ / name).string(), img).ok());
   }
   void TearDown() override {
@@ -149,9 +149,9 @@ TEST_F(ReportDir, HtmlIsSelfContained) {
   ASSERT_TRUE(html.ok()) << html.error().message;
   const std::string& h = html.value();
   EXPECT_EQ(h.rfind("<!DOCTYPE html>", 0), 0u);
-  // Both renders (side by side and in the flip view), diff.png, id_mismatch.png and the
-  // cost picture of the renderer that has one.
-  EXPECT_EQ(count_of(h, "data:image/png;base64,"), 7u);
+  // Both renders (side by side and in the flip view), diff.png, id_mismatch.png,
+  // depth_diff.png and the cost picture of the renderer that has one.
+  EXPECT_EQ(count_of(h, "data:image/png;base64,"), 8u);
   EXPECT_NE(h.find("raytrace.cost.png</b>: BVH nodes visited + primitive tests per pixel; mean "
                    "12.5, yellow-white &ge; 31"),
             std::string::npos);
@@ -164,8 +164,9 @@ TEST_F(ReportDir, HtmlIsSelfContained) {
   // Warnings are shown, escaped.
   EXPECT_NE(h.find("csg objects skipped: &lt;1&gt; &amp; &quot;more&quot;"), std::string::npos);
   EXPECT_EQ(h.find("<1>"), std::string::npos);
-  for (const char* word : {"id_agreement", "mismatched_off_edge", "max_rel_error", "psnr_db",
-                           "ssim", "time.render", "time.build", "diff.png", "id_mismatch.png"})
+  for (const char* word :
+       {"id_agreement", "mismatched_off_edge", "max_rel_error", "psnr_db", "ssim", "time.render",
+        "time.build", "diff.png", "id_mismatch.png", "depth_diff.png"})
     EXPECT_NE(h.find(word), std::string::npos) << word;
   EXPECT_NE(h.find("</html>"), std::string::npos);
 }
@@ -183,4 +184,93 @@ TEST_F(ReportDir, MissingImageIsAnError) {
   auto html = report_html(sample_input(dir_.string()));
   ASSERT_FALSE(html.ok());
   EXPECT_NE(html.error().message.find("id_mismatch.png"), std::string::npos);
+}
+
+// The SVG of an element with this id, from its opening tag to the next </svg>.
+std::string svg_with_id(const std::string& html, const std::string& id) {
+  size_t at = html.find("<svg id=\"" + id + "\"");
+  if (at == std::string::npos) return "";
+  size_t end = html.find("</svg>", at);
+  return end == std::string::npos ? "" : html.substr(at, end + 6 - at);
+}
+
+TEST_F(ReportDir, DepthDifferenceWithItsScale) {
+  ReportInput in = sample_input(dir_.string());
+  in.depth_diff_scale = {1e-5f, 1e-2f};
+  auto html = report_html(in);
+  ASSERT_TRUE(html.ok()) << html.error().message;
+  const std::string& h = html.value();
+  std::ifstream file(dir_ / "depth_diff.png", std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  EXPECT_NE(h.find("<img src=\"data:image/png;base64," + base64(bytes) +
+                   "\" alt=\"relative depth difference\">"),
+            std::string::npos);
+  // The caption states the scale and the two background colours; the colour bar has a tick
+  // per decade.
+  EXPECT_NE(h.find("log scale</b>: black &le; 1e-5"), std::string::npos);
+  EXPECT_NE(h.find("yellow-white &ge; 1e-2"), std::string::npos);
+  EXPECT_NE(h.find("background in both"), std::string::npos);
+  EXPECT_NE(h.find("background in one, a hit in the other"), std::string::npos);
+  for (const char* tick : {">1e-5</text>", ">1e-4</text>", ">1e-3</text>", ">1e-2</text>"})
+    EXPECT_NE(h.find(tick), std::string::npos) << tick;
+  auto doc = nlohmann::json::parse(metrics_json(in));
+  EXPECT_EQ(doc["files"]["depth_diff"], "depth_diff.png");
+  EXPECT_EQ(doc["depth_diff_scale"]["low"].get<double>(), 1e-5);
+  EXPECT_EQ(doc["depth_diff_scale"]["high"].get<double>(), 1e-2);
+  fs::remove(dir_ / "depth_diff.png");
+  auto missing = report_html(in);
+  ASSERT_FALSE(missing.ok());
+  EXPECT_NE(missing.error().message.find("depth_diff.png"), std::string::npos);
+}
+
+TEST_F(ReportDir, TimingChartHasEveryPhaseOfEveryRenderer) {
+  ReportInput in = sample_input(dir_.string());
+  in.renderers[0].stats = {{"time.load", 0.002},
+                           {"time.setup", 0.01},
+                           {"time.upload", 0.02},
+                           {"time.render", 0.05},
+                           {"time.readback", 0.01}};
+  in.renderers[0].seconds = 0.12;  // 0.03 s in no phase: "other"
+  in.renderers[1].stats = {
+      {"time.load", 0.002}, {"time.build", 0.05}, {"time.bvh_build", 0.04}, {"time.render", 0.35}};
+  in.renderers[1].seconds = 0.4;  // every bit in a phase: no "other"
+  auto html = report_html(in);
+  ASSERT_TRUE(html.ok()) << html.error().message;
+  const std::string svg = svg_with_id(html.value(), "timing-chart");
+  ASSERT_FALSE(svg.empty());
+  EXPECT_NE(svg.find("role=\"img\""), std::string::npos);
+  EXPECT_NE(svg.find("<title id=\"timing-title\">"), std::string::npos);
+
+  auto row = [&](const std::string& name) {
+    size_t at = svg.find("<g class=\"bar-row\" data-renderer=\"" + name + "\">");
+    if (at == std::string::npos) return std::string();
+    return svg.substr(at, svg.find("</g>", at) - at);
+  };
+  const std::string raster = row("raster"), raytrace = row("raytrace");
+  ASSERT_FALSE(raster.empty());
+  ASSERT_FALSE(raytrace.empty());
+  for (const char* phase : {"load", "setup", "upload", "render", "readback", "other"})
+    EXPECT_NE(raster.find(std::string("data-phase=\"") + phase + "\""), std::string::npos) << phase;
+  for (const char* phase : {"load", "build", "render"})
+    EXPECT_NE(raytrace.find(std::string("data-phase=\"") + phase + "\""), std::string::npos)
+        << phase;
+  // Nested in time.build, so not stacked a second time; named in the build tooltip instead.
+  EXPECT_EQ(raytrace.find("data-phase=\"bvh_build\""), std::string::npos);
+  EXPECT_NE(raytrace.find("build 0.05 s (of which bvh_build 0.04 s)"), std::string::npos);
+  EXPECT_EQ(raytrace.find("data-phase=\"other\""), std::string::npos);
+  // Seconds per segment (tooltips) and the bar totals: load plus the render call.
+  EXPECT_NE(raster.find("raster: upload 0.02 s"), std::string::npos);
+  EXPECT_NE(raster.find("raster: other 0.03 s"), std::string::npos);
+  EXPECT_NE(raster.find(">0.122 s</text>"), std::string::npos);
+  EXPECT_NE(raytrace.find(">0.402 s</text>"), std::string::npos);
+  // Pipeline order within a bar: load, setup, upload, render, readback, other.
+  size_t last = 0;
+  for (const char* phase : {"load", "setup", "upload", "render", "readback", "other"}) {
+    size_t at = raster.find(std::string("data-phase=\"") + phase + "\"");
+    EXPECT_GT(at, last) << phase;
+    last = at;
+  }
+  // The same numbers as text for screen readers.
+  EXPECT_NE(svg.find("<desc id=\"timing-desc\">raster: load 0.002 s, setup 0.01 s"),
+            std::string::npos);
 }

@@ -311,6 +311,8 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
                     diff_heat_map(images[0], images[1], report.heat_map_scale), false));
   check(write_image(a.out_dir + "/id_mismatch.png", id_mismatch_image(buffers[0], buffers[1]),
                     false));
+  check(write_image(a.out_dir + "/depth_diff.png",
+                    depth_diff_image(buffers[0], buffers[1], report.depth_diff_scale), false));
   check(write_text_file(a.out_dir + "/metrics.json", metrics_json(report)));
   check(write_text_file(a.out_dir + "/report.html", take(report_html(report))));
 
@@ -331,8 +333,10 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
               m.depth.mean_rel_error);
   std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
               m.color.psnr_db, m.color.max_abs, m.color.ssim);
-  std::printf("  wrote %s/{%s.png,%s.png,diff.png,id_mismatch.png,metrics.json,report.html}\n",
-              a.out_dir.c_str(), a.renderers[0].c_str(), a.renderers[1].c_str());
+  std::printf(
+      "  wrote %s/{%s.png,%s.png,diff.png,depth_diff.png,id_mismatch.png,metrics.json,"
+      "report.html}\n",
+      a.out_dir.c_str(), a.renderers[0].c_str(), a.renderers[1].c_str());
   if (a.fail_below_agreement && m.visibility.id_agreement < *a.fail_below_agreement) {
     std::fprintf(stderr, "id agreement %.5f is below %.5f\n", m.visibility.id_agreement,
                  *a.fail_below_agreement);

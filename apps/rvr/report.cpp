@@ -1,8 +1,9 @@
 // metrics.json and report.html of `rvr compare`.
 //
 // metrics.json holds exactly the fields cli.md requires, plus a few extras ("command",
-// "heat_map_scale", "compared", "files", and "image" per renderer). JSON has no infinity or NaN:
-// an infinite PSNR (identical colour) is written as 999.0, any other non-finite number as null.
+// "heat_map_scale", "depth_diff_scale", "compared", "files", and "image" per renderer). JSON
+// has no infinity or NaN: an infinite PSNR (identical colour) is written as 999.0, any other
+// non-finite number as null.
 //
 // report.html is one self-contained file: the images are embedded as base64 data URIs, the CSS
 // and the few lines of script are inline, nothing is fetched from anywhere.
@@ -13,10 +14,12 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -32,6 +35,13 @@ constexpr double kPsnrIdentical = 999.0;  // stands for +inf in metrics.json
 
 ordered_json number(double v) {
   return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr);
+}
+
+std::string fmt(const char* format, double v);
+
+// The float as it reads (0.1), not as its double widening prints (0.10000000149011612).
+ordered_json float_number(float v) {
+  return number(std::isfinite(v) ? std::strtod(fmt("%.7g", v).c_str(), nullptr) : v);
 }
 
 ordered_json psnr_number(double v) {
@@ -103,6 +113,218 @@ std::string fmt_seconds(double s) {
   return fmt("%.3f s", s);
 }
 
+// A number as people write it: 1e-6 rather than 1e-06 or 9.99999997e-07 (a float widened), and
+// powers of ten of one form (1e-2 next to 1e-5, not 0.01).
+std::string short_number(double v) {
+  if (v > 0 && std::isfinite(v)) {
+    const double e = std::round(std::log10(v));
+    if (std::fabs(v / std::pow(10.0, e) - 1.0) < 1e-6 && std::fabs(e) >= 2)
+      return "1e" + std::to_string(int(e));
+  }
+  std::string t = fmt("%.6g", v);
+  for (const char* from : {"e-0", "e+0", "e+"}) {
+    size_t at = t.find(from);
+    if (at != std::string::npos) t.replace(at, std::strlen(from), from[1] == '-' ? "e-" : "e");
+  }
+  return t;
+}
+
+// Seconds as the timing chart labels them: three significant digits, always in seconds.
+std::string fmt_s(double s) {
+  return fmt("%.3g s", s);
+}
+
+// OpenImageIO's / matplotlib's inferno map at 0, 0.1, ..., 1 (sRGB), for the colour bars.
+const char* kInfernoStops[] = {"#000004", "#160b39", "#420a68", "#6a176e", "#932667", "#bc3754",
+                               "#dd513a", "#f37819", "#fca50a", "#f6d746", "#fcffa4"};
+
+// An inline SVG colour bar of the inferno map with labelled ticks (position in [0, 1], text),
+// so a heat map can be read without the caption.
+std::string inferno_bar(const std::string& id, const std::string& label,
+                        const std::vector<std::pair<double, std::string>>& ticks) {
+  constexpr double kX0 = 10, kWidth = 300;
+  std::ostringstream o;
+  o << "<svg class=\"bar\" viewBox=\"0 0 320 40\" width=\"320\" height=\"40\" role=\"img\" "
+       "aria-label=\""
+    << escape_html(label) << "\"><defs><linearGradient id=\"" << id << "\">";
+  for (int i = 0; i <= 10; ++i)
+    o << "<stop offset=\"" << i * 10 << "%\" stop-color=\"" << kInfernoStops[i] << "\"/>";
+  o << "</linearGradient></defs><rect x=\"" << kX0 << "\" y=\"2\" width=\"" << kWidth
+    << "\" height=\"14\" fill=\"url(#" << id << ")\" stroke=\"#9aa3b5\" stroke-width=\"0.5\"/>";
+  for (const auto& [pos, text] : ticks) {
+    const double x = kX0 + pos * kWidth;
+    o << "<line x1=\"" << x << "\" x2=\"" << x << "\" y1=\"16\" y2=\"21\" stroke=\"#4a5366\"/>"
+      << "<text x=\"" << x << "\" y=\"33\" text-anchor=\""
+      << (pos < 0.01   ? "start"
+          : pos > 0.99 ? "end"
+                       : "middle")
+      << "\">" << text << "</text>";
+  }
+  o << "</svg>";
+  return o.str();
+}
+
+// A colour swatch as the captions use it.
+std::string swatch(const float rgb[3]) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "<span class=\"sw\" style=\"background:#%02x%02x%02x\"></span>",
+                int(std::lround(rgb[0] * 255)), int(std::lround(rgb[1] * 255)),
+                int(std::lround(rgb[2] * 255)));
+  return buf;
+}
+
+// The phases of one renderer's bar in the timing chart, in pipeline order. time.load is the
+// scene load (shared by every renderer, outside its render call); "other" is the part of the
+// render call no phase accounts for. A phase nested in another (the BVH build is part of
+// time.build) is left out of the stack so nothing is counted twice.
+struct Phase {
+  std::string name;  // "load", "render", ..., "other"
+  double seconds = 0.0;
+};
+
+const std::map<std::string, std::string> kNestedPhases = {{"time.bvh_build", "time.build"}};
+
+int phase_rank(const std::string& name) {
+  static const char* order[] = {"load",   "setup", "build", "upload",   "shadow_maps", "raster",
+                                "render", "shade", "cost",  "readback", "write"};
+  for (int i = 0; i < int(std::size(order)); ++i)
+    if (name == order[i]) return i;
+  return name == "other" ? 1000 : 100;
+}
+
+std::vector<Phase> phases_of(const ReportRenderer& r) {
+  std::vector<Phase> phases;
+  double in_call = 0.0;
+  for (const auto& [key, value] : r.stats) {
+    if (key.rfind("time.", 0) != 0 || kNestedPhases.count(key) || !std::isfinite(value) ||
+        value < 0)
+      continue;
+    phases.push_back({key.substr(5), value});
+    if (key != "time.load") in_call += value;
+  }
+  // Timer granularity and bookkeeping between phases: only a visible remainder is shown.
+  const double other = r.seconds - in_call;
+  if (std::isfinite(other) && other > 0.01 * r.seconds && other > 1e-6)
+    phases.push_back({"other", other});
+  std::stable_sort(phases.begin(), phases.end(), [](const Phase& a, const Phase& b) {
+    return phase_rank(a.name) < phase_rank(b.name);
+  });
+  return phases;
+}
+
+// A round axis step giving about 5 ticks up to `top`.
+double nice_step(double top) {
+  const double raw = top / 5.0;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  for (double m : {1.0, 2.0, 2.5, 5.0})
+    if (raw <= m * mag) return m * mag;
+  return 10.0 * mag;
+}
+
+// Inline SVG: per renderer one horizontal bar of its phases stacked, with labels and seconds;
+// a <title> and <desc> carry the same numbers as text for screen readers, and every segment
+// has a tooltip.
+std::string timing_chart(const std::vector<ReportRenderer>& renderers) {
+  // Colour blind safe (Okabe-Ito, then Tol), one colour per phase name across every bar; grey =
+  // other.
+  static const char* palette[][2] = {
+      {"#0072b2", "#fff"},    {"#e69f00", "#1d2330"}, {"#009e73", "#fff"},
+      {"#cc79a7", "#1d2330"}, {"#56b4e9", "#1d2330"}, {"#d55e00", "#fff"},
+      {"#f0e442", "#1d2330"}, {"#332288", "#fff"},    {"#882255", "#fff"},
+      {"#44aa99", "#1d2330"}, {"#999933", "#1d2330"}};
+  std::vector<std::vector<Phase>> bars;
+  std::vector<std::string> names;  // every phase name, in pipeline order
+  double top = 0.0;
+  for (const auto& r : renderers) {
+    bars.push_back(phases_of(r));
+    double total = 0.0;
+    for (const auto& p : bars.back()) {
+      total += p.seconds;
+      if (std::find(names.begin(), names.end(), p.name) == names.end()) names.push_back(p.name);
+    }
+    top = std::max(top, total);
+  }
+  std::stable_sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
+    return phase_rank(a) < phase_rank(b);
+  });
+  auto colour = [&](const std::string& name) -> const char* const* {
+    static const char* grey[2] = {"#9aa3b5", "#1d2330"};
+    if (name == "other") return grey;
+    size_t i = std::find(names.begin(), names.end(), name) - names.begin();
+    return palette[i % std::size(palette)];
+  };
+  if (!(top > 0.0)) top = 1.0;
+  const double step = nice_step(top);
+  const double axis_top = std::ceil(top / step - 1e-9) * step;
+
+  constexpr double kLeft = 120, kBarWidth = 640, kRow = 34, kBar = 22;
+  const double height = 14 + kRow * double(renderers.size()) + 30;
+  auto x_of = [&](double s) { return kLeft + s / axis_top * kBarWidth; };
+
+  std::ostringstream desc;
+  for (size_t i = 0; i < renderers.size(); ++i) {
+    double total = 0.0;
+    desc << (i ? "; " : "") << renderers[i].name << ":";
+    for (const auto& p : bars[i]) {
+      desc << " " << p.name << " " << fmt_s(p.seconds) << ",";
+      total += p.seconds;
+    }
+    desc << " total " << fmt_s(total);
+  }
+
+  std::ostringstream o;
+  o << "<svg id=\"timing-chart\" class=\"chart\" viewBox=\"0 0 880 " << height
+    << "\" role=\"img\" aria-labelledby=\"timing-title timing-desc\">"
+    << "<title id=\"timing-title\">Time per phase of each renderer, in seconds</title>"
+    << "<desc id=\"timing-desc\">" << escape_html(desc.str()) << "</desc>";
+  // Axis: grid lines and tick labels in seconds.
+  const double axis_y = 14 + kRow * double(renderers.size());
+  for (int k = 0; k * step <= axis_top + 1e-12; ++k) {
+    const double x = x_of(k * step);
+    o << "<line x1=\"" << x << "\" x2=\"" << x << "\" y1=\"8\" y2=\"" << axis_y
+      << "\" stroke=\"#d8dce3\"/><text class=\"tick\" x=\"" << x << "\" y=\"" << axis_y + 16
+      << "\" text-anchor=\"middle\">" << fmt("%g", k * step) << "</text>";
+  }
+  o << "<text class=\"tick\" x=\"" << kLeft - 8 << "\" y=\"" << axis_y + 16
+    << "\" text-anchor=\"end\">seconds</text>";
+  for (size_t i = 0; i < renderers.size(); ++i) {
+    const double y = 14 + kRow * double(i);
+    const std::string name = escape_html(renderers[i].name);
+    o << "<g class=\"bar-row\" data-renderer=\"" << name << "\"><text class=\"name\" x=\""
+      << kLeft - 8 << "\" y=\"" << y + kBar / 2 + 5 << "\" text-anchor=\"end\">" << name
+      << "</text>";
+    double at = 0.0;
+    for (const auto& p : bars[i]) {
+      const double x0 = x_of(at), x1 = x_of(at + p.seconds);
+      at += p.seconds;
+      const char* const* c = colour(p.name);
+      std::string tip = renderers[i].name + ": " + p.name + " " + fmt_s(p.seconds);
+      if (p.name == "build")
+        for (const auto& [nested, parent] : kNestedPhases)
+          if (auto it = renderers[i].stats.find(nested);
+              parent == "time.build" && it != renderers[i].stats.end())
+            tip += " (of which " + nested.substr(5) + " " + fmt_s(it->second) + ")";
+      o << "<rect data-phase=\"" << escape_html(p.name) << "\" x=\"" << x0 << "\" y=\"" << y
+        << "\" width=\"" << std::max(0.0, x1 - x0) << "\" height=\"" << kBar << "\" fill=\"" << c[0]
+        << "\"><title>" << escape_html(tip) << "</title></rect>";
+      // A label only where it fits (about 6.5 px per character at 11 px).
+      const std::string label = p.name + " " + fmt_s(p.seconds);
+      if (x1 - x0 > 6.5 * double(label.size()) + 6)
+        o << "<text class=\"seg\" x=\"" << (x0 + x1) / 2 << "\" y=\"" << y + kBar / 2 + 4
+          << "\" text-anchor=\"middle\" fill=\"" << c[1] << "\">" << escape_html(label)
+          << "</text>";
+    }
+    o << "<text class=\"total\" x=\"" << x_of(at) + 6 << "\" y=\"" << y + kBar / 2 + 5 << "\">"
+      << fmt_s(at) << "</text></g>";
+  }
+  o << "</svg>\n<div class=\"legend\">";
+  for (const auto& n : names)
+    o << "<span><span class=\"sw\" style=\"background:" << colour(n)[0] << "\"></span>"
+      << escape_html(n) << "</span>";
+  o << "</div>\n";
+  return o.str();
+}
+
 const char* kCss = R"(
 body{font:15px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:0;
   background:#f6f7f9;color:#1d2330}
@@ -139,6 +361,14 @@ th{background:#eef1f6;font-weight:600} td.num{text-align:right;font-variant-nume
 td.why{color:#4a5366;font-size:13px;max-width:560px}
 details{margin:6px 0} summary{cursor:pointer;color:#2b3447}
 footer{margin-top:30px;color:#7a8394;font-size:12px}
+svg.bar{display:block;margin-top:4px;font-size:11px;fill:#4a5366}
+.sw{display:inline-block;width:11px;height:11px;border:1px solid #9aa3b5;
+  vertical-align:-1px;margin-right:4px}
+svg.chart{display:block;width:100%;max-width:1000px;background:#fff;border-radius:6px;
+  box-shadow:0 1px 3px rgba(0,0,0,.12);font-size:12px}
+svg.chart text{fill:#1d2330} svg.chart text.tick{fill:#4a5366;font-size:11px}
+svg.chart text.name{font-weight:600} svg.chart text.seg{font-size:11px}
+.legend{display:flex;flex-wrap:wrap;gap:14px;margin:8px 0 14px;font-size:13px;color:#4a5366}
 )";
 
 // Flip / slider between the first two renders: the top image is clipped from the left.
@@ -232,12 +462,14 @@ std::string metrics_json(const ReportInput& input) {
     // Extras.
     doc["compared"] = compared;
     doc["command"] = input.command_line;
-    // The float as it reads (0.1), not as its double widening prints (0.10000000149011612).
-    const double scale = input.heat_map_scale;
-    doc["heat_map_scale"] =
-        number(std::isfinite(scale) ? std::strtod(fmt("%.7g", scale).c_str(), nullptr) : scale);
-    doc["files"] = {
-        {"diff", "diff.png"}, {"id_mismatch", "id_mismatch.png"}, {"report", "report.html"}};
+    doc["heat_map_scale"] = float_number(input.heat_map_scale);
+    doc["depth_diff_scale"] = {{"low", float_number(input.depth_diff_scale.low)},
+                               {"high", float_number(input.depth_diff_scale.high)},
+                               {"map", "log10"}};
+    doc["files"] = {{"diff", "diff.png"},
+                    {"depth_diff", "depth_diff.png"},
+                    {"id_mismatch", "id_mismatch.png"},
+                    {"report", "report.html"}};
     // Invalid UTF-8 in a path or command line must not make dump() throw.
     return doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   } catch (const std::exception& e) {
@@ -276,6 +508,8 @@ Expected<std::string> report_html(const ReportInput& input) {
     if (!diff_uri) return diff_uri.error();
     auto mismatch_uri = data_uri(input.out_dir, "id_mismatch.png");
     if (!mismatch_uri) return mismatch_uri.error();
+    auto depth_uri = data_uri(input.out_dir, "depth_diff.png");
+    if (!depth_uri) return depth_uri.error();
 
     std::ostringstream h;
     const std::string title = "rvr compare: " + name_a + " vs " + name_b + " on " + input.scene;
@@ -339,17 +573,42 @@ Expected<std::string> report_html(const ReportInput& input) {
         << ". Drag the slider, or flip between the whole images.</figcaption></figure></div>\n";
     }
 
-    // Heat maps.
+    // Heat maps. The depth scale's decades as ticks of its colour bar.
+    const double low = input.depth_diff_scale.low, high = input.depth_diff_scale.high;
+    std::vector<std::pair<double, std::string>> depth_ticks;
+    if (low > 0 && high > low) {
+      const double decades = std::log10(high / low);
+      // The ends are floats: 1e-2f is 0.0099999998, still a tick.
+      for (double e = std::ceil(std::log10(low) - 1e-6); e <= std::log10(high) + 1e-6; e += 1)
+        depth_ticks.push_back({(e - std::log10(low)) / decades, short_number(std::pow(10.0, e))});
+    }
     h << "<h2>Differences</h2>\n<div class=\"grid\">\n"
       << "<figure><img src=\"" << diff_uri.value()
       << "\" alt=\"colour difference heat map\"><figcaption><b>diff.png</b>: per pixel, the "
          "largest |difference| over R, G, B of the linear colours, on the inferno colour map "
          "(black = 0, yellow-white &ge; "
-      << fmt("%g", input.heat_map_scale) << ").</figcaption></figure>\n"
+      << fmt("%g", input.heat_map_scale) << ")."
+      << inferno_bar("bar-diff", "colour difference scale",
+                     {{0.0, "0"},
+                      {0.5, fmt("%g", input.heat_map_scale / 2)},
+                      {1.0, "&ge; " + fmt("%g", input.heat_map_scale)}})
+      << "</figcaption></figure>\n"
       << "<figure><img src=\"" << mismatch_uri.value()
       << "\" alt=\"object id mismatches\"><figcaption><b>id_mismatch.png</b>: pixels whose "
          "object id differs, in red, over a grey version of "
-      << escape_html(name_a) << ".</figcaption></figure>\n</div>\n";
+      << escape_html(name_a) << ".</figcaption></figure>\n"
+      << "<figure><img src=\"" << depth_uri.value()
+      << "\" alt=\"relative depth difference\"><figcaption><b>depth_diff.png</b>: relative "
+         "view-depth difference |d<sub>A</sub> &minus; d<sub>B</sub>| / max(d<sub>A</sub>, "
+         "d<sub>B</sub>) of "
+      << escape_html(name_a) << " and " << escape_html(name_b)
+      << " where both hit something (whatever the ids), on a <b>log scale</b>: black &le; "
+      << short_number(low) << ", each decade an equal stretch of the colour map, yellow-white "
+      << "&ge; " << short_number(high) << ". " << swatch(kDepthDiffBackground)
+      << "background in both; " << swatch(kDepthDiffHitVsBackground)
+      << "background in one, a hit in the other."
+      << inferno_bar("bar-depth", "relative depth difference scale, logarithmic", depth_ticks)
+      << "</figcaption></figure>\n</div>\n";
 
     // Work per pixel: what each loop order pays where.
     h << "<h2>Work per pixel</h2>\n<div class=\"grid\">\n";
@@ -411,8 +670,12 @@ Expected<std::string> report_html(const ReportInput& input) {
     for (const auto& r : input.renderers)
       for (const auto& [k, v] : r.stats)
         if (k.rfind("time.", 0) == 0) time_keys.insert(k);
-    h << "<h2>Timings</h2>\n<table><thead><tr><th>renderer</th><th>seconds</th>"
-         "<th>relative</th>";
+    h << "<h2>Timings</h2>\n"
+      << timing_chart(input.renderers)
+      << "<p class=\"why\" style=\"color:#4a5366;font-size:13px\">Each bar: the scene load "
+         "(shared, outside the render call), the phases the renderer reports (time.* below) "
+         "and, as <i>other</i>, the rest of its render call.</p>\n"
+      << "<table><thead><tr><th>renderer</th><th>seconds</th><th>relative</th>";
     for (const auto& k : time_keys) h << "<th>" << escape_html(k) << "</th>";
     h << "<th>warnings</th></tr></thead><tbody>\n";
     const double base = input.renderers.empty() ? 0.0 : input.renderers[0].seconds;

@@ -28,9 +28,11 @@ struct ReportInput {
   std::string mode;                       // "local"
   std::vector<ReportRenderer> renderers;  // the first two are the compared pair
   ComparisonMetrics metrics;
-  float heat_map_scale = 0.1f;  // colour difference at the top of diff.png's colour map
+  float heat_map_scale = 0.1f;      // colour difference at the top of diff.png's colour map
+  DepthDiffScale depth_diff_scale;  // relative depth difference at the ends of depth_diff.png
   std::string command_line;
-  std::string out_dir;  // holds the images named here plus diff.png and id_mismatch.png
+  // Holds the images named here plus diff.png, depth_diff.png and id_mismatch.png.
+  std::string out_dir;
 };
 
 // The metrics.json document (cli.md), as text.

@@ -51,6 +51,15 @@ std::vector<bool> dilate3x3(const std::vector<bool>& mask, int w, int h) {
   return out;
 }
 
+// |da - db| / max(|da|, |db|) of a pixel both renders hit; unequal infinite or NaN depth on a
+// hit is as wrong as a depth can be (1).
+double relative_depth_error(double da, double db) {
+  if (da == db) return 0.0;
+  if (!std::isfinite(da) || !std::isfinite(db)) return 1.0;
+  double denom = std::max(std::fabs(da), std::fabs(db));
+  return denom > 0 ? std::fabs(da - db) / denom : 0.0;
+}
+
 float luminance(const glm::vec3& c) {
   auto cl = [](float v) { return v > 0.0f ? std::min(v, 1.0f) : 0.0f; };  // NaN -> 0
   return 0.2126f * cl(c.r) + 0.7152f * cl(c.g) + 0.0722f * cl(c.b);
@@ -186,13 +195,7 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) 
       continue;
     }
     if (a.object_id[i] == kNoId) continue;
-    double da = a.depth[i], db = b.depth[i], rel = 0.0;
-    if (da != db) {
-      double denom = std::max(std::fabs(da), std::fabs(db));
-      // Unequal infinite or NaN depth on a hit is as wrong as a depth can be.
-      rel = (std::isfinite(da) && std::isfinite(db)) ? (denom > 0 ? std::fabs(da - db) / denom : 0)
-                                                     : 1.0;
-    }
+    const double rel = relative_depth_error(a.depth[i], b.depth[i]);
     depth_sum += rel;
     depth_max = std::max(depth_max, rel);
     ++depth_count;
@@ -306,6 +309,45 @@ Image id_mismatch_image(const FrameBuffers& a, const FrameBuffers& b) {
     // Display-referred grey: the sRGB encoding of a's linear luminance.
     float g = i < a.color.size() ? srgb_encode(luminance(a.color[i])) : 0.0f;
     p[0] = p[1] = p[2] = g;
+  }
+  return img;
+}
+
+Image depth_diff_image(const FrameBuffers& a, const FrameBuffers& b, DepthDiffScale scale) {
+  const int w = std::max(a.width, 0), h = std::max(a.height, 0);
+  const size_t n = size_t(w) * h;
+  if (n == 0) return Image{a.width, a.height, 3, {"R", "G", "B"}, {}};
+  const bool a_sized = a.object_id.size() == n && a.depth.size() == n;
+  const bool b_sized = b.object_id.size() == b.pixel_count() && b.depth.size() == b.pixel_count();
+  // A bad scale (low <= 0, high <= low) still gives a picture: one decade above low.
+  const double low = scale.low > 0.0f ? scale.low : 1e-6;
+  const double high = scale.high > low ? double(scale.high) : low * 10.0;
+  const double decades = std::log10(high / low);
+
+  enum class Kind : uint8_t { Both, Background, HitVsBackground };
+  std::vector<Kind> kind(n, Kind::Both);
+  std::vector<float> v(n, 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * w + x;
+      const bool has_b = b_sized && x < b.width && y < b.height;
+      const size_t j = has_b ? b.index(x, y) : 0;
+      const bool hit_a = a_sized && a.object_id[i] != kNoId;
+      const bool hit_b = has_b && b.object_id[j] != kNoId;
+      if (!has_b || !a_sized || hit_a != hit_b) {
+        kind[i] = Kind::HitVsBackground;
+      } else if (!hit_a) {
+        kind[i] = Kind::Background;
+      } else {
+        const double rel = relative_depth_error(a.depth[i], b.depth[j]);
+        v[i] = rel > low ? float(std::log10(rel / low) / decades) : 0.0f;
+      }
+    }
+  Image img = detail::inferno_display(v, w, h, 1.0f);
+  for (size_t i = 0; i < n; ++i) {
+    if (kind[i] == Kind::Both) continue;
+    const float* c = kind[i] == Kind::Background ? kDepthDiffBackground : kDepthDiffHitVsBackground;
+    std::copy(c, c + 3, &img.pixels[3 * i]);
   }
   return img;
 }

@@ -30,7 +30,7 @@ struct ColorMetrics {  // linear RGB, peak value 1 for PSNR and SSIM
   double rmse = 0.0;
   double psnr_db = 0.0;  // +inf when identical
   double max_abs = 0.0;
-  double ssim = 1.0;     // luminance, 11x11 Gaussian window (sigma 1.5)
+  double ssim = 1.0;  // luminance, 11x11 Gaussian window (sigma 1.5)
 };
 
 struct ComparisonMetrics {
@@ -62,5 +62,20 @@ Image diff_heat_map(const Image& a, const Image& b, float scale);
 
 // Pixels whose object id differs in red over a grey version of a's colour.
 Image id_mismatch_image(const FrameBuffers& a, const FrameBuffers& b);
+
+// The relative view-depth difference |dA - dB| / max(dA, dB) of every pixel that both render
+// as a hit (whatever the ids), display referred. It spans decades, so the colour map is
+// logarithmic: inferno of log10(rel / low) / log10(high / low), clamped, so 0 and anything up
+// to `low` is black and `high` or more is yellow-white. Pixels that are background in both
+// are kDepthDiffBackground; background in one and a hit in the other, kDepthDiffHitVsBackground
+// (colours the inferno map never takes). Pixels without a counterpart (sizes differ) count as
+// hit vs background.
+struct DepthDiffScale {
+  float low = 1e-6f;
+  float high = 1e-1f;
+};
+inline constexpr float kDepthDiffBackground[3] = {0.5f, 0.5f, 0.5f};       // mid grey
+inline constexpr float kDepthDiffHitVsBackground[3] = {0.0f, 1.0f, 1.0f};  // cyan
+Image depth_diff_image(const FrameBuffers& a, const FrameBuffers& b, DepthDiffScale scale = {});
 
 }  // namespace rvr
