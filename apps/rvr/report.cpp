@@ -357,7 +357,9 @@ button{font:inherit;font-size:13px;padding:2px 10px;border-radius:4px;
 table{border-collapse:collapse;background:#fff;box-shadow:0 1px 3px rgba(0,0,0,.12);
   border-radius:6px;overflow:hidden;margin-bottom:8px}
 th,td{padding:5px 12px;border-bottom:1px solid #e6e9ef;text-align:left;vertical-align:top}
-th{background:#eef1f6;font-weight:600} td.num{text-align:right;font-variant-numeric:tabular-nums}
+th{background:#eef1f6;font-weight:600} td.num{text-align:right;font-variant-numeric:tabular-nums;
+  white-space:nowrap}
+.scroll{overflow-x:auto;max-width:100%} .nowrap{white-space:nowrap}
 td.why{color:#4a5366;font-size:13px;max-width:560px}
 details{margin:6px 0} summary{cursor:pointer;color:#2b3447}
 footer{margin-top:30px;color:#7a8394;font-size:12px}
@@ -604,9 +606,9 @@ Expected<std::string> report_html(const ReportInput& input) {
       << escape_html(name_a) << " and " << escape_html(name_b)
       << " where both hit something (whatever the ids), on a <b>log scale</b>: black &le; "
       << short_number(low) << ", each decade an equal stretch of the colour map, yellow-white "
-      << "&ge; " << short_number(high) << ". " << swatch(kDepthDiffBackground)
-      << "background in both; " << swatch(kDepthDiffHitVsBackground)
-      << "background in one, a hit in the other."
+      << "&ge; " << short_number(high) << ". <span class=\"nowrap\">"
+      << swatch(kDepthDiffBackground) << "background in both</span>; <span class=\"nowrap\">"
+      << swatch(kDepthDiffHitVsBackground) << "background in one, a hit in the other</span>."
       << inferno_bar("bar-depth", "relative depth difference scale, logarithmic", depth_ticks)
       << "</figcaption></figure>\n</div>\n";
 
@@ -675,7 +677,8 @@ Expected<std::string> report_html(const ReportInput& input) {
       << "<p class=\"why\" style=\"color:#4a5366;font-size:13px\">Each bar: the scene load "
          "(shared, outside the render call), the phases the renderer reports (time.* below) "
          "and, as <i>other</i>, the rest of its render call.</p>\n"
-      << "<table><thead><tr><th>renderer</th><th>seconds</th><th>relative</th>";
+      << "<div class=\"scroll\"><table><thead><tr><th>renderer</th><th>seconds</th>"
+         "<th>relative</th>";
     for (const auto& k : time_keys) h << "<th>" << escape_html(k) << "</th>";
     h << "<th>warnings</th></tr></thead><tbody>\n";
     const double base = input.renderers.empty() ? 0.0 : input.renderers[0].seconds;
@@ -690,7 +693,7 @@ Expected<std::string> report_html(const ReportInput& input) {
       }
       h << "<td class=\"num\">" << r.warnings.size() << "</td></tr>\n";
     }
-    h << "</tbody></table>\n<p class=\"why\" style=\"color:#4a5366;font-size:13px\">seconds: "
+    h << "</tbody></table></div>\n<p class=\"why\" style=\"color:#4a5366;font-size:13px\">seconds: "
          "wall-clock time of the render call; relative: divided by the first renderer's; "
          "time.*: the phases each renderer reports.</p>\n";
 
