@@ -23,6 +23,7 @@
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/limits.h"
 #include "rvr/shared/scene_loader.h"
+#include "terminal_progress.h"
 
 namespace {
 
@@ -41,6 +42,7 @@ struct Exit {
 };
 
 [[noreturn]] void fail(const Error& e) {
+  stop_active_progress();  // the error line starts a clean line, not the progress bar's
   std::fprintf(stderr, "error: %s\n", e.message.c_str());
   throw Exit{int(e.kind)};
 }
@@ -203,18 +205,24 @@ int run_render(const RenderArgs& a) {
     outputs.push_back(base + "." + aov + (aov == "cost" ? ".png" : ".exr"));
   if (std::count(a.aovs.begin(), a.aovs.end(), "cost")) outputs.push_back(base + ".cost.exr");
   refuse_overwriting_inputs({a.common.scene}, outputs);
+  TerminalProgress progress(progress_wanted(a.common.quiet));
+  progress.begin("", "load");
   RenderOptions options = render_options(a.common, "full");
   double load_seconds = 0;
   Scene scene = load(a.common, options, load_seconds);
   std::unique_ptr<Renderer> renderer = take(make_renderer(a.renderer, gl_backend(a.common)));
+  options.progress = progress.sink();
+  progress.begin(a.renderer, "render");
   auto start = Clock::now();
   RenderOutput out = take(renderer->render(scene, options));
   double render_seconds = seconds_since(start);
 
+  progress.begin(a.renderer, "write");
   auto write_start = Clock::now();
   check(write_image(a.out, color_image(out.buffers)));
   if (!a.aovs.empty()) check(write_aovs(a.out, out.buffers, a.aovs));
   double write_seconds = seconds_since(write_start);
+  progress.stop();  // before the warnings and the summary
 
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   for (const std::string& w : out.warnings)
@@ -256,12 +264,16 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
     fail(bad_input("--renderers: need at least two renderers to compare"));
   refuse_overwriting_inputs({a.common.scene},
                             {a.out_dir + "/metrics.json", a.out_dir + "/report.html"});
+  TerminalProgress progress(progress_wanted(a.common.quiet));
+  progress.begin("", "load");
   RenderOptions options = render_options(a.common, "local");
   double load_seconds = 0;
   Scene scene = load(a.common, options, load_seconds);
+  options.progress = progress.sink();
 
   std::vector<std::unique_ptr<Renderer>> renderers;
-  for (const std::string& name : a.renderers) renderers.push_back(take(make_renderer(name, gl_backend(a.common))));
+  for (const std::string& name : a.renderers)
+    renderers.push_back(take(make_renderer(name, gl_backend(a.common))));
 
   ReportInput report;
   report.scene = scene.source;
@@ -272,6 +284,7 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   report.out_dir = a.out_dir;
   std::vector<FrameBuffers> buffers;
   for (size_t i = 0; i < renderers.size(); ++i) {
+    progress.begin(fmt::format("{}/{} {}", i + 1, renderers.size(), a.renderers[i]), "render");
     auto start = Clock::now();
     RenderOutput out = take(renderers[i]->render(scene, options));
     ReportRenderer r;
@@ -284,6 +297,7 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
     report.renderers.push_back(r);
     buffers.push_back(std::move(out.buffers));
   }
+  progress.begin("", "compare");
   report.metrics = compare_buffers(buffers[0], buffers[1]);
 
   // Everything is computed before the first file is written.
@@ -316,6 +330,7 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   check(write_text_file(a.out_dir + "/metrics.json", metrics_json(report)));
   check(write_text_file(a.out_dir + "/report.html", take(report_html(report))));
 
+  progress.stop();  // before the warnings and the table
   const ComparisonMetrics& m = report.metrics;
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   for (const ReportRenderer& r : report.renderers)
@@ -522,8 +537,10 @@ int run(int argc, char** argv) {
 // complete, having been renamed into place), and exit 130 as shells expect.
 extern "C" void on_interrupt(int signal_number) {
   rvr::remove_unfinished_output();
-  const char message[] = "error: interrupted\n";
-  ssize_t ignored = ::write(2, message, sizeof(message) - 1);
+  // One write, so that the progress line is erased and the message begins at column 0.
+  const char message[] = "\r\x1b[Kerror: interrupted\n";
+  const size_t skip = rvr::progress_line_on_screen() ? 0 : 4;  // no erase without a line
+  ssize_t ignored = ::write(2, message + skip, sizeof(message) - 1 - skip);
   (void)ignored;
   ::_exit(128 + signal_number);
 }

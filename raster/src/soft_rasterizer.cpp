@@ -268,6 +268,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     return bad_input(fmt::format("image size {}x{}: softraster draws at most {} pixels a side", w,
                                  h, kMaxImageSide));
   RenderOutput out;
+  ProgressSink* const progress = options.progress;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
 
   // --- setup: objects to triangles, transform, clip, bin (in submission order)
@@ -338,6 +339,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   const size_t chunk_count = (order.size() + kChunk - 1) / kChunk;
   std::vector<Setup> chunks(chunk_count, Setup{w, h, view_projection, {}, 0, {}, {}});
   std::vector<std::vector<std::vector<uint32_t>>> chunk_bins(chunk_count);
+  if (progress) progress->begin("setup", submitted, "triangles");
   arena.execute([&] {
     tbb::parallel_for(size_t(0), chunk_count, [&](size_t c) {
       Setup& setup = chunks[c];
@@ -357,8 +359,11 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
           for (int tx = st.x0 / kTile; tx <= st.x1 / kTile; ++tx)
             bins[size_t(ty) * size_t(tiles_x) + size_t(tx)].push_back(uint32_t(i));
       }
+      if (progress) progress->advance(end - c * kChunk);
     });
   });
+  // Joining the chunks: mostly allocation and copies, so time only.
+  if (progress) progress->begin("bin");
   // Offsets of each chunk's triangles in the joined list.
   std::vector<uint32_t> first(chunk_count + 1, 0);
   size_t clipped = 0;
@@ -389,12 +394,18 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   std::vector<uint32_t> visible(fb.pixel_count(), kNoId);
   std::vector<TileCounters> counters(bins.size());
   const double near_plane = scene.camera.near, far_plane = scene.camera.far;
+  // The fraction in tiles, the speed in fragments (a tile's cost is its fragments).
+  if (progress) progress->begin("raster", bins.size(), "tiles", "fragments");
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<size_t>(0, bins.size()),
                       [&](const tbb::blocked_range<size_t>& r) {
-                        for (size_t b = r.begin(); b != r.end(); ++b)
+                        uint64_t fragments = 0;
+                        for (size_t b = r.begin(); b != r.end(); ++b) {
                           raster_tile(int(b % size_t(tiles_x)), int(b / size_t(tiles_x)), bins[b],
                                       tris, near_plane, far_plane, fb, visible, counters[b]);
+                          fragments += counters[b].generated;
+                        }
+                        if (progress) progress->advance(r.size(), fragments);
                       });
   });
   out.stats["time.raster"] = seconds_since(t);
@@ -405,6 +416,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
                                                ? std::vector<LightSample>{}
                                                : light_samples(scene.lights);
   const glm::vec3 eye = scene.camera.eye;
+  if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
       std::array<double, 3> q;
@@ -434,6 +446,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
             fb.color[o] = shade_local(*d.material, P, N, V, scene.ambient, samples);
         }
       }
+      if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));
     });
   });
   out.stats["time.shade"] = seconds_since(t);

@@ -50,6 +50,7 @@ struct RayCounters {
   uint64_t primary = 0, shadow = 0, reflection = 0, refraction = 0;
   TraversalCounters traversal;
 
+  uint64_t rays() const { return primary + shadow + reflection + refraction; }
   void add(const RayCounters& o) {
     primary += o.primary;
     shadow += o.shadow;
@@ -229,6 +230,7 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
     return bad_input("image size must be positive");
 
   auto t_build = Clock::now();
+  if (ProgressSink* p = options.progress) p->begin("build");  // no count: time only
   TraceGeometry geometry(scene, options.spheres, options.sphere_segments, options.accel,
                          options.triangle_test);
   double build_seconds = seconds_since(t_build);
@@ -252,6 +254,9 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
   tbb::combinable<RayCounters> counters;
   const int tiles_x = (w + kTileSize - 1) / kTileSize;
   const int tiles_y = (h + kTileSize - 1) / kTileSize;
+  // The fraction in pixels (known up front), the speed in rays of every kind (known as they go).
+  ProgressSink* const progress = options.progress;
+  if (progress) progress->begin("trace", uint64_t(w) * uint64_t(h), "pixels", "rays");
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   arena.execute([&] {
     tbb::parallel_for(
@@ -260,9 +265,12 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
           RayCounters& local = counters.local();
           for (int tile = range.begin(); tile != range.end(); ++tile) {
             int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
-            for (int y = y0; y < std::min(y0 + kTileSize, h); ++y)
-              for (int x = x0; x < std::min(x0 + kTileSize, w); ++x)
-                tracer.render_pixel(x, y, out.buffers, local);
+            int x1 = std::min(x0 + kTileSize, w), y1 = std::min(y0 + kTileSize, h);
+            const uint64_t rays_before = local.rays();
+            for (int y = y0; y < y1; ++y)
+              for (int x = x0; x < x1; ++x) tracer.render_pixel(x, y, out.buffers, local);
+            if (progress)
+              progress->advance(uint64_t(x1 - x0) * uint64_t(y1 - y0), local.rays() - rays_before);
           }
         },
         tbb::simple_partitioner());

@@ -9,6 +9,7 @@
 
 #include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
+#include "rvr/shared/progress.h"
 #include "rvr/shared/scene.h"
 
 namespace rvr {
@@ -35,6 +36,9 @@ struct RenderOptions {
   int shadow_map_size = 1024;
   float shadow_bias = 0.01f;
   bool shadow_pcf = false;
+  // Where to report work done (per tile or chunk, never per ray); null: nobody is watching.
+  // Reporting must change neither the image nor the order of work.
+  ProgressSink* progress = nullptr;
 };
 
 struct RenderOutput {

@@ -1,0 +1,300 @@
+// Progress on long work: what the renderers count, the line the command line draws from it, and
+// rvr itself run under a pseudo-terminal (a bar, a rate and a time left, erased at the end), with
+// stderr redirected (nothing but the summary), with --quiet and TERM=dumb (nothing), and failing
+// after the bar was drawn (one clean "error:" line).
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <poll.h>
+#include <sys/ioctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "renderers.h"
+#include "rvr/shared/progress.h"
+#include "rvr/shared/scene_loader.h"
+#include "terminal_progress.h"
+
+namespace fs = std::filesystem;
+using namespace rvr;
+
+namespace {
+
+// ------------------------------------------------------------------------ sink and line
+
+TEST(ProgressSink, CountsFromManyThreadsAndBeginResets) {
+  ProgressSink sink;
+  sink.begin("trace", 8000, "pixels", "rays");
+  std::vector<std::thread> workers;
+  for (int t = 0; t < 4; ++t)
+    workers.emplace_back([&] {
+      for (int i = 0; i < 1000; ++i) sink.advance(2, 5);
+    });
+  for (std::thread& w : workers) w.join();
+  ProgressSnapshot s = sink.snapshot();
+  EXPECT_EQ(s.phase, "trace");
+  EXPECT_EQ(s.total, 8000u);
+  EXPECT_EQ(s.done, 8000u);
+  EXPECT_EQ(s.rate_unit, "rays");
+  EXPECT_EQ(s.rate_done, 20000u);
+  EXPECT_GE(s.seconds, 0.0);
+
+  sink.begin("setup", 10, "triangles");  // no rate unit: the speed is in the unit itself
+  sink.advance(3);
+  s = sink.snapshot();
+  EXPECT_EQ(s.done, 3u);
+  EXPECT_EQ(s.rate_unit, "triangles");
+  EXPECT_EQ(s.rate_done, 3u);
+}
+
+TEST(ProgressLine, PercentBarRateAndTimeLeft) {
+  ProgressSnapshot s;
+  s.phase = "trace";
+  s.unit = "pixels";
+  s.rate_unit = "rays";
+  s.total = 1000;
+  s.done = 250;
+  s.rate_done = 2'460'000;
+  s.seconds = 2.0;
+  EXPECT_EQ(format_progress_line("2/3 raytrace", s, 120),
+            "2/3 raytrace  trace   25% [#####...............]  1.23M rays/s  ETA 6s");
+  // Narrow terminals lose the bar, then the end; the line never wraps.
+  std::string narrow = format_progress_line("2/3 raytrace", s, 60);
+  EXPECT_EQ(narrow, "2/3 raytrace  trace   25%  1.23M rays/s  ETA 6s");
+  EXPECT_LT(format_progress_line("2/3 raytrace", s, 20).size(), 20u);
+  s.done = 0;
+  s.rate_done = 0;
+  EXPECT_NE(format_progress_line("", s, 120).find("ETA --"), std::string::npos);
+  // Nothing counted: the phase and its time only.
+  ProgressSnapshot t;
+  t.phase = "render";
+  t.seconds = 2.05;
+  EXPECT_EQ(format_progress_line("raster", t, 120), "raster  render  2.0s");
+}
+
+TEST(ProgressLine, CountsAndDurations) {
+  EXPECT_EQ(format_count(850), "850");
+  EXPECT_EQ(format_count(12'340), "12.3k");
+  EXPECT_EQ(format_count(4'560'000'000.0), "4.56G");
+  EXPECT_EQ(format_duration(2.2), "3s");
+  EXPECT_EQ(format_duration(125), "2m05s");
+  EXPECT_EQ(format_duration(3720), "1h02m");
+}
+
+// Counting is all a renderer does with the sink: the same bytes, and every phase counted to
+// its end.
+TEST(ProgressSink, RenderersReachTheTotalAndImagesAreUnchanged) {
+  Scene scene = load_scene("builtin:spheres").value();
+  scene.image.width = 70;  // not a multiple of any tile size
+  scene.image.height = 37;
+  for (const char* name : {"raytrace", "softraster", "embree"}) {
+    std::unique_ptr<Renderer> renderer = make_renderer(name).value();
+    RenderOptions options;
+    options.mode = RenderMode::Full;
+    RenderOutput plain = renderer->render(scene, options).value();
+    ProgressSink sink;
+    options.progress = &sink;
+    RenderOutput watched = renderer->render(scene, options).value();
+    EXPECT_EQ(plain.buffers.color, watched.buffers.color) << name;
+    EXPECT_EQ(plain.buffers.object_id, watched.buffers.object_id) << name;
+    ProgressSnapshot s = sink.snapshot();  // the last phase
+    EXPECT_GT(s.total, 0u) << name;
+    EXPECT_EQ(s.done, s.total) << name;
+    if (std::string(name) != "softraster") {
+      EXPECT_EQ(s.phase, "trace");
+      EXPECT_EQ(s.total, 70u * 37u);
+      EXPECT_EQ(s.rate_unit, "rays");
+      EXPECT_EQ(double(s.rate_done), plain.stats["rays.primary"] + plain.stats["rays.shadow"] +
+                                         plain.stats["rays.reflection"] +
+                                         plain.stats["rays.refraction"]);
+    }
+  }
+}
+
+// ----------------------------------------------------------------------- rvr on a terminal
+
+struct PtyRun {
+  int status = -1;
+  std::string err;  // what the terminal received on stderr (with the tty's \n -> \r\n)
+  double seconds = 0;
+};
+
+// Runs rvr with stderr on a new pseudo-terminal (stdout to /dev/null), TERM set to `term`.
+PtyRun run_on_pty(const std::vector<std::string>& args, const char* term = "xterm") {
+  PtyRun r;
+  int master = ::posix_openpt(O_RDWR | O_NOCTTY);
+  if (master < 0 || ::grantpt(master) != 0 || ::unlockpt(master) != 0) return r;
+  winsize ws{};
+  ws.ws_col = 120;
+  ws.ws_row = 40;
+  ::ioctl(master, TIOCSWINSZ, &ws);
+  std::string slave_name = ::ptsname(master);
+  auto start = std::chrono::steady_clock::now();
+  pid_t pid = ::fork();
+  if (pid == 0) {
+    ::setsid();
+    int slave = ::open(slave_name.c_str(), O_RDWR);
+    int null = ::open("/dev/null", O_RDWR);
+    if (slave < 0 || null < 0) ::_exit(127);
+    ::dup2(null, 0);
+    ::dup2(null, 1);
+    ::dup2(slave, 2);
+    ::setenv("TERM", term, 1);
+    std::vector<char*> argv{const_cast<char*>(RVR_BINARY)};
+    for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    ::execv(RVR_BINARY, argv.data());
+    ::_exit(127);
+  }
+  // Read until every holder of the terminal has gone (EIO), with a generous guard.
+  char buf[4096];
+  while (true) {
+    pollfd p{master, POLLIN, 0};
+    int ready = ::poll(&p, 1, 60'000);
+    if (ready <= 0) {
+      ::kill(pid, SIGKILL);
+      break;
+    }
+    ssize_t n = ::read(master, buf, sizeof buf);
+    if (n <= 0) break;
+    r.err.append(buf, size_t(n));
+  }
+  int raw = 0;
+  ::waitpid(pid, &raw, 0);
+  ::close(master);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  return r;
+}
+
+// What a terminal shows after interpreting "\r", "\n" and "ESC [ K" (erase to end of line).
+std::vector<std::string> screen(const std::string& bytes) {
+  std::vector<std::string> lines{""};
+  size_t col = 0;
+  for (size_t i = 0; i < bytes.size(); ++i) {
+    std::string& line = lines.back();
+    char c = bytes[i];
+    if (c == '\r') {
+      col = 0;
+    } else if (c == '\n') {
+      lines.emplace_back();
+      col = 0;
+    } else if (c == '\x1b' && bytes.compare(i, 3, "\x1b[K") == 0) {
+      line.resize(std::min(line.size(), col));
+      i += 2;
+    } else {
+      if (col < line.size())
+        line[col] = c;
+      else
+        line.push_back(c);
+      ++col;
+    }
+  }
+  if (lines.back().empty()) lines.pop_back();
+  return lines;
+}
+
+class ProgressCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("rvr_progress_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // About a second of tracing on one thread (20000 triangles, no BVH, 64x48 pixels, 12 tiles):
+  // well over the half second before a bar appears, well under the test's time budget.
+  std::vector<std::string> long_render(const std::string& out) const {
+    return {"render",    "builtin:soup:20000",
+            "-r",        "raytrace",
+            "--accel",   "none",
+            "--mode",    "local",
+            "--threads", "1",
+            "--width",   "64",
+            "--height",  "48",
+            "-o",        out};
+  }
+
+  fs::path dir_;
+};
+
+const std::regex kBar(R"(\d+% \[[#.]{20}\]  [0-9.]+[kMG]? rays/s  ETA [0-9hm]+s?)");
+
+TEST_F(ProgressCli, TerminalShowsPercentRateAndTimeLeftThenErases) {
+  PtyRun r = run_on_pty(long_render((dir_ / "a.png").string()));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(std::regex_search(r.err, kBar)) << r.err;
+  EXPECT_NE(r.err.find("raytrace  trace"), std::string::npos) << r.err;
+  // Erased before the summary, which then stands alone on the screen.
+  EXPECT_NE(r.err.find("\r\x1b[Kraytrace: builtin:soup:20000 64x48 local in"), std::string::npos)
+      << r.err;
+  std::vector<std::string> shown = screen(r.err);
+  ASSERT_EQ(shown.size(), 1u) << r.err;
+  EXPECT_EQ(shown[0].rfind("raytrace: builtin:soup:20000", 0), 0u) << shown[0];
+  EXPECT_TRUE(fs::exists(dir_ / "a.png"));
+}
+
+TEST_F(ProgressCli, CompareNamesWhichRendererOfHowMany) {
+  PtyRun r = run_on_pty({"compare", "builtin:soup:20000", "-r", "softraster,raytrace", "--accel",
+                         "none", "--threads", "1", "--width", "64", "--height", "48", "-o",
+                         (dir_ / "cmp").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("2/2 raytrace  trace"), std::string::npos) << r.err;
+  EXPECT_TRUE(std::regex_search(r.err, kBar)) << r.err;
+  for (const std::string& line : screen(r.err))  // only warnings remain, if any
+    EXPECT_EQ(line.rfind("warning: ", 0), 0u) << line;
+}
+
+TEST_F(ProgressCli, RedirectedStderrGetsOnlyTheSummary) {
+  std::string cmd = std::string(RVR_BINARY);
+  for (const std::string& a : long_render((dir_ / "a.png").string())) cmd += " " + a;
+  cmd += " 2>" + (dir_ / "err.txt").string() + " >/dev/null </dev/null";
+  ASSERT_EQ(std::system(("TERM=xterm " + cmd).c_str()), 0);
+  std::ifstream in(dir_ / "err.txt");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string err = ss.str();
+  EXPECT_EQ(err.rfind("raytrace: builtin:soup:20000 64x48 local in ", 0), 0u) << err;
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  EXPECT_EQ(err.find_first_of("\r\x1b%"), std::string::npos) << err;
+}
+
+TEST_F(ProgressCli, QuietAndDumbTerminalsShowNoProgress) {
+  std::vector<std::string> quiet = long_render((dir_ / "q.png").string());
+  quiet.push_back("--quiet");
+  PtyRun q = run_on_pty(quiet);
+  EXPECT_EQ(q.status, 0) << q.err;
+  EXPECT_EQ(q.err, "");  // not even the summary
+
+  PtyRun dumb = run_on_pty(long_render((dir_ / "d.png").string()), "dumb");
+  EXPECT_EQ(dumb.status, 0) << dumb.err;
+  EXPECT_EQ(dumb.err.find_first_of("\x1b%"), std::string::npos) << dumb.err;
+  EXPECT_EQ(screen(dumb.err).size(), 1u) << dumb.err;
+}
+
+TEST_F(ProgressCli, ErrorAfterTheBarIsOneCleanLine) {
+  // The output's folder would have to be made inside a regular file: found out only when
+  // writing, after the render and its progress bar.
+  std::ofstream(dir_ / "file") << "x";
+  PtyRun r = run_on_pty(long_render((dir_ / "file" / "a.png").string()));
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_TRUE(std::regex_search(r.err, kBar)) << r.err;
+  EXPECT_NE(r.err.find("\r\x1b[Kerror: "), std::string::npos) << r.err;
+  std::vector<std::string> shown = screen(r.err);
+  ASSERT_EQ(shown.size(), 1u) << r.err;
+  EXPECT_EQ(shown[0].rfind("error: ", 0), 0u) << shown[0];
+}
+
+}  // namespace
