@@ -127,8 +127,10 @@ struct PtyRun {
   double seconds = 0;
 };
 
-// Runs rvr with stderr on a new pseudo-terminal (stdout to /dev/null), TERM set to `term`.
-PtyRun run_on_pty(const std::vector<std::string>& args, const char* term = "xterm") {
+// Runs rvr with stderr on a new pseudo-terminal (stdout to /dev/null), TERM set to `term`;
+// sends SIGINT after `interrupt_after` seconds when that is positive.
+PtyRun run_on_pty(const std::vector<std::string>& args, const char* term = "xterm",
+                  double interrupt_after = 0) {
   PtyRun r;
   int master = ::posix_openpt(O_RDWR | O_NOCTTY);
   if (master < 0 || ::grantpt(master) != 0 || ::unlockpt(master) != 0) return r;
@@ -156,9 +158,18 @@ PtyRun run_on_pty(const std::vector<std::string>& args, const char* term = "xter
   }
   // Read until every holder of the terminal has gone (EIO), with a generous guard.
   char buf[4096];
+  bool interrupted = false;
   while (true) {
+    const double now =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (interrupt_after > 0 && !interrupted && now >= interrupt_after) {
+      ::kill(pid, SIGINT);
+      interrupted = true;
+    }
     pollfd p{master, POLLIN, 0};
-    int ready = ::poll(&p, 1, 60'000);
+    const int wait_ms = interrupt_after > 0 && !interrupted ? 20 : 60'000;
+    int ready = ::poll(&p, 1, wait_ms);
+    if (ready == 0 && wait_ms == 20) continue;
     if (ready <= 0) {
       ::kill(pid, SIGKILL);
       break;
@@ -295,6 +306,19 @@ TEST_F(ProgressCli, ErrorAfterTheBarIsOneCleanLine) {
   std::vector<std::string> shown = screen(r.err);
   ASSERT_EQ(shown.size(), 1u) << r.err;
   EXPECT_EQ(shown[0].rfind("error: ", 0), 0u) << shown[0];
+}
+
+TEST_F(ProgressCli, InterruptedWhileTheBarIsShownIsOneCleanLine) {
+  std::vector<std::string> args = long_render((dir_ / "i.png").string());
+  args.insert(args.end(), {"--spp", "64"});   // far longer than the wait below
+  PtyRun r = run_on_pty(args, "xterm", 1.8);  // start-up, the half second, a few redraws
+  EXPECT_EQ(r.status, 130) << r.err;
+  EXPECT_LT(r.seconds, 10.0);
+  EXPECT_NE(r.err.find('%'), std::string::npos) << r.err;
+  std::vector<std::string> shown = screen(r.err);
+  ASSERT_EQ(shown.size(), 1u) << r.err;
+  EXPECT_EQ(shown[0], "error: interrupted");
+  EXPECT_FALSE(fs::exists(dir_ / "i.png"));
 }
 
 }  // namespace
