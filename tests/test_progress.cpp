@@ -119,6 +119,26 @@ TEST(ProgressSink, RenderersReachTheTotalAndImagesAreUnchanged) {
   }
 }
 
+// The GL raster reports phases (setup, upload, render, cost, readback) and must draw the same
+// image whether watched or not, on both GL back ends.
+TEST(ProgressSink, GlRasterReportsItsPhasesAndImagesAreUnchanged) {
+  Scene scene = load_scene("builtin:cornell").value();
+  scene.image.width = 70;
+  scene.image.height = 37;
+  for (GlBackend gl : {GlBackend::OsMesa, GlBackend::Egl}) {
+    std::unique_ptr<Renderer> renderer = make_renderer("raster", gl).value();
+    RenderOptions options;
+    options.mode = RenderMode::Full;
+    RenderOutput plain = renderer->render(scene, options).value();
+    ProgressSink sink;
+    options.progress = &sink;
+    RenderOutput watched = renderer->render(scene, options).value();
+    EXPECT_EQ(plain.buffers.color, watched.buffers.color) << to_string(gl);
+    EXPECT_EQ(plain.buffers.object_id, watched.buffers.object_id) << to_string(gl);
+    EXPECT_EQ(sink.snapshot().phase, "readback") << to_string(gl);
+  }
+}
+
 // ----------------------------------------------------------------------- rvr on a terminal
 
 struct PtyRun {

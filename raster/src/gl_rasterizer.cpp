@@ -508,8 +508,10 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   const int w = scene.image.width, h = scene.image.height;
   if (w < 1 || h < 1) return bad_input(fmt::format("image size {}x{} is empty", w, h));
   RenderOutput out;
+  ProgressSink* progress = options.progress;  // null when nobody is watching
 
   // --- setup: context, programs (first call only), render targets (on size change)
+  if (progress) progress->begin("setup");
   auto t = Clock::now();
   RVR_TRY(init());
   out.warnings = context_warnings;
@@ -517,6 +519,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   out.stats["time.setup"] = seconds_since(t);
 
   // --- upload: expand every object to triangles, then one vertex buffer and one light buffer
+  if (progress) progress->begin("upload");  // mostly one glBufferData: time only
   t = Clock::now();
   vertices.clear();
   vertices.reserve(3 * scene.triangle_count());  // meshes; tessellated shapes add a little
@@ -697,6 +700,15 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   gl().BindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
   gl().ActiveTexture(GL_TEXTURE0);
   const size_t batches = shadows ? (samples.size() + batch - 1) / batch : 1;
+  // With several batches of light samples, progress counts passes (the speed, triangles drawn,
+  // shadow maps' six faces per sample included); one pass shows its time only. GL is
+  // asynchronous: a pass counts when submitted; the next batch's glFinish waits for it.
+  if (progress) {
+    if (batches > 1)
+      progress->begin("render", batches, "passes", "triangles");
+    else
+      progress->begin("render");
+  }
   for (size_t b = 0; b < batches; ++b) {
     const size_t first = b * batch, end = std::min(samples.size(), first + batch);
     if (shadows) {
@@ -734,6 +746,10 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
       gl().DepthMask(GL_TRUE);
       gl().DepthFunc(GL_LESS);
     }
+    if (progress && batches > 1) {
+      const uint64_t triangles = vertices.size() / 3;
+      progress->advance(1, triangles * (1 + (shadows ? 6 * (end - first) : 0)));
+    }
   }
   if (msaa > 1) {
     // The per-pixel AOVs (ids, depth, normal) come from one sample at the pixel centre; the
@@ -767,6 +783,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   }
 
   // --- cost pass: every fragment generated, whatever the depth test would say
+  if (progress) progress->begin("cost");
   t = Clock::now();
   gl().BindFramebuffer(GL_FRAMEBUFFER, cost_fbo);
   gl().ClearBufferfv(GL_COLOR, 0, glm::value_ptr(zero));
@@ -783,6 +800,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   out.stats["time.cost"] = seconds_since(t);
 
   // --- readback
+  if (progress) progress->begin("readback");
   t = Clock::now();
   FrameBuffers& fb = out.buffers;
   fb.width = w;
