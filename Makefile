@@ -38,16 +38,27 @@ SANITIZE_TARGETS := rvr $(patsubst tests/%.cpp,%,$(wildcard tests/test_*.cpp))
 # structure) takes 10 s natively and ~9 minutes under ASan; the same tracer code runs under
 # ASan with the BVH in every other conformance case, and the brute-force path in test_bvh.
 SANITIZE_EXCLUDE ?= Conformance[.]AgreesWithTheOtherLoopOrder/raytrace_none_
+# Tests that make EGL contexts run with AddressSanitizer and UBSan but without the leak check:
+# once Mesa's EGL driver is loaded, LeakSanitizer's exit-time scan crashes ("Tracer caught
+# signal 11") on a garbage dynamic-TLS entry in about 1 run in 10 (measured with gcc 12's
+# libsanitizer). LSAN use_tls=0 avoids the crash but reports TLS-held objects of OpenImageIO's
+# dependencies as leaks. The same rasterizer code is leak-checked through OSMesa elsewhere.
+SANITIZE_EGL ?= Egl|egl
+SANITIZE_ASAN := strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1
+SANITIZE_LSAN := suppressions=$(CURDIR)/tests/sanitize/lsan.supp:print_suppressions=0
+SANITIZE_UBSAN := print_stacktrace=1:halt_on_error=1
 sanitize: deps
 	cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 		-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" \
 		-DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)"
 	cmake --build $(SANITIZE_DIR) -j $(JOBS) --target $(SANITIZE_TARGETS)
 	cd $(SANITIZE_DIR) && \
-		ASAN_OPTIONS=detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1 \
-		LSAN_OPTIONS=suppressions=$(CURDIR)/tests/sanitize/lsan.supp:print_suppressions=0 \
-		UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-		ctest --output-on-failure -j $(JOBS) -E '$(SANITIZE_EXCLUDE)'
+		ASAN_OPTIONS=detect_leaks=1:$(SANITIZE_ASAN) LSAN_OPTIONS=$(SANITIZE_LSAN) \
+		UBSAN_OPTIONS=$(SANITIZE_UBSAN) \
+		ctest --output-on-failure -j $(JOBS) -E '$(SANITIZE_EXCLUDE)|$(SANITIZE_EGL)'
+	cd $(SANITIZE_DIR) && \
+		ASAN_OPTIONS=detect_leaks=0:$(SANITIZE_ASAN) UBSAN_OPTIONS=$(SANITIZE_UBSAN) \
+		ctest --output-on-failure -j $(JOBS) -R '$(SANITIZE_EGL)' -E '$(SANITIZE_EXCLUDE)'
 
 # libFuzzer (clang 14) on the scene loader and the mesh importer path, FUZZ_SECONDS per
 # harness; see tests/fuzz/run.sh and notes in tests/fuzz/README.md.

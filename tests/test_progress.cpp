@@ -9,11 +9,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <thread>
 #include <utility>
@@ -93,7 +94,7 @@ TEST(ProgressLine, CountsAndDurations) {
 // Counting is all a renderer does with the sink: the same bytes whether watched or not. Tracers
 // and softraster count their last phase to its end; the GL raster (both back ends) reports
 // phases, readback last.
-TEST(ProgressSink, RenderersReachTheTotalAndImagesAreUnchanged) {
+TEST(ProgressSink, EveryRendererAndRasterOnEglDrawsTheSameWhenWatched) {
   Scene scene = load_scene("builtin:spheres").value();
   scene.image.width = 70;  // not a multiple of any tile size
   scene.image.height = 37;
@@ -253,12 +254,34 @@ class ProgressCli : public ::testing::Test {
   fs::path dir_;
 };
 
-const std::regex kBar(R"(\d+% \[[#.]{20}\]  [0-9.]+[kMG]? rays/s  ETA [0-9hm]+s?)");
+// Whether `text` holds a line like "39% [#######.............]  1.14M rays/s  ETA 1s". (By hand:
+// std::regex draws false -Wmaybe-uninitialized warnings from g++ 12 in the sanitizer build.)
+bool has_progress_bar(const std::string& text) {
+  for (size_t at = text.find("% ["); at != std::string::npos; at = text.find("% [", at + 1)) {
+    if (at == 0 || !std::isdigit(static_cast<unsigned char>(text[at - 1]))) continue;
+    const size_t bar = at + 3;
+    if (text.size() < bar + 22) break;
+    bool cells = std::all_of(text.begin() + bar, text.begin() + bar + 20,
+                             [](char c) { return c == '#' || c == '.'; });
+    if (!cells || text.compare(bar + 20, 3, "]  ") != 0) continue;
+    size_t rate = bar + 23, digits = rate;
+    while (digits < text.size() &&
+           (std::isdigit(static_cast<unsigned char>(text[digits])) || text[digits] == '.'))
+      ++digits;
+    if (digits == rate) continue;
+    if (digits < text.size() && std::string("kMG").find(text[digits]) != std::string::npos)
+      ++digits;
+    if (text.compare(digits, 13, " rays/s  ETA ") != 0) continue;
+    const size_t eta = digits + 13;
+    if (eta < text.size() && std::isdigit(static_cast<unsigned char>(text[eta]))) return true;
+  }
+  return false;
+}
 
 TEST_F(ProgressCli, TerminalShowsPercentRateAndTimeLeftThenErases) {
   PtyRun r = run_on_pty(long_render((dir_ / "a.png").string()));
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_TRUE(std::regex_search(r.err, kBar)) << r.err;
+  EXPECT_TRUE(has_progress_bar(r.err)) << r.err;
   EXPECT_NE(r.err.find("raytrace  trace"), std::string::npos) << r.err;
   // Erased before the summary, which then stands alone on the screen.
   EXPECT_NE(r.err.find("\r\x1b[Kraytrace: builtin:soup:20000 64x48 local in"), std::string::npos)
@@ -275,7 +298,7 @@ TEST_F(ProgressCli, CompareNamesWhichRendererOfHowMany) {
                          (dir_ / "cmp").string()});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("2/2 raytrace  trace"), std::string::npos) << r.err;
-  EXPECT_TRUE(std::regex_search(r.err, kBar)) << r.err;
+  EXPECT_TRUE(has_progress_bar(r.err)) << r.err;
   for (const std::string& line : screen(r.err))  // only warnings remain, if any
     EXPECT_EQ(line.rfind("warning: ", 0), 0u) << line;
 }
@@ -313,7 +336,7 @@ TEST_F(ProgressCli, ErrorAfterTheBarIsOneCleanLine) {
   std::ofstream(dir_ / "file") << "x";
   PtyRun r = run_on_pty(long_render((dir_ / "file" / "a.png").string()));
   EXPECT_EQ(r.status, 2) << r.err;
-  EXPECT_TRUE(std::regex_search(r.err, kBar)) << r.err;
+  EXPECT_TRUE(has_progress_bar(r.err)) << r.err;
   EXPECT_NE(r.err.find("\r\x1b[Kerror: "), std::string::npos) << r.err;
   std::vector<std::string> shown = screen(r.err);
   ASSERT_EQ(shown.size(), 1u) << r.err;
