@@ -21,6 +21,11 @@ namespace rvr {
 
 namespace {
 
+#ifdef RVR_LINK_OSMESA
+// A reference the linker must resolve, so libOSMesa is loaded at start-up (see CMakeLists.txt).
+[[gnu::used]] void* const kLinkedOSMesa = reinterpret_cast<void*>(&OSMesaGetProcAddress);
+#endif
+
 // The four functions we use, looked up once per process.
 struct OsMesaLibrary {
   decltype(&OSMesaCreateContextAttribs) create_context = nullptr;
