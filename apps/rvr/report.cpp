@@ -342,9 +342,9 @@ pre.cmd{background:#1d2330;color:#e8ecf3;padding:10px 12px;border-radius:6px;
 .warn{background:#fff4d6;border:1px solid #e6b400;border-left:6px solid #e6b400;
   padding:10px 14px;border-radius:6px;margin:14px 0}
 .warn h2{border:0;margin:0 0 6px;padding:0}
-.grid{display:flex;flex-wrap:wrap;gap:16px}
+.grid{display:grid;grid-template-columns:repeat(auto-fill,minmax(360px,1fr));gap:16px}
 figure{margin:0;background:#fff;padding:8px;border-radius:6px;
-  box-shadow:0 1px 3px rgba(0,0,0,.12);flex:1 1 360px;max-width:calc(50% - 8px)}
+  box-shadow:0 1px 3px rgba(0,0,0,.12);min-width:0}
 figure img{display:block;width:100%;height:auto;image-rendering:pixelated}
 figcaption{font-size:13px;color:#4a5366;margin-top:6px}
 .flip{position:relative;display:block;width:100%;user-select:none}
