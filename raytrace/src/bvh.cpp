@@ -24,11 +24,6 @@ void advise_huge_pages(void* p, size_t bytes) {
 namespace {
 
 constexpr int kBins = 16;
-// A node visit (box test, stack traffic, often a cache miss) against one triangle test.
-// Measured on this machine (BM_Trace, BM_Build): 1 gives leaves of ~1 triangle and 98 bytes per
-// triangle; 2 gives 71 B/tri; 3 gives 59 B/tri (under the 64 B target) at the same rays/s on
-// tessphere:100000 and 30% more on soup:1000000 than 1; 4 starts to lose speed.
-constexpr float kTraversalCost = 3.0f;
 constexpr float kIntersectCost = 1.0f;
 // Past this depth splits are object medians, so the depth (and the traversal stack) stays
 // bounded whatever the input.
@@ -48,7 +43,10 @@ struct Split {
 
 }  // namespace
 
-Bvh Bvh::build(const std::vector<Aabb>& bounds) {
+Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) {
+  const float kTraversalCost = options.traversal_cost;
+  const uint32_t block = uint32_t(std::max(1, options.leaf_block));
+  auto tests = [block](uint32_t n) { return float((n + block - 1) / block); };
   auto start = std::chrono::steady_clock::now();
   Bvh bvh;
   const uint32_t n = uint32_t(bounds.size());
@@ -89,10 +87,10 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds) {
       node.count = uint16_t(count);
       node.axis = 0;
       bvh.stats_.leaves++;
-      bvh.stats_.sah_cost += area_ratio * kIntersectCost * float(count);
+      bvh.stats_.sah_cost += area_ratio * kIntersectCost * tests(count);
     };
 
-    float leaf_cost = kIntersectCost * float(count);
+    float leaf_cost = kIntersectCost * tests(count);
     Split best;
     glm::vec3 extent = centroid_box.hi - centroid_box.lo;
     if (count > 1 && task.depth < kMedianDepth) {
@@ -129,14 +127,14 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds) {
           cnt += bin_count[a][b];
           if (cnt == 0 || right_count[b + 1] == 0) continue;
           float cost = kTraversalCost + kIntersectCost * inv_area *
-                                            (acc.surface_area() * float(cnt) +
-                                             right_area[b + 1] * float(right_count[b + 1]));
+                                            (acc.surface_area() * tests(cnt) +
+                                             right_area[b + 1] * tests(right_count[b + 1]));
           if (cost < best.cost) best = {a, b, cost};
         }
       }
     }
 
-    bool must_split = count > uint32_t(kMaxLeafSize);
+    bool must_split = count > uint32_t(std::min(options.max_leaf_size, int(kMaxLeafSize)));
     if (count == 1 || (!must_split && !(best.cost < leaf_cost))) {
       make_leaf();
       continue;

@@ -228,15 +228,25 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
   if (has_forced_) options.accel = forced_;
   if (scene.image.width <= 0 || scene.image.height <= 0)
     return bad_input("image size must be positive");
+  std::vector<std::string> notes;
+  if (options.triangle_test == TriangleTest::Chapter && options.accel == AccelKind::Bvh) {
+    // The SIMD kernels run Moller-Trumbore only; the chapter's test runs on the binary tree.
+    options.accel = AccelKind::Bvh2;
+    notes.push_back("--triangle-test chapter runs on the binary BVH (bvh2): the wide BVH's "
+                    "SIMD kernels test triangles with Moller-Trumbore only");
+  }
 
   auto t_build = Clock::now();
   if (ProgressSink* p = options.progress) p->begin("build");  // no count: time only
   TraceGeometry geometry(scene, options.spheres, options.sphere_segments, options.accel,
-                         options.triangle_test);
+                         options.triangle_test, options.isa);
   double build_seconds = seconds_since(t_build);
-  if (!geometry.error().empty()) return internal_error(geometry.error());
+  if (!geometry.error().empty()) return Error{geometry.error(), geometry.error_kind()};
   Expected<RenderOutput> out = render(scene, options, geometry);
-  if (out.ok()) out.value().stats["time.build"] = build_seconds;
+  if (out.ok()) {
+    out.value().stats["time.build"] = build_seconds;
+    out.value().warnings.insert(out.value().warnings.begin(), notes.begin(), notes.end());
+  }
   return out;
 }
 
@@ -291,8 +301,22 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
   }
   out.stats["primitives"] = double(geometry.primitive_count());
   out.stats["triangles"] = double(geometry.triangle_count());
+  out.info["accel"] = to_string(options.accel);
   if (options.accel == AccelKind::Bvh) {
+    const WideBvhStats& w = geometry.wide_bvh().stats();
+    out.info["kernel"] = geometry.kernel_isa();
+    out.stats["bvh.width"] = double(kWideBvhWidth);
+    out.stats["bvh.nodes"] = double(w.nodes + geometry.bvh().stats().nodes);
+    out.stats["bvh.leaves"] = double(w.leaves + geometry.bvh().stats().leaves);
+    out.stats["bvh.triangle_blocks"] = double(w.blocks);
+    out.stats["bvh.block_fill"] = w.blocks ? double(w.triangles) / double(4 * w.blocks) : 0.0;
+    out.stats["bvh.node_fill"] = w.nodes ? double(w.child_slots) / double(8 * w.nodes) : 0.0;
+    out.stats["bvh.max_depth"] = double(w.max_depth);
+    out.stats["bvh.bytes"] = double(geometry.acceleration_bytes());
+    out.stats["time.bvh_build"] = w.seconds + geometry.bvh().stats().seconds;
+  } else if (options.accel == AccelKind::Bvh2) {
     const BvhBuildStats& b = geometry.bvh().stats();
+    out.stats["bvh.width"] = 2.0;
     out.stats["bvh.nodes"] = double(b.nodes);
     out.stats["bvh.leaves"] = double(b.leaves);
     out.stats["bvh.max_depth"] = double(b.max_depth);

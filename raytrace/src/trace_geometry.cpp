@@ -1,6 +1,7 @@
 #include "rvr/raytrace/trace_geometry.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "embree_backend.h"
 #include "rvr/shared/tessellate.h"
@@ -72,7 +73,7 @@ void csg_boundaries(const CsgNode* node, const Ray& ray, uint32_t& next_leaf,
 }  // namespace
 
 TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_segments,
-                             AccelKind accel, TriangleTest triangle_test)
+                             AccelKind accel, TriangleTest triangle_test, std::optional<Isa> isa)
     : accel_(accel), triangle_test_(triangle_test) {
   size_t n_objects = scene.objects.size();
   object_mesh_.assign(n_objects, nullptr);
@@ -129,10 +130,39 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
   }
 
   if (accel_ == AccelKind::Embree) {
-    embree_.reset(make_embree_backend(*this, error_));
+    embree_.reset(make_embree_backend(*this, error_.message));
     return;
   }
-  if (accel_ != AccelKind::Bvh) return;
+  if (accel_ == AccelKind::None) return;
+  if (accel_ == AccelKind::Bvh) {
+    // Triangles in the wide BVH, for the SIMD kernels; analytic shapes in a binary one.
+    if (!isa) {
+      Expected<Isa> selected = selected_isa();
+      if (!selected) {
+        error_ = selected.error();
+        return;
+      }
+      isa = *selected;
+    }
+    if (!cpu_supports(*isa)) {
+      error_ = bad_input(std::string("this CPU cannot run the ") + to_string(*isa) + " kernels");
+      return;
+    }
+    kernels_ = &traversal_kernels(*isa);
+    if (!triangles_.empty()) {
+      Expected<WideBvh> wide = WideBvh::build(triangles_);
+      if (!wide) {
+        error_ = wide.error();
+        return;
+      }
+      wide_ = std::move(wide).value();
+    }
+    std::vector<Aabb> bounds(analytic_.size());
+    for (size_t k = 0; k < analytic_.size(); ++k) bounds[k] = analytic_bounds(analytic_[k]);
+    bvh_ = Bvh::build(bounds);
+    slot_primitive_.assign(bvh_.primitive_order().begin(), bvh_.primitive_order().end());
+    return;
+  }
   std::vector<Aabb> bounds(primitive_count());
   for (size_t i = 0; i < triangles_.size(); ++i) {
     const TrianglePrecomputed& t = triangles_[i];
@@ -177,7 +207,8 @@ Aabb TraceGeometry::analytic_bounds(const Analytic& a) {
 }
 
 size_t TraceGeometry::acceleration_bytes() const {
-  return bvh_.nodes().size() * sizeof(BvhNode) + slot_primitive_.size() * sizeof(uint32_t) +
+  return wide_.bytes() + bvh_.nodes().size() * sizeof(BvhNode) +
+         slot_primitive_.size() * sizeof(uint32_t) +
          slot_triangles_.size() * sizeof(TrianglePrecomputed);
 }
 
@@ -224,6 +255,14 @@ struct ChapterTest {
   }
 };
 
+// A hit at t is nearer than the best so far when t is smaller or, at the same t, its primitive
+// index is lower: the result does not depend on the order primitives are tested in. A test
+// accepting t < limit is given the float after t_max so that t == t_max gets through.
+inline float tie_limit(float t_max) { return std::nextafter(t_max, INFINITY); }
+inline bool nearer(float t, uint32_t p, float t_max, uint32_t best) {
+  return t < t_max || (t == t_max && p < best);
+}
+
 template <class TriangleTestFn, bool kAnyHit>
 bool TraceGeometry::query(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
   TriangleTestFn test;
@@ -233,17 +272,21 @@ bool TraceGeometry::query(const Ray& ray, HitRecord& hit, TraversalCounters& cou
   Ray r = ray;
   // Tests primitive p (whose triangle, if it is one, is `tri`); true when it is a new nearest.
   auto test_primitive = [&](uint32_t p, const TrianglePrecomputed& tri) {
+    float limit = found && !kAnyHit ? tie_limit(t_max) : t_max;
     if (p < n_triangles) {
-      r.tmax = t_max;
+      r.tmax = limit;
       TriangleHit th;
-      if (!test(r, tri, th)) return false;
+      if (!test(r, tri, th) || (found && !nearer(th.t, p, t_max, hit.primitive))) return false;
       t_max = th.t;
+      hit = HitRecord{};
       hit.t = th.t;
       hit.u = th.u;
       hit.v = th.v;
     } else {
       HitRecord h;
-      if (!hit_analytic(analytic_[p - n_triangles], ray, t_max, h)) return false;
+      if (!hit_analytic(analytic_[p - n_triangles], ray, limit, h) ||
+          (found && !nearer(h.t, p, t_max, hit.primitive)))
+        return false;
       t_max = h.t;
       hit = h;
     }
@@ -274,17 +317,151 @@ bool TraceGeometry::query(const Ray& ray, HitRecord& hit, TraversalCounters& cou
   return found;
 }
 
+// The analytic shapes of the wide-BVH configuration, nearer than t_max (a triangle hit there has
+// a lower primitive index, so it wins a tie).
+template <bool kAnyHit>
+bool TraceGeometry::query_analytic(const Ray& ray, float t_max, HitRecord& hit,
+                                   TraversalCounters* counters) const {
+  if (bvh_.empty()) return false;
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  bool found = false;
+  TraversalCounters unused;
+  float limit = t_max;
+  bvh_.traverse(
+      ray, limit,
+      [&](uint32_t first, uint32_t count, float& t) {
+        for (uint32_t s = first; s < first + count; ++s) {
+          uint32_t p = n_triangles + slot_primitive_[s];
+          HitRecord h;
+          float lim = found && !kAnyHit ? tie_limit(t) : t;
+          if (!hit_analytic(analytic_[slot_primitive_[s]], ray, lim, h)) continue;
+          if (found && !nearer(h.t, p, t, hit.primitive)) continue;
+          hit = h;
+          hit.primitive = p;
+          t = h.t;
+          found = true;
+          if (kAnyHit) return true;
+        }
+        return false;
+      },
+      counters ? *counters : unused);
+  return found;
+}
+
+template <bool kCount>
+bool TraceGeometry::closest_wide(const Ray& ray, HitRecord& hit, TraversalCounters* counters) const {
+  KernelRay kr{{ray.origin.x, ray.origin.y, ray.origin.z},
+               {ray.dir.x, ray.dir.y, ray.dir.z},
+               ray.tmin,
+               ray.tmax};
+  KernelHit kh;
+  bool found = false;
+  if (!wide_.empty()) {
+    if (kCount) {
+      KernelCounters kc;
+      found = kernels_->closest_counted(wide_.view(), kr, kh, kc);
+      counters->nodes_visited += kc.nodes;
+      counters->primitive_tests += kc.tests;
+    } else {
+      found = kernels_->closest(wide_.view(), kr, kh);
+    }
+  }
+  if (found) {
+    hit.t = kh.t;
+    hit.u = kh.u;
+    hit.v = kh.v;
+    hit.primitive = kh.primitive;
+  }
+  if (!analytic_.empty() && query_analytic<false>(ray, found ? kh.t : ray.tmax, hit, counters))
+    found = true;
+  return found;
+}
+
+template <bool kCount>
+bool TraceGeometry::occluded_wide(const Ray& ray, TraversalCounters* counters) const {
+  KernelRay kr{{ray.origin.x, ray.origin.y, ray.origin.z},
+               {ray.dir.x, ray.dir.y, ray.dir.z},
+               ray.tmin,
+               ray.tmax};
+  if (!wide_.empty()) {
+    if (kCount) {
+      KernelCounters kc;
+      bool hit = kernels_->occluded_counted(wide_.view(), kr, kc);
+      counters->nodes_visited += kc.nodes;
+      counters->primitive_tests += kc.tests;
+      if (hit) return true;
+    } else if (kernels_->occluded(wide_.view(), kr)) {
+      return true;
+    }
+  }
+  HitRecord unused;
+  return !analytic_.empty() && query_analytic<true>(ray, ray.tmax, unused, counters);
+}
+
 bool TraceGeometry::closest(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
   if (embree_) return embree_closest(*embree_, ray, hit);
+  if (kernels_) return closest_wide<true>(ray, hit, &counters);
   if (triangle_test_ == TriangleTest::Chapter) return query<ChapterTest, false>(ray, hit, counters);
   return query<MollerTrumboreTest, false>(ray, hit, counters);
 }
 
+bool TraceGeometry::closest(const Ray& ray, HitRecord& hit) const {
+  if (kernels_) return closest_wide<false>(ray, hit, nullptr);
+  TraversalCounters unused;
+  return closest(ray, hit, unused);
+}
+
+void TraceGeometry::closest_packet(const RayPacket& packet, HitRecord* hits,
+                                   TraversalCounters* counters) const {
+  auto ray = [&](int i) {
+    return Ray{{packet.origin[0], packet.origin[1], packet.origin[2]},
+               {packet.dir[0][i], packet.dir[1][i], packet.dir[2][i]},
+               packet.tmin,
+               packet.tmax};
+  };
+  if (!kernels_) {
+    TraversalCounters unused;
+    for (int i = 0; i < packet.count; ++i) {
+      hits[i] = HitRecord{};
+      closest(ray(i), hits[i], counters ? counters[i] : unused);
+    }
+    return;
+  }
+  KernelHit kh[kPacketRays];
+  KernelCounters kc[kPacketRays];
+  for (int i = 0; i < packet.count; ++i) kh[i].primitive = kUnusedLane;
+  if (!wide_.empty()) kernels_->closest_packet(wide_.view(), packet, kh, counters ? kc : nullptr);
+  for (int i = 0; i < packet.count; ++i) {
+    HitRecord& h = hits[i];
+    h = HitRecord{};
+    bool found = kh[i].primitive != kUnusedLane;
+    if (found) {
+      h.t = kh[i].t;
+      h.u = kh[i].u;
+      h.v = kh[i].v;
+      h.primitive = kh[i].primitive;
+    }
+    if (counters) {
+      counters[i].nodes_visited += kc[i].nodes;
+      counters[i].primitive_tests += kc[i].tests;
+    }
+    if (!analytic_.empty())
+      query_analytic<false>(ray(i), found ? h.t : packet.tmax, h, counters ? &counters[i] : nullptr);
+  }
+}
+
 bool TraceGeometry::occluded(const Ray& ray, TraversalCounters& counters) const {
   if (embree_) return embree_occluded(*embree_, ray);
+  if (kernels_) return occluded_wide<true>(ray, &counters);
   HitRecord hit;
   if (triangle_test_ == TriangleTest::Chapter) return query<ChapterTest, true>(ray, hit, counters);
   return query<MollerTrumboreTest, true>(ray, hit, counters);
+}
+
+bool TraceGeometry::occluded(const Ray& ray) const {
+  if (kernels_) return occluded_wide<false>(ray, nullptr);
+  TraversalCounters unused;
+  return occluded(ray, unused);
 }
 
 SurfaceHit TraceGeometry::surface(const Ray& ray, const HitRecord& hit) const {

@@ -14,4 +14,18 @@ const char* to_string(RenderMode mode) {
   return "?";
 }
 
+const char* to_string(AccelKind accel) {
+  switch (accel) {
+    case AccelKind::Bvh:
+      return "bvh";
+    case AccelKind::Bvh2:
+      return "bvh2";
+    case AccelKind::None:
+      return "none";
+    case AccelKind::Embree:
+      return "embree";
+  }
+  return "?";
+}
+
 }  // namespace rvr

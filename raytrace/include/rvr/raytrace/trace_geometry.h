@@ -1,16 +1,24 @@
 // The scene as the tracer sees it: triangles precomputed as (v0, e1, e2), analytic spheres,
-// squares and CSG solids, one BVH over all of them (or none: the plain loop of the chapter).
-// Queries are two-phase: traversal finds the closest cheap hit (t, primitive, u, v); full
-// surface data is computed once, for that hit only.
+// squares and CSG solids, and what finds the nearest of them along a ray:
+//  - bvh: the wide BVH over the triangles, traversed by SIMD kernels, plus a binary BVH over the
+//    analytic shapes (a few in any scene);
+//  - bvh2: one binary BVH over everything, one box at a time;
+//  - none: the plain loop of the chapter; embree: Intel Embree.
+// Among hits at the same t the lowest primitive index wins, so bvh, bvh2 and none return the
+// same hit for every ray. Queries are two-phase: traversal finds the closest cheap hit (t,
+// primitive, u, v); full surface data is computed once, for that hit only.
 #pragma once
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
+#include "rvr/raytrace/traversal_kernels.h"
+#include "rvr/raytrace/wide_bvh.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
 
@@ -47,24 +55,40 @@ struct SurfaceHit {
 
 class TraceGeometry {
  public:
+  // `isa` picks the SIMD kernels of the wide BVH; unset: selected_isa().
   TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_segments, AccelKind accel,
-                TriangleTest triangle_test = TriangleTest::MollerTrumbore);
+                TriangleTest triangle_test = TriangleTest::MollerTrumbore,
+                std::optional<Isa> isa = std::nullopt);
   ~TraceGeometry();
 
-  // Empty unless building failed (Embree could not make a device or scene).
-  const std::string& error() const { return error_; }
+  // Empty unless building failed (Embree could not make a device or scene, RVR_ISA asks for
+  // kernels this CPU cannot run, the scene is too large for the wide BVH).
+  const std::string& error() const { return error_.message; }
+  ErrorKind error_kind() const { return error_.kind; }
 
   // Closest hit in (ray.tmin, ray.tmax).
   bool closest(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
+  // The same without counting traversal steps (benchmarks).
+  bool closest(const Ray& ray, HitRecord& hit) const;
+  // Closest hits of a tile of rays from one origin (primary rays), hits[i] for ray i: with the
+  // wide BVH a packet traversal, otherwise one ray at a time. Same hits as closest().
+  // counters[i] per ray, when not null.
+  void closest_packet(const RayPacket& packet, HitRecord* hits, TraversalCounters* counters) const;
   // Any hit in (ray.tmin, ray.tmax): shadow rays.
   bool occluded(const Ray& ray, TraversalCounters& counters) const;
+  bool occluded(const Ray& ray) const;
   SurfaceHit surface(const Ray& ray, const HitRecord& hit) const;
 
   size_t primitive_count() const { return triangles_.size() + analytic_.size(); }
   size_t triangle_count() const { return triangles_.size(); }
+  // bvh2: the tree over every primitive; bvh: the tree over the analytic shapes only.
   const Bvh& bvh() const { return bvh_; }
+  const WideBvh& wide_bvh() const { return wide_; }
   AccelKind accel() const { return accel_; }
-  // Bytes held for traversal: nodes + leaf-ordered triangles + slot indices.
+  // The instruction set of the kernels the wide BVH runs ("sse", "avx2", "avx512").
+  const char* kernel_isa() const { return kernels_ ? kernels_->isa : "scalar"; }
+  // Bytes held for traversal: bvh: wide nodes + triangle blocks + the analytic shapes' tree;
+  // bvh2: nodes + leaf-ordered triangles + slot indices.
   size_t acceleration_bytes() const;
 
  private:
@@ -81,6 +105,13 @@ class TraceGeometry {
 
   template <class TriangleTestFn, bool kAnyHit>
   bool query(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
+  template <bool kAnyHit>
+  bool query_analytic(const Ray& ray, float t_max, HitRecord& hit,
+                      TraversalCounters* counters) const;
+  template <bool kCount>
+  bool closest_wide(const Ray& ray, HitRecord& hit, TraversalCounters* counters) const;
+  template <bool kCount>
+  bool occluded_wide(const Ray& ray, TraversalCounters* counters) const;
   bool hit_analytic(const Analytic& a, const Ray& ray, float t_max, HitRecord& hit) const;
   static Aabb analytic_bounds(const Analytic& a);
   friend struct EmbreeBackend;
@@ -98,12 +129,15 @@ class TraceGeometry {
   std::vector<std::unique_ptr<TriangleMesh>> owned_meshes_;  // tessellated spheres
   std::vector<uint32_t> object_material_;
   std::vector<uint32_t> object_first_triangle_;  // unified index of each object's triangle 0
-  // BVH leaf slots: primitive index and, for triangles, a copy in leaf order for locality.
+  // bvh2: leaf slots of bvh_ hold a primitive index and, for triangles, a copy in leaf order for
+  // locality. bvh: bvh_ is over analytic_ only (slot -> analytic index), wide_ over triangles_.
   Bvh bvh_;
   TraversalVector<uint32_t> slot_primitive_;
   TraversalVector<TrianglePrecomputed> slot_triangles_;
+  WideBvh wide_;
+  const TraversalKernels* kernels_ = nullptr;
   std::unique_ptr<EmbreeBackend, EmbreeBackendDeleter> embree_;
-  std::string error_;
+  Error error_{"", ErrorKind::Internal};
 };
 
 }  // namespace rvr

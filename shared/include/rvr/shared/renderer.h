@@ -4,11 +4,13 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
+#include "rvr/shared/isa.h"
 #include "rvr/shared/progress.h"
 #include "rvr/shared/scene.h"
 
@@ -16,10 +18,14 @@ namespace rvr {
 
 enum class RenderMode { Visibility, Local, Full };
 enum class SphereMode { Analytic, Mesh };
-enum class AccelKind { Bvh, None, Embree };  // Embree: Intel Embree 3 answers the queries
+// Bvh: the wide SIMD BVH (default); Bvh2: the binary BVH traversed one box at a time (the
+// chapter's early rejection in its plainest form); None: every object for every ray; Embree:
+// Intel Embree 3 answers the queries.
+enum class AccelKind { Bvh, Bvh2, None, Embree };
 enum class TriangleTest { MollerTrumbore, Chapter };
 
 const char* to_string(RenderMode mode);
+const char* to_string(AccelKind accel);  // bvh, bvh2, none, embree
 
 struct RenderOptions {
   RenderMode mode = RenderMode::Local;
@@ -30,6 +36,8 @@ struct RenderOptions {
   uint64_t seed = 0;
   AccelKind accel = AccelKind::Bvh;
   TriangleTest triangle_test = TriangleTest::MollerTrumbore;
+  // SIMD kernels to run; unset: selected_isa() (RVR_ISA, or the best the CPU has).
+  std::optional<Isa> isa;
   // Rasterizers, full mode: shadow maps (a cube map per point light, one map per area-light
   // sample point). Resolution in texels per side; bias in units of view depth of the map,
   // added to the stored depth before comparing; percentage-closer filtering over 3x3 texels.
@@ -47,6 +55,8 @@ struct RenderOutput {
   std::map<std::string, double> stats;
   // What the renderer could not do for this scene (e.g. "csg objects skipped: 1").
   std::vector<std::string> warnings;
+  // Facts that are words, not numbers, e.g. "kernel": "avx2".
+  std::map<std::string, std::string> info;
 };
 
 class Renderer {

@@ -1,0 +1,12 @@
+// The wide BVH's traversal kernels of one instruction set, picked once (shared/isa.h).
+#pragma once
+
+#include "rvr/raytrace/wide_bvh_layout.h"
+#include "rvr/shared/isa.h"
+
+namespace rvr {
+
+// The kernels compiled for `isa`. The caller must have checked cpu_supports(isa).
+const TraversalKernels& traversal_kernels(Isa isa);
+
+}  // namespace rvr

@@ -1,0 +1,110 @@
+// The memory layout of the wide BVH, shared by its builder (wide_bvh.cpp, baseline x86-64) and
+// its traversal kernels (src/kernels/, compiled once per instruction set). Plain data only:
+// a kernel translation unit must not instantiate inline code that baseline code also uses,
+// or the linker could hand an AVX2 copy of it to code running on any x86-64.
+#pragma once
+
+#include <cstdint>
+
+namespace rvr {
+
+constexpr int kWideBvhWidth = 8;   // children per node
+constexpr int kTriangleBlock = 4;  // triangles per SoA leaf block
+constexpr int kMaxLeafTriangles = 8;
+
+// Eight child boxes in SoA, tested against a ray with one SIMD slab test (two halves with SSE).
+// Rows are lower x, upper x, lower y, upper y, lower z, upper z, so the near and far planes of
+// an axis are rows 2a + s and 2a + 1 - s, with s the sign bit of the ray's direction. An empty
+// slot has lower = +inf, upper = -inf: no ray ever enters it.
+struct alignas(32) WideNode {
+  float bounds[6][kWideBvhWidth];
+  uint32_t child[kWideBvhWidth];
+};
+static_assert(sizeof(WideNode) == 224, "wide nodes are 7 cache half-lines");
+
+// Child references: an inner node's index, or a leaf of 1..8 triangles in consecutive blocks.
+constexpr uint32_t kLeafFlag = 0x80000000u;
+constexpr uint32_t kLeafCountBits = 4;
+constexpr uint32_t kMaxBlocks = 1u << (31 - kLeafCountBits);
+constexpr uint32_t kEmptyTree = 0xFFFFFFFFu;
+
+// Four triangles as v0, e1 = v1 - v0, e2 = v2 - v0 in SoA, with the primitive index each lane
+// reports. Unused lanes hold a degenerate triangle (e1 = e2 = 0: determinant 0, never hit) and
+// primitive kUnusedLane.
+struct alignas(16) TriangleBlock {
+  float v0[3][kTriangleBlock];
+  float e1[3][kTriangleBlock];
+  float e2[3][kTriangleBlock];
+  uint32_t primitive[kTriangleBlock];
+};
+static_assert(sizeof(TriangleBlock) == 160, "40 bytes per triangle when blocks are full");
+constexpr uint32_t kUnusedLane = 0xFFFFFFFFu;
+
+// What a kernel traverses.
+struct WideBvhView {
+  const WideNode* nodes = nullptr;
+  const TriangleBlock* blocks = nullptr;
+  uint32_t root = kEmptyTree;
+  uint32_t max_depth = 0;  // levels of inner nodes below the root (bounds the stack)
+};
+
+// A ray for the kernels; t in (tmin, tmax).
+struct KernelRay {
+  float origin[3];
+  float dir[3];
+  float tmin;
+  float tmax;
+};
+
+// Closest hit: t, barycentrics, primitive (kUnusedLane when nothing was hit).
+struct KernelHit {
+  float t;
+  float u, v;
+  uint32_t primitive;
+};
+
+struct KernelCounters {
+  uint64_t nodes = 0;  // wide nodes whose children were tested
+  uint64_t tests = 0;  // triangles tested (real lanes of the blocks visited)
+};
+
+// A tile of primary rays sharing one origin (a pinhole camera): up to kPacketRays directions in
+// SoA, the same tmin and tmax for all.
+constexpr int kPacketRays = 64;
+struct alignas(32) RayPacket {
+  float origin[3];
+  float tmin, tmax;
+  int count;
+  float dir[3][kPacketRays];
+};
+
+// One instruction set's traversal functions. Counting variants fill KernelCounters (for the cost
+// AOV and statistics); the others count nothing, for benchmarks.
+struct TraversalKernels {
+  const char* isa;
+  bool (*closest)(const WideBvhView&, const KernelRay&, KernelHit&);
+  bool (*closest_counted)(const WideBvhView&, const KernelRay&, KernelHit&, KernelCounters&);
+  bool (*occluded)(const WideBvhView&, const KernelRay&);
+  bool (*occluded_counted)(const WideBvhView&, const KernelRay&, KernelCounters&);
+  // hits[i] for ray i of the packet; counters[i] per ray (may be null).
+  void (*closest_packet)(const WideBvhView&, const RayPacket&, KernelHit* hits,
+                         KernelCounters* counters);
+};
+
+// Defined in baseline code (wide_bvh.cpp): the double-precision recheck of a hit near a
+// triangle's edge, exactly as the scalar intersect_triangle_mt does it. tri = v0, e1, e2.
+// Accepts t in (ray.tmin, t_limit] (t_limit included: ties are decided by primitive index).
+bool recheck_triangle_near_edge(const KernelRay& ray, const float tri[9], float t_limit,
+                                KernelHit& hit);
+
+namespace isa_sse {
+extern const TraversalKernels kKernels;
+}
+namespace isa_avx2 {
+extern const TraversalKernels kKernels;
+}
+namespace isa_avx512 {
+extern const TraversalKernels kKernels;
+}
+
+}  // namespace rvr

@@ -1,0 +1,4 @@
+// The wide-BVH traversal kernels compiled for avx512 (flags in raytrace/CMakeLists.txt).
+#define RVR_KERNEL_NS isa_avx512
+#define RVR_KERNEL_NAME "avx512"
+#include "wide_kernels.inl"

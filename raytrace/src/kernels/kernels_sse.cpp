@@ -1,0 +1,4 @@
+// The wide-BVH traversal kernels compiled for sse (flags in raytrace/CMakeLists.txt).
+#define RVR_KERNEL_NS isa_sse
+#define RVR_KERNEL_NAME "sse"
+#include "wide_kernels.inl"

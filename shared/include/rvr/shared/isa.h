@@ -1,0 +1,27 @@
+// Which SIMD kernels run: chosen once from the CPU (as Embree does), or forced with RVR_ISA.
+// The binary itself targets baseline x86-64; only kernel translation units are compiled for
+// wider instruction sets, and a kernel is never called on a CPU that lacks its instructions.
+#pragma once
+
+#include <string>
+
+#include "rvr/shared/expected.h"
+
+namespace rvr {
+
+enum class Isa { Sse, Avx2, Avx512 };
+
+const char* to_string(Isa isa);  // "sse", "avx2", "avx512"
+
+// What this CPU (and its operating system, which must save the wide registers) can run.
+bool cpu_supports(Isa isa);
+Isa best_supported_isa();
+
+// The kernel set to use: RVR_ISA=sse|avx2|avx512 when set, otherwise the best the CPU offers.
+// A bad value, or an ISA this CPU cannot run, is a BadInput error naming RVR_ISA.
+Expected<Isa> selected_isa();
+
+// For messages: "avx2 (chosen from the CPU)" or "sse (forced by RVR_ISA)".
+std::string describe_isa_choice();
+
+}  // namespace rvr

@@ -1,0 +1,66 @@
+#include "rvr/shared/isa.h"
+
+#include <cstdlib>
+#include <cstring>
+
+namespace rvr {
+
+const char* to_string(Isa isa) {
+  switch (isa) {
+    case Isa::Sse:
+      return "sse";
+    case Isa::Avx2:
+      return "avx2";
+    case Isa::Avx512:
+      return "avx512";
+  }
+  return "?";
+}
+
+bool cpu_supports(Isa isa) {
+  // libgcc's probe checks CPUID and, for AVX and AVX-512, that the OS enables the registers
+  // (XGETBV), so a "yes" here means the instructions can run.
+  __builtin_cpu_init();
+  switch (isa) {
+    case Isa::Sse:
+      return true;  // SSE2 is baseline x86-64; the SSE kernels use nothing newer
+    case Isa::Avx2:
+      return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+             __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2") &&
+             __builtin_cpu_supports("popcnt");
+    case Isa::Avx512:
+      return cpu_supports(Isa::Avx2) && __builtin_cpu_supports("avx512f") &&
+             __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512dq") &&
+             __builtin_cpu_supports("avx512bw");
+  }
+  return false;
+}
+
+Isa best_supported_isa() {
+  if (cpu_supports(Isa::Avx512)) return Isa::Avx512;
+  if (cpu_supports(Isa::Avx2)) return Isa::Avx2;
+  return Isa::Sse;
+}
+
+Expected<Isa> selected_isa() {
+  const char* forced = std::getenv("RVR_ISA");
+  if (!forced || !*forced) return best_supported_isa();
+  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
+    if (std::strcmp(forced, to_string(isa)) != 0) continue;
+    if (!cpu_supports(isa))
+      return bad_input(std::string("RVR_ISA=") + forced + ": this CPU cannot run " + forced +
+                       " kernels (best available: " + to_string(best_supported_isa()) + ")");
+    return isa;
+  }
+  return bad_input(std::string("RVR_ISA=") + forced + ": unknown (use sse, avx2 or avx512)");
+}
+
+std::string describe_isa_choice() {
+  Expected<Isa> isa = selected_isa();
+  if (!isa) return isa.error().message;
+  const char* forced = std::getenv("RVR_ISA");
+  return std::string(to_string(*isa)) +
+         (forced && *forced ? " (forced by RVR_ISA)" : " (chosen from the CPU)");
+}
+
+}  // namespace rvr
