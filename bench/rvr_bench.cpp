@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <cmath>
 #include <random>
 #include <string>
 
@@ -176,30 +177,146 @@ std::vector<Ray> make_rays(const Scene& scene, const std::string& kind) {
   return rays;
 }
 
-// Rays only, one thread: our BVH's closest-hit query against Embree's rtcIntersect1.
+AccelKind accel_kind(const std::string& name) {
+  if (name == "embree" || name == "embree_medium" || name == "embree_high") return AccelKind::Embree;
+  if (name == "bvh2") return AccelKind::Bvh2;
+  return AccelKind::Bvh;
+}
+
+struct TraceAnswer {
+  bool hit;
+  HitRecord h;
+};
+
+// Embree's answers for one scene and set of rays, computed once: the reference every other
+// accelerator's answers are checked against.
+const std::vector<TraceAnswer>& embree_answers(const std::string& key, const Scene& scene,
+                                               const std::vector<Ray>& rays) {
+  static std::mutex mutex;
+  static std::map<std::string, std::vector<TraceAnswer>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[key];
+  if (slot.empty()) {
+    TraceGeometry embree(scene, SphereMode::Analytic, 64, AccelKind::Embree);
+    slot.resize(rays.size());
+    for (size_t i = 0; i < rays.size(); ++i) slot[i].hit = embree.closest(rays[i], slot[i].h);
+  }
+  return slot;
+}
+
+// Checks that `answers` are Embree's, ray for ray: the same primitive (or the same miss) and t
+// within 1e-5 relative. Exceptions, counted, each a limit of float arithmetic rather than a
+// disagreement about what is there:
+//  - edge: the nearer hit of the two lies within 1e-4 (in barycentrics) of its triangle's edge:
+//    the two tests put the ray on different sides of that edge (exact arithmetic sides with
+//    either one, as checked by hand on soup:1000000);
+//  - crossing: two triangles at the same t to 1e-6 (they cross; the ray meets them there);
+//  - ill-conditioned: the same primitive, t apart by more than 1e-5 relative but within the
+//    float error bound of Moller-Trumbore's t, 16 eps kappa t, where kappa =
+//    |e1||e2| (|s| / |s.n| + |d| / |d.n|) (s = origin - v0, n = e1 x e2) grows at grazing
+//    angles and for small triangles far from the origin (soup:1000000's are 0.01 across).
+struct TraceCheck {
+  size_t edge = 0, crossing = 0, ill_conditioned = 0, wrong = 0, first_wrong = 0;
+};
+
+TraceCheck check_against_embree(const std::vector<TraceAnswer>& answers,
+                                const std::vector<TraceAnswer>& embree, const TraceGeometry& g,
+                                const std::vector<Ray>& rays) {
+  auto near_edge = [](const HitRecord& h) {
+    constexpr float kEdge = 1e-4f;
+    return h.u < kEdge || h.v < kEdge || 1.0f - h.u - h.v < kEdge;
+  };
+  TraceCheck c;
+  for (size_t i = 0; i < answers.size(); ++i) {
+    const TraceAnswer& a = answers[i];
+    const TraceAnswer& e = embree[i];
+    if (!a.hit && !e.hit) continue;
+    if (a.hit && e.hit && a.h.primitive == e.h.primitive) {
+      float dt = std::abs(a.h.t - e.h.t);
+      if (dt <= 1e-5f * std::abs(e.h.t)) continue;
+      const Ray& r = rays[i];
+      const TrianglePrecomputed& tri = g.triangle(a.h.primitive);
+      glm::dvec3 n = glm::cross(glm::dvec3(tri.e1), glm::dvec3(tri.e2));
+      glm::dvec3 sv = glm::dvec3(r.origin) - glm::dvec3(tri.v0), d(r.dir);
+      double kappa = glm::length(glm::dvec3(tri.e1)) * glm::length(glm::dvec3(tri.e2)) *
+                     (glm::length(sv) / std::abs(glm::dot(sv, n)) +
+                      glm::length(d) / std::abs(glm::dot(d, n)));
+      if (dt <= 16.0 * 0x1p-24 * kappa * std::abs(e.h.t)) {
+        ++c.ill_conditioned;
+        continue;
+      }
+    } else {
+      // The nearer of the two hits (or the only one) decides.
+      bool ours_nearer = a.hit && (!e.hit || a.h.t <= e.h.t);
+      if (near_edge(ours_nearer ? a.h : e.h)) {
+        ++c.edge;
+        continue;
+      }
+      // Two triangles crossing each other (soups have them), the ray through the crossing.
+      if (a.hit && e.hit && std::abs(a.h.t - e.h.t) <= 1e-6f * std::abs(e.h.t)) {
+        ++c.crossing;
+        continue;
+      }
+    }
+    if (std::getenv("RVR_BENCH_DEBUG"))
+      std::fprintf(stderr, "ray %zu: ours %d p%u t%.9g u%.6g v%.6g  embree %d p%u t%.9g u%.6g v%.6g\n", i,
+                   a.hit, a.h.primitive, a.h.t, a.h.u, a.h.v, e.hit, e.h.primitive, e.h.t, e.h.u, e.h.v);
+    if (c.wrong++ == 0) c.first_wrong = i;
+  }
+  return c;
+}
+
+// Rays only, one thread: closest-hit queries through bvh (the wide BVH, the SIMD kernels
+// chosen for this CPU), bvh2 (the binary tree) or embree (rtcIntersect1), over the same rays.
+// Before timing, every answer is checked against Embree's and the traversal counted (the timed
+// loop counts nothing).
 void BM_Trace(benchmark::State& state, std::string accel, std::string rays_kind,
               std::string scene_name) {
-  const Scene& scene = builtin(scene_name + ":" + std::to_string(state.range(0)));
-  TraceGeometry geometry(scene, SphereMode::Analytic, 64,
-                         accel == "embree" ? AccelKind::Embree : AccelKind::Bvh);
+  std::string name = scene_name + ":" + std::to_string(state.range(0));
+  const Scene& scene = builtin(name);
+  TraceGeometry geometry(scene, SphereMode::Analytic, 64, accel_kind(accel),
+                         TriangleTest::MollerTrumbore, std::nullopt,
+                         accel == "embree_medium" ? EmbreeQuality::Medium : EmbreeQuality::High);
   std::vector<Ray> rays = make_rays(scene, rays_kind);
   tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+
+  std::vector<TraceAnswer> answers(rays.size());
   TraversalCounters counters;
+  for (size_t i = 0; i < rays.size(); ++i)
+    answers[i].hit = geometry.closest(rays[i], answers[i].h, counters);
+  if (accel_kind(accel) != AccelKind::Embree) {
+    TraceCheck check =
+        check_against_embree(answers, embree_answers(name + rays_kind, scene, rays), geometry, rays);
+    // Edge cases are rare: a ray must pass within 1e-4 of an edge (in barycentrics).
+    if (check.wrong > 0 || check.edge + check.crossing + check.ill_conditioned > rays.size() / 1000) {
+      std::string error = "answers differ from Embree's on " + std::to_string(check.wrong) +
+                          " rays (first: ray " + std::to_string(check.first_wrong) + "), " +
+                          std::to_string(check.edge) + " edge cases, " +
+                          std::to_string(check.crossing) + " crossings, " +
+                          std::to_string(check.ill_conditioned) + " ill-conditioned";
+      state.SkipWithError(error.c_str());
+      return;
+    }
+    state.counters["check.edge"] = double(check.edge);
+    state.counters["check.crossing"] = double(check.crossing);
+    state.counters["check.ill_conditioned"] = double(check.ill_conditioned);
+  }
+
   size_t hits = 0;
   for (auto _ : state) {
-    counters = {};
     for (const Ray& r : rays) {
       HitRecord h;
-      hits += geometry.closest(r, h, counters);
+      hits += geometry.closest(r, h);
     }
   }
   benchmark::DoNotOptimize(hits);
   using C = benchmark::Counter;
   state.counters["rays/s"] = C(double(rays.size()), C::kIsIterationInvariantRate);
-  if (accel == "bvh") {
+  if (accel_kind(accel) != AccelKind::Embree) {
     state.counters["nodes/ray"] = double(counters.nodes_visited) / double(rays.size());
     state.counters["tests/ray"] = double(counters.primitive_tests) / double(rays.size());
   }
+  if (accel == "bvh") state.SetLabel(std::string("kernel ") + geometry.kernel_isa());
 }
 
 // Acceleration structure build, one thread for both (Embree builds with TBB too).
@@ -252,7 +369,7 @@ void register_all() {
     benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-  for (std::string a : {"bvh", "embree"})
+  for (std::string a : {"bvh", "bvh2", "embree", "embree_medium"})
     for (std::string rays : {"primary", "random"}) {
       benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/tessphere").c_str(), BM_Trace,
                                    a, rays, std::string("tessphere"))
@@ -261,6 +378,7 @@ void register_all() {
       benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/soup").c_str(), BM_Trace, a,
                                    rays, std::string("soup"))
           ->Arg(1000000)
+          ->Arg(100000)
           ->Unit(benchmark::kMillisecond);
     }
   for (std::string r : {"raytrace", "softraster"})

@@ -105,7 +105,9 @@ EmbreeBackend* EmbreeBackend::create(const TraceGeometry& g, std::string& error)
     return nullptr;
   }
   backend->scene = rtcNewScene(backend->device);
-  rtcSetSceneBuildQuality(backend->scene, RTC_BUILD_QUALITY_HIGH);
+  rtcSetSceneBuildQuality(backend->scene, g.embree_quality_ == EmbreeQuality::High
+                                              ? RTC_BUILD_QUALITY_HIGH
+                                              : RTC_BUILD_QUALITY_MEDIUM);
   for (size_t object = 0; object < g.object_mesh_.size(); ++object) {
     const TriangleMesh* mesh = g.object_mesh_[object];
     if (!mesh || mesh->triangles.empty()) continue;

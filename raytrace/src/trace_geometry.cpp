@@ -73,8 +73,9 @@ void csg_boundaries(const CsgNode* node, const Ray& ray, uint32_t& next_leaf,
 }  // namespace
 
 TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_segments,
-                             AccelKind accel, TriangleTest triangle_test, std::optional<Isa> isa)
-    : accel_(accel), triangle_test_(triangle_test) {
+                             AccelKind accel, TriangleTest triangle_test, std::optional<Isa> isa,
+                             EmbreeQuality embree_quality)
+    : accel_(accel), triangle_test_(triangle_test), embree_quality_(embree_quality) {
   size_t n_objects = scene.objects.size();
   object_mesh_.assign(n_objects, nullptr);
   object_material_.resize(n_objects);

@@ -79,7 +79,7 @@ constexpr float kWiden = 1.0f + 1.0f / 1048576.0f;
 // A direction component below this is treated as zero: the ray takes the robust slab test.
 constexpr float kTinyDirection = 1e-20f;
 
-float abs1(float x) { return x < 0.0f ? -x : x; }
+float abs1(float x) { return __builtin_fabsf(x); }  // no branch
 bool sign1(float x) { return __builtin_signbit(x) != 0; }
 
 // One ray's constants for the slab tests of every node it meets, set up once per ray. Near and
@@ -115,7 +115,7 @@ struct RayBox {
 
   // Bit i set when child i is entered in [t_min, t_max]; near[i] its entry distance.
   template <bool kRobust>
-  unsigned intersect(const WideNode& n, V8 t_min, V8 t_max, float* near) const {
+  unsigned intersect(const WideNode& n, V8 t_min, V8 t_max, V8& near) const {
     V8 tn[3], tf[3];
     for (int a = 0; a < 3; ++a) {
       if (kRobust) {
@@ -128,7 +128,7 @@ struct RayBox {
     }
     V8 t0 = max8(tn[2], max8(tn[1], max8(tn[0], t_min)));
     V8 t1 = min8(tf[2], min8(tf[1], min8(tf[0], t_max)));
-    store8(near, t0);
+    near = t0;
     return le_mask8(t0, mul8(t1, splat8(kWiden)));
   }
 };
@@ -157,6 +157,10 @@ struct BlockCandidates {
   alignas(16) float t[4], u[4], v[4];
 };
 
+inline __m128 dot3(__m128 ax, __m128 ay, __m128 az, __m128 bx, __m128 by, __m128 bz) {
+  return _mm_add_ps(_mm_add_ps(_mm_mul_ps(ax, bx), _mm_mul_ps(ay, by)), _mm_mul_ps(az, bz));
+}
+
 inline void intersect_block(const TriangleBlock& b, const BlockRay& r, __m128 t_limit,
                             BlockCandidates& out) {
   const __m128 e1x = _mm_load_ps(b.e1[0]), e1y = _mm_load_ps(b.e1[1]), e1z = _mm_load_ps(b.e1[2]);
@@ -165,40 +169,45 @@ inline void intersect_block(const TriangleBlock& b, const BlockRay& r, __m128 t_
   __m128 px = _mm_sub_ps(_mm_mul_ps(r.d[1], e2z), _mm_mul_ps(e2y, r.d[2]));
   __m128 py = _mm_sub_ps(_mm_mul_ps(r.d[2], e2x), _mm_mul_ps(e2z, r.d[0]));
   __m128 pz = _mm_sub_ps(_mm_mul_ps(r.d[0], e2y), _mm_mul_ps(e2x, r.d[1]));
-  __m128 det = _mm_add_ps(_mm_add_ps(_mm_mul_ps(e1x, px), _mm_mul_ps(e1y, py)), _mm_mul_ps(e1z, pz));
-  __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), det);
+  __m128 det = dot3(e1x, e1y, e1z, px, py, pz);
+  const __m128 sign_bit = _mm_set1_ps(-0.0f);
+  __m128 sign = _mm_and_ps(det, sign_bit);  // x * (+-1) is x with its sign bit flipped
+  __m128 abs_det = _mm_andnot_ps(sign_bit, det);
   __m128 sx = _mm_sub_ps(r.o[0], _mm_load_ps(b.v0[0]));
   __m128 sy = _mm_sub_ps(r.o[1], _mm_load_ps(b.v0[1]));
   __m128 sz = _mm_sub_ps(r.o[2], _mm_load_ps(b.v0[2]));
-  __m128 u = _mm_mul_ps(
-      _mm_add_ps(_mm_add_ps(_mm_mul_ps(sx, px), _mm_mul_ps(sy, py)), _mm_mul_ps(sz, pz)), inv);
+  __m128 su = dot3(sx, sy, sz, px, py, pz);
   // q = cross(s, e1)
   __m128 qx = _mm_sub_ps(_mm_mul_ps(sy, e1z), _mm_mul_ps(e1y, sz));
   __m128 qy = _mm_sub_ps(_mm_mul_ps(sz, e1x), _mm_mul_ps(e1z, sx));
   __m128 qz = _mm_sub_ps(_mm_mul_ps(sx, e1y), _mm_mul_ps(e1x, sy));
-  __m128 v = _mm_mul_ps(
-      _mm_add_ps(_mm_add_ps(_mm_mul_ps(r.d[0], qx), _mm_mul_ps(r.d[1], qy)), _mm_mul_ps(r.d[2], qz)),
-      inv);
-  __m128 t = _mm_mul_ps(
-      _mm_add_ps(_mm_add_ps(_mm_mul_ps(e2x, qx), _mm_mul_ps(e2y, qy)), _mm_mul_ps(e2z, qz)), inv);
-  __m128 uv = _mm_add_ps(u, v);
-  const __m128 lo = _mm_set1_ps(-kEdgeBand), hi = _mm_set1_ps(1.0f + kEdgeBand);
-  const __m128 band = _mm_set1_ps(kEdgeBand), inner_hi = _mm_set1_ps(1.0f - kEdgeBand);
+  __m128 sv = dot3(r.d[0], r.d[1], r.d[2], qx, qy, qz);
+  __m128 U = _mm_xor_ps(su, sign), V = _mm_xor_ps(sv, sign), UV = _mm_add_ps(U, V);
+  __m128 outer_lo = _mm_mul_ps(_mm_set1_ps(-kEdgeBand), abs_det);
+  __m128 outer_hi = _mm_mul_ps(_mm_set1_ps(1.0f + kEdgeBand), abs_det);
   // Ordered comparisons: a NaN rejects nothing here, exactly as in the scalar test.
   __m128 reject = _mm_or_ps(_mm_cmpeq_ps(det, _mm_setzero_ps()),
-                            _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, lo), _mm_cmpgt_ps(u, hi)),
-                                      _mm_or_ps(_mm_cmplt_ps(v, lo), _mm_cmpgt_ps(uv, hi))));
-  __m128 edge = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(u, band), _mm_cmplt_ps(v, band)),
-                          _mm_cmpgt_ps(uv, inner_hi));
-  __m128 in_range = _mm_and_ps(_mm_cmpgt_ps(t, r.tmin), _mm_cmple_ps(t, t_limit));
+                            _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, outer_lo), _mm_cmpgt_ps(U, outer_hi)),
+                                      _mm_or_ps(_mm_cmplt_ps(V, outer_lo), _mm_cmpgt_ps(UV, outer_hi))));
   unsigned keep = unsigned(_mm_movemask_ps(reject)) ^ 0xFu;
+  out.inner = out.edge = 0;
+  if (!keep) return;  // most blocks: no division, no t
+  __m128 band = _mm_mul_ps(_mm_set1_ps(kEdgeBand), abs_det);
+  __m128 inner_hi = _mm_mul_ps(_mm_set1_ps(1.0f - kEdgeBand), abs_det);
+  __m128 edge = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, band), _mm_cmplt_ps(V, band)),
+                          _mm_cmpgt_ps(UV, inner_hi));
   unsigned edge_bits = unsigned(_mm_movemask_ps(edge));
   out.edge = keep & edge_bits;
-  out.inner = keep & ~edge_bits & unsigned(_mm_movemask_ps(in_range));
+  unsigned inner = keep & ~edge_bits;
+  if (!inner) return;
+  __m128 inv = _mm_div_ps(_mm_set1_ps(1.0f), det);
+  __m128 t = _mm_mul_ps(dot3(e2x, e2y, e2z, qx, qy, qz), inv);
+  __m128 in_range = _mm_and_ps(_mm_cmpgt_ps(t, r.tmin), _mm_cmple_ps(t, t_limit));
+  out.inner = inner & unsigned(_mm_movemask_ps(in_range));
   if (out.inner) {
     _mm_store_ps(out.t, t);
-    _mm_store_ps(out.u, u);
-    _mm_store_ps(out.v, v);
+    _mm_store_ps(out.u, _mm_mul_ps(su, inv));
+    _mm_store_ps(out.v, _mm_mul_ps(sv, inv));
   }
 }
 
@@ -212,12 +221,15 @@ inline void lane_triangle(const TriangleBlock& b, unsigned lane, float tri[9]) {
 
 // ----------------------------------------------------------------------- single-ray traversal
 
-struct StackEntry {
-  uint32_t ref;
-  float dist;
-};
-// Each inner level pushes at most seven entries.
+// Entries still to visit, with the entry distance of each: popped entries farther than the
+// nearest hit so far are skipped without loading them. SoA, so eight children can be pushed with
+// two stores. Each inner level pushes at most seven entries; the slack takes full-width stores.
 constexpr int kStackSize = 7 * 64 + 8;
+struct Stack {
+  alignas(32) uint32_t ref[kStackSize + kWideBvhWidth];
+  alignas(32) float dist[kStackSize + kWideBvhWidth];
+  int top = 0;
+};
 
 // The closest hit so far; ties at equal t go to the lower primitive index. best.primitive
 // starts at 0 with t = tmax, so a hit exactly at tmax (excluded) never wins.
@@ -232,26 +244,80 @@ struct Closest {
   }
 };
 
-// Sorts the children in `mask` by entry distance and pushes all but the nearest, farthest first;
-// returns the nearest.
-inline uint32_t push_hit_children(const WideNode& node, unsigned mask, const float* near,
-                                  StackEntry* stack, int& top) {
-  StackEntry hits[kWideBvhWidth];
-  int n = 0;
-  while (mask) {
-    unsigned i = lowest_bit(mask);
-    mask &= mask - 1;
-    StackEntry e{node.child[i], near[i]};
-    int k = n++;
-    while (k > 0 && hits[k - 1].dist < e.dist) {  // descending
-      hits[k] = hits[k - 1];
-      --k;
-    }
-    hits[k] = e;
+#if defined(__AVX2__)
+// One compare-exchange stage of a bitonic network over 8 lanes: every lane meets its partner
+// (lane ^ J); `kMaxLanes` has a bit set for the lanes that keep the larger key. A lane takes its
+// partner's key and payload only when the partner's key is strictly larger (smaller), so equal
+// keys never duplicate a payload.
+template <int J, int kMaxLanes>
+inline void exchange(__m256& key, __m256& payload) {
+  __m256 pk, pp;
+  if (J == 1) {
+    pk = _mm256_permute_ps(key, 0xB1);
+    pp = _mm256_permute_ps(payload, 0xB1);
+  } else if (J == 2) {
+    pk = _mm256_permute_ps(key, 0x4E);
+    pp = _mm256_permute_ps(payload, 0x4E);
+  } else {
+    pk = _mm256_permute2f128_ps(key, key, 1);
+    pp = _mm256_permute2f128_ps(payload, payload, 1);
   }
-  for (int k = 0; k < n - 1; ++k) stack[top++] = hits[k];
-  return hits[n - 1].ref;
+  __m256 take = _mm256_blend_ps(_mm256_cmp_ps(pk, key, _CMP_LT_OQ),
+                                _mm256_cmp_ps(pk, key, _CMP_GT_OQ), kMaxLanes);
+  key = _mm256_blendv_ps(key, pk, take);
+  payload = _mm256_blendv_ps(payload, pp, take);
 }
+
+// Three or more children hit: pushes all but the nearest, farthest first, and returns the
+// nearest, with no branch that depends on the distances: a bitonic network sorts the eight
+// (distance, child) pairs in registers (children not hit get -inf and sort last), and two
+// full-width stores push them.
+inline uint32_t visit_children(const WideNode& node, unsigned mask, V8 near, Stack& stack) {
+  const __m256i lanes = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  __m256 hit = _mm256_castsi256_ps(
+      _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int(mask)), lanes), lanes));
+  __m256 key = _mm256_blendv_ps(_mm256_set1_ps(-__builtin_inff()), near.v, hit);
+  __m256 payload = _mm256_castsi256_ps(_mm256_load_si256(reinterpret_cast<const __m256i*>(node.child)));
+  // Descending bitonic sort: stages (k, j) = (2,1) (4,2) (4,1) (8,4) (8,2) (8,1); lane i keeps
+  // the maximum when (i & k) == 0 equals i < (i ^ j).
+  exchange<1, 0x99>(key, payload);
+  exchange<2, 0xC3>(key, payload);
+  exchange<1, 0xA5>(key, payload);
+  exchange<4, 0x0F>(key, payload);
+  exchange<2, 0x33>(key, payload);
+  exchange<1, 0x55>(key, payload);
+  const int hits = __builtin_popcount(mask);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.ref + stack.top), _mm256_castps_si256(payload));
+  _mm256_storeu_ps(stack.dist + stack.top, key);
+  stack.top += hits - 1;
+  return stack.ref[stack.top];  // the nearest: stored, but not pushed
+}
+#else
+// Three or more children hit: sorted by insertion, farthest pushed first.
+inline uint32_t visit_children(const WideNode& node, unsigned mask, V8 near8, Stack& stack) {
+  alignas(32) float near[kWideBvhWidth];
+  store8(near, near8);
+  uint32_t refs[kWideBvhWidth];
+  float dists[kWideBvhWidth];
+  int n = 0;
+  for (; mask; mask &= mask - 1) {
+    unsigned i = lowest_bit(mask);
+    int k = n++;
+    for (; k > 0 && dists[k - 1] < near[i]; --k) {
+      dists[k] = dists[k - 1];
+      refs[k] = refs[k - 1];
+    }
+    dists[k] = near[i];
+    refs[k] = node.child[i];
+  }
+  for (int k = 0; k < n - 1; ++k) {
+    stack.ref[stack.top] = refs[k];
+    stack.dist[stack.top++] = dists[k];
+  }
+  return refs[n - 1];
+}
+#endif
+
 
 template <bool kAnyHit, bool kCount, bool kRobust>
 bool traverse(const WideBvhView& bvh, const KernelRay& ray, KernelHit* hit,
@@ -262,19 +328,20 @@ bool traverse(const WideBvhView& bvh, const KernelRay& ray, KernelHit* hit,
   Closest closest;
   closest.best = {ray.tmax, 0.0f, 0.0f, 0u};
   // Occlusion accepts t in (tmin, tmax): the largest float below tmax is the limit.
-  const float any_limit = __builtin_nextafterf(ray.tmax, -__builtin_inff());
-  StackEntry stack[kStackSize];
-  int top = 0;
-  stack[top++] = {bvh.root, -__builtin_inff()};
-  alignas(32) float near[kWideBvhWidth];
-  while (top > 0) {
-    StackEntry entry = stack[--top];
-    if (entry.dist > closest.best.t) continue;  // a nearer hit is known: skip without loading
-    uint32_t ref = entry.ref;
+  const float any_limit = kAnyHit ? __builtin_nextafterf(ray.tmax, -__builtin_inff()) : 0.0f;
+  Stack stack;
+  stack.ref[0] = bvh.root;
+  stack.dist[0] = -__builtin_inff();
+  stack.top = 1;
+  while (stack.top > 0) {
+    --stack.top;
+    if (stack.dist[stack.top] > closest.best.t) continue;  // a nearer hit is known: skip it
+    uint32_t ref = stack.ref[stack.top];
     bool leaf_reached = true;
     while (!(ref & kLeafFlag)) {
       const WideNode& node = bvh.nodes[ref];
       if (kCount) counters->nodes++;
+      V8 near;
       unsigned mask = box.intersect<kRobust>(node, t_min, splat8(closest.best.t), near);
       if (mask == 0) {
         leaf_reached = false;
@@ -283,10 +350,22 @@ bool traverse(const WideBvhView& bvh, const KernelRay& ray, KernelHit* hit,
       if ((mask & (mask - 1)) == 0) {
         ref = node.child[lowest_bit(mask)];
       } else {
-        ref = push_hit_children(node, mask, near, stack, top);
+unsigned rest = mask & (mask - 1);
+        if ((rest & (rest - 1)) == 0) {  // two: the nearer now, the other later (no branch)
+          alignas(32) float nd[kWideBvhWidth];
+          store8(nd, near);
+          unsigned a = lowest_bit(mask), b = lowest_bit(rest);
+          unsigned swap = nd[b] < nd[a];
+          unsigned nearer = swap ? b : a, farther = swap ? a : b;
+          stack.ref[stack.top] = node.child[farther];
+          stack.dist[stack.top++] = nd[farther];
+          ref = node.child[nearer];
+        } else {
+          ref = visit_children(node, mask, near, stack);
+        }
       }
     }
-    if (!leaf_reached || ref == kEmptyTree) continue;
+    if (!leaf_reached) continue;
     const uint32_t first = (ref & ~kLeafFlag) >> kLeafCountBits;
     const uint32_t triangles = ref & ((1u << kLeafCountBits) - 1);
     if (kCount) counters->tests += triangles;

@@ -65,25 +65,32 @@ inline bool intersect_triangle_mt_double(const Ray& ray, const TrianglePrecomput
 // Moller-Trumbore: solves o + t d = v0 + u e1 + v e2 by Cramer's rule. Edges and vertices are
 // inside (u, v >= 0, u + v <= 1, with kBarycentricSlack). The float pass rejects what is
 // clearly outside and accepts what is clearly inside; within kEdgeBand of an edge the
-// barycentrics are recomputed in double, so a shared edge never leaks.
+// barycentrics are recomputed in double, so a shared edge never leaks. The pass compares
+// U = u det and V = v det against det (signs flipped when det < 0), so the division is done
+// only for a hit. The SIMD kernels (src/kernels/wide_kernels.inl) do exactly these operations
+// in this order, so they find the same hits to the bit.
+constexpr float kEdgeBand = 1e-3f;
+
 inline bool intersect_triangle_mt(const Ray& ray, const TrianglePrecomputed& tri,
                                   TriangleHit& hit) {
-  constexpr float kEdgeBand = 1e-3f;
   glm::vec3 p = glm::cross(ray.dir, tri.e2);
   float det = glm::dot(tri.e1, p);
   if (det == 0.0f) return false;  // ray parallel to the triangle's plane (or degenerate)
-  float inv_det = 1.0f / det;
+  const float sign = std::signbit(det) ? -1.0f : 1.0f;
+  const float abs_det = det * sign;
   glm::vec3 s = ray.origin - tri.v0;
-  float u = glm::dot(s, p) * inv_det;
-  if (u < -kEdgeBand || u > 1.0f + kEdgeBand) return false;
+  float su = glm::dot(s, p);
   glm::vec3 q = glm::cross(s, tri.e1);
-  float v = glm::dot(ray.dir, q) * inv_det;
-  if (v < -kEdgeBand || u + v > 1.0f + kEdgeBand) return false;
-  if (u < kEdgeBand || v < kEdgeBand || u + v > 1.0f - kEdgeBand)
+  float sv = glm::dot(ray.dir, q);
+  float U = su * sign, V = sv * sign, UV = U + V;
+  float outer_lo = -kEdgeBand * abs_det, outer_hi = (1.0f + kEdgeBand) * abs_det;
+  if (U < outer_lo || U > outer_hi || V < outer_lo || UV > outer_hi) return false;
+  if (U < kEdgeBand * abs_det || V < kEdgeBand * abs_det || UV > (1.0f - kEdgeBand) * abs_det)
     return intersect_triangle_mt_double(ray, tri, hit);
+  float inv_det = 1.0f / det;
   float t = glm::dot(tri.e2, q) * inv_det;
   if (!(t > ray.tmin && t < ray.tmax)) return false;
-  hit = {t, u, v};
+  hit = {t, su * inv_det, sv * inv_det};
   return true;
 }
 

@@ -53,12 +53,17 @@ struct SurfaceHit {
   uint32_t material = 0;
 };
 
+// Embree's build quality: HIGH (spatial splits; what the embree renderer uses) or MEDIUM (binned
+// SAH without spatial splits, the same kind of tree as ours).
+enum class EmbreeQuality { High, Medium };
+
 class TraceGeometry {
  public:
   // `isa` picks the SIMD kernels of the wide BVH; unset: selected_isa().
   TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_segments, AccelKind accel,
                 TriangleTest triangle_test = TriangleTest::MollerTrumbore,
-                std::optional<Isa> isa = std::nullopt);
+                std::optional<Isa> isa = std::nullopt,
+                EmbreeQuality embree_quality = EmbreeQuality::High);
   ~TraceGeometry();
 
   // Empty unless building failed (Embree could not make a device or scene, RVR_ISA asks for
@@ -81,6 +86,8 @@ class TraceGeometry {
 
   size_t primitive_count() const { return triangles_.size() + analytic_.size(); }
   size_t triangle_count() const { return triangles_.size(); }
+  // Triangle p (a unified primitive index below triangle_count()).
+  const TrianglePrecomputed& triangle(uint32_t p) const { return triangles_[p]; }
   // bvh2: the tree over every primitive; bvh: the tree over the analytic shapes only.
   const Bvh& bvh() const { return bvh_; }
   const WideBvh& wide_bvh() const { return wide_; }
@@ -119,6 +126,7 @@ class TraceGeometry {
 
   AccelKind accel_;
   TriangleTest triangle_test_;
+  EmbreeQuality embree_quality_;
   // Unified primitive index: [0, T) triangles, [T, T + A) analytic shapes.
   std::vector<TrianglePrecomputed> triangles_;
   std::vector<uint32_t> triangle_object_;
