@@ -319,6 +319,90 @@ void BM_Trace(benchmark::State& state, std::string accel, std::string rays_kind,
   if (accel == "bvh") state.SetLabel(std::string("kernel ") + geometry.kernel_isa());
 }
 
+// Primary rays of a 1024x768 frame as 8x8 tiles (row-major inside a tile), the packets the
+// raytrace renderer traces. tile_first[k] is the index of tile k's first ray in make_rays order.
+std::vector<RayPacket> make_tiles(const Scene& scene, std::vector<std::vector<int>>& ray_index) {
+  CameraFrame f = make_camera_frame(scene.camera, 1024, 768);
+  std::vector<RayPacket> tiles;
+  for (int y0 = 0; y0 < 768; y0 += 8) {
+    for (int x0 = 0; x0 < 1024; x0 += 8) {
+      RayPacket p;
+      p.origin[0] = f.eye.x;
+      p.origin[1] = f.eye.y;
+      p.origin[2] = f.eye.z;
+      p.tmin = scene.camera.near;
+      p.tmax = scene.camera.far;
+      p.count = 64;
+      std::vector<int> index;
+      for (int k = 0; k < 64; ++k) {
+        int x = x0 + k % 8, y = y0 + k / 8;
+        glm::vec3 d = camera_ray_direction(f, x + 0.5f, y + 0.5f);
+        for (int a = 0; a < 3; ++a) p.dir[a][k] = d[a];
+        index.push_back(y * 1024 + x);
+      }
+      tiles.push_back(p);
+      ray_index.push_back(index);
+    }
+  }
+  return tiles;
+}
+
+// Primary rays, one thread, as packets: bvh (our packet traversal of the wide BVH) or embree
+// (rtcIntersect8 or rtcIntersect16, its native width on this CPU), over the same 8x8 tiles.
+// Answers are checked against Embree's single-ray ones first.
+void BM_TracePacket(benchmark::State& state, std::string accel, std::string scene_name) {
+  std::string name = scene_name + ":" + std::to_string(state.range(0));
+  const Scene& scene = builtin(name);
+  TraceGeometry geometry(scene, SphereMode::Analytic, 64, accel_kind(accel));
+  std::vector<std::vector<int>> ray_index;
+  std::vector<RayPacket> tiles = make_tiles(scene, ray_index);
+  std::vector<Ray> rays = make_rays(scene, "primary");
+  tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+
+  std::vector<TraceAnswer> answers(rays.size());
+  std::vector<TraversalCounters> counters(kPacketRays);
+  TraversalCounters total;
+  for (size_t t = 0; t < tiles.size(); ++t) {
+    HitRecord hits[kPacketRays];
+    for (auto& c : counters) c = {};
+    geometry.closest_packet(tiles[t], hits, counters.data());
+    for (int k = 0; k < tiles[t].count; ++k) {
+      TraceAnswer& a = answers[size_t(ray_index[t][size_t(k)])];
+      a.hit = hits[k].primitive != kNoPrimitive;
+      a.h = hits[k];
+      total.nodes_visited += counters[size_t(k)].nodes_visited;
+      total.primitive_tests += counters[size_t(k)].primitive_tests;
+    }
+  }
+  TraceCheck check =
+      check_against_embree(answers, embree_answers(name + "primary", scene, rays), geometry, rays);
+  if (check.wrong > 0 || check.edge + check.crossing + check.ill_conditioned > rays.size() / 1000) {
+    std::string error = "packet answers differ from Embree's single-ray ones on " +
+                        std::to_string(check.wrong) + " rays (first: ray " +
+                        std::to_string(check.first_wrong) + ")";
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  size_t hit_count = 0;
+  for (auto _ : state) {
+    for (const RayPacket& tile : tiles) {
+      HitRecord hits[kPacketRays];
+      geometry.closest_packet(tile, hits, nullptr);
+      hit_count += hits[0].primitive != kNoPrimitive;
+    }
+  }
+  benchmark::DoNotOptimize(hit_count);
+  using C = benchmark::Counter;
+  state.counters["rays/s"] = C(double(rays.size()), C::kIsIterationInvariantRate);
+  if (accel == "bvh") {
+    state.counters["nodes/ray"] = double(total.nodes_visited) / double(rays.size());
+    state.counters["tests/ray"] = double(total.primitive_tests) / double(rays.size());
+    state.SetLabel(std::string("kernel ") + geometry.kernel_isa());
+  } else {
+    state.SetLabel("rtcIntersect" + std::to_string(geometry.embree_packet_width()));
+  }
+}
+
 // Acceleration structure build, one thread for both (Embree builds with TBB too).
 void BM_Build(benchmark::State& state, std::string accel) {
   tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
@@ -381,6 +465,12 @@ void register_all() {
           ->Arg(100000)
           ->Unit(benchmark::kMillisecond);
     }
+  for (std::string a : {"bvh", "embree"})
+    for (std::string scene : {"tessphere", "soup"})
+      benchmark::RegisterBenchmark(("BM_TracePacket/" + a + "/" + scene).c_str(), BM_TracePacket,
+                                   a, scene)
+          ->Arg(scene == "soup" ? 1000000 : 100000)
+          ->Unit(benchmark::kMillisecond);
   for (std::string r : {"raytrace", "softraster"})
     for (long threads : {1L, 2L})
       benchmark::RegisterBenchmark(("BM_Threads/" + r).c_str(), BM_Threads, r)

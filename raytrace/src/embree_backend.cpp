@@ -14,6 +14,7 @@ struct EmbreeBackend {
   const TraceGeometry* owner = nullptr;
   std::vector<uint32_t> geometry_base;  // per geomID: unified index of its primitive 0
   uint32_t analytic_geometry = RTC_INVALID_GEOMETRY_ID;
+  int packet_width = 8;  // rtcIntersect8 or rtcIntersect16: the widest this device runs natively
 
   static EmbreeBackend* create(const TraceGeometry& g, std::string& error);
   ~EmbreeBackend() {
@@ -33,15 +34,12 @@ void EmbreeBackendDeleter::operator()(EmbreeBackend* backend) const {
 
 namespace {
 
-// The intersect context carries where a CSG hit's extra data goes (Embree keeps only t, u, v).
+// The intersect context carries where a CSG hit's extra data goes (Embree keeps only t, u, v):
+// hits[ray id] (ray ids are lane numbers in a packet, 0 for a single ray).
 struct QueryContext {
   RTCIntersectContext embree;
-  HitRecord* hit;
+  HitRecord* hits;
 };
-
-Ray to_ray(const RTCRay& r) {
-  return Ray{{r.org_x, r.org_y, r.org_z}, {r.dir_x, r.dir_y, r.dir_z}, r.tnear, r.tfar};
-}
 
 void set_ray(RTCRay& r, const Ray& ray) {
   r.org_x = ray.origin.x;
@@ -66,33 +64,49 @@ void EmbreeBackend::bounds(const RTCBoundsFunctionArguments* args) {
   *args->bounds_o = {b.lo.x, b.lo.y, b.lo.z, 0.0f, b.hi.x, b.hi.y, b.hi.z, 0.0f};
 }
 
+// Called for one ray or a packet of N (args->valid says which lanes are live).
 void EmbreeBackend::intersect(const RTCIntersectFunctionNArguments* args) {
-  if (args->N != 1 || !args->valid[0]) return;  // only rtcIntersect1 is used
   auto* self = static_cast<const EmbreeBackend*>(args->geometryUserPtr);
-  auto* rayhit = reinterpret_cast<RTCRayHit*>(args->rayhit);
-  HitRecord h;
-  if (!self->owner->hit_analytic(self->owner->analytic_[args->primID], to_ray(rayhit->ray),
-                                 rayhit->ray.tfar, h))
-    return;
-  rayhit->ray.tfar = h.t;
-  rayhit->hit.u = 0.0f;
-  rayhit->hit.v = 0.0f;
-  rayhit->hit.geomID = args->geomID;
-  rayhit->hit.primID = args->primID;
-  rayhit->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  // The last accepted analytic hit is the nearest one so far.
   auto* context = reinterpret_cast<QueryContext*>(args->context);
-  context->hit->csg_leaf = h.csg_leaf;
-  context->hit->csg_flip = h.csg_flip;
+  const unsigned N = args->N;
+  RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, N);
+  RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, N);
+  for (unsigned i = 0; i < N; ++i) {
+    if (!args->valid[i]) continue;
+    Ray ray{{RTCRayN_org_x(rays, N, i), RTCRayN_org_y(rays, N, i), RTCRayN_org_z(rays, N, i)},
+            {RTCRayN_dir_x(rays, N, i), RTCRayN_dir_y(rays, N, i), RTCRayN_dir_z(rays, N, i)},
+            RTCRayN_tnear(rays, N, i),
+            RTCRayN_tfar(rays, N, i)};
+    HitRecord h;
+    if (!self->owner->hit_analytic(self->owner->analytic_[args->primID], ray, ray.tmax, h))
+      continue;
+    RTCRayN_tfar(rays, N, i) = h.t;
+    RTCHitN_u(hits, N, i) = 0.0f;
+    RTCHitN_v(hits, N, i) = 0.0f;
+    RTCHitN_geomID(hits, N, i) = args->geomID;
+    RTCHitN_primID(hits, N, i) = args->primID;
+    RTCHitN_instID(hits, N, i, 0) = RTC_INVALID_GEOMETRY_ID;
+    // The last accepted analytic hit is the nearest one so far.
+    HitRecord& out = context->hits[RTCRayN_id(rays, N, i)];
+    out.csg_leaf = h.csg_leaf;
+    out.csg_flip = h.csg_flip;
+  }
 }
 
 void EmbreeBackend::occluded(const RTCOccludedFunctionNArguments* args) {
-  if (args->N != 1 || !args->valid[0]) return;
   auto* self = static_cast<const EmbreeBackend*>(args->geometryUserPtr);
-  auto* ray = reinterpret_cast<RTCRay*>(args->ray);
-  HitRecord h;
-  if (self->owner->hit_analytic(self->owner->analytic_[args->primID], to_ray(*ray), ray->tfar, h))
-    ray->tfar = -std::numeric_limits<float>::infinity();
+  const unsigned N = args->N;
+  RTCRayN* rays = args->ray;
+  for (unsigned i = 0; i < N; ++i) {
+    if (!args->valid[i]) continue;
+    Ray ray{{RTCRayN_org_x(rays, N, i), RTCRayN_org_y(rays, N, i), RTCRayN_org_z(rays, N, i)},
+            {RTCRayN_dir_x(rays, N, i), RTCRayN_dir_y(rays, N, i), RTCRayN_dir_z(rays, N, i)},
+            RTCRayN_tnear(rays, N, i),
+            RTCRayN_tfar(rays, N, i)};
+    HitRecord h;
+    if (self->owner->hit_analytic(self->owner->analytic_[args->primID], ray, ray.tmax, h))
+      RTCRayN_tfar(rays, N, i) = -std::numeric_limits<float>::infinity();
+  }
 }
 
 EmbreeBackend* EmbreeBackend::create(const TraceGeometry& g, std::string& error) {
@@ -148,6 +162,8 @@ EmbreeBackend* EmbreeBackend::create(const TraceGeometry& g, std::string& error)
     backend->geometry_base[id] = uint32_t(g.triangles_.size());
   }
   rtcCommitScene(backend->scene);
+  backend->packet_width =
+      rtcGetDeviceProperty(backend->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16 : 8;
   if (RTCError e = rtcGetDeviceError(backend->device); e != RTC_ERROR_NONE) {
     error = "Embree: building the scene failed (error " + std::to_string(int(e)) + ")";
     return nullptr;
@@ -162,7 +178,7 @@ EmbreeBackend* make_embree_backend(const TraceGeometry& geometry, std::string& e
 bool embree_closest(const EmbreeBackend& backend, const Ray& ray, HitRecord& hit) {
   QueryContext context;
   rtcInitIntersectContext(&context.embree);
-  context.hit = &hit;
+  context.hits = &hit;
   RTCRayHit rayhit;
   set_ray(rayhit.ray, ray);
   rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -184,6 +200,67 @@ bool embree_occluded(const EmbreeBackend& backend, const Ray& ray) {
   rtcOccluded1(backend.scene, &context, &r);
   return r.tfar < 0.0f;
 }
+
+namespace {
+
+// Rays [first, first + K) of the packet as one rtcIntersectK call.
+template <int K, class RayHitK, class Fn>
+void intersect_k(const EmbreeBackend& backend, const RayPacket& packet, int first, HitRecord* hits,
+                 Fn&& rtc_intersect) {
+  alignas(64) int valid[K];
+  alignas(64) RayHitK rh;
+  for (int i = 0; i < K; ++i) {
+    int k = first + i;
+    valid[i] = k < packet.count ? -1 : 0;
+    rh.ray.org_x[i] = packet.origin[0];
+    rh.ray.org_y[i] = packet.origin[1];
+    rh.ray.org_z[i] = packet.origin[2];
+    rh.ray.dir_x[i] = k < packet.count ? packet.dir[0][k] : 0.0f;
+    rh.ray.dir_y[i] = k < packet.count ? packet.dir[1][k] : 0.0f;
+    rh.ray.dir_z[i] = k < packet.count ? packet.dir[2][k] : 1.0f;
+    rh.ray.tnear[i] = packet.tmin;
+    rh.ray.tfar[i] = packet.tmax;
+    rh.ray.time[i] = 0.0f;
+    rh.ray.mask[i] = 0xFFFFFFFFu;
+    rh.ray.id[i] = unsigned(i);
+    rh.ray.flags[i] = 0;
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  QueryContext context;
+  rtcInitIntersectContext(&context.embree);
+  context.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  context.hits = hits + first;
+  rtc_intersect(valid, backend.scene, &context.embree, &rh);
+  for (int i = 0; i < K && first + i < packet.count; ++i) {
+    if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
+    HitRecord& h = hits[first + i];
+    h.t = rh.ray.tfar[i];
+    h.primitive = backend.geometry_base[rh.hit.geomID[i]] + rh.hit.primID[i];
+    h.u = rh.hit.u[i];
+    h.v = rh.hit.v[i];
+  }
+}
+
+}  // namespace
+
+void embree_closest_packet(const EmbreeBackend& backend, const RayPacket& packet,
+                           HitRecord* hits) {
+  for (int i = 0; i < packet.count; ++i) hits[i] = HitRecord{};
+  if (backend.packet_width == 16) {
+    for (int first = 0; first < packet.count; first += 16)
+      intersect_k<16, RTCRayHit16>(backend, packet, first, hits,
+                                   [](const int* v, RTCScene s, RTCIntersectContext* c,
+                                      RTCRayHit16* r) { rtcIntersect16(v, s, c, r); });
+  } else {
+    for (int first = 0; first < packet.count; first += 8)
+      intersect_k<8, RTCRayHit8>(backend, packet, first, hits,
+                                 [](const int* v, RTCScene s, RTCIntersectContext* c,
+                                    RTCRayHit8* r) { rtcIntersect8(v, s, c, r); });
+  }
+}
+
+int embree_packet_width(const EmbreeBackend& backend) { return backend.packet_width; }
 
 std::string embree_version() {
   return RTC_VERSION_STRING;

@@ -12,5 +12,9 @@ namespace rvr {
 EmbreeBackend* make_embree_backend(const TraceGeometry& geometry, std::string& error);
 bool embree_closest(const EmbreeBackend& backend, const Ray& ray, HitRecord& hit);
 bool embree_occluded(const EmbreeBackend& backend, const Ray& ray);
+// A tile of primary rays through rtcIntersect8 or rtcIntersect16 (the device's native width),
+// in consecutive groups of that many rays.
+void embree_closest_packet(const EmbreeBackend& backend, const RayPacket& packet, HitRecord* hits);
+int embree_packet_width(const EmbreeBackend& backend);
 
 }  // namespace rvr

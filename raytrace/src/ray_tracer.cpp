@@ -20,6 +20,9 @@ namespace rvr {
 namespace {
 
 constexpr int kTileSize = 16;
+// Primary rays go as packets of kPacketSide x kPacketSide pixel-centre rays (kPacketRays).
+constexpr int kPacketSide = 8;
+static_assert(kPacketSide * kPacketSide == kPacketRays);
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
@@ -77,15 +80,43 @@ class FrameTracer {
         lights_(light_samples(scene.lights)),
         frame_(make_camera_frame(scene.camera, scene.image.width, scene.image.height)) {}
 
-  void render_pixel(int x, int y, FrameBuffers& fb, RayCounters& counters) const {
+  // The pixels [x0, x1) x [y0, y1) of one tile (at most kPacketSide on a side): their centre
+  // rays traced together as one packet, then each pixel shaded on its own.
+  void render_block(int x0, int y0, int x1, int y1, FrameBuffers& fb, RayCounters& counters) const {
+    const int w = x1 - x0;
+    RayPacket packet;
+    packet.origin[0] = frame_.eye.x;
+    packet.origin[1] = frame_.eye.y;
+    packet.origin[2] = frame_.eye.z;
+    packet.tmin = scene_.camera.near;
+    packet.tmax = scene_.camera.far;
+    packet.count = w * (y1 - y0);
+    for (int k = 0; k < packet.count; ++k) {
+      Ray r = primary_ray(float(x0 + k % w) + 0.5f, float(y0 + k / w) + 0.5f);
+      for (int a = 0; a < 3; ++a) packet.dir[a][k] = r.dir[a];
+    }
+    HitRecord hits[kPacketRays];
+    TraversalCounters work[kPacketRays];
+    geometry_.closest_packet(packet, hits, work);
+    for (int k = 0; k < packet.count; ++k) {
+      counters.traversal.nodes_visited += work[k].nodes_visited;
+      counters.traversal.primitive_tests += work[k].primitive_tests;
+      render_pixel(x0 + k % w, y0 + k / w, hits[k], work[k], fb, counters);
+    }
+  }
+
+ private:
+  // `hit` is the closest hit of the ray through the pixel centre (primitive kNoPrimitive when it
+  // missed), found with `primary_work`.
+  void render_pixel(int x, int y, const HitRecord& hit, const TraversalCounters& primary_work,
+                    FrameBuffers& fb, RayCounters& counters) const {
     uint64_t work_before = counters.traversal.nodes_visited + counters.traversal.primitive_tests;
     size_t i = fb.index(x, y);
     // The AOVs come from the ray through the pixel centre, where OpenGL samples too.
     Ray ray = primary_ray(float(x) + 0.5f, float(y) + 0.5f);
     counters.primary++;
-    HitRecord hit;
     glm::vec3 centre_colour = scene_.image.background;
-    if (geometry_.closest(ray, hit, counters.traversal)) {
+    if (hit.primitive != kNoPrimitive) {
       SurfaceHit s = geometry_.surface(ray, hit);
       glm::vec3 V = -glm::normalize(ray.dir);
       glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
@@ -104,11 +135,11 @@ class FrameTracer {
     } else {
       fb.color[i] = supersample(x, y, spp, counters);
     }
-    fb.cost[i] =
-        float(counters.traversal.nodes_visited + counters.traversal.primitive_tests - work_before);
+    fb.cost[i] = float(primary_work.nodes_visited + primary_work.primitive_tests +
+                       counters.traversal.nodes_visited + counters.traversal.primitive_tests -
+                       work_before);
   }
 
- private:
   Ray primary_ray(float px, float py) const {
     Ray r;
     r.origin = frame_.eye;
@@ -277,8 +308,10 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
             int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
             int x1 = std::min(x0 + kTileSize, w), y1 = std::min(y0 + kTileSize, h);
             const uint64_t rays_before = local.rays();
-            for (int y = y0; y < y1; ++y)
-              for (int x = x0; x < x1; ++x) tracer.render_pixel(x, y, out.buffers, local);
+            for (int by = y0; by < y1; by += kPacketSide)
+              for (int bx = x0; bx < x1; bx += kPacketSide)
+                tracer.render_block(bx, by, std::min(bx + kPacketSide, x1),
+                                    std::min(by + kPacketSide, y1), out.buffers, local);
             if (progress)
               progress->advance(uint64_t(x1 - x0) * uint64_t(y1 - y0), local.rays() - rays_before);
           }

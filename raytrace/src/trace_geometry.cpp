@@ -207,6 +207,8 @@ Aabb TraceGeometry::analytic_bounds(const Analytic& a) {
   return b;
 }
 
+int TraceGeometry::embree_packet_width() const { return embree_ ? rvr::embree_packet_width(*embree_) : 0; }
+
 size_t TraceGeometry::acceleration_bytes() const {
   return wide_.bytes() + bvh_.nodes().size() * sizeof(BvhNode) +
          slot_primitive_.size() * sizeof(uint32_t) +
@@ -420,6 +422,10 @@ void TraceGeometry::closest_packet(const RayPacket& packet, HitRecord* hits,
                packet.tmin,
                packet.tmax};
   };
+  if (embree_) {
+    embree_closest_packet(*embree_, packet, hits);
+    return;
+  }
   if (!kernels_) {
     TraversalCounters unused;
     for (int i = 0; i < packet.count; ++i) {

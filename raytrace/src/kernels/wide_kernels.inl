@@ -47,6 +47,29 @@ inline unsigned le_mask8(V8 a, V8 b) {
 #endif
 }
 inline void store8(float* p, V8 a) { _mm256_store_ps(p, a.v); }
+inline V8 add8(V8 a, V8 b) { return {_mm256_add_ps(a.v, b.v)}; }
+inline V8 div8(V8 a, V8 b) { return {_mm256_div_ps(a.v, b.v)}; }
+inline V8 and8(V8 a, V8 b) { return {_mm256_and_ps(a.v, b.v)}; }
+inline V8 or8(V8 a, V8 b) { return {_mm256_or_ps(a.v, b.v)}; }
+inline V8 xor8(V8 a, V8 b) { return {_mm256_xor_ps(a.v, b.v)}; }
+inline V8 andnot8(V8 a, V8 b) { return {_mm256_andnot_ps(a.v, b.v)}; }  // ~a & b
+inline V8 lt8(V8 a, V8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ)}; }
+inline V8 le8(V8 a, V8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)}; }
+inline V8 gt8(V8 a, V8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ)}; }
+inline V8 eq8(V8 a, V8 b) { return {_mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ)}; }
+inline unsigned mask8(V8 m) { return unsigned(_mm256_movemask_ps(m.v)); }
+inline V8 select8(V8 m, V8 b, V8 a) { return {_mm256_blendv_ps(a.v, b.v, m.v)}; }  // m ? b : a
+// Lanes holding unsigned integers below 2^31 (primitive indices): a < b.
+inline V8 lt_index8(V8 a, V8 b) {
+  return {_mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_castps_si256(b.v), _mm256_castps_si256(a.v)))};
+}
+inline V8 bits8(uint32_t x) { return {_mm256_castsi256_ps(_mm256_set1_epi32(int(x)))}; }
+// Lane i set when bit i of m is.
+inline V8 lanes8(unsigned m) {
+  const __m256i bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  return {_mm256_castsi256_ps(
+      _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int(m)), bit), bit))};
+}
 #else
 struct V8 {
   __m128 lo, hi;
@@ -66,6 +89,37 @@ inline unsigned le_mask8(V8 a, V8 b) {
 inline void store8(float* p, V8 a) {
   _mm_store_ps(p, a.lo);
   _mm_store_ps(p + 4, a.hi);
+}
+inline V8 add8(V8 a, V8 b) { return {_mm_add_ps(a.lo, b.lo), _mm_add_ps(a.hi, b.hi)}; }
+inline V8 div8(V8 a, V8 b) { return {_mm_div_ps(a.lo, b.lo), _mm_div_ps(a.hi, b.hi)}; }
+inline V8 and8(V8 a, V8 b) { return {_mm_and_ps(a.lo, b.lo), _mm_and_ps(a.hi, b.hi)}; }
+inline V8 or8(V8 a, V8 b) { return {_mm_or_ps(a.lo, b.lo), _mm_or_ps(a.hi, b.hi)}; }
+inline V8 xor8(V8 a, V8 b) { return {_mm_xor_ps(a.lo, b.lo), _mm_xor_ps(a.hi, b.hi)}; }
+inline V8 andnot8(V8 a, V8 b) { return {_mm_andnot_ps(a.lo, b.lo), _mm_andnot_ps(a.hi, b.hi)}; }
+inline V8 lt8(V8 a, V8 b) { return {_mm_cmplt_ps(a.lo, b.lo), _mm_cmplt_ps(a.hi, b.hi)}; }
+inline V8 le8(V8 a, V8 b) { return {_mm_cmple_ps(a.lo, b.lo), _mm_cmple_ps(a.hi, b.hi)}; }
+inline V8 gt8(V8 a, V8 b) { return {_mm_cmpgt_ps(a.lo, b.lo), _mm_cmpgt_ps(a.hi, b.hi)}; }
+inline V8 eq8(V8 a, V8 b) { return {_mm_cmpeq_ps(a.lo, b.lo), _mm_cmpeq_ps(a.hi, b.hi)}; }
+inline unsigned mask8(V8 m) {
+  return unsigned(_mm_movemask_ps(m.lo)) | unsigned(_mm_movemask_ps(m.hi)) << 4;
+}
+inline __m128 select4(__m128 m, __m128 b, __m128 a) {
+  return _mm_or_ps(_mm_and_ps(m, b), _mm_andnot_ps(m, a));  // SSE2 has no blendv
+}
+inline V8 select8(V8 m, V8 b, V8 a) { return {select4(m.lo, b.lo, a.lo), select4(m.hi, b.hi, a.hi)}; }
+inline V8 lt_index8(V8 a, V8 b) {
+  return {_mm_castsi128_ps(_mm_cmpgt_epi32(_mm_castps_si128(b.lo), _mm_castps_si128(a.lo))),
+          _mm_castsi128_ps(_mm_cmpgt_epi32(_mm_castps_si128(b.hi), _mm_castps_si128(a.hi)))};
+}
+inline V8 bits8(uint32_t x) {
+  __m128 v = _mm_castsi128_ps(_mm_set1_epi32(int(x)));
+  return {v, v};
+}
+inline V8 lanes8(unsigned m) {
+  const __m128i lo_bits = _mm_setr_epi32(1, 2, 4, 8), hi_bits = _mm_setr_epi32(16, 32, 64, 128);
+  __m128i mm = _mm_set1_epi32(int(m));
+  return {_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(mm, lo_bits), lo_bits)),
+          _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(mm, hi_bits), hi_bits))};
 }
 #endif
 
@@ -319,18 +373,18 @@ inline uint32_t visit_children(const WideNode& node, unsigned mask, V8 near8, St
 #endif
 
 
+// From the subtree `start`, with what `closest` already holds (a packet's lane handed over to a
+// single ray keeps its hit so far). For any-hit queries, true as soon as anything is hit.
 template <bool kAnyHit, bool kCount, bool kRobust>
-bool traverse(const WideBvhView& bvh, const KernelRay& ray, KernelHit* hit,
-              KernelCounters* counters) {
+bool traverse_from(const WideBvhView& bvh, const KernelRay& ray, uint32_t start, Closest& closest,
+                   KernelCounters* counters) {
   const RayBox box(ray);
   const BlockRay block_ray(ray);
   const V8 t_min = splat8(ray.tmin);
-  Closest closest;
-  closest.best = {ray.tmax, 0.0f, 0.0f, 0u};
   // Occlusion accepts t in (tmin, tmax): the largest float below tmax is the limit.
   const float any_limit = kAnyHit ? __builtin_nextafterf(ray.tmax, -__builtin_inff()) : 0.0f;
   Stack stack;
-  stack.ref[0] = bvh.root;
+  stack.ref[0] = start;
   stack.dist[0] = -__builtin_inff();
   stack.top = 1;
   while (stack.top > 0) {
@@ -391,9 +445,17 @@ unsigned rest = mask & (mask - 1);
       }
     }
   }
-  if (kAnyHit) return false;
-  if (closest.found) *hit = closest.best;
-  return closest.found;
+  return kAnyHit ? false : closest.found;
+}
+
+template <bool kAnyHit, bool kCount, bool kRobust>
+bool traverse(const WideBvhView& bvh, const KernelRay& ray, KernelHit* hit,
+              KernelCounters* counters) {
+  Closest closest;
+  closest.best = {ray.tmax, 0.0f, 0.0f, 0u};
+  bool found = traverse_from<kAnyHit, kCount, kRobust>(bvh, ray, bvh.root, closest, counters);
+  if (!kAnyHit && found) *hit = closest.best;
+  return found;
 }
 
 template <bool kAnyHit, bool kCount>
@@ -418,20 +480,289 @@ bool occluded_counted(const WideBvhView& bvh, const KernelRay& ray, KernelCounte
   return trace<true, true>(bvh, ray, nullptr, &counters);
 }
 
-// Placeholder until the packet traversal lands: single rays.
+// ---------------------------------------------------------------------- packets of 8 rays
+
+// Eight rays from one origin in the lanes of V8s. A node's children are tested one at a time
+// against all eight (both planes per axis, then min/max, so each lane may point its own way);
+// each lane keeps its own nearest hit, found with the same triangle arithmetic as a single ray,
+// so every lane ends with exactly the hit a single ray would find.
+struct Packet8 {
+  V8 d[3];
+  V8 rdir[3], org_rdir[3];
+  V8 margin;  // per lane, absolute: covers the rounding of org * rdir (as RayBox's margins)
+  V8 tmin;
+  float o[3];
+  unsigned valid;
+  KernelRay ray[8];  // the same rays one by one: edge rechecks, single-ray fallback
+};
+
+struct PacketBest8 {
+  V8 t, u, v, primitive;  // primitive: index bits; starts at 0 with t = tmax (see Closest)
+  unsigned found;
+};
+
+// When this few lanes remain active at a node, each goes on alone (as Embree's hybrid
+// traversal switches from packets to single rays): testing a node or a triangle costs a packet
+// as much for one lane as for eight.
+constexpr int kSingleRayThreshold = 2;
+
+struct PacketStack {
+  uint32_t ref[8 * 66];
+  alignas(32) float near[8 * 66][8];
+  int top = 0;
+};
+
+// Hands lane `lane` to the single-ray traversal of subtree `ref`, keeping its hit so far.
+template <bool kCount>
+void finish_lane(const WideBvhView& bvh, const Packet8& p, unsigned lane, uint32_t ref,
+                 PacketBest8& best, KernelCounters* counters) {
+  alignas(32) float t[8], u[8], v[8], prim[8];
+  store8(t, best.t);
+  store8(u, best.u);
+  store8(v, best.v);
+  store8(prim, best.primitive);
+  Closest c;
+  c.best.t = t[lane];
+  c.best.u = u[lane];
+  c.best.v = v[lane];
+  __builtin_memcpy(&c.best.primitive, &prim[lane], 4);
+  c.found = (best.found >> lane) & 1;
+  traverse_from<false, kCount, false>(bvh, p.ray[lane], ref, c, kCount ? &counters[lane] : nullptr);
+  if (!c.found) return;
+  t[lane] = c.best.t;
+  u[lane] = c.best.u;
+  v[lane] = c.best.v;
+  __builtin_memcpy(&prim[lane], &c.best.primitive, 4);
+  best.t = load8(t);
+  best.u = load8(u);
+  best.v = load8(v);
+  best.primitive = load8(prim);
+  best.found |= 1u << lane;
+}
+
+// Lanes `active` against triangle `lane` of block b: intersect_triangle_mt lane by lane (s and
+// q depend only on the shared origin, so they are computed once, in the same float operations).
+inline void intersect_triangle8(const TriangleBlock& b, unsigned j, const Packet8& p,
+                                unsigned active, PacketBest8& best) {
+  const float e1x = b.e1[0][j], e1y = b.e1[1][j], e1z = b.e1[2][j];
+  const float e2x = b.e2[0][j], e2y = b.e2[1][j], e2z = b.e2[2][j];
+  const V8 E1x = splat8(e1x), E1y = splat8(e1y), E1z = splat8(e1z);
+  const V8 E2x = splat8(e2x), E2y = splat8(e2y), E2z = splat8(e2z);
+  // p = cross(d, e2), det = dot(e1, p)
+  V8 px = sub8(mul8(p.d[1], E2z), mul8(E2y, p.d[2]));
+  V8 py = sub8(mul8(p.d[2], E2x), mul8(E2z, p.d[0]));
+  V8 pz = sub8(mul8(p.d[0], E2y), mul8(E2x, p.d[1]));
+  V8 det = add8(add8(mul8(E1x, px), mul8(E1y, py)), mul8(E1z, pz));
+  const float sx = p.o[0] - b.v0[0][j], sy = p.o[1] - b.v0[1][j], sz = p.o[2] - b.v0[2][j];
+  const float qx = sy * e1z - e1y * sz, qy = sz * e1x - e1z * sx, qz = sx * e1y - e1x * sy;
+  V8 su = add8(add8(mul8(splat8(sx), px), mul8(splat8(sy), py)), mul8(splat8(sz), pz));
+  V8 sv = add8(add8(mul8(p.d[0], splat8(qx)), mul8(p.d[1], splat8(qy))), mul8(p.d[2], splat8(qz)));
+  const V8 sign_bit = splat8(-0.0f);
+  V8 sign = and8(det, sign_bit);
+  V8 abs_det = andnot8(sign_bit, det);
+  V8 U = xor8(su, sign), V = xor8(sv, sign), UV = add8(U, V);
+  V8 outer_lo = mul8(splat8(-kEdgeBand), abs_det), outer_hi = mul8(splat8(1.0f + kEdgeBand), abs_det);
+  V8 reject = or8(eq8(det, splat8(0.0f)), or8(or8(lt8(U, outer_lo), gt8(U, outer_hi)),
+                                              or8(lt8(V, outer_lo), gt8(UV, outer_hi))));
+  unsigned keep = active & ~mask8(reject);
+  if (!keep) return;
+  V8 band = mul8(splat8(kEdgeBand), abs_det), inner_hi = mul8(splat8(1.0f - kEdgeBand), abs_det);
+  unsigned edge = keep & mask8(or8(or8(lt8(U, band), lt8(V, band)), gt8(UV, inner_hi)));
+  unsigned inner = keep & ~edge;
+  const V8 prim = bits8(b.primitive[j]);
+  if (inner) {
+    V8 inv = div8(splat8(1.0f), det);
+    const float tnum = e2x * qx + e2y * qy + e2z * qz;  // dot(e2, q), as (x + y) + z
+    V8 t = mul8(splat8(tnum), inv);
+    V8 better = or8(lt8(t, best.t), and8(eq8(t, best.t), lt_index8(prim, best.primitive)));
+    V8 take = and8(and8(lanes8(inner), gt8(t, p.tmin)), better);
+    unsigned taken = mask8(take);
+    if (taken) {
+      best.t = select8(take, t, best.t);
+      best.u = select8(take, mul8(su, inv), best.u);
+      best.v = select8(take, mul8(sv, inv), best.v);
+      best.primitive = select8(take, prim, best.primitive);
+      best.found |= taken;
+    }
+  }
+  if (edge) {
+    float tri[9];
+    lane_triangle(b, j, tri);
+    alignas(32) float bt[8];
+    store8(bt, best.t);
+    for (; edge; edge &= edge - 1) {
+      unsigned lane = lowest_bit(edge);
+      KernelHit h;
+      if (!recheck_triangle_near_edge(p.ray[lane], tri, bt[lane], h)) continue;
+      alignas(32) float t[8], u[8], v[8], pr[8];
+      store8(t, best.t);
+      store8(u, best.u);
+      store8(v, best.v);
+      store8(pr, best.primitive);
+      uint32_t cur;
+      __builtin_memcpy(&cur, &pr[lane], 4);
+      if (!(h.t < t[lane] || (h.t == t[lane] && b.primitive[j] < cur))) continue;
+      t[lane] = h.t;
+      u[lane] = h.u;
+      v[lane] = h.v;
+      __builtin_memcpy(&pr[lane], &b.primitive[j], 4);
+      bt[lane] = h.t;
+      best.t = load8(t);
+      best.u = load8(u);
+      best.v = load8(v);
+      best.primitive = load8(pr);
+      best.found |= 1u << lane;
+    }
+  }
+}
+
+template <bool kCount>
+void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best,
+                     KernelCounters* counters) {
+  PacketStack stack;
+  stack.ref[0] = bvh.root;
+  store8(stack.near[0], p.tmin);
+  stack.top = 1;
+  const V8 inf = splat8(__builtin_inff());
+  while (stack.top > 0) {
+    --stack.top;
+    uint32_t ref = stack.ref[stack.top];
+    unsigned active = p.valid & mask8(le8(load8(stack.near[stack.top]), best.t));
+    if (!active) continue;
+    if (__builtin_popcount(active) <= kSingleRayThreshold) {
+      for (; active; active &= active - 1)
+        finish_lane<kCount>(bvh, p, lowest_bit(active), ref, best, counters);
+      continue;
+    }
+    if (kCount)
+      for (unsigned m = active; m; m &= m - 1) counters[lowest_bit(m)].nodes += !(ref & kLeafFlag);
+    if (!(ref & kLeafFlag)) {
+      const WideNode& node = bvh.nodes[ref];
+      const V8 act = lanes8(active);
+      uint32_t refs[kWideBvhWidth];
+      float keys[kWideBvhWidth];
+      alignas(32) float nears[kWideBvhWidth][8];
+      int n = 0;
+      for (int i = 0; i < kWideBvhWidth && node.child[i] != kEmptyTree; ++i) {
+        V8 tn[3], tf[3];
+        for (int a = 0; a < 3; ++a) {
+          V8 t_lo = mul_sub8(splat8(node.bounds[2 * a][i]), p.rdir[a], p.org_rdir[a]);
+          V8 t_hi = mul_sub8(splat8(node.bounds[2 * a + 1][i]), p.rdir[a], p.org_rdir[a]);
+          tn[a] = min8(t_lo, t_hi);
+          tf[a] = max8(t_lo, t_hi);
+        }
+        V8 t0 = sub8(max8(tn[2], max8(tn[1], max8(tn[0], p.tmin))), p.margin);
+        V8 t1 = mul8(add8(min8(tf[2], min8(tf[1], min8(tf[0], best.t))), p.margin), splat8(kWiden));
+        V8 hit = and8(act, le8(t0, t1));
+        if (!mask8(hit)) continue;
+        // The child's distance for ordering: its nearest entry among the lanes that hit it.
+        V8 d = select8(hit, t0, inf);
+        alignas(32) float dd[8];
+        store8(dd, d);
+        float key = dd[0];
+        for (int k = 1; k < 8; ++k) key = dd[k] < key ? dd[k] : key;
+        int k = n++;
+        for (; k > 0 && keys[k - 1] < key; --k) {  // descending: the nearest ends last
+          keys[k] = keys[k - 1];
+          refs[k] = refs[k - 1];
+          for (int l = 0; l < 8; ++l) nears[k][l] = nears[k - 1][l];
+        }
+        keys[k] = key;
+        refs[k] = node.child[i];
+        store8(nears[k], select8(hit, t0, inf));  // lanes that missed it never go in
+      }
+      for (int k = 0; k < n; ++k) {
+        stack.ref[stack.top] = refs[k];
+        for (int l = 0; l < 8; ++l) stack.near[stack.top][l] = nears[k][l];
+        ++stack.top;
+      }
+      continue;
+    }
+    const uint32_t first = (ref & ~kLeafFlag) >> kLeafCountBits;
+    const uint32_t triangles = ref & ((1u << kLeafCountBits) - 1);
+    if (kCount)
+      for (unsigned m = active; m; m &= m - 1) counters[lowest_bit(m)].tests += triangles;
+    for (uint32_t k = 0; k < triangles; ++k)
+      intersect_triangle8(bvh.blocks[first + k / kTriangleBlock], k % kTriangleBlock, p, active,
+                          best);
+  }
+}
+
+// Sets up lanes [first, first + 8) of a tile; false when a direction has a zero component (such
+// rays take the robust single-ray path).
+bool make_packet8(const RayPacket& packet, int first, Packet8& p) {
+  alignas(32) float d[3][8], rdir[3][8], org_rdir[3][8], margin[8];
+  p.valid = 0;
+  for (int a = 0; a < 3; ++a) p.o[a] = packet.origin[a];
+  for (int l = 0; l < 8; ++l) {
+    int k = first + l < packet.count ? first + l : first;  // unused lanes copy a live one
+    if (first + l < packet.count) p.valid |= 1u << l;
+    float m = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+      float da = packet.dir[a][k];
+      if (abs1(da) < kTinyDirection) return false;
+      d[a][l] = da;
+      rdir[a][l] = 1.0f / da;
+      org_rdir[a][l] = packet.origin[a] * rdir[a][l];
+      float e = abs1(org_rdir[a][l]) * (1.0f / 1048576.0f);  // 2^-20: org * rdir's rounding, x16
+      m = e > m ? e : m;
+      p.ray[l].origin[a] = packet.origin[a];
+      p.ray[l].dir[a] = da;
+    }
+    margin[l] = m;
+    p.ray[l].tmin = packet.tmin;
+    p.ray[l].tmax = packet.tmax;
+  }
+  for (int a = 0; a < 3; ++a) {
+    p.d[a] = load8(d[a]);
+    p.rdir[a] = load8(rdir[a]);
+    p.org_rdir[a] = load8(org_rdir[a]);
+  }
+  p.margin = load8(margin);
+  p.tmin = splat8(packet.tmin);
+  return true;
+}
+
+template <bool kCount>
+void closest_packet_impl(const WideBvhView& bvh, const RayPacket& packet, KernelHit* hits,
+                         KernelCounters* counters) {
+  for (int first = 0; first < packet.count; first += 8) {
+    Packet8 p;
+    if (bvh.root == kEmptyTree) break;
+    if (!make_packet8(packet, first, p)) {
+      for (int i = first; i < first + 8 && i < packet.count; ++i) {
+        KernelRay r{{packet.origin[0], packet.origin[1], packet.origin[2]},
+                    {packet.dir[0][i], packet.dir[1][i], packet.dir[2][i]},
+                    packet.tmin,
+                    packet.tmax};
+        trace<false, kCount>(bvh, r, &hits[i], kCount ? &counters[i] : nullptr);
+      }
+      continue;
+    }
+    PacketBest8 best{splat8(packet.tmax), splat8(0.0f), splat8(0.0f), bits8(0u), 0u};
+    traverse_packet<kCount>(bvh, p, best, kCount ? counters + first : nullptr);
+    alignas(32) float t[8], u[8], v[8], prim[8];
+    store8(t, best.t);
+    store8(u, best.u);
+    store8(v, best.v);
+    store8(prim, best.primitive);
+    for (int l = 0; l < 8 && first + l < packet.count; ++l) {
+      if (!((best.found >> l) & 1)) continue;
+      KernelHit& h = hits[first + l];
+      h.t = t[l];
+      h.u = u[l];
+      h.v = v[l];
+      __builtin_memcpy(&h.primitive, &prim[l], 4);
+    }
+  }
+}
+
 void closest_packet(const WideBvhView& bvh, const RayPacket& packet, KernelHit* hits,
                     KernelCounters* counters) {
-  for (int i = 0; i < packet.count; ++i) {
-    KernelRay r{{packet.origin[0], packet.origin[1], packet.origin[2]},
-                {packet.dir[0][i], packet.dir[1][i], packet.dir[2][i]},
-                packet.tmin,
-                packet.tmax};
-    hits[i].primitive = kUnusedLane;
-    if (counters)
-      closest_counted(bvh, r, hits[i], counters[i]);
-    else
-      closest(bvh, r, hits[i]);
-  }
+  if (counters)
+    closest_packet_impl<true>(bvh, packet, hits, counters);
+  else
+    closest_packet_impl<false>(bvh, packet, hits, nullptr);
 }
 
 }  // namespace

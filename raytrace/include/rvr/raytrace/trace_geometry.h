@@ -94,6 +94,8 @@ class TraceGeometry {
   AccelKind accel() const { return accel_; }
   // The instruction set of the kernels the wide BVH runs ("sse", "avx2", "avx512").
   const char* kernel_isa() const { return kernels_ ? kernels_->isa : "scalar"; }
+  // Embree's packet width (rtcIntersect8 or 16) when Embree answers; 0 otherwise.
+  int embree_packet_width() const;
   // Bytes held for traversal: bvh: wide nodes + triangle blocks + the analytic shapes' tree;
   // bvh2: nodes + leaf-ordered triangles + slot indices.
   size_t acceleration_bytes() const;
@@ -123,6 +125,7 @@ class TraceGeometry {
   static Aabb analytic_bounds(const Analytic& a);
   friend struct EmbreeBackend;
   friend bool embree_closest(const EmbreeBackend&, const Ray&, HitRecord&);
+  friend void embree_closest_packet(const EmbreeBackend&, const RayPacket&, HitRecord*);
 
   AccelKind accel_;
   TriangleTest triangle_test_;
