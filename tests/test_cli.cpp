@@ -452,10 +452,69 @@ TEST_F(Cli, InfoHasWhatABugReportNeeds) {
   RunResult r = run("info");
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* field :
-       {"rvr ", "cpu: ", "hardware threads", "renderers: raster softraster", "simd: built for ",
+       {"rvr ", "cpu: ", "hardware threads", "renderers: raster softraster", "simd: baseline build ",
+        "kernels: ", "compiled: sse avx2 avx512", "this CPU runs: sse",
         "embree: 3.", "openimageio: ", "tbb: ", "gl backend: osmesa",
         "GL_VERSION: ", "GL_RENDERER: llvmpipe", "llvmpipe threads: "})
     EXPECT_NE(r.out.find(field), std::string::npos) << field << " missing in:\n" << r.out;
+}
+
+// RVR_ISA forces the tracer's SIMD kernels: the image is the same bytes whichever runs; a bad
+// value or one this CPU cannot run is refused before any work, one line, exit 2.
+TEST_F(Cli, RvrIsaForcesTheKernelsAndImagesDoNotChange) {
+  RunResult info = run("info", "RVR_ISA=sse");
+  ASSERT_EQ(info.status, 0) << info.err;
+  EXPECT_NE(info.out.find("kernels: sse (forced by RVR_ISA)"), std::string::npos) << info.out;
+
+  const std::string args = "render builtin:cornell -r raytrace --mode full --width 96 --height 72 ";
+  std::vector<std::string> isas{"sse"};
+  RunResult avx2 = run("info", "RVR_ISA=avx2");
+  if (avx2.out.find("this CPU runs: sse avx2") != std::string::npos) isas.push_back("avx2");
+  if (avx2.out.find("this CPU runs: sse avx2 avx512") != std::string::npos) isas.push_back("avx512");
+  std::string first;
+  for (const std::string& isa : isas) {
+    fs::path png = dir_ / (isa + ".png"), stats = dir_ / (isa + ".json");
+    RunResult r = run(args + "-o " + png.string() + " --stats " + stats.string(), "RVR_ISA=" + isa);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(slurp(stats).find("\"kernel\": \"" + isa + "\""), std::string::npos) << slurp(stats);
+    if (first.empty()) first = slurp(png);
+    EXPECT_EQ(slurp(png), first) << isa << " gives other bytes than " << isas[0];
+  }
+
+  for (const char* bad : {"RVR_ISA=avx3", "RVR_ISA=AVX2"}) {
+    RunResult r = run(args + "-o " + (dir_ / "bad.png").string(), bad);
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_EQ(r.err, std::string("error: ") + bad + ": unknown (use sse, avx2 or avx512)\n");
+    EXPECT_FALSE(fs::exists(dir_ / "bad.png"));
+  }
+  if (isas.size() < 3) {  // a CPU without AVX-512 is told so, for render and compare alike
+    RunResult r = run(args + "-o " + (dir_ / "bad.png").string(), "RVR_ISA=avx512");
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(r.err.rfind("error: RVR_ISA=avx512: this CPU cannot run avx512 kernels", 0), 0u)
+        << r.err;
+    RunResult c = run("compare builtin:cornell --width 32 --height 24 -o " +
+                          (dir_ / "cmp").string(),
+                      "RVR_ISA=avx512");
+    EXPECT_EQ(c.status, 2);
+    EXPECT_EQ(std::count(c.err.begin(), c.err.end(), '\n'), 1) << c.err;
+    EXPECT_FALSE(fs::exists(dir_ / "cmp"));
+  }
+}
+
+// --accel: the wide BVH (default), the binary one, or none; the same image from all three.
+TEST_F(Cli, AccelChoicesRenderTheSameImage) {
+  const std::string args = "render builtin:spheres -r raytrace --width 64 --height 48 ";
+  std::string first;
+  for (const char* accel : {"bvh", "bvh2", "none"}) {
+    fs::path png = dir_ / (std::string(accel) + ".png"), stats = dir_ / (std::string(accel) + ".json");
+    RunResult r = run(args + "--accel " + accel + " -o " + png.string() + " --stats " + stats.string());
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_NE(slurp(stats).find(std::string("\"accel\": \"") + accel + "\""), std::string::npos);
+    if (first.empty()) first = slurp(png);
+    EXPECT_EQ(slurp(png), first) << accel;
+  }
+  RunResult bad = run(args + "--accel bvh4 -o " + (dir_ / "x.png").string());
+  EXPECT_EQ(bad.status, 2);
 }
 
 // --gl picks the raster's GL back end; by default OSMesa, falling back to EGL (and saying so)

@@ -36,6 +36,7 @@ const RendererCase kRenderers[] = {
     {"raster_egl", "raster", AccelKind::Bvh, "raytrace", 0, GlBackend::Egl},
     {"softraster", "softraster", AccelKind::Bvh, "raytrace", 0},
     {"raytrace", "raytrace", AccelKind::Bvh, "raster", 0},
+    {"raytrace_bvh2", "raytrace", AccelKind::Bvh2, "raster", 0},
     {"raytrace_none", "raytrace", AccelKind::None, "raster", 1.6e9},
     {"embree", "embree", AccelKind::Embree, "raster", 0},
 };

@@ -33,7 +33,7 @@ ReportInput sample_input(const std::string& out_dir) {
   in.out_dir = out_dir;
   in.command_line = "rvr compare builtin:cornell -o out --renderers raster,raytrace";
   ReportRenderer a{"raster", "raster.png", 0.12, {}, {{"time.render", 0.1}, {"fragments", 99}},
-                   "",       0.0,          0.0};
+                   "",       0.0,          0.0,  {}};
   ReportRenderer b{"raytrace",
                    "raytrace.png",
                    0.4,
@@ -41,7 +41,8 @@ ReportInput sample_input(const std::string& out_dir) {
                    {{"time.build", 0.01}, {"time.render", 0.38}, {"rays.primary", 48}},
                    "raytrace.cost.png",
                    31.0,
-                   12.5};
+                   12.5,
+                   {{"kernel", "avx2"}}};
   in.renderers = {a, b};
   in.metrics.visibility = {48, 47.0 / 48.0, 1, 0};
   in.metrics.depth = {0.0004, 0.00001};

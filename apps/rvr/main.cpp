@@ -21,6 +21,7 @@
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/isa.h"
 #include "rvr/shared/limits.h"
 #include "rvr/shared/scene_loader.h"
 #include "terminal_progress.h"
@@ -90,8 +91,10 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
       ->check(CLI::Range(1, 65536));
   cmd.add_option("--threads", o.threads, "worker threads, 0 = every core")
       ->check(CLI::Range(0, 1024));
-  cmd.add_option("--accel", o.accel, "tracer acceleration: bvh | none")
-      ->check(CLI::IsMember({"bvh", "none"}));
+  cmd.add_option("--accel", o.accel,
+                 "tracer acceleration: bvh (wide SIMD BVH, default) | bvh2 (binary, one box at a "
+                 "time) | none (every object for every ray)")
+      ->check(CLI::IsMember({"bvh", "bvh2", "none"}));
   cmd.add_option("--spheres", o.spheres,
                  "tracer spheres: analytic | mesh (the raster's tessellation)")
       ->check(CLI::IsMember({"analytic", "mesh"}));
@@ -143,7 +146,9 @@ RenderOptions render_options(const CommonOptions& o, const std::string& default_
   r.threads = o.threads;
   r.max_depth = o.max_depth;
   r.seed = o.seed;
-  r.accel = o.accel == "none" ? AccelKind::None : AccelKind::Bvh;
+  r.accel = o.accel == "none"   ? AccelKind::None
+            : o.accel == "bvh2" ? AccelKind::Bvh2
+                                : AccelKind::Bvh;
   r.triangle_test =
       o.triangle_test == "chapter" ? TriangleTest::Chapter : TriangleTest::MollerTrumbore;
   r.shadow_map_size = o.shadow_map_size;
@@ -153,6 +158,7 @@ RenderOptions render_options(const CommonOptions& o, const std::string& default_
 }
 
 Scene load(const CommonOptions& o, const RenderOptions& options, double& load_seconds) {
+  take(selected_isa());  // a bad RVR_ISA is refused before any work
   auto start = Clock::now();
   Scene scene = take(load_scene(o.scene));
   if (o.width) scene.image.width = *o.width;
@@ -238,6 +244,7 @@ int run_render(const RenderArgs& a) {
     nlohmann::json counters = nlohmann::json::object();
     for (const auto& [k, v] : out.stats) counters[k] = finite_or_null(v);
     j["stats"] = counters;
+    j["info"] = out.info;
     j["warnings"] = out.warnings;
     j["peak_memory_bytes"] = peak_memory_bytes();
     check(write_text_file(a.stats, j.dump(2) + "\n"));
@@ -293,6 +300,7 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
     r.seconds = seconds_since(start);
     r.warnings = out.warnings;
     r.stats = out.stats;
+    r.info = out.info;
     r.stats["time.load"] = load_seconds;
     report.renderers.push_back(r);
     buffers.push_back(std::move(out.buffers));
@@ -406,7 +414,8 @@ std::string cpu_model() {
   return "unknown";
 }
 
-// The widest vector instructions this build of rvr uses (Embree picks its own at run time).
+// The vector instructions the baseline code is built for; the SIMD kernels are compiled for
+// several and picked at run time (shared/isa.h), as Embree picks its own.
 const char* built_simd() {
 #if defined(__AVX512F__)
   return "AVX-512 (512-bit)";
@@ -442,7 +451,11 @@ int run_info(const std::string& gl_name) {
   std::printf("renderers: ");
   for (const std::string& n : renderer_names()) std::printf("%s ", n.c_str());
   std::printf("\n");
-  std::printf("simd: built for %s; the CPU has %s\n", built_simd(), cpu_simd().c_str());
+  std::printf("simd: baseline build %s; the CPU has %s\n", built_simd(), cpu_simd().c_str());
+  std::printf("kernels: %s; compiled: sse avx2 avx512; this CPU runs:", describe_isa_choice().c_str());
+  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512})
+    if (cpu_supports(isa)) std::printf(" %s", to_string(isa));
+  std::printf(" (RVR_ISA=sse|avx2|avx512 forces one)\n");
   std::printf("embree: %s\nopenimageio: %s\ntbb: %s\n", embree_version().c_str(),
               openimageio_version().c_str(), tbb_version().c_str());
   CommonOptions gl_choice;

@@ -439,6 +439,7 @@ std::string metrics_json(const ReportInput& input) {
       renderers[key] = {{"seconds", number(r.seconds)},
                         {"warnings", r.warnings},
                         {"stats", stats},
+                        {"info", r.info},
                         {"image", r.image_file}};
       if (!r.cost_file.empty())
         renderers[key]["cost"] = {
@@ -702,6 +703,9 @@ Expected<std::string> report_html(const ReportInput& input) {
       if (r.stats.empty()) continue;
       h << "<details><summary>All statistics of <b>" << escape_html(r.name) << "</b> ("
         << r.stats.size() << ")</summary><table><tbody>\n";
+      for (const auto& [k, v] : r.info)
+        h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">"
+          << escape_html(v) << "</td></tr>\n";
       for (const auto& [k, v] : r.stats)
         h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">"
           << fmt("%.6g", v) << "</td></tr>\n";

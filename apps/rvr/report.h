@@ -20,6 +20,7 @@ struct ReportRenderer {
   // reports none (embree); the cost at the top of its colour map; the mean over pixels.
   std::string cost_file;
   double cost_scale = 0.0, cost_mean = 0.0;
+  std::map<std::string, std::string> info;  // e.g. accel: bvh, kernel: avx2
 };
 
 struct ReportInput {

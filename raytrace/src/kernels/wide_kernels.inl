@@ -33,8 +33,11 @@ inline V8 load8(const float* p) { return {_mm256_load_ps(p)}; }
 inline V8 splat8(float x) { return {_mm256_set1_ps(x)}; }
 inline V8 sub8(V8 a, V8 b) { return {_mm256_sub_ps(a.v, b.v)}; }
 inline V8 mul8(V8 a, V8 b) { return {_mm256_mul_ps(a.v, b.v)}; }
-// a * b - c in one rounding: the slab test's one instruction per plane.
-inline V8 mul_sub8(V8 a, V8 b, V8 c) { return {_mm256_fmsub_ps(a.v, b.v, c.v)}; }
+// a * b - c, rounded twice as in the SSE kernels: a fused multiply-subtract (one instruction
+// per slab) measured no faster here (A/B against Embree, min of 7 interleaved rounds: within
+// the +-10% noise on every scene) and would let traversal counts, hence the cost AOV, differ
+// between SSE and FMA kernels.
+inline V8 mul_sub8(V8 a, V8 b, V8 c) { return {_mm256_sub_ps(_mm256_mul_ps(a.v, b.v), c.v)}; }
 // max/min return their second operand when either is NaN (MAXPS/MINPS): the accumulator goes
 // second so a NaN slab leaves it unchanged.
 inline V8 max8(V8 a, V8 b) { return {_mm256_max_ps(a.v, b.v)}; }
@@ -47,6 +50,7 @@ inline unsigned le_mask8(V8 a, V8 b) {
 #endif
 }
 inline void store8(float* p, V8 a) { _mm256_store_ps(p, a.v); }
+inline void store8u(float* p, V8 a) { _mm256_storeu_ps(p, a.v); }
 inline V8 add8(V8 a, V8 b) { return {_mm256_add_ps(a.v, b.v)}; }
 inline V8 div8(V8 a, V8 b) { return {_mm256_div_ps(a.v, b.v)}; }
 inline V8 and8(V8 a, V8 b) { return {_mm256_and_ps(a.v, b.v)}; }
@@ -78,7 +82,7 @@ inline V8 load8(const float* p) { return {_mm_load_ps(p), _mm_load_ps(p + 4)}; }
 inline V8 splat8(float x) { return {_mm_set1_ps(x), _mm_set1_ps(x)}; }
 inline V8 sub8(V8 a, V8 b) { return {_mm_sub_ps(a.lo, b.lo), _mm_sub_ps(a.hi, b.hi)}; }
 inline V8 mul8(V8 a, V8 b) { return {_mm_mul_ps(a.lo, b.lo), _mm_mul_ps(a.hi, b.hi)}; }
-// Without FMA: two roundings; the margins of RayBox cover the second one.
+// Two roundings; the margins of RayBox cover the second one.
 inline V8 mul_sub8(V8 a, V8 b, V8 c) { return sub8(mul8(a, b), c); }
 inline V8 max8(V8 a, V8 b) { return {_mm_max_ps(a.lo, b.lo), _mm_max_ps(a.hi, b.hi)}; }
 inline V8 min8(V8 a, V8 b) { return {_mm_min_ps(a.lo, b.lo), _mm_min_ps(a.hi, b.hi)}; }
@@ -89,6 +93,10 @@ inline unsigned le_mask8(V8 a, V8 b) {
 inline void store8(float* p, V8 a) {
   _mm_store_ps(p, a.lo);
   _mm_store_ps(p + 4, a.hi);
+}
+inline void store8u(float* p, V8 a) {
+  _mm_storeu_ps(p, a.lo);
+  _mm_storeu_ps(p + 4, a.hi);
 }
 inline V8 add8(V8 a, V8 b) { return {_mm_add_ps(a.lo, b.lo), _mm_add_ps(a.hi, b.hi)}; }
 inline V8 div8(V8 a, V8 b) { return {_mm_div_ps(a.lo, b.lo), _mm_div_ps(a.hi, b.hi)}; }
@@ -137,8 +145,8 @@ float abs1(float x) { return __builtin_fabsf(x); }  // no branch
 bool sign1(float x) { return __builtin_signbit(x) != 0; }
 
 // One ray's constants for the slab tests of every node it meets, set up once per ray. Near and
-// far planes per axis come from the direction's sign, so each slab is one multiply-subtract
-// b * rdir - org * rdir. org * rdir is rounded once; the absolute margin moves the near planes
+// far planes per axis come from the direction's sign, and each slab is b * rdir - org * rdir
+// with org * rdir precomputed. org * rdir is rounded once; the absolute margin moves the near planes
 // back and the far planes forward by more than that rounding, so the test stays conservative.
 // A direction with a zero component (an axis-parallel ray) has infinite rdir there: such rays
 // take the robust form (b - org) * rdir, where a ray lying in a slab's plane gives NaN and the
@@ -298,28 +306,30 @@ struct Closest {
   }
 };
 
-#if defined(__AVX2__)
 // One compare-exchange stage of a bitonic network over 8 lanes: every lane meets its partner
 // (lane ^ J); `kMaxLanes` has a bit set for the lanes that keep the larger key. A lane takes its
 // partner's key and payload only when the partner's key is strictly larger (smaller), so equal
-// keys never duplicate a payload.
-template <int J, int kMaxLanes>
-inline void exchange(__m256& key, __m256& payload) {
-  __m256 pk, pp;
-  if (J == 1) {
-    pk = _mm256_permute_ps(key, 0xB1);
-    pp = _mm256_permute_ps(payload, 0xB1);
-  } else if (J == 2) {
-    pk = _mm256_permute_ps(key, 0x4E);
-    pp = _mm256_permute_ps(payload, 0x4E);
-  } else {
-    pk = _mm256_permute2f128_ps(key, key, 1);
-    pp = _mm256_permute2f128_ps(payload, payload, 1);
-  }
-  __m256 take = _mm256_blend_ps(_mm256_cmp_ps(pk, key, _CMP_LT_OQ),
-                                _mm256_cmp_ps(pk, key, _CMP_GT_OQ), kMaxLanes);
-  key = _mm256_blendv_ps(key, pk, take);
-  payload = _mm256_blendv_ps(payload, pp, take);
+// keys never duplicate a payload. Every kernel runs this same network (SSE on two halves), so
+// children at equal distances come out in the same order and traversal counts agree too.
+template <int J>
+inline V8 partner8(V8 x) {
+#if defined(__AVX2__)
+  if (J == 1) return {_mm256_permute_ps(x.v, 0xB1)};
+  if (J == 2) return {_mm256_permute_ps(x.v, 0x4E)};
+  return {_mm256_permute2f128_ps(x.v, x.v, 1)};
+#else
+  if (J == 1) return {_mm_shuffle_ps(x.lo, x.lo, 0xB1), _mm_shuffle_ps(x.hi, x.hi, 0xB1)};
+  if (J == 2) return {_mm_shuffle_ps(x.lo, x.lo, 0x4E), _mm_shuffle_ps(x.hi, x.hi, 0x4E)};
+  return {x.hi, x.lo};
+#endif
+}
+
+template <int J, unsigned kMaxLanes>
+inline void exchange(V8& key, V8& payload) {
+  V8 pk = partner8<J>(key), pp = partner8<J>(payload);
+  V8 take = select8(lanes8(kMaxLanes), gt8(pk, key), lt8(pk, key));
+  key = select8(take, pk, key);
+  payload = select8(take, pp, payload);
 }
 
 // Three or more children hit: pushes all but the nearest, farthest first, and returns the
@@ -327,11 +337,8 @@ inline void exchange(__m256& key, __m256& payload) {
 // (distance, child) pairs in registers (children not hit get -inf and sort last), and two
 // full-width stores push them.
 inline uint32_t visit_children(const WideNode& node, unsigned mask, V8 near, Stack& stack) {
-  const __m256i lanes = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
-  __m256 hit = _mm256_castsi256_ps(
-      _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(int(mask)), lanes), lanes));
-  __m256 key = _mm256_blendv_ps(_mm256_set1_ps(-__builtin_inff()), near.v, hit);
-  __m256 payload = _mm256_castsi256_ps(_mm256_load_si256(reinterpret_cast<const __m256i*>(node.child)));
+  V8 key = select8(lanes8(mask), near, splat8(-__builtin_inff()));
+  V8 payload = load8(reinterpret_cast<const float*>(node.child));
   // Descending bitonic sort: stages (k, j) = (2,1) (4,2) (4,1) (8,4) (8,2) (8,1); lane i keeps
   // the maximum when (i & k) == 0 equals i < (i ^ j).
   exchange<1, 0x99>(key, payload);
@@ -340,37 +347,11 @@ inline uint32_t visit_children(const WideNode& node, unsigned mask, V8 near, Sta
   exchange<4, 0x0F>(key, payload);
   exchange<2, 0x33>(key, payload);
   exchange<1, 0x55>(key, payload);
-  const int hits = __builtin_popcount(mask);
-  _mm256_storeu_si256(reinterpret_cast<__m256i*>(stack.ref + stack.top), _mm256_castps_si256(payload));
-  _mm256_storeu_ps(stack.dist + stack.top, key);
-  stack.top += hits - 1;
+  store8u(reinterpret_cast<float*>(stack.ref + stack.top), payload);
+  store8u(stack.dist + stack.top, key);
+  stack.top += __builtin_popcount(mask) - 1;
   return stack.ref[stack.top];  // the nearest: stored, but not pushed
 }
-#else
-// Three or more children hit: sorted by insertion, farthest pushed first.
-inline uint32_t visit_children(const WideNode& node, unsigned mask, V8 near8, Stack& stack) {
-  alignas(32) float near[kWideBvhWidth];
-  store8(near, near8);
-  uint32_t refs[kWideBvhWidth];
-  float dists[kWideBvhWidth];
-  int n = 0;
-  for (; mask; mask &= mask - 1) {
-    unsigned i = lowest_bit(mask);
-    int k = n++;
-    for (; k > 0 && dists[k - 1] < near[i]; --k) {
-      dists[k] = dists[k - 1];
-      refs[k] = refs[k - 1];
-    }
-    dists[k] = near[i];
-    refs[k] = node.child[i];
-  }
-  for (int k = 0; k < n - 1; ++k) {
-    stack.ref[stack.top] = refs[k];
-    stack.dist[stack.top++] = dists[k];
-  }
-  return refs[n - 1];
-}
-#endif
 
 
 // From the subtree `start`, with what `closest` already holds (a packet's lane handed over to a
