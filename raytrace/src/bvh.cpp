@@ -30,10 +30,24 @@ constexpr float kIntersectCost = 1.0f;
 // bounded whatever the input.
 constexpr size_t kMedianDepth = 32;
 
+// A primitive's bounds and index, partitioned in place as the tree is built (as Embree's
+// PrimRef): every pass over a node's primitives reads memory in order, where an index array into
+// the input would jump around it at every level.
+struct alignas(32) PrimRef {
+  glm::vec3 lo;
+  uint32_t id;
+  glm::vec3 hi;
+  uint32_t pad;
+  glm::vec3 centroid2() const { return lo + hi; }  // twice the centroid: no multiply needed
+};
+
+// A node to build: its primitives, bounds and the bounds of their (doubled) centroids, computed
+// by the parent's partition pass.
 struct BuildTask {
-  uint32_t begin, end;  // range in the order array
+  uint32_t begin, end;  // range in the PrimRef array
   uint32_t parent;      // node whose `offset` must point here (second children), or ~0
   size_t depth;
+  Aabb box, centroid_box;
 };
 
 struct Split {
@@ -41,6 +55,15 @@ struct Split {
   int bin = 0;  // primitives in bins [0, bin] go left
   float cost = INFINITY;
 };
+
+void bounds_of(const PrimRef* first, const PrimRef* last, Aabb& box, Aabb& centroids) {
+  box = Aabb();
+  centroids = Aabb();
+  for (const PrimRef* r = first; r != last; ++r) {
+    box.grow(Aabb{r->lo, r->hi});
+    centroids.grow(r->centroid2());
+  }
+}
 
 }  // namespace
 
@@ -54,15 +77,17 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
   bvh.stats_.primitives = n;
   if (n == 0) return bvh;
 
-  std::vector<glm::vec3> centroids(n);
-  for (uint32_t i = 0; i < n; ++i) centroids[i] = bounds[i].centroid();
-  bvh.order_.resize(n);
-  for (uint32_t i = 0; i < n; ++i) bvh.order_[i] = i;
+  std::vector<PrimRef> refs(n);
+  for (uint32_t i = 0; i < n; ++i) refs[i] = {bounds[i].lo, i, bounds[i].hi, 0};
   bvh.nodes_.reserve(size_t(n) / 2 + 1);
 
   std::vector<BuildTask> tasks;
-  tasks.push_back({0, n, ~0u, 0});
-  float root_area = 0.0f;
+  {
+    BuildTask root{0, n, ~0u, 0, {}, {}};
+    bounds_of(refs.data(), refs.data() + n, root.box, root.centroid_box);
+    tasks.push_back(root);
+  }
+  const float root_area = std::max(tasks[0].box.surface_area(), 1e-30f);
   while (!tasks.empty()) {
     BuildTask task = tasks.back();
     tasks.pop_back();
@@ -70,12 +95,8 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
     if (task.parent != ~0u) bvh.nodes_[task.parent].offset = index;
     bvh.nodes_.push_back({});
 
-    Aabb box, centroid_box;
-    for (uint32_t i = task.begin; i < task.end; ++i) {
-      box.grow(bounds[bvh.order_[i]]);
-      centroid_box.grow(centroids[bvh.order_[i]]);
-    }
-    if (index == 0) root_area = std::max(box.surface_area(), 1e-30f);
+    const Aabb& box = task.box;
+    const Aabb& centroid_box = task.centroid_box;
     uint32_t count = task.end - task.begin;
     bvh.stats_.max_depth = std::max(bvh.stats_.max_depth, task.depth);
     float area_ratio = box.surface_area() / root_area;
@@ -97,14 +118,16 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
     if (count > 1 && task.depth < kMedianDepth) {
       Aabb bin_box[3][kBins];
       uint32_t bin_count[3][kBins] = {};
-      for (uint32_t i = task.begin; i < task.end; ++i) {
-        uint32_t p = bvh.order_[i];
+      float scale[3];
+      for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0.0f ? float(kBins) / extent[a] : 0.0f;
+      for (const PrimRef* r = refs.data() + task.begin; r != refs.data() + task.end; ++r) {
+        glm::vec3 c = r->centroid2();
+        Aabb prim{r->lo, r->hi};
         for (int a = 0; a < 3; ++a) {
           if (extent[a] <= 0.0f) continue;
-          int b = std::min(
-              kBins - 1, int((centroids[p][a] - centroid_box.lo[a]) * (float(kBins) / extent[a])));
+          int b = std::min(kBins - 1, int((c[a] - centroid_box.lo[a]) * scale[a]));
           bin_count[a][b]++;
-          bin_box[a][b].grow(bounds[p]);
+          bin_box[a][b].grow(prim);
         }
       }
       float inv_area = 1.0f / std::max(box.surface_area(), 1e-30f);
@@ -143,22 +166,44 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
 
     uint32_t mid;
     int axis;
+    Aabb left_box, left_centroids, right_box, right_centroids;
+    PrimRef* first = refs.data() + task.begin;
+    PrimRef* last = refs.data() + task.end;
     if (best.axis >= 0) {
       axis = best.axis;
       float scale = float(kBins) / extent[axis];
       float lo = centroid_box.lo[axis];
-      auto* first = bvh.order_.data() + task.begin;
-      auto* split = std::partition(first, bvh.order_.data() + task.end, [&](uint32_t p) {
-        return std::min(kBins - 1, int((centroids[p][axis] - lo) * scale)) <= best.bin;
-      });
-      mid = uint32_t(split - bvh.order_.data());
+      auto goes_left = [&](const PrimRef& r) {
+        return std::min(kBins - 1, int((r.centroid2()[axis] - lo) * scale)) <= best.bin;
+      };
+      // Hoare partition that also gathers each side's bounds, so the children need no pass of
+      // their own.
+      PrimRef* i = first;
+      PrimRef* j = last;
+      for (;;) {
+        while (i < j && goes_left(*i)) {
+          left_box.grow(Aabb{i->lo, i->hi});
+          left_centroids.grow(i->centroid2());
+          ++i;
+        }
+        while (i < j && !goes_left(*(j - 1))) {
+          --j;
+          right_box.grow(Aabb{j->lo, j->hi});
+          right_centroids.grow(j->centroid2());
+        }
+        if (i >= j) break;
+        std::swap(*i, *(j - 1));
+      }
+      mid = uint32_t(i - refs.data());
     } else {
       // No useful SAH split (all centroids equal, or too deep): split at the object median.
       axis = int(std::max_element(&extent[0], &extent[0] + 3) - &extent[0]);
       mid = task.begin + count / 2;
-      std::nth_element(
-          bvh.order_.begin() + task.begin, bvh.order_.begin() + mid, bvh.order_.begin() + task.end,
-          [&](uint32_t a, uint32_t b) { return centroids[a][axis] < centroids[b][axis]; });
+      std::nth_element(first, refs.data() + mid, last, [&](const PrimRef& a, const PrimRef& b) {
+        return a.centroid2()[axis] < b.centroid2()[axis];
+      });
+      bounds_of(first, refs.data() + mid, left_box, left_centroids);
+      bounds_of(refs.data() + mid, last, right_box, right_centroids);
     }
 
     BvhNode& node = bvh.nodes_[index];
@@ -168,9 +213,11 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
     node.axis = uint8_t(axis);
     bvh.stats_.sah_cost += area_ratio * kTraversalCost;
     // Second child first onto the stack, so the first child is built next at index + 1.
-    tasks.push_back({mid, task.end, index, task.depth + 1});
-    tasks.push_back({task.begin, mid, ~0u, task.depth + 1});
+    tasks.push_back({mid, task.end, index, task.depth + 1, right_box, right_centroids});
+    tasks.push_back({task.begin, mid, ~0u, task.depth + 1, left_box, left_centroids});
   }
+  bvh.order_.resize(n);
+  for (uint32_t i = 0; i < n; ++i) bvh.order_[i] = refs[i].id;
   bvh.nodes_.shrink_to_fit();
   bvh.stats_.nodes = bvh.nodes_.size();
   bvh.stats_.seconds =

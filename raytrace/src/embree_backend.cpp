@@ -2,6 +2,9 @@
 
 #include <embree3/rtcore.h>
 
+#include <unistd.h>
+
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -261,6 +264,42 @@ void embree_closest_packet(const EmbreeBackend& backend, const RayPacket& packet
 }
 
 int embree_packet_width(const EmbreeBackend& backend) { return backend.packet_width; }
+
+std::string embree_kernel_isa() {
+  // Embree says which of its kernels it runs only in its verbose start-up report, on stdout:
+  // capture it once in a temporary file.
+  static const std::string isa = [] {
+    std::fflush(stdout);
+    FILE* capture = std::tmpfile();
+    if (!capture) return std::string("unknown");
+    int saved = ::dup(1);
+    ::dup2(::fileno(capture), 1);
+    RTCDevice device = rtcNewDevice("verbose=1");
+    std::fflush(stdout);
+    ::dup2(saved, 1);
+    ::close(saved);
+    if (device) rtcReleaseDevice(device);
+    std::rewind(capture);
+    std::string result = "unknown";
+    char line[512];
+    while (std::fgets(line, sizeof line, capture)) {
+      std::string l = line;
+      size_t supported = l.find("(supported)");
+      size_t colon = l.find(':');
+      if (l.find("Targets") == std::string::npos || supported == std::string::npos ||
+          colon == std::string::npos)
+        continue;
+      // "Targets : SSE SSE2 ... AVX2  (supported)": the last one is the widest it runs.
+      std::string targets = l.substr(colon + 1, supported - colon - 1);
+      size_t end = targets.find_last_not_of(' ');
+      size_t begin = targets.find_last_of(' ', end);
+      result = targets.substr(begin == std::string::npos ? 0 : begin + 1, end - begin);
+    }
+    std::fclose(capture);
+    return result;
+  }();
+  return isa;
+}
 
 std::string embree_version() {
   return RTC_VERSION_STRING;

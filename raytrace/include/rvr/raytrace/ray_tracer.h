@@ -10,6 +10,8 @@ namespace rvr {
 
 // Versions of the libraries the tracer runs on, for `rvr info`.
 std::string embree_version();
+// The widest of Embree's kernels it runs on this CPU, e.g. "AVX2".
+std::string embree_kernel_isa();
 std::string tbb_version();
 
 class RayTracer : public Renderer {
