@@ -13,7 +13,7 @@ using namespace rvr;
 namespace {
 
 template <class T>
-bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
+bool same_bytes(const PixelVector<T>& a, const PixelVector<T>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
 }
 

@@ -826,7 +826,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
       std::memcpy(dst.data() + size_t(y) * size_t(w),
                   scratch.data() + size_t(h - 1 - y) * size_t(w), size_t(w) * sizeof(T));
   };
-  auto read_rgb = [&](int attachment, std::vector<glm::vec3>& dst) {
+  auto read_rgb = [&](int attachment, PixelVector<glm::vec3>& dst) {
     scratch_rgba.resize(n);
     gl().BindFramebuffer(GL_READ_FRAMEBUFFER, scene_fbo);
     gl().ReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + attachment));

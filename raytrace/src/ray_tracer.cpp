@@ -112,6 +112,7 @@ class FrameTracer {
                     FrameBuffers& fb, RayCounters& counters) const {
     uint64_t work_before = counters.traversal.nodes_visited + counters.traversal.primitive_tests;
     size_t i = fb.index(x, y);
+    fb.set_background(i, scene_.image.background);
     // The AOVs come from the ray through the pixel centre, where OpenGL samples too.
     Ray ray = primary_ray(float(x) + 0.5f, float(y) + 0.5f);
     counters.primary++;
@@ -290,7 +291,7 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
   if (w <= 0 || h <= 0) return bad_input("image size must be positive");
 
   auto t_render = Clock::now();
-  out.buffers.reset(w, h, scene.image.background);
+  out.buffers.allocate(w, h);  // every pixel is written below, in parallel
   FrameTracer tracer(scene, options, geometry);
   tbb::combinable<RayCounters> counters;
   const int tiles_x = (w + kTileSize - 1) / kTileSize;

@@ -3,6 +3,7 @@
 #include "rvr/shared/compare.h"
 
 #include <algorithm>
+#include <span>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -15,7 +16,7 @@ namespace rvr {
 
 namespace detail {
 // Defined in image_io.cpp: OpenImageIO's "inferno" map of values / scale, sRGB-encoded.
-Image inferno_display(const std::vector<float>& values, int width, int height, float scale);
+Image inferno_display(std::span<const float> values, int width, int height, float scale);
 }  // namespace detail
 
 namespace {

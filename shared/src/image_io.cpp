@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <span>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -174,7 +175,7 @@ bool write_pixels(const fs::path& temp, const Image& image, bool linear_to_srgb,
 }
 
 // Linear inferno colours of `values` / `scale` (clamped to [0, 1]), through OpenImageIO.
-Image inferno_linear(const std::vector<float>& values, int width, int height, float scale) {
+Image inferno_linear(std::span<const float> values, int width, int height, float scale) {
   OIIO::ImageBuf src(OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::FLOAT));
   std::vector<float> scaled(values.size());
   const float inv = scale > 0.0f ? 1.0f / scale : 0.0f;
@@ -201,7 +202,7 @@ namespace detail {
 // Also used by compare.cpp (which declares it): OpenImageIO's "inferno" colour map of
 // values / scale, clamped to [0, 1]. OpenImageIO's map is linear; this returns it sRGB-encoded
 // (display referred, the colours matplotlib shows), to be written with linear_to_srgb = false.
-Image inferno_display(const std::vector<float>& values, int width, int height, float scale) {
+Image inferno_display(std::span<const float> values, int width, int height, float scale) {
   Image img = inferno_linear(values, width, height, scale);
   for (float& v : img.pixels) v = srgb_encode(v);
   return img;
@@ -280,7 +281,7 @@ float id_value(uint32_t id) {
 
 // The value at the top of OUT.cost.png's colour map: the 99th percentile of the non-zero costs
 // (a few very expensive pixels would otherwise turn the rest black), at least 1.
-float cost_scale(const std::vector<float>& cost) {
+float cost_scale(std::span<const float> cost) {
   std::vector<float> positive;
   positive.reserve(cost.size());
   for (float c : cost)

@@ -4,7 +4,10 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <memory>
+#include <new>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -13,18 +16,54 @@ namespace rvr {
 
 constexpr uint32_t kNoId = 0xFFFFFFFFu;  // object/primitive id of the background
 
+// std::allocator whose resize() leaves new elements uninitialised (default-initialised), so a
+// renderer that writes every pixel can size its buffers without a serial pass over them: the
+// pages are then first touched by the threads that render them.
+template <class T>
+struct PixelAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = PixelAllocator<U>;
+  };
+  PixelAllocator() = default;
+  template <class U>
+  PixelAllocator(const PixelAllocator<U>&) {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+template <class T>
+using PixelVector = std::vector<T, PixelAllocator<T>>;
+
 struct FrameBuffers {
   int width = 0;
   int height = 0;
-  std::vector<glm::vec3> color;          // linear RGB
-  std::vector<float> depth;              // view-axis depth, +inf on background
-  std::vector<uint32_t> object_id;       // index in Scene::objects, kNoId on background
-  std::vector<uint32_t> primitive_id;    // triangle index in the object (0 for analytic)
-  std::vector<glm::vec3> normal;         // world-space shading normal facing the viewer, 0 on bg
-  std::vector<float> cost;               // work per pixel (nodes + tests, or fragments)
+  PixelVector<glm::vec3> color;          // linear RGB
+  PixelVector<float> depth;              // view-axis depth, +inf on background
+  PixelVector<uint32_t> object_id;       // index in Scene::objects, kNoId on background
+  PixelVector<uint32_t> primitive_id;    // triangle index in the object (0 for analytic)
+  PixelVector<glm::vec3> normal;         // world-space shading normal facing the viewer, 0 on bg
+  PixelVector<float> cost;               // work per pixel (nodes + tests, or fragments)
 
   // Sizes every buffer and fills it with the background values.
   void reset(int w, int h, const glm::vec3& background);
+  // Sizes every buffer and leaves the contents undefined: the caller writes every pixel of
+  // every buffer (set_background for the pixels nothing covers).
+  void allocate(int w, int h);
+  void set_background(size_t i, const glm::vec3& background) {
+    color[i] = background;
+    depth[i] = std::numeric_limits<float>::infinity();
+    object_id[i] = kNoId;
+    primitive_id[i] = kNoId;
+    normal[i] = glm::vec3(0.0f);
+    cost[i] = 0.0f;
+  }
   size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
   size_t pixel_count() const { return size_t(width) * size_t(height); }
 };
@@ -39,6 +78,24 @@ inline void FrameBuffers::reset(int w, int h, const glm::vec3& background) {
   primitive_id.assign(n, kNoId);
   normal.assign(n, glm::vec3(0.0f));
   cost.assign(n, 0.0f);
+}
+
+inline void FrameBuffers::allocate(int w, int h) {
+  width = w;
+  height = h;
+  size_t n = pixel_count();
+  for (auto* v : {&depth, &cost}) {
+    v->clear();
+    v->resize(n);
+  }
+  for (auto* v : {&color, &normal}) {
+    v->clear();
+    v->resize(n);
+  }
+  for (auto* v : {&object_id, &primitive_id}) {
+    v->clear();
+    v->resize(n);
+  }
 }
 
 }  // namespace rvr
