@@ -9,10 +9,10 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <cmath>
 #include <map>
 #include <memory>
 #include <mutex>
-#include <cmath>
 #include <random>
 #include <string>
 
@@ -181,7 +181,8 @@ std::vector<Ray> make_rays(const Scene& scene, const std::string& kind) {
 }
 
 AccelKind accel_kind(const std::string& name) {
-  if (name == "embree" || name == "embree_medium" || name == "embree_high") return AccelKind::Embree;
+  if (name == "embree" || name == "embree_medium" || name == "embree_high")
+    return AccelKind::Embree;
   if (name == "bvh2") return AccelKind::Bvh2;
   return AccelKind::Bvh;
 }
@@ -241,9 +242,9 @@ TraceCheck check_against_embree(const std::vector<TraceAnswer>& answers,
       const TrianglePrecomputed& tri = g.triangle(a.h.primitive);
       glm::dvec3 n = glm::cross(glm::dvec3(tri.e1), glm::dvec3(tri.e2));
       glm::dvec3 sv = glm::dvec3(r.origin) - glm::dvec3(tri.v0), d(r.dir);
-      double kappa = glm::length(glm::dvec3(tri.e1)) * glm::length(glm::dvec3(tri.e2)) *
-                     (glm::length(sv) / std::abs(glm::dot(sv, n)) +
-                      glm::length(d) / std::abs(glm::dot(d, n)));
+      double kappa =
+          glm::length(glm::dvec3(tri.e1)) * glm::length(glm::dvec3(tri.e2)) *
+          (glm::length(sv) / std::abs(glm::dot(sv, n)) + glm::length(d) / std::abs(glm::dot(d, n)));
       if (dt <= 16.0 * 0x1p-24 * kappa * std::abs(e.h.t)) {
         ++c.ill_conditioned;
         continue;
@@ -262,8 +263,9 @@ TraceCheck check_against_embree(const std::vector<TraceAnswer>& answers,
       }
     }
     if (std::getenv("RVR_BENCH_DEBUG"))
-      std::fprintf(stderr, "ray %zu: ours %d p%u t%.9g u%.6g v%.6g  embree %d p%u t%.9g u%.6g v%.6g\n", i,
-                   a.hit, a.h.primitive, a.h.t, a.h.u, a.h.v, e.hit, e.h.primitive, e.h.t, e.h.u, e.h.v);
+      std::fprintf(
+          stderr, "ray %zu: ours %d p%u t%.9g u%.6g v%.6g  embree %d p%u t%.9g u%.6g v%.6g\n", i,
+          a.hit, a.h.primitive, a.h.t, a.h.u, a.h.v, e.hit, e.h.primitive, e.h.t, e.h.u, e.h.v);
     if (c.wrong++ == 0) c.first_wrong = i;
   }
   return c;
@@ -288,10 +290,11 @@ void BM_Trace(benchmark::State& state, std::string accel, std::string rays_kind,
   for (size_t i = 0; i < rays.size(); ++i)
     answers[i].hit = geometry.closest(rays[i], answers[i].h, counters);
   if (accel_kind(accel) != AccelKind::Embree) {
-    TraceCheck check =
-        check_against_embree(answers, embree_answers(name + rays_kind, scene, rays), geometry, rays);
+    TraceCheck check = check_against_embree(answers, embree_answers(name + rays_kind, scene, rays),
+                                            geometry, rays);
     // Edge cases are rare: a ray must pass within 1e-4 of an edge (in barycentrics).
-    if (check.wrong > 0 || check.edge + check.crossing + check.ill_conditioned > rays.size() / 1000) {
+    if (check.wrong > 0 ||
+        check.edge + check.crossing + check.ill_conditioned > rays.size() / 1000) {
       std::string error = "answers differ from Embree's on " + std::to_string(check.wrong) +
                           " rays (first: ray " + std::to_string(check.first_wrong) + "), " +
                           std::to_string(check.edge) + " edge cases, " +
@@ -439,7 +442,8 @@ void BM_Build(benchmark::State& state, std::string accel) {
 }
 
 void register_all() {
-  for (std::string r : {"raster", "softraster", "raytrace", "raytrace_bvh2", "raytrace_none", "embree"}) {
+  for (std::string r :
+       {"raster", "softraster", "raytrace", "raytrace_bvh2", "raytrace_none", "embree"}) {
     for (std::string s : {"tessphere", "soup"}) {
       for (long n : {100L, 1000L, 10000L, 100000L, 1000000L}) {
         if (r == "raytrace_none" && n > 1000) continue;  // O(pixels x triangles)
@@ -477,8 +481,8 @@ void register_all() {
     }
   for (std::string a : {"bvh", "embree"})
     for (std::string scene : {"tessphere", "soup"})
-      benchmark::RegisterBenchmark(("BM_TracePacket/" + a + "/" + scene).c_str(), BM_TracePacket,
-                                   a, scene)
+      benchmark::RegisterBenchmark(("BM_TracePacket/" + a + "/" + scene).c_str(), BM_TracePacket, a,
+                                   scene)
           ->Arg(scene == "soup" ? 1000000 : 100000)
           ->Unit(benchmark::kMillisecond);
   for (std::string r : {"raytrace", "softraster"})

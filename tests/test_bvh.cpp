@@ -74,7 +74,9 @@ std::vector<Ray> random_rays(size_t n, uint32_t seed) {
   return rays;
 }
 
-bool same_bits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(float a, float b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
 
 // The accelerators under test: bvh2 and the wide BVH with each kernel.
 struct Accelerated {
@@ -88,7 +90,7 @@ std::vector<Accelerated> accelerated(const Scene& scene, SphereMode spheres) {
   for (Isa isa : runnable_isas())
     out.push_back({std::string("bvh/") + to_string(isa),
                    std::make_unique<TraceGeometry>(scene, spheres, 24, AccelKind::Bvh,
-                                                    TriangleTest::MollerTrumbore, isa)});
+                                                   TriangleTest::MollerTrumbore, isa)});
   for (const Accelerated& a : out) EXPECT_EQ(a.geometry->error(), "") << a.label;
   return out;
 }
@@ -180,7 +182,9 @@ Scene grid_triangles(size_t n, uint32_t seed) {
 
 }  // namespace
 
-TEST(Bvh, MatchesBruteForceOnSoup) { expect_same_hits(builtin("soup:3000"), SphereMode::Analytic, 1); }
+TEST(Bvh, MatchesBruteForceOnSoup) {
+  expect_same_hits(builtin("soup:3000"), SphereMode::Analytic, 1);
+}
 TEST(Bvh, MatchesBruteForceOnTessellatedSphere) {
   expect_same_hits(builtin("tessphere:5000"), SphereMode::Analytic, 2);
 }
@@ -193,7 +197,9 @@ TEST(Bvh, MatchesBruteForceOnSpheresAsMeshes) {
 TEST(Bvh, MatchesBruteForceOnMixedPrimitives) {
   expect_same_hits(mixed_scene(), SphereMode::Analytic, 5);
 }
-TEST(Bvh, MatchesBruteForceOnCornell) { expect_same_hits(builtin("cornell"), SphereMode::Analytic, 6); }
+TEST(Bvh, MatchesBruteForceOnCornell) {
+  expect_same_hits(builtin("cornell"), SphereMode::Analytic, 6);
+}
 
 // Rays along an axis (the other two direction components +0 or -0, every sign combination)
 // from grid points: they run inside box faces and along triangle edges. A slab test computes
@@ -225,8 +231,8 @@ TEST(Bvh, AxisParallelRaysOnBoxFacesFindWhatBruteForceFinds) {
             ++rays;
             for (const Accelerated& a : accels) {
               expect_same_hit(brute, a, ray,
-                              "origin (" + std::to_string(o.x) + ", " + std::to_string(o.y) +
-                                  ", " + std::to_string(o.z) + ") axis " + std::to_string(axis));
+                              "origin (" + std::to_string(o.x) + ", " + std::to_string(o.y) + ", " +
+                                  std::to_string(o.z) + ") axis " + std::to_string(axis));
               if (HasFatalFailure()) return;
             }
           }
@@ -377,11 +383,11 @@ TEST(WideBvh, EveryTriangleOnceAndEveryBoxContainsItsSubtree) {
     EXPECT_GT(double(slots) / double(w.nodes().size()), 4.0) << name;
     // Memory target: at most 64 bytes per triangle, nodes and leaf blocks included.
     double bytes_per_triangle = double(g.acceleration_bytes()) / double(n);
-    std::printf("%s: %.1f bytes per triangle, %zu nodes (%.2f of 8 slots used), %zu blocks (%.2f "
-                "of 4 lanes used)\n",
-                name, bytes_per_triangle, w.nodes().size(),
-                double(slots) / double(w.nodes().size()), w.blocks().size(),
-                double(n) / double(4 * w.blocks().size()));
+    std::printf(
+        "%s: %.1f bytes per triangle, %zu nodes (%.2f of 8 slots used), %zu blocks (%.2f "
+        "of 4 lanes used)\n",
+        name, bytes_per_triangle, w.nodes().size(), double(slots) / double(w.nodes().size()),
+        w.blocks().size(), double(n) / double(4 * w.blocks().size()));
     EXPECT_LE(bytes_per_triangle, 64.0) << name;
     RecordProperty(std::string("bytes_per_triangle_") + name, std::to_string(bytes_per_triangle));
     EXPECT_EQ(g.acceleration_bytes(),
@@ -468,8 +474,8 @@ TEST(Packets, SameHitsAsSingleRays) {
     int hits = 0;
     for (int tile = 0; tile < 60; ++tile) {
       RayPacket p;
-      glm::vec3 o = tile % 2 ? scene.camera.eye
-                             : scene.camera.eye + 0.1f * glm::vec3(U(rng), U(rng), U(rng));
+      glm::vec3 o =
+          tile % 2 ? scene.camera.eye : scene.camera.eye + 0.1f * glm::vec3(U(rng), U(rng), U(rng));
       p.origin[0] = o.x;
       p.origin[1] = o.y;
       p.origin[2] = o.z;
@@ -495,13 +501,15 @@ TEST(Packets, SameHitsAsSingleRays) {
           HitRecord single;
           bool found = brute.closest(ray, single);
           const HitRecord& h = packet_hits[k];
-          std::string what = a.label + " tile " + std::to_string(tile) + " ray " + std::to_string(k);
+          std::string what =
+              a.label + " tile " + std::to_string(tile) + " ray " + std::to_string(k);
           ASSERT_EQ(h.primitive != kNoPrimitive, found) << what;
           ASSERT_EQ(unused_hits[k].primitive, h.primitive) << what;
           if (!found) continue;
           hits += a.label == "bvh2";
           if (a.label == "embree") {  // its own triangle test: same object, t to float precision
-            EXPECT_EQ(a.geometry->surface(ray, h).object, brute.surface(ray, single).object) << what;
+            EXPECT_EQ(a.geometry->surface(ray, h).object, brute.surface(ray, single).object)
+                << what;
             EXPECT_NEAR(h.t, single.t, 1e-4f * single.t) << what;
             continue;
           }

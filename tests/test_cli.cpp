@@ -452,8 +452,8 @@ TEST_F(Cli, InfoHasWhatABugReportNeeds) {
   RunResult r = run("info");
   ASSERT_EQ(r.status, 0) << r.err;
   for (const char* field :
-       {"rvr ", "cpu: ", "hardware threads", "renderers: raster softraster", "simd: baseline build ",
-        "kernels: ", "compiled: sse avx2 avx512", "this CPU runs: sse",
+       {"rvr ", "cpu: ", "hardware threads", "renderers: raster softraster",
+        "simd: baseline build ", "kernels: ", "compiled: sse avx2 avx512", "this CPU runs: sse",
         "embree: 3.", "openimageio: ", "tbb: ", "gl backend: osmesa",
         "GL_VERSION: ", "GL_RENDERER: llvmpipe", "llvmpipe threads: "})
     EXPECT_NE(r.out.find(field), std::string::npos) << field << " missing in:\n" << r.out;
@@ -470,7 +470,8 @@ TEST_F(Cli, RvrIsaForcesTheKernelsAndImagesDoNotChange) {
   std::vector<std::string> isas{"sse"};
   RunResult avx2 = run("info", "RVR_ISA=avx2");
   if (avx2.out.find("this CPU runs: sse avx2") != std::string::npos) isas.push_back("avx2");
-  if (avx2.out.find("this CPU runs: sse avx2 avx512") != std::string::npos) isas.push_back("avx512");
+  if (avx2.out.find("this CPU runs: sse avx2 avx512") != std::string::npos)
+    isas.push_back("avx512");
   std::string first;
   for (const std::string& isa : isas) {
     fs::path png = dir_ / (isa + ".png"), stats = dir_ / (isa + ".json");
@@ -492,9 +493,9 @@ TEST_F(Cli, RvrIsaForcesTheKernelsAndImagesDoNotChange) {
     EXPECT_EQ(r.status, 2);
     EXPECT_EQ(r.err.rfind("error: RVR_ISA=avx512: this CPU cannot run avx512 kernels", 0), 0u)
         << r.err;
-    RunResult c = run("compare builtin:cornell --width 32 --height 24 -o " +
-                          (dir_ / "cmp").string(),
-                      "RVR_ISA=avx512");
+    RunResult c =
+        run("compare builtin:cornell --width 32 --height 24 -o " + (dir_ / "cmp").string(),
+            "RVR_ISA=avx512");
     EXPECT_EQ(c.status, 2);
     EXPECT_EQ(std::count(c.err.begin(), c.err.end(), '\n'), 1) << c.err;
     EXPECT_FALSE(fs::exists(dir_ / "cmp"));
@@ -506,8 +507,10 @@ TEST_F(Cli, AccelChoicesRenderTheSameImage) {
   const std::string args = "render builtin:spheres -r raytrace --width 64 --height 48 ";
   std::string first;
   for (const char* accel : {"bvh", "bvh2", "none"}) {
-    fs::path png = dir_ / (std::string(accel) + ".png"), stats = dir_ / (std::string(accel) + ".json");
-    RunResult r = run(args + "--accel " + accel + " -o " + png.string() + " --stats " + stats.string());
+    fs::path png = dir_ / (std::string(accel) + ".png"),
+             stats = dir_ / (std::string(accel) + ".json");
+    RunResult r =
+        run(args + "--accel " + accel + " -o " + png.string() + " --stats " + stats.string());
     ASSERT_EQ(r.status, 0) << r.err;
     EXPECT_NE(slurp(stats).find(std::string("\"accel\": \"") + accel + "\""), std::string::npos);
     if (first.empty()) first = slurp(png);

@@ -125,16 +125,20 @@ void check_triangle_cases(Test test) {
   EXPECT_FLOAT_EQ(h.t, 1.0f);
 }
 
-TEST(Triangle, MollerTrumboreAnalyticCases) { check_triangle_cases(intersect_triangle_mt); }
-TEST(Triangle, ChapterTestAnalyticCases) { check_triangle_cases(intersect_triangle_chapter); }
+TEST(Triangle, MollerTrumboreAnalyticCases) {
+  check_triangle_cases(intersect_triangle_mt);
+}
+TEST(Triangle, ChapterTestAnalyticCases) {
+  check_triangle_cases(intersect_triangle_chapter);
+}
 
 TEST(Triangle, TheTwoTestsAgreeOnRandomRays) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> U(-2.0f, 2.0f);
   int hits = 0, disagreements_off_edge = 0;
   for (int i = 0; i < 100000; ++i) {
-    TrianglePrecomputed tri = precompute_triangle({U(rng), U(rng), U(rng)}, {U(rng), U(rng), U(rng)},
-                                                  {U(rng), U(rng), U(rng)});
+    TrianglePrecomputed tri = precompute_triangle(
+        {U(rng), U(rng), U(rng)}, {U(rng), U(rng), U(rng)}, {U(rng), U(rng), U(rng)});
     Ray ray = make_ray({U(rng), U(rng), U(rng) + 4}, {U(rng) * 0.3f, U(rng) * 0.3f, -1});
     TriangleHit a, b;
     bool ha = intersect_triangle_mt(ray, tri, a);

@@ -69,8 +69,8 @@ TEST_P(Kernels, EveryKernelAndThreadCountRendersTheSameBytes) {
               << name << " " << to_string(mode) << (spheres == SphereMode::Mesh ? " mesh" : "")
               << ": " << to_string(isa) << " on " << threads << " threads differs from "
               << to_string(isas[0]) << " on 1";
-          for (const char* k : {"rays.primary", "rays.shadow", "rays.reflection",
-                                "rays.refraction", "bvh.nodes_visited", "primitive_tests"})
+          for (const char* k : {"rays.primary", "rays.shadow", "rays.reflection", "rays.refraction",
+                                "bvh.nodes_visited", "primitive_tests"})
             EXPECT_EQ(out.stats[k], reference.stats[k]) << name << " " << k;
         }
       }
@@ -78,11 +78,12 @@ TEST_P(Kernels, EveryKernelAndThreadCountRendersTheSameBytes) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(EveryBuiltinScene, Kernels,
-                         ::testing::ValuesIn([] {
+INSTANTIATE_TEST_SUITE_P(EveryBuiltinScene, Kernels, ::testing::ValuesIn([] {
                            std::vector<std::string> names;
                            for (const BuiltinSceneInfo& b : builtin_scenes())
                              names.push_back(b.name.substr(0, b.name.find(':')));
                            return names;
                          }()),
-                         [](const ::testing::TestParamInfo<std::string>& info) { return info.param; });
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           return info.param;
+                         });

@@ -7,17 +7,13 @@
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/camera.h"
-#include "scene_builders.h"
 #include "rvr/shared/scene_loader.h"
+#include "scene_builders.h"
 
 using namespace rvr;
 using namespace rvr::test;
 
 namespace {
-
-
-
-
 
 RenderOutput trace(const Scene& s, RenderMode mode, int threads = 0) {
   RayTracer tracer;
@@ -130,7 +126,8 @@ TEST(Tracer, MirrorShowsTheQuadWhereReflectionGeometryPredicts) {
       // The quad's image sits at z = -2; the ray reaches it after crossing the mirror.
       float t_image = (-quad_centre.z - o.z) / d.z;
       glm::vec3 q = o + t_image * d - glm::vec3(quad_centre.x, quad_centre.y, -quad_centre.z);
-      bool on_image = std::abs(glm::dot(q, qu)) <= quad_half && std::abs(glm::dot(q, qv)) <= quad_half;
+      bool on_image =
+          std::abs(glm::dot(q, qu)) <= quad_half && std::abs(glm::dot(q, qv)) <= quad_half;
       expected[y * w + x] = on_mirror && on_image;
     }
   std::vector<bool> boundary = class_boundary(expected, w, h);
@@ -259,7 +256,8 @@ TEST(Tracer, NoShadowAcneOnConvexSurfaces) {
       // Only points facing the light: behind the terminator the surface shadows itself for
       // real (Blinn-Phong's specular term is not zero there, the shadow ray correctly is).
       int x = int(i % size_t(s.image.width)), y = int(i / size_t(s.image.width));
-      glm::vec3 p = s.camera.eye + full.buffers.depth[i] * camera_ray_direction(frame, x + 0.5f, y + 0.5f);
+      glm::vec3 p =
+          s.camera.eye + full.buffers.depth[i] * camera_ray_direction(frame, x + 0.5f, y + 0.5f);
       // On the tessellated sphere the flat facets differ from the interpolated normal by up to
       // half a facet (pi/64, sin = 0.05): within that band of the terminator a facet can face
       // away from the light while its smooth normal faces it, and the mesh really does block

@@ -7,8 +7,8 @@
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/camera.h"
-#include "scene_builders.h"
 #include "rvr/shared/shading.h"
+#include "scene_builders.h"
 
 using namespace rvr;
 using namespace rvr::test;
@@ -16,11 +16,6 @@ using namespace rvr::test;
 namespace {
 
 const float kPi = 3.14159265358979f;
-
-
-
-
-
 
 RenderOutput trace(const Scene& s, int max_depth = 5) {
   RayTracer tracer;
@@ -203,7 +198,8 @@ ShadowRow render_soft_shadow(float size, int samples, float H, float h_occ, int 
   for (int x = 0; x < w; ++x) {
     size_t i = out.buffers.index(x, h / 2);
     if (out.buffers.object_id[i] != 0) continue;
-    glm::vec3 p = s.camera.eye + out.buffers.depth[i] * camera_ray_direction(frame, x + 0.5f, h / 2 + 0.5f);
+    glm::vec3 p =
+        s.camera.eye + out.buffers.depth[i] * camera_ray_direction(frame, x + 0.5f, h / 2 + 0.5f);
     row.p.push_back(p);
     row.x.push_back(p.x);
     row.brightness.push_back(out.buffers.color[i].x);
@@ -275,9 +271,10 @@ TEST(SoftShadows, StratifiedSamplesConvergeToTheAnalyticOcclusion) {
     }
     error /= count;
     EXPECT_LT(error, previous_error) << samples << "x" << samples;
-    std::printf("%2dx%-2d light samples: mean |error| in the penumbra %.5f\n", samples, samples, error);
+    std::printf("%2dx%-2d light samples: mean |error| in the penumbra %.5f\n", samples, samples,
+                error);
     previous_error = float(error);
   }
   float lit = reference({0.6f, 0.0f, 0.0f});  // just outside the penumbra
-  EXPECT_LT(previous_error, 0.03f * lit);  // 16 x 16: within 3% of full brightness
+  EXPECT_LT(previous_error, 0.03f * lit);     // 16 x 16: within 3% of full brightness
 }

@@ -452,7 +452,8 @@ int run_info(const std::string& gl_name) {
   for (const std::string& n : renderer_names()) std::printf("%s ", n.c_str());
   std::printf("\n");
   std::printf("simd: baseline build %s; the CPU has %s\n", built_simd(), cpu_simd().c_str());
-  std::printf("kernels: %s; compiled: sse avx2 avx512; this CPU runs:", describe_isa_choice().c_str());
+  std::printf("kernels: %s; compiled: sse avx2 avx512; this CPU runs:",
+              describe_isa_choice().c_str());
   for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512})
     if (cpu_supports(isa)) std::printf(" %s", to_string(isa));
   std::printf(" (RVR_ISA=sse|avx2|avx512 forces one)\n");

@@ -1,7 +1,6 @@
 #include "embree_backend.h"
 
 #include <embree3/rtcore.h>
-
 #include <unistd.h>
 
 #include <cstdio>
@@ -247,8 +246,7 @@ void intersect_k(const EmbreeBackend& backend, const RayPacket& packet, int firs
 
 }  // namespace
 
-void embree_closest_packet(const EmbreeBackend& backend, const RayPacket& packet,
-                           HitRecord* hits) {
+void embree_closest_packet(const EmbreeBackend& backend, const RayPacket& packet, HitRecord* hits) {
   for (int i = 0; i < packet.count; ++i) hits[i] = HitRecord{};
   if (backend.packet_width == 16) {
     for (int first = 0; first < packet.count; first += 16)
@@ -263,7 +261,9 @@ void embree_closest_packet(const EmbreeBackend& backend, const RayPacket& packet
   }
 }
 
-int embree_packet_width(const EmbreeBackend& backend) { return backend.packet_width; }
+int embree_packet_width(const EmbreeBackend& backend) {
+  return backend.packet_width;
+}
 
 std::string embree_kernel_isa() {
   // Embree says which of its kernels it runs only in its verbose start-up report, on stdout:

@@ -136,9 +136,9 @@ class FrameTracer {
     } else {
       fb.color[i] = supersample(x, y, spp, counters);
     }
-    fb.cost[i] = float(primary_work.nodes_visited + primary_work.primitive_tests +
-                       counters.traversal.nodes_visited + counters.traversal.primitive_tests -
-                       work_before);
+    fb.cost[i] =
+        float(primary_work.nodes_visited + primary_work.primitive_tests +
+              counters.traversal.nodes_visited + counters.traversal.primitive_tests - work_before);
   }
 
   Ray primary_ray(float px, float py) const {
@@ -264,8 +264,9 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
   if (options.triangle_test == TriangleTest::Chapter && options.accel == AccelKind::Bvh) {
     // The SIMD kernels run Moller-Trumbore only; the chapter's test runs on the binary tree.
     options.accel = AccelKind::Bvh2;
-    notes.push_back("--triangle-test chapter runs on the binary BVH (bvh2): the wide BVH's "
-                    "SIMD kernels test triangles with Moller-Trumbore only");
+    notes.push_back(
+        "--triangle-test chapter runs on the binary BVH (bvh2): the wide BVH's "
+        "SIMD kernels test triangles with Moller-Trumbore only");
   }
 
   auto t_build = Clock::now();

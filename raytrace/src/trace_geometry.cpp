@@ -207,7 +207,9 @@ Aabb TraceGeometry::analytic_bounds(const Analytic& a) {
   return b;
 }
 
-int TraceGeometry::embree_packet_width() const { return embree_ ? rvr::embree_packet_width(*embree_) : 0; }
+int TraceGeometry::embree_packet_width() const {
+  return embree_ ? rvr::embree_packet_width(*embree_) : 0;
+}
 
 size_t TraceGeometry::acceleration_bytes() const {
   return wide_.bytes() + bvh_.nodes().size() * sizeof(BvhNode) +
@@ -261,7 +263,9 @@ struct ChapterTest {
 // A hit at t is nearer than the best so far when t is smaller or, at the same t, its primitive
 // index is lower: the result does not depend on the order primitives are tested in. A test
 // accepting t < limit is given the float after t_max so that t == t_max gets through.
-inline float tie_limit(float t_max) { return std::nextafter(t_max, INFINITY); }
+inline float tie_limit(float t_max) {
+  return std::nextafter(t_max, INFINITY);
+}
 inline bool nearer(float t, uint32_t p, float t_max, uint32_t best) {
   return t < t_max || (t == t_max && p < best);
 }
@@ -352,7 +356,8 @@ bool TraceGeometry::query_analytic(const Ray& ray, float t_max, HitRecord& hit,
 }
 
 template <bool kCount>
-bool TraceGeometry::closest_wide(const Ray& ray, HitRecord& hit, TraversalCounters* counters) const {
+bool TraceGeometry::closest_wide(const Ray& ray, HitRecord& hit,
+                                 TraversalCounters* counters) const {
   KernelRay kr{{ray.origin.x, ray.origin.y, ray.origin.z},
                {ray.dir.x, ray.dir.y, ray.dir.z},
                ray.tmin,
@@ -453,7 +458,8 @@ void TraceGeometry::closest_packet(const RayPacket& packet, HitRecord* hits,
       counters[i].primitive_tests += kc[i].tests;
     }
     if (!analytic_.empty())
-      query_analytic<false>(ray(i), found ? h.t : packet.tmax, h, counters ? &counters[i] : nullptr);
+      query_analytic<false>(ray(i), found ? h.t : packet.tmax, h,
+                            counters ? &counters[i] : nullptr);
   }
 }
 

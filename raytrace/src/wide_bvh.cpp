@@ -160,7 +160,8 @@ bool recheck_triangle_near_edge(const KernelRay& ray, const float tri[9], float 
   r.dir = {ray.dir[0], ray.dir[1], ray.dir[2]};
   r.tmin = ray.tmin;
   r.tmax = std::nextafter(t_limit, INFINITY);  // t_limit itself is allowed
-  TrianglePrecomputed t{{tri[0], tri[1], tri[2]}, {tri[3], tri[4], tri[5]}, {tri[6], tri[7], tri[8]}};
+  TrianglePrecomputed t{
+      {tri[0], tri[1], tri[2]}, {tri[3], tri[4], tri[5]}, {tri[6], tri[7], tri[8]}};
   TriangleHit h;
   if (!intersect_triangle_mt_double(r, t, h)) return false;
   hit.t = h.t;

@@ -2,8 +2,8 @@
 // (cornell: everything; spheres: analytic shapes; occluders: depth complexity; soup and
 // tessphere: triangle count).
 #include <charconv>
-#include <memory>
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include "rvr/shared/scene_loader.h"
@@ -109,8 +109,8 @@ Scene cornell() {
   uint32_t red = add_material(s, "red", {0.63f, 0.065f, 0.05f});
   uint32_t green = add_material(s, "green", {0.14f, 0.45f, 0.091f});
   // The lamp only emits: lit from its own light samples a few mm away it would blow up.
-  uint32_t lamp = add_material(s, "lamp", {0.0f, 0.0f, 0.0f}, glm::vec3(0.0f), 32.0f,
-                               {4.0f, 4.0f, 4.0f});
+  uint32_t lamp =
+      add_material(s, "lamp", {0.0f, 0.0f, 0.0f}, glm::vec3(0.0f), 32.0f, {4.0f, 4.0f, 4.0f});
   uint32_t mirror = add_material(s, "mirror", {0.1f, 0.1f, 0.1f}, {0.9f, 0.9f, 0.9f}, 200.0f);
   s.materials[mirror].mirror = 0.85f;
   uint32_t glass = add_material(s, "glass", {0.05f, 0.05f, 0.05f}, {0.8f, 0.8f, 0.8f}, 300.0f);
@@ -156,8 +156,8 @@ Scene spheres() {
     for (int i = 0; i < n; ++i) {
       float hue = float(i * n + j) / float(n * n);
       glm::vec3 colour(0.2f + 0.7f * hue, 0.3f + 0.5f * (1.0f - hue), 0.9f - 0.6f * hue);
-      uint32_t m = add_material(s, "ball" + std::to_string(i * n + j), colour,
-                                glm::vec3(0.4f), 16.0f + 8.0f * float(i));
+      uint32_t m = add_material(s, "ball" + std::to_string(i * n + j), colour, glm::vec3(0.4f),
+                                16.0f + 8.0f * float(i));
       add_sphere(s, "sphere " + std::to_string(i) + "," + std::to_string(j), m,
                  {float(i - n / 2) * 1.1f, 0.45f, float(j - n / 2) * 1.1f}, 0.45f);
     }
@@ -176,7 +176,8 @@ Scene occluders(size_t n) {
   const float spacing = 0.05f;
   for (size_t i = 0; i < n; ++i) {
     float t = n > 1 ? float(i) / float(n - 1) : 0.0f;
-    uint32_t m = add_material(s, "quad" + std::to_string(i), {0.9f - 0.6f * t, 0.3f, 0.2f + 0.7f * t});
+    uint32_t m =
+        add_material(s, "quad" + std::to_string(i), {0.9f - 0.6f * t, 0.3f, 0.2f + 0.7f * t});
     Object& o = add_object(s, "quad " + std::to_string(i), ObjectType::Plane, m);
     o.plane = {{0.0f, 0.0f, -float(i) * spacing}, {0, 0, 1}, 1.0f};
   }
@@ -239,7 +240,8 @@ std::shared_ptr<CsgNode> csg_op(CsgOp op, std::shared_ptr<const CsgNode> a,
   return n;
 }
 
-void add_csg(Scene& s, const std::string& name, uint32_t material, std::shared_ptr<const CsgNode> tree) {
+void add_csg(Scene& s, const std::string& name, uint32_t material,
+             std::shared_ptr<const CsgNode> tree) {
   add_object(s, name, ObjectType::Csg, material).csg = std::move(tree);
 }
 
@@ -247,7 +249,8 @@ void add_csg(Scene& s, const std::string& name, uint32_t material, std::shared_p
 void add_box(Scene& s, const std::string& name, uint32_t material, glm::vec3 c, glm::vec3 h) {
   Object& o = add_object(s, name, ObjectType::Triangles, material);
   for (int i = 0; i < 8; ++i)
-    o.mesh.positions.push_back(c + glm::vec3(i & 1 ? h.x : -h.x, i & 2 ? h.y : -h.y, i & 4 ? h.z : -h.z));
+    o.mesh.positions.push_back(
+        c + glm::vec3(i & 1 ? h.x : -h.x, i & 2 ? h.y : -h.y, i & 4 ? h.z : -h.z));
   const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 4, 6, 2},
                                 {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}};
   for (const auto& q : quads) {
@@ -265,7 +268,8 @@ Scene csg() {
   uint32_t blue = add_material(s, "blue", {0.2f, 0.3f, 0.85f}, glm::vec3(0.3f), 32.0f);
   uint32_t gold = add_material(s, "gold", {0.85f, 0.65f, 0.2f}, glm::vec3(0.4f), 64.0f);
   add_csg(s, "union", red,
-          csg_op(CsgOp::Union, csg_sphere({-2.4f, 0.6f, 0}, 0.6f), csg_sphere({-2.0f, 0.9f, 0.2f}, 0.5f)));
+          csg_op(CsgOp::Union, csg_sphere({-2.4f, 0.6f, 0}, 0.6f),
+                 csg_sphere({-2.0f, 0.9f, 0.2f}, 0.5f)));
   add_csg(s, "intersection", green,
           csg_op(CsgOp::Intersection, csg_sphere({-0.55f, 0.7f, 0}, 0.7f),
                  csg_sphere({-0.05f, 0.7f, 0}, 0.7f)));
@@ -290,10 +294,10 @@ Scene dof() {
   add_floor(s, {0.5f, 0.5f, 0.5f}, {0, 0, -4}, 10.0f);
   for (int i = 0; i < 7; ++i) {
     float t = float(i) / 6.0f;
-    uint32_t m = add_material(s, "ball" + std::to_string(i), {0.9f - 0.7f * t, 0.4f, 0.2f + 0.7f * t},
-                              glm::vec3(0.5f), 64.0f);
-    add_sphere(s, "sphere " + std::to_string(i), m, {-2.4f + 0.8f * float(i), 0.35f, 1.5f - 1.5f * float(i)},
-               0.35f);
+    uint32_t m = add_material(s, "ball" + std::to_string(i),
+                              {0.9f - 0.7f * t, 0.4f, 0.2f + 0.7f * t}, glm::vec3(0.5f), 64.0f);
+    add_sphere(s, "sphere " + std::to_string(i), m,
+               {-2.4f + 0.8f * float(i), 0.35f, 1.5f - 1.5f * float(i)}, 0.35f);
   }
   look_at(s, {0.0f, 1.2f, 4.0f}, {0.0f, 0.35f, -3.0f}, 40.0f, 0.1f, 100.0f);
   s.camera.aperture_radius = 0.12f;
@@ -308,10 +312,12 @@ Scene dof() {
 Scene glass() {
   Scene s = base_scene("glass");
   add_floor(s, {0.6f, 0.6f, 0.6f}, {0, 0, 0}, 6.0f);
-  const glm::vec3 colours[4] = {{0.85f, 0.2f, 0.2f}, {0.2f, 0.75f, 0.25f}, {0.2f, 0.3f, 0.9f}, {0.9f, 0.8f, 0.2f}};
+  const glm::vec3 colours[4] = {
+      {0.85f, 0.2f, 0.2f}, {0.2f, 0.75f, 0.25f}, {0.2f, 0.3f, 0.9f}, {0.9f, 0.8f, 0.2f}};
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < 2; ++j) {
-      uint32_t m = add_material(s, "quad" + std::to_string(i) + std::to_string(j), colours[(i + j) % 4]);
+      uint32_t m =
+          add_material(s, "quad" + std::to_string(i) + std::to_string(j), colours[(i + j) % 4]);
       float x0 = -2.0f + float(i), y0 = float(j);
       add_quad(s, "wall " + std::to_string(i) + "," + std::to_string(j), m, {x0, y0, -1.5f},
                {x0 + 1, y0, -1.5f}, {x0 + 1, y0 + 1, -1.5f}, {x0, y0 + 1, -1.5f});
@@ -338,9 +344,11 @@ Scene glass() {
 
 std::vector<BuiltinSceneInfo> builtin_scenes() {
   return {
-      {"cornell", "the Cornell box (published geometry), a mirror and a glass sphere, an area light"},
+      {"cornell",
+       "the Cornell box (published geometry), a mirror and a glass sphere, an area light"},
       {"spheres", "a 5x5 grid of analytic spheres on a square plane, two point lights"},
-      {"occluders:N", "N parallel quads one behind another facing the camera: depth complexity N (default 8)"},
+      {"occluders:N",
+       "N parallel quads one behind another facing the camera: depth complexity N (default 8)"},
       {"soup:N", "N random triangles in a box, seeded, constant total area (default 1000)"},
       {"tessphere:N", "one smooth sphere tessellated into about N triangles (default 10000)"},
       {"csg", "union, intersection, difference of spheres and a nested tree, on a floor"},
@@ -357,8 +365,8 @@ Expected<Scene> make_builtin_scene(const std::string& spec) {
     name = spec.substr(0, colon);
     std::string digits = spec.substr(colon + 1);
     auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), count);
-    if (digits.empty() || ec != std::errc() || end != digits.data() + digits.size() ||
-        count < 1 || count > kMaxBuiltinCount) {
+    if (digits.empty() || ec != std::errc() || end != digits.data() + digits.size() || count < 1 ||
+        count > kMaxBuiltinCount) {
       return bad_input("builtin:" + spec + ": N must be an integer in 1.." +
                        std::to_string(kMaxBuiltinCount) + ", got '" + digits + "'");
     }

@@ -1,7 +1,6 @@
 #include "rvr/shared/camera.h"
 
 #include <cmath>
-
 #include <glm/gtc/matrix_transform.hpp>
 
 namespace rvr {
@@ -24,8 +23,8 @@ glm::mat4 view_matrix(const Camera& camera) {
 }
 
 glm::mat4 projection_matrix(const Camera& camera, int width, int height) {
-  return glm::perspective(glm::radians(camera.fov_y_deg), float(width) / float(height),
-                          camera.near, camera.far);
+  return glm::perspective(glm::radians(camera.fov_y_deg), float(width) / float(height), camera.near,
+                          camera.far);
 }
 
 }  // namespace rvr

@@ -3,12 +3,12 @@
 #include "rvr/shared/compare.h"
 
 #include <algorithm>
-#include <span>
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <exception>
 #include <limits>
+#include <span>
 #include <string>
 #include <vector>
 

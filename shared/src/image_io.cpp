@@ -8,7 +8,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <span>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -18,6 +17,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 #include <system_error>
 #include <vector>

@@ -29,14 +29,18 @@ TriangleMesh tessellate_sphere(const Sphere& s, int segments) {
     float theta = pi * float(r) / float(rings);
     for (int k = 0; k < segments; ++k) {
       float phi = 2.0f * pi * float(k) / float(segments);
-      add_vertex({std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi)});
+      add_vertex(
+          {std::sin(theta) * std::cos(phi), std::cos(theta), -std::sin(theta) * std::sin(phi)});
     }
   }
   uint32_t south = uint32_t(mesh.positions.size());
   add_vertex({0, -1, 0});
-  auto ring_vertex = [&](int r, int k) { return uint32_t(1 + (r - 1) * segments + (k % segments)); };
+  auto ring_vertex = [&](int r, int k) {
+    return uint32_t(1 + (r - 1) * segments + (k % segments));
+  };
   // Counter-clockwise seen from outside: longitude k grows counter-clockwise seen from +y.
-  for (int k = 0; k < segments; ++k) mesh.triangles.push_back({0, ring_vertex(1, k), ring_vertex(1, k + 1)});
+  for (int k = 0; k < segments; ++k)
+    mesh.triangles.push_back({0, ring_vertex(1, k), ring_vertex(1, k + 1)});
   for (int r = 1; r < rings - 1; ++r) {
     for (int k = 0; k < segments; ++k) {
       uint32_t a = ring_vertex(r, k), b = ring_vertex(r, k + 1);

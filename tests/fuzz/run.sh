@@ -24,7 +24,11 @@ for name in "${names[@]}"; do
     scene) extra=(-dict="$here/scene.dict" -max_len=16384) ;;
     mesh) extra=(-max_len=65536) ;;
   esac
-  regressions=$(find "$here/regressions/$name" -type f 2>/dev/null | sort)
+  # A harness may have no regression inputs yet (git keeps no empty folder).
+  regressions=""
+  if [ -d "$here/regressions/$name" ]; then
+    regressions=$(find "$here/regressions/$name" -type f | sort)
+  fi
   if [ -n "$regressions" ]; then
     echo "fuzz_$name: replaying $(echo "$regressions" | wc -l) regression inputs"
     # shellcheck disable=SC2086

@@ -605,6 +605,8 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
   store8(stack.near[0], p.tmin);
   stack.top = 1;
   const V8 inf = splat8(__builtin_inff());
+  // Work per lane, counted in float lanes (exact up to 2^24 per ray) with one add per step.
+  V8 nodes = splat8(0.0f), tests = splat8(0.0f);
   while (stack.top > 0) {
     --stack.top;
     uint32_t ref = stack.ref[stack.top];
@@ -615,9 +617,8 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
         finish_lane<kCount>(bvh, p, lowest_bit(active), ref, best, counters);
       continue;
     }
-    if (kCount)
-      for (unsigned m = active; m; m &= m - 1) counters[lowest_bit(m)].nodes += !(ref & kLeafFlag);
     if (!(ref & kLeafFlag)) {
+      if (kCount) nodes = add8(nodes, and8(lanes8(active), splat8(1.0f)));
       const WideNode& node = bvh.nodes[ref];
       const V8 act = lanes8(active);
       uint32_t refs[kWideBvhWidth];
@@ -661,11 +662,19 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
     }
     const uint32_t first = (ref & ~kLeafFlag) >> kLeafCountBits;
     const uint32_t triangles = ref & ((1u << kLeafCountBits) - 1);
-    if (kCount)
-      for (unsigned m = active; m; m &= m - 1) counters[lowest_bit(m)].tests += triangles;
+    if (kCount) tests = add8(tests, and8(lanes8(active), splat8(float(triangles))));
     for (uint32_t k = 0; k < triangles; ++k)
       intersect_triangle8(bvh.blocks[first + k / kTriangleBlock], k % kTriangleBlock, p, active,
                           best);
+  }
+  if (kCount) {
+    alignas(32) float n[8], t[8];
+    store8(n, nodes);
+    store8(t, tests);
+    for (int l = 0; l < 8; ++l) {
+      counters[l].nodes += uint64_t(n[l]);
+      counters[l].tests += uint64_t(t[l]);
+    }
   }
 }
 

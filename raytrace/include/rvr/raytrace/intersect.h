@@ -4,10 +4,9 @@
 #pragma once
 
 #include <cmath>
-#include <utility>
 #include <cstdint>
-
 #include <glm/glm.hpp>
+#include <utility>
 
 #include "rvr/shared/scene.h"
 

@@ -17,14 +17,14 @@ namespace rvr {
 
 struct WideBvhStats {
   size_t triangles = 0;
-  size_t nodes = 0;         // wide nodes
-  size_t leaves = 0;        // leaf references
-  size_t blocks = 0;        // triangle blocks
-  size_t child_slots = 0;   // child slots in use, over all nodes (fill = child_slots / 8 nodes)
-  size_t max_depth = 0;     // inner levels below the root
+  size_t nodes = 0;        // wide nodes
+  size_t leaves = 0;       // leaf references
+  size_t blocks = 0;       // triangle blocks
+  size_t child_slots = 0;  // child slots in use, over all nodes (fill = child_slots / 8 nodes)
+  size_t max_depth = 0;    // inner levels below the root
   double binary_sah_cost = 0.0;
-  double seconds = 0.0;           // whole build
-  double binary_seconds = 0.0;    // of which the binary SAH tree
+  double seconds = 0.0;         // whole build
+  double binary_seconds = 0.0;  // of which the binary SAH tree
 };
 
 class WideBvh {
@@ -33,7 +33,9 @@ class WideBvh {
   // when the tree would not fit its 32-bit references (over 2^29 triangles).
   static Expected<WideBvh> build(const std::vector<TrianglePrecomputed>& triangles);
 
-  WideBvhView view() const { return {nodes_.data(), blocks_.data(), root_, uint32_t(stats_.max_depth)}; }
+  WideBvhView view() const {
+    return {nodes_.data(), blocks_.data(), root_, uint32_t(stats_.max_depth)};
+  }
   const TraversalVector<WideNode>& nodes() const { return nodes_; }
   const TraversalVector<TriangleBlock>& blocks() const { return blocks_; }
   uint32_t root() const { return root_; }

@@ -16,7 +16,9 @@ struct Error {
   ErrorKind kind = ErrorKind::BadInput;
 };
 
-inline Error bad_input(std::string message) { return Error{std::move(message), ErrorKind::BadInput}; }
+inline Error bad_input(std::string message) {
+  return Error{std::move(message), ErrorKind::BadInput};
+}
 inline Error internal_error(std::string message) {
   return Error{std::move(message), ErrorKind::Internal};
 }
@@ -46,6 +48,8 @@ class Expected {
 // For operations that produce nothing but may fail.
 struct Done {};
 using Status = Expected<Done>;
-inline Status ok_status() { return Done{}; }
+inline Status ok_status() {
+  return Done{};
+}
 
 }  // namespace rvr

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <limits>
 #include <map>
 #include <memory>
@@ -9,8 +10,6 @@
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace rvr {
 
@@ -44,12 +43,12 @@ using PixelVector = std::vector<T, PixelAllocator<T>>;
 struct FrameBuffers {
   int width = 0;
   int height = 0;
-  PixelVector<glm::vec3> color;          // linear RGB
-  PixelVector<float> depth;              // view-axis depth, +inf on background
-  PixelVector<uint32_t> object_id;       // index in Scene::objects, kNoId on background
-  PixelVector<uint32_t> primitive_id;    // triangle index in the object (0 for analytic)
-  PixelVector<glm::vec3> normal;         // world-space shading normal facing the viewer, 0 on bg
-  PixelVector<float> cost;               // work per pixel (nodes + tests, or fragments)
+  PixelVector<glm::vec3> color;        // linear RGB
+  PixelVector<float> depth;            // view-axis depth, +inf on background
+  PixelVector<uint32_t> object_id;     // index in Scene::objects, kNoId on background
+  PixelVector<uint32_t> primitive_id;  // triangle index in the object (0 for analytic)
+  PixelVector<glm::vec3> normal;       // world-space shading normal facing the viewer, 0 on bg
+  PixelVector<float> cost;             // work per pixel (nodes + tests, or fragments)
 
   // Sizes every buffer and fills it with the background values.
   void reset(int w, int h, const glm::vec3& background);

@@ -3,11 +3,10 @@
 #pragma once
 
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <memory>
 #include <string>
 #include <vector>
-
-#include <glm/glm.hpp>
 
 namespace rvr {
 
@@ -90,10 +89,10 @@ enum class ObjectType { Sphere, Plane, Triangles, Csg };
 struct Object {
   std::string name;
   ObjectType type = ObjectType::Triangles;
-  uint32_t material = 0;  // index into Scene::materials
-  Sphere sphere;          // ObjectType::Sphere
-  Plane plane;            // ObjectType::Plane
-  TriangleMesh mesh;      // ObjectType::Triangles ("triangle" and "mesh" in the file)
+  uint32_t material = 0;               // index into Scene::materials
+  Sphere sphere;                       // ObjectType::Sphere
+  Plane plane;                         // ObjectType::Plane
+  TriangleMesh mesh;                   // ObjectType::Triangles ("triangle" and "mesh" in the file)
   std::shared_ptr<const CsgNode> csg;  // ObjectType::Csg
 };
 

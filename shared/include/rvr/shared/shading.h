@@ -4,9 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "rvr/shared/scene.h"
 
@@ -30,9 +29,9 @@ inline float specular_power(float x, float s) {
 // N: unit normal facing the viewer; V: unit vector towards the viewer.
 // visibility(sample_index, P, L) returns vis_l in [0, 1] (1 in local mode).
 template <class Visibility>
-glm::vec3 shade_local(const Material& m, const glm::vec3& P, const glm::vec3& N,
-                      const glm::vec3& V, const glm::vec3& ambient,
-                      const std::vector<LightSample>& lights, Visibility&& visibility) {
+glm::vec3 shade_local(const Material& m, const glm::vec3& P, const glm::vec3& N, const glm::vec3& V,
+                      const glm::vec3& ambient, const std::vector<LightSample>& lights,
+                      Visibility&& visibility) {
   glm::vec3 colour = m.emission + ambient * m.diffuse;
   for (size_t i = 0; i < lights.size(); ++i) {
     glm::vec3 to_light = lights[i].position - P;

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <array>
-
 #include <glm/glm.hpp>
 
 #include "rvr/shared/scene.h"
