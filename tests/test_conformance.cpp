@@ -44,8 +44,8 @@ const RendererCase kRenderers[] = {
 // Every built-in scene, sized for the test. `csg` is the one exception, by the format's rule:
 // a csg object has no z-buffer form, so rasterizers skip it (with a warning; tested in
 // test_raster) and there is nothing to agree on.
-const char* kScenes[] = {"cornell",         "spheres", "occluders:16", "soup:2000",
-                         "tessphere:20000", "dof",     "glass"};
+const char* kScenes[] = {"cornell",   "spheres",         "occluders:16", "occluders_back:16",
+                         "soup:2000", "tessphere:20000", "dof",          "glass"};
 
 TEST(ConformanceScenes, CoverEveryBuiltinSceneButCsg) {
   std::set<std::string> listed;

@@ -17,11 +17,13 @@
 namespace rvr {
 namespace {
 
-RenderOutput render_soft(const Scene& scene, RenderMode mode = RenderMode::Local, int threads = 0) {
+RenderOutput render_soft(const Scene& scene, RenderMode mode = RenderMode::Local, int threads = 0,
+                         bool hiz = true) {
   SoftRasterizer r;
   RenderOptions options;
   options.mode = mode;
   options.threads = threads;
+  options.hiz = hiz;
   options.spheres = SphereMode::Mesh;
   Expected<RenderOutput> out = r.render(scene, options);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().message);
@@ -157,13 +159,13 @@ TEST(SoftRasterizer, AgreesWithTheGlRasterizerOnIds) {
 TEST(SoftRasterizer, CostIsDepthComplexity) {
   Expected<Scene> scene = make_builtin_scene("occluders:8");
   ASSERT_TRUE(scene.ok());
-  RenderOutput all = render_soft(*scene, RenderMode::Visibility);
+  RenderOutput all = render_soft(*scene, RenderMode::Visibility, 0, /*hiz=*/false);
   std::vector<float> complexity(all.buffers.pixel_count(), 0.0f);
   std::vector<bool> rear;
   for (size_t k = 0; k < scene->objects.size(); ++k) {
     Scene one = *scene;
     one.objects = {scene->objects[k]};
-    const FrameBuffers& fb = render_soft(one, RenderMode::Visibility).buffers;
+    const FrameBuffers& fb = render_soft(one, RenderMode::Visibility, 0, false).buffers;
     for (size_t i = 0; i < fb.pixel_count(); ++i) complexity[i] += fb.object_id[i] != kNoId;
     if (k + 1 == scene->objects.size())
       for (uint32_t id : fb.object_id) rear.push_back(id != kNoId);
@@ -178,6 +180,73 @@ TEST(SoftRasterizer, CostIsDepthComplexity) {
   }
   EXPECT_GT(full_depth, complexity.size() / 10);
   EXPECT_GT(all.stats.at("overdraw"), 1.0);
+}
+
+// Hierarchical z only skips work that the depth test would throw away: everything seen is the
+// same bytes with it on or off. Drawn front to back, the occluders behind the first quad are
+// rejected block by block; drawn back to front, every quad is nearer than what is there, and
+// nothing is rejected. The cost AOV adds each rejection as 1/64 to the pixels of its block, so
+// over the frame it sums to fragments + blocks rejected.
+TEST(SoftRasterizer, HierarchicalZChangesNothingSeen) {
+  auto same = [](const auto& x, const auto& y) {
+    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
+  };
+  for (const char* name : {"occluders:16", "occluders_back:16", "tessphere:20000", "soup:2000",
+                           "cornell", "spheres"}) {
+    Expected<Scene> scene = make_builtin_scene(name);
+    ASSERT_TRUE(scene.ok());
+    RenderOutput on = render_soft(*scene, RenderMode::Local, 0, true);
+    RenderOutput off = render_soft(*scene, RenderMode::Local, 0, false);
+    EXPECT_TRUE(same(on.buffers.color, off.buffers.color)) << name;
+    EXPECT_TRUE(same(on.buffers.depth, off.buffers.depth)) << name;
+    EXPECT_TRUE(same(on.buffers.object_id, off.buffers.object_id)) << name;
+    EXPECT_TRUE(same(on.buffers.primitive_id, off.buffers.primitive_id)) << name;
+    EXPECT_TRUE(same(on.buffers.normal, off.buffers.normal)) << name;
+    EXPECT_EQ(off.stats.at("hiz.blocks_rejected"), 0.0);
+    EXPECT_LE(on.stats.at("fragments.generated"), off.stats.at("fragments.generated")) << name;
+    double cost_sum = 0;
+    for (float c : on.buffers.cost) cost_sum += c;
+    ASSERT_EQ(on.buffers.width % 8, 0);
+    ASSERT_EQ(on.buffers.height % 8, 0);
+    EXPECT_DOUBLE_EQ(cost_sum,
+                     on.stats.at("fragments.generated") + on.stats.at("hiz.blocks_rejected"))
+        << name;
+    const std::string n = name;
+    if (n == "occluders:16") {
+      EXPECT_GT(on.stats.at("hiz.blocks_rejected"), 1000.0);
+      // 15 of the 16 quads lie behind the first wherever it covers them.
+      EXPECT_LT(on.stats.at("fragments.generated"), 0.5 * off.stats.at("fragments.generated"));
+    }
+    if (n == "occluders_back:16") {
+      EXPECT_EQ(on.stats.at("hiz.blocks_rejected"), 0.0);
+    }
+    if (n == "tessphere:20000") {  // its far half lies behind the near half drawn before it
+      EXPECT_GT(on.stats.at("hiz.triangles_rejected"), 0.0);
+    }
+  }
+}
+
+// Triangles stream through in chunks of 65,536: a scene of several chunks gives the same bytes
+// on one thread as on two, with and without hi-z, and the rasterizer's memory (the frame's
+// z-buffer state plus one chunk) does not grow with the number of triangles.
+TEST(SoftRasterizer, ManyChunksSameBytesBoundedMemory) {
+  double memory[2] = {0, 0};
+  int k = 0;
+  for (const char* name : {"soup:150000", "soup:600000"}) {
+    Expected<Scene> scene = make_builtin_scene(name);
+    ASSERT_TRUE(scene.ok());
+    for (bool hiz : {true, false}) {
+      RenderOutput a = render_soft(*scene, RenderMode::Local, 1, hiz);
+      RenderOutput b = render_soft(*scene, RenderMode::Local, 2, hiz);
+      EXPECT_EQ(a.buffers.color, b.buffers.color) << name;
+      EXPECT_EQ(a.buffers.object_id, b.buffers.object_id) << name;
+      EXPECT_EQ(a.buffers.cost, b.buffers.cost) << name;
+      memory[k] = std::max(memory[k], a.stats.at("memory.raster_bytes"));
+    }
+    ++k;
+  }
+  // Four times the triangles, the same memory (to within the growth of one chunk's bins).
+  EXPECT_LT(memory[1], 1.05 * memory[0]) << memory[0] << " then " << memory[1];
 }
 
 TEST(SoftRasterizer, WarnsAboutWhatItCannotDraw) {

@@ -74,6 +74,7 @@ struct CommonOptions {
   int shadow_map_size = 1024;
   float shadow_bias = 0.01f;
   bool shadow_pcf = false;
+  std::string hiz = "on";
   bool quiet = false;
   Limits limits;
   uint64_t max_memory_mb = 0;
@@ -114,6 +115,10 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--shadow-bias", o.shadow_bias, "raster shadow maps: depth bias (scene units)")
       ->check(CLI::Range(0.0f, 10.0f));
   cmd.add_flag("--shadow-pcf", o.shadow_pcf, "raster shadow maps: 3x3 percentage-closer filtering");
+  cmd.add_option("--hiz", o.hiz,
+                 "softraster: hierarchical z, each 8x8 block's farthest depth rejecting what lies "
+                 "behind it: on | off (the textbook z-buffer)")
+      ->check(CLI::IsMember({"on", "off"}));
   cmd.add_flag("--quiet,-q", o.quiet, "no progress output");
   cmd.add_option("--max-samples", o.limits.max_samples,
                  "refuse more than N pixels x samples (default 2^30)")
@@ -154,6 +159,7 @@ RenderOptions render_options(const CommonOptions& o, const std::string& default_
   r.shadow_map_size = o.shadow_map_size;
   r.shadow_bias = o.shadow_bias;
   r.shadow_pcf = o.shadow_pcf;
+  r.hiz = o.hiz == "on";
   return r;
 }
 

@@ -2,11 +2,13 @@
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -18,26 +20,29 @@
 #include "rvr/shared/camera.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/tessellate.h"
+#include "soft/tile_raster.h"
+#include "soft/triangle_setup.h"
 
 namespace rvr {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
+using soft::DepthTarget;
+using soft::ProjectedVertex;
+using soft::SetupTriangle;
+using soft::TileCounters;
+using soft::TriangleSetup;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-constexpr int kTile = 64;
-// Sub-pixel precision of the edge functions: finer than GL's usual 8 bits, so that snapping
-// an edge-on sliver (a sphere's silhouette) rarely makes it cover a centre it does not.
-constexpr int kSubBits = 12;
-constexpr int64_t kSub = int64_t(1) << kSubBits;
-// Guard-band clipping keeps screen coordinates within +-(2^15 + 2^14) pixels, i.e. 28-bit
-// fixed point, so edge functions (products of 29-bit differences) never overflow int64.
-constexpr double kGuardPixels = double(1 << 16);
-constexpr int kMaxImageSide = 1 << 15;
+// Triangles stream through in chunks of kChunk (in submission order), each set up by kSubChunk at
+// a time in parallel, binned, and drawn into every tile before the next: memory holds one chunk,
+// whatever the triangle count.
+constexpr size_t kChunk = size_t(1) << 16;
+constexpr size_t kSubChunk = 4096;
 
 // What shading needs per object; tessellated shapes point into SoftRasterizer-owned meshes.
 struct DrawObject {
@@ -47,215 +52,25 @@ struct DrawObject {
   bool use_primitive_id = false;
 };
 
-// A screen-space triangle after clipping. One input triangle gives up to a few of these.
-struct SetupTriangle {
-  std::array<int64_t, 3> x, y;   // fixed point, oriented so the edge functions are >= 0 inside
-  std::array<bool, 3> top_left;  // edge i runs from vertex i to vertex i+1
-  // q_j(p) = q0[j] + qa[j]*(px - ox) + qb[j]*(py - oy) = (barycentric j of the ORIGINAL
-  // triangle) / w: linear in screen space, so sum_j q_j = 1/w = 1/view depth, and q_j/sum is
-  // the perspective-correct barycentric. From the unsnapped vertices, in double: P must be
-  // exact where 1/|L - P|^2 is steep (surfaces next to a light).
-  std::array<double, 3> q0, qa, qb;
-  double ox = 0, oy = 0;
-  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // pixel bounding box, inclusive, on screen
-  uint32_t object = 0, primitive = 0;
-
-  double inv_w(double px, double py, std::array<double, 3>& q) const {
-    double s = 0;
-    for (int j = 0; j < 3; ++j) {
-      // Clamped: a sliver may cover a centre just outside itself (snapping); it is then seen
-      // at its nearest edge point instead of extrapolating depth.
-      q[j] = std::max(0.0, q0[j] + qa[j] * (px - ox) + qb[j] * (py - oy));
-      s += q[j];
+// A thread's setup state: its own clipping scratch and a cache of projected vertices (a mesh's
+// neighbouring triangles share them, so most are projected once, not once per triangle).
+struct SetupWorker {
+  static constexpr size_t kCacheSize = 4096;
+  explicit SetupWorker(const TriangleSetup& prototype)
+      : setup(prototype), keys(kCacheSize, ~0ull), cache(kCacheSize) {}
+  const ProjectedVertex& vertex(uint32_t object, uint32_t index, const glm::vec3& p) {
+    const uint64_t key = uint64_t(object) << 32 | index;
+    const size_t slot = (index ^ object * 0x9E3779B1u) & (kCacheSize - 1);
+    if (keys[slot] != key) {
+      keys[slot] = key;
+      cache[slot] = setup.project(p);
     }
-    return s;
+    return cache[slot];
   }
+  TriangleSetup setup;
+  std::vector<uint64_t> keys;
+  std::vector<ProjectedVertex> cache;
 };
-
-struct ClipVertex {
-  glm::dvec4 c;  // clip space
-  glm::dvec3 b;  // barycentric in the original triangle
-};
-
-// Clip-space planes as dot(plane, c) >= 0.
-using Polygon = std::vector<ClipVertex>;
-
-void clip_polygon(const Polygon& in, const glm::dvec4& plane, Polygon& out) {
-  out.clear();
-  for (size_t i = 0; i < in.size(); ++i) {
-    const ClipVertex& a = in[i];
-    const ClipVertex& b = in[(i + 1) % in.size()];
-    double da = glm::dot(plane, a.c), db = glm::dot(plane, b.c);
-    if (da >= 0) out.push_back(a);
-    if ((da >= 0) != (db >= 0)) {
-      double t = da / (da - db);
-      out.push_back({a.c + t * (b.c - a.c), a.b + t * (b.b - a.b)});
-    }
-  }
-}
-
-struct Setup {
-  int width, height;
-  glm::dmat4 view_projection;
-  std::vector<SetupTriangle> triangles;
-  size_t clipped = 0;  // input triangles culled or clipped
-  Polygon poly, scratch;
-
-  void add(const std::array<glm::vec3, 3>& p, uint32_t object, uint32_t primitive) {
-    Polygon& v = poly;
-    v.resize(3);
-    for (int i = 0; i < 3; ++i) {
-      v[i].c = view_projection * glm::dvec4(glm::dvec3(p[i]), 1.0);
-      v[i].b = glm::dvec3(0.0);
-      v[i].b[i] = 1.0;
-    }
-    // Trivial reject against the view frustum; then clip only where a plane is crossed.
-    const double gx = kGuardPixels / width, gy = kGuardPixels / height;
-    const glm::dvec4 frustum[6] = {{1, 0, 0, 1},  {-1, 0, 0, 1}, {0, 1, 0, 1},
-                                   {0, -1, 0, 1}, {0, 0, 1, 1},  {0, 0, -1, 1}};
-    for (const glm::dvec4& f : frustum) {
-      if (glm::dot(f, v[0].c) < 0 && glm::dot(f, v[1].c) < 0 && glm::dot(f, v[2].c) < 0) {
-        ++clipped;
-        return;
-      }
-    }
-    // Near first: afterwards w >= near > 0, so the guard planes (scaled by w) are well defined.
-    const glm::dvec4 planes[5] = {
-        {0, 0, 1, 1}, {1, 0, 0, gx}, {-1, 0, 0, gx}, {0, 1, 0, gy}, {0, -1, 0, gy}};
-    bool was_clipped = false;
-    for (const glm::dvec4& plane : planes) {
-      bool outside = false;
-      for (const ClipVertex& c : v) outside |= glm::dot(plane, c.c) < 0;
-      if (!outside) continue;
-      was_clipped = true;
-      clip_polygon(v, plane, scratch);
-      std::swap(v, scratch);
-      if (v.size() < 3) break;
-    }
-    clipped += was_clipped ? 1 : 0;
-    // A convex polygon as a fan: the inner diagonals are shared edges, drawn once by the rule.
-    for (size_t i = 1; i + 1 < v.size(); ++i) emit(v[0], v[i], v[i + 1], object, primitive);
-  }
-
-  void emit(const ClipVertex& a, const ClipVertex& b, const ClipVertex& c, uint32_t object,
-            uint32_t primitive) {
-    const ClipVertex* cv[3] = {&a, &b, &c};
-    SetupTriangle t;
-    std::array<double, 3> sx, sy;
-    for (int i = 0; i < 3; ++i) {
-      const glm::dvec4& k = cv[i]->c;
-      // Viewport with y flipped: row 0 is the top.
-      sx[i] = (k.x / k.w * 0.5 + 0.5) * width;
-      sy[i] = (0.5 - k.y / k.w * 0.5) * height;
-      t.x[i] = std::llround(sx[i] * double(kSub));
-      t.y[i] = std::llround(sy[i] * double(kSub));
-    }
-    int64_t area = (t.x[1] - t.x[0]) * (t.y[2] - t.y[0]) - (t.y[1] - t.y[0]) * (t.x[2] - t.x[0]);
-    if (area == 0) return;  // covers no pixel centre
-    if (area < 0) {         // two-sided: either winding, oriented here
-      std::swap(cv[1], cv[2]);
-      std::swap(sx[1], sx[2]);
-      std::swap(sy[1], sy[2]);
-      std::swap(t.x[1], t.x[2]);
-      std::swap(t.y[1], t.y[2]);
-    }
-    int64_t min_x = std::min({t.x[0], t.x[1], t.x[2]}), max_x = std::max({t.x[0], t.x[1], t.x[2]});
-    int64_t min_y = std::min({t.y[0], t.y[1], t.y[2]}), max_y = std::max({t.y[0], t.y[1], t.y[2]});
-    t.x0 = int(std::max<int64_t>(0, min_x >> kSubBits));
-    t.y0 = int(std::max<int64_t>(0, min_y >> kSubBits));
-    t.x1 = int(std::min<int64_t>(width - 1, max_x >> kSubBits));
-    t.y1 = int(std::min<int64_t>(height - 1, max_y >> kSubBits));
-    if (t.x0 > t.x1 || t.y0 > t.y1) return;
-    for (int i = 0; i < 3; ++i) {
-      int64_t dx = t.x[(i + 1) % 3] - t.x[i], dy = t.y[(i + 1) % 3] - t.y[i];
-      // y points down: with positive area, top edges run right and left edges run up.
-      t.top_left[i] = (dy == 0 && dx > 0) || dy < 0;
-    }
-    double dx1 = sx[1] - sx[0], dy1 = sy[1] - sy[0], dx2 = sx[2] - sx[0], dy2 = sy[2] - sy[0];
-    double det = dx1 * dy2 - dx2 * dy1;
-    if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return;
-    t.ox = sx[0];
-    t.oy = sy[0];
-    for (int j = 0; j < 3; ++j) {
-      double f0 = cv[0]->b[j] / cv[0]->c.w, f1 = cv[1]->b[j] / cv[1]->c.w,
-             f2 = cv[2]->b[j] / cv[2]->c.w;
-      t.q0[j] = f0;
-      t.qa[j] = ((f1 - f0) * dy2 - (f2 - f0) * dy1) / det;
-      t.qb[j] = ((f2 - f0) * dx1 - (f1 - f0) * dx2) / det;
-    }
-    t.object = object;
-    t.primitive = primitive;
-    triangles.push_back(t);
-  }
-};
-
-struct TileCounters {
-  uint64_t generated = 0;
-};
-
-// Rasterizes one tile: every binned triangle in submission order, strict-less depth test, so
-// the result does not depend on which thread runs which tile.
-void raster_tile(int tx, int ty, const std::vector<uint32_t>& bin,
-                 const std::vector<SetupTriangle>& tris, double near_plane, double far_plane,
-                 FrameBuffers& fb, std::vector<uint32_t>& visible, TileCounters& counters) {
-  const int ox = tx * kTile, oy = ty * kTile;
-  const int tw = std::min(kTile, fb.width - ox), th = std::min(kTile, fb.height - oy);
-  std::array<double, kTile * kTile> zbuf;
-  std::array<uint32_t, kTile * kTile> ids;
-  std::array<uint32_t, kTile * kTile> cost;
-  zbuf.fill(std::numeric_limits<double>::infinity());
-  ids.fill(kNoId);
-  cost.fill(0);
-  uint64_t generated = 0;
-  std::array<double, 3> q;
-  for (uint32_t index : bin) {
-    const SetupTriangle& t = tris[index];
-    const int x0 = std::max(t.x0, ox), x1 = std::min(t.x1, ox + tw - 1);
-    const int y0 = std::max(t.y0, oy), y1 = std::min(t.y1, oy + th - 1);
-    if (x0 > x1 || y0 > y1) continue;
-    // E_i(p) = (x[i+1]-x[i])*(py-y[i]) - (y[i+1]-y[i])*(px-x[i]) at pixel centres, in
-    // sub-pixel units; a non-top-left edge needs E > 0, i.e. E - 1 >= 0 in integers.
-    const int64_t px0 = int64_t(x0) * kSub + kSub / 2, py0 = int64_t(y0) * kSub + kSub / 2;
-    int64_t row[3], step_x[3], step_y[3];
-    for (int i = 0; i < 3; ++i) {
-      const int n = (i + 1) % 3;
-      const int64_t dx = t.x[n] - t.x[i], dy = t.y[n] - t.y[i];
-      row[i] = dx * (py0 - t.y[i]) - dy * (px0 - t.x[i]) - (t.top_left[i] ? 0 : 1);
-      step_x[i] = -dy * kSub;
-      step_y[i] = dx * kSub;
-    }
-    for (int y = y0; y <= y1; ++y) {
-      int64_t e0 = row[0], e1 = row[1], e2 = row[2];
-      for (int x = x0; x <= x1; ++x) {
-        if ((e0 | e1 | e2) >= 0) {
-          const size_t i = size_t(y - oy) * kTile + size_t(x - ox);
-          ++cost[i];
-          ++generated;
-          const double depth = 1.0 / t.inv_w(x + 0.5, y + 0.5, q);
-          // The depth range clips what lies beyond far (and rounding just inside near).
-          if (depth < zbuf[i] && depth >= near_plane && depth <= far_plane) {
-            zbuf[i] = depth;
-            ids[i] = index;
-          }
-        }
-        e0 += step_x[0];
-        e1 += step_x[1];
-        e2 += step_x[2];
-      }
-      for (int i = 0; i < 3; ++i) row[i] += step_y[i];
-    }
-  }
-  for (int y = 0; y < th; ++y) {
-    for (int x = 0; x < tw; ++x) {
-      const size_t i = size_t(y) * kTile + size_t(x);
-      const size_t o = fb.index(ox + x, oy + y);
-      fb.depth[o] = ids[i] == kNoId ? std::numeric_limits<float>::infinity() : float(zbuf[i]);
-      fb.cost[o] = float(cost[i]);
-      visible[o] = ids[i];
-    }
-  }
-  counters.generated = generated;
-}
 
 std::string object_label(const Object& o, size_t index) {
   return o.name.empty() ? fmt::format("csg#{}", index) : o.name;
@@ -264,9 +79,9 @@ std::string object_label(const Object& o, size_t index) {
 Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options) {
   const int w = scene.image.width, h = scene.image.height;
   if (w < 1 || h < 1) return bad_input(fmt::format("image size {}x{} is empty", w, h));
-  if (w > kMaxImageSide || h > kMaxImageSide)
+  if (w > soft::kMaxImageSide || h > soft::kMaxImageSide)
     return bad_input(fmt::format("image size {}x{}: softraster draws at most {} pixels a side", w,
-                                 h, kMaxImageSide));
+                                 h, soft::kMaxImageSide));
   RenderOutput out;
   ProgressSink* const progress = options.progress;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
@@ -320,98 +135,128 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     transparency |= d.material->transparency > 0.0f;
   }
 
-  // Setup in parallel over fixed chunks of the submission order, each chunk transforming,
-  // clipping and binning its own triangles; chunks are joined in order, so the triangle list and
-  // every bin come out exactly as a serial pass would make them, whatever the thread count.
   const glm::dmat4 view_projection =
       glm::dmat4(projection_matrix(scene.camera, w, h)) * glm::dmat4(view_matrix(scene.camera));
-  struct Submitted {
-    uint32_t object, primitive;
-  };
-  std::vector<Submitted> order;
+  // Submission order: objects in turn, each mesh's triangles in turn.
+  std::vector<size_t> object_first(objects.size() + 1, 0);
   for (size_t i = 0; i < objects.size(); ++i)
-    if (const TriangleMesh* m = objects[i].mesh)
-      for (size_t k = 0; k < m->triangles.size(); ++k) order.push_back({uint32_t(i), uint32_t(k)});
-  const size_t submitted = order.size();
-  const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-  const size_t tile_count = size_t(tiles_x) * size_t(tiles_y);
-  constexpr size_t kChunk = 8192;
-  const size_t chunk_count = (order.size() + kChunk - 1) / kChunk;
-  std::vector<Setup> chunks(chunk_count, Setup{w, h, view_projection, {}, 0, {}, {}});
-  std::vector<std::vector<std::vector<uint32_t>>> chunk_bins(chunk_count);
-  if (progress) progress->begin("setup", submitted, "triangles");
-  arena.execute([&] {
-    tbb::parallel_for(size_t(0), chunk_count, [&](size_t c) {
-      Setup& setup = chunks[c];
-      const size_t end = std::min(order.size(), (c + 1) * kChunk);
-      setup.triangles.reserve(end - c * kChunk);
-      for (size_t j = c * kChunk; j < end; ++j) {
-        const TriangleMesh& m = *objects[order[j].object].mesh;
-        const glm::uvec3& tri = m.triangles[order[j].primitive];
-        setup.add({m.positions[tri.x], m.positions[tri.y], m.positions[tri.z]}, order[j].object,
-                  order[j].primitive);
-      }
-      auto& bins = chunk_bins[c];
-      bins.resize(tile_count);
-      for (size_t i = 0; i < setup.triangles.size(); ++i) {
-        const SetupTriangle& st = setup.triangles[i];
-        for (int ty = st.y0 / kTile; ty <= st.y1 / kTile; ++ty)
-          for (int tx = st.x0 / kTile; tx <= st.x1 / kTile; ++tx)
-            bins[size_t(ty) * size_t(tiles_x) + size_t(tx)].push_back(uint32_t(i));
-      }
-      if (progress) progress->advance(end - c * kChunk);
-    });
-  });
-  // Joining the chunks: mostly allocation and copies, so time only.
-  if (progress) progress->begin("bin");
-  // Offsets of each chunk's triangles in the joined list.
-  std::vector<uint32_t> first(chunk_count + 1, 0);
-  size_t clipped = 0;
-  for (size_t c = 0; c < chunk_count; ++c) {
-    first[c + 1] = first[c] + uint32_t(chunks[c].triangles.size());
-    clipped += chunks[c].clipped;
-  }
-  std::vector<SetupTriangle> tris(first[chunk_count]);
-  std::vector<std::vector<uint32_t>> bins(tile_count);
-  arena.execute([&] {
-    tbb::parallel_for(size_t(0), chunk_count, [&](size_t c) {
-      std::copy(chunks[c].triangles.begin(), chunks[c].triangles.end(), tris.begin() + first[c]);
-    });
-    tbb::parallel_for(size_t(0), tile_count, [&](size_t b) {
-      size_t n = 0;
-      for (size_t c = 0; c < chunk_count; ++c) n += chunk_bins[c][b].size();
-      bins[b].reserve(n);
-      for (size_t c = 0; c < chunk_count; ++c)
-        for (uint32_t i : chunk_bins[c][b]) bins[b].push_back(first[c] + i);
-    });
-  });
+    object_first[i + 1] =
+        object_first[i] + (objects[i].mesh ? objects[i].mesh->triangles.size() : 0);
+  const size_t submitted = object_first.back();
   out.stats["time.setup"] = seconds_since(t);
 
-  // --- raster: tiles in parallel, each independent of the others
-  t = Clock::now();
-  FrameBuffers& fb = out.buffers;
-  fb.reset(w, h, scene.image.background);
-  std::vector<uint32_t> visible(fb.pixel_count(), kNoId);
-  std::vector<TileCounters> counters(bins.size());
-  const double near_plane = scene.camera.near, far_plane = scene.camera.far;
-  // The fraction in tiles, the speed in fragments (a tile's cost is its fragments).
-  if (progress) progress->begin("raster", bins.size(), "tiles", "fragments");
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, bins.size()),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        uint64_t fragments = 0;
-                        for (size_t b = r.begin(); b != r.end(); ++b) {
-                          raster_tile(int(b % size_t(tiles_x)), int(b / size_t(tiles_x)), bins[b],
-                                      tris, near_plane, far_plane, fb, visible, counters[b]);
-                          fragments += counters[b].generated;
-                        }
-                        if (progress) progress->advance(r.size(), fragments);
-                      });
-  });
-  out.stats["time.raster"] = seconds_since(t);
+  DepthTarget target(w, h, scene.camera.near, scene.camera.far, options.hiz);
+  const size_t tile_count = size_t(target.tiles_x()) * size_t(target.tiles_y());
+  const TriangleSetup prototype(w, h, view_projection);
+  tbb::enumerable_thread_specific<SetupWorker> workers(prototype);
+  std::vector<std::vector<SetupTriangle>> sub_out((kChunk + kSubChunk - 1) / kSubChunk);
+  std::vector<size_t> sub_clipped(sub_out.size());
+  std::vector<uint32_t> counts, bin_start(tile_count + 1), bin;
+  std::vector<TileCounters> counters(tile_count);
+  size_t clipped = 0, set_up = 0, peak_chunk_bytes = 0;
+  double setup_seconds = 0, bin_seconds = 0, raster_seconds = 0;
+  // The fraction in triangles, the speed in fragments.
+  if (progress) progress->begin("draw", submitted, "triangles", "fragments");
+  for (size_t chunk = 0; chunk < submitted; chunk += kChunk) {
+    const size_t chunk_end = std::min(submitted, chunk + kChunk);
+    const size_t subs = (chunk_end - chunk + kSubChunk - 1) / kSubChunk;
+    // --- setup: transform, cull, clip; sub-chunks in parallel, joined in order
+    t = Clock::now();
+    arena.execute([&] {
+      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
+        SetupWorker& worker = workers.local();
+        std::vector<SetupTriangle>& local = sub_out[s];
+        local.clear();
+        local.reserve(kSubChunk);
+        size_t local_clipped = 0;
+        const size_t begin = chunk + s * kSubChunk, end = std::min(chunk_end, begin + kSubChunk);
+        size_t object = size_t(std::upper_bound(object_first.begin(), object_first.end(), begin) -
+                               object_first.begin()) -
+                        1;
+        for (size_t g = begin; g < end; ++g) {
+          while (g >= object_first[object + 1]) ++object;
+          const TriangleMesh& m = *objects[object].mesh;
+          const uint32_t primitive = uint32_t(g - object_first[object]);
+          const glm::uvec3& tri = m.triangles[primitive];
+          const uint32_t o = uint32_t(object);
+          // Copies: the next lookups may evict an entry.
+          const ProjectedVertex a = worker.vertex(o, tri.x, m.positions[tri.x]);
+          const ProjectedVertex b = worker.vertex(o, tri.y, m.positions[tri.y]);
+          const ProjectedVertex c = worker.vertex(o, tri.z, m.positions[tri.z]);
+          worker.setup.add(a, b, c, o, primitive, local, local_clipped);
+        }
+        sub_clipped[s] = local_clipped;
+      });
+    });
+    for (size_t s = 0; s < subs; ++s) {
+      clipped += sub_clipped[s];
+      set_up += sub_out[s].size();
+    }
+    setup_seconds += seconds_since(t);
+
+    // --- bin: a counting sort of the chunk's triangles into tiles, in submission order
+    t = Clock::now();
+    const int tiles_x = target.tiles_x();
+    auto for_tiles = [&](const SetupTriangle& st, auto&& fn) {
+      for (int ty = st.y0 / soft::kTile; ty <= st.y1 / soft::kTile; ++ty)
+        for (int tx = st.x0 / soft::kTile; tx <= st.x1 / soft::kTile; ++tx)
+          fn(size_t(ty) * size_t(tiles_x) + size_t(tx));
+    };
+    counts.assign(subs * tile_count, 0);
+    arena.execute([&] {
+      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
+        uint32_t* c = &counts[s * tile_count];
+        for (const SetupTriangle& st : sub_out[s]) for_tiles(st, [&](size_t b) { ++c[b]; });
+      });
+    });
+    // Offsets: tile by tile, and within a tile sub-chunk by sub-chunk (submission order).
+    uint32_t running = 0;
+    for (size_t b = 0; b < tile_count; ++b) {
+      bin_start[b] = running;
+      for (size_t s = 0; s < subs; ++s) {
+        uint32_t n = counts[s * tile_count + b];
+        counts[s * tile_count + b] = running;
+        running += n;
+      }
+    }
+    bin_start[tile_count] = running;
+    bin.resize(running);
+    arena.execute([&] {
+      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
+        uint32_t* next = &counts[s * tile_count];
+        const uint32_t tag = uint32_t(s) << DepthTarget::kLocalBits;
+        for (size_t i = 0; i < sub_out[s].size(); ++i)
+          for_tiles(sub_out[s][i], [&](size_t b) { bin[next[b]++] = tag | uint32_t(i); });
+      });
+    });
+    bin_seconds += seconds_since(t);
+    size_t chunk_bytes = (bin.capacity() + counts.capacity()) * sizeof(uint32_t);
+    for (const auto& v : sub_out) chunk_bytes += v.capacity() * sizeof(SetupTriangle);
+    peak_chunk_bytes = std::max(peak_chunk_bytes, chunk_bytes);
+
+    // --- raster: tiles in parallel, each independent of the others
+    t = Clock::now();
+    std::atomic<uint64_t> fragments{0};
+    arena.execute([&] {
+      tbb::parallel_for(size_t(0), tile_count, [&](size_t b) {
+        if (bin_start[b + 1] == bin_start[b]) return;
+        const uint64_t before = counters[b].generated;
+        target.draw_tile(int(b % size_t(tiles_x)), int(b / size_t(tiles_x)), sub_out.data(),
+                         bin.data() + bin_start[b], bin_start[b + 1] - bin_start[b], counters[b]);
+        fragments.fetch_add(counters[b].generated - before, std::memory_order_relaxed);
+      });
+    });
+    raster_seconds += seconds_since(t);
+    if (progress) progress->advance(chunk_end - chunk, fragments.load());
+  }
+  out.stats["time.setup"] += setup_seconds;
+  out.stats["time.bin"] = bin_seconds;
+  out.stats["time.raster"] = raster_seconds;
 
   // --- shade: deferred, each visible pixel once
   t = Clock::now();
+  FrameBuffers& fb = out.buffers;
+  fb.allocate(w, h);  // every pixel is written below
   const std::vector<LightSample> samples = options.mode == RenderMode::Visibility
                                                ? std::vector<LightSample>{}
                                                : light_samples(scene.lights);
@@ -419,16 +264,16 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
-      std::array<double, 3> q;
       for (int y = r.begin(); y != r.end(); ++y) {
         for (int x = 0; x < w; ++x) {
           const size_t o = fb.index(x, y);
-          if (visible[o] == kNoId) continue;
-          const SetupTriangle& s = tris[visible[o]];
-          const DrawObject& d = objects[s.object];
-          const double inv_w = s.inv_w(x + 0.5, y + 0.5, q);
-          const glm::vec3 b(float(q[0] / inv_w), float(q[1] / inv_w), float(q[2] / inv_w));
-          const glm::uvec3& tri = d.mesh->triangles[s.primitive];
+          fb.set_background(o, scene.image.background);
+          fb.cost[o] = target.cost(o);
+          if (!target.covered(o)) continue;
+          const DrawObject& d = objects[target.object(o)];
+          const uint32_t primitive = target.primitive(o);
+          const glm::vec3 b = target.barycentric(o);
+          const glm::uvec3& tri = d.mesh->triangles[primitive];
           const glm::vec3 &p0 = d.mesh->positions[tri.x], &p1 = d.mesh->positions[tri.y],
                           &p2 = d.mesh->positions[tri.z];
           const glm::vec3 P = b.x * p0 + b.y * p1 + b.z * p2;
@@ -439,8 +284,9 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
                        : g;
           const glm::vec3 V = glm::normalize(eye - P);
           const glm::vec3 N = face_viewer(shading, g, V);
-          fb.object_id[o] = s.object;
-          fb.primitive_id[o] = d.use_primitive_id ? s.primitive : 0u;
+          fb.depth[o] = float(target.depth(o));
+          fb.object_id[o] = target.object(o);
+          fb.primitive_id[o] = d.use_primitive_id ? primitive : 0u;
           fb.normal[o] = N;
           if (options.mode != RenderMode::Visibility)
             fb.color[o] = shade_local(*d.material, P, N, V, scene.ambient, samples);
@@ -451,16 +297,27 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   });
   out.stats["time.shade"] = seconds_since(t);
 
-  uint64_t generated = 0, covered = 0;
-  for (const TileCounters& c : counters) generated += c.generated;
-  for (uint32_t v : visible) covered += v != kNoId ? 1 : 0;
+  TileCounters sum;
+  for (const TileCounters& c : counters) {
+    sum.generated += c.generated;
+    sum.blocks_rejected += c.blocks_rejected;
+    sum.triangles_rejected += c.triangles_rejected;
+    sum.blocks_full += c.blocks_full;
+  }
+  uint64_t covered = 0;
+  for (size_t i = 0; i < fb.pixel_count(); ++i) covered += target.covered(i) ? 1 : 0;
   out.stats["triangles.submitted"] = double(submitted);
   out.stats["triangles.clipped"] = double(clipped);
-  out.stats["triangles.setup"] = double(tris.size());
-  out.stats["fragments.generated"] = double(generated);
+  out.stats["triangles.setup"] = double(set_up);
+  out.stats["fragments.generated"] = double(sum.generated);
   out.stats["fragments.shaded"] = double(covered);
   out.stats["pixels.covered"] = double(covered);
-  out.stats["overdraw"] = covered > 0 ? double(generated) / double(covered) : 0.0;
+  out.stats["overdraw"] = covered > 0 ? double(sum.generated) / double(covered) : 0.0;
+  out.stats["blocks.full"] = double(sum.blocks_full);
+  out.stats["hiz.blocks_rejected"] = double(sum.blocks_rejected);
+  out.stats["hiz.triangles_rejected"] = double(sum.triangles_rejected);
+  out.stats["memory.raster_bytes"] = double(target.bytes() + peak_chunk_bytes);
+  out.info["hiz"] = options.hiz ? "on" : "off";
 
   if (!skipped_csg.empty()) {
     std::string names;

@@ -33,7 +33,7 @@ constexpr size_t kMedianDepth = 32;
 // A primitive's bounds and index, partitioned in place as the tree is built (as Embree's
 // PrimRef): every pass over a node's primitives reads memory in order, where an index array into
 // the input would jump around it at every level.
-struct alignas(32) PrimRef {
+struct PrimRef {  // 32 bytes
   glm::vec3 lo;
   uint32_t id;
   glm::vec3 hi;

@@ -1,6 +1,7 @@
 // The built-in scenes: small, deterministic, and chosen to stress one axis each
 // (cornell: everything; spheres: analytic shapes; occluders: depth complexity; soup and
 // tessphere: triangle count).
+#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <memory>
@@ -171,8 +172,9 @@ Scene spheres() {
 
 // N parallel quads facing the camera, one behind another; the rear ones are hidden by the
 // front one wherever it covers them, so the z-buffer shades N fragments there and the tracer 1.
-Scene occluders(size_t n) {
-  Scene s = base_scene("occluders:" + std::to_string(n));
+// back_to_front submits the rearmost first: the order hi-z cannot exploit.
+Scene occluders(size_t n, bool back_to_front = false) {
+  Scene s = base_scene((back_to_front ? "occluders_back:" : "occluders:") + std::to_string(n));
   const float spacing = 0.05f;
   for (size_t i = 0; i < n; ++i) {
     float t = n > 1 ? float(i) / float(n - 1) : 0.0f;
@@ -181,6 +183,7 @@ Scene occluders(size_t n) {
     Object& o = add_object(s, "quad " + std::to_string(i), ObjectType::Plane, m);
     o.plane = {{0.0f, 0.0f, -float(i) * spacing}, {0, 0, 1}, 1.0f};
   }
+  if (back_to_front) std::reverse(s.objects.begin(), s.objects.end());
   look_at(s, {0.0f, 0.0f, 3.0f}, {0.0f, 0.0f, 0.0f}, 45.0f, 0.1f, 100.0f);
   s.ambient = {0.05f, 0.05f, 0.05f};
   add_point_light(s, {1.0f, 1.5f, 3.0f}, {10.0f, 10.0f, 10.0f});
@@ -348,7 +351,9 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
        "the Cornell box (published geometry), a mirror and a glass sphere, an area light"},
       {"spheres", "a 5x5 grid of analytic spheres on a square plane, two point lights"},
       {"occluders:N",
-       "N parallel quads one behind another facing the camera: depth complexity N (default 8)"},
+       "N parallel quads one behind another facing the camera, drawn front to back: depth "
+       "complexity N (default 8)"},
+      {"occluders_back:N", "the same quads drawn back to front (what hierarchical z cannot skip)"},
       {"soup:N", "N random triangles in a box, seeded, constant total area (default 1000)"},
       {"tessphere:N", "one smooth sphere tessellated into about N triangles (default 10000)"},
       {"csg", "union, intersection, difference of spheres and a nested tree, on a floor"},
@@ -378,6 +383,7 @@ Expected<Scene> make_builtin_scene(const std::string& spec) {
   if (name == "cornell") return has_count ? no_count() : Expected<Scene>(cornell());
   if (name == "spheres") return has_count ? no_count() : Expected<Scene>(spheres());
   if (name == "occluders") return occluders(has_count ? count : 8);
+  if (name == "occluders_back") return occluders(has_count ? count : 8, true);
   if (name == "soup") return soup(has_count ? count : 1000);
   if (name == "tessphere") return tessphere(has_count ? count : 10000);
   if (name == "csg") return has_count ? no_count() : Expected<Scene>(csg());

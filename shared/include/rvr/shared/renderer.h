@@ -44,6 +44,8 @@ struct RenderOptions {
   int shadow_map_size = 1024;
   float shadow_bias = 0.01f;
   bool shadow_pcf = false;
+  // softraster: hierarchical z (each 8x8 block's farthest depth rejects triangles behind it).
+  bool hiz = true;
   // Where to report work done (per tile or chunk, never per ray); null: nobody is watching.
   // Reporting must change neither the image nor the order of work.
   ProgressSink* progress = nullptr;

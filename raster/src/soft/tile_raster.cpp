@@ -1,0 +1,161 @@
+#include "soft/tile_raster.h"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+
+namespace rvr::soft {
+
+DepthTarget::DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz)
+    : width_(width),
+      height_(height),
+      tiles_x_((width + kTile - 1) / kTile),
+      tiles_y_((height + kTile - 1) / kTile),
+      blocks_x_((width + kBlock - 1) / kBlock),
+      blocks_y_((height + kBlock - 1) / kBlock),
+      near_(near_plane),
+      far_(far_plane),
+      hiz_(hiz) {
+  const size_t n = size_t(width) * size_t(height);
+  depth_.assign(n, std::numeric_limits<double>::infinity());
+  object_.assign(n, 0xFFFFFFFFu);
+  primitive_.assign(n, 0xFFFFFFFFu);
+  fragments_.assign(n, 0);
+  bary_.assign(3 * n, 0.0f);
+  block_max_.assign(size_t(blocks_x_) * size_t(blocks_y_), std::numeric_limits<double>::infinity());
+  block_rejects_.assign(block_max_.size(), 0);
+}
+
+size_t DepthTarget::bytes() const {
+  return depth_.size() * sizeof(double) +
+         (object_.size() + primitive_.size() + fragments_.size()) * sizeof(uint32_t) +
+         bary_.size() * sizeof(float) + block_max_.size() * sizeof(double) +
+         block_rejects_.size() * sizeof(uint32_t);
+}
+
+float DepthTarget::cost(size_t i) const {
+  const int x = int(i % size_t(width_)), y = int(i / size_t(width_));
+  return float(fragments_[i]) + float(block_rejects_[block_index(x, y)]) / float(kBlock * kBlock);
+}
+
+void DepthTarget::update_block_max(int bx, int by) {
+  const int x0 = bx * kBlock, y0 = by * kBlock;
+  const int x1 = std::min(x0 + kBlock, width_), y1 = std::min(y0 + kBlock, height_);
+  double m = 0;
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) m = std::max(m, depth_[size_t(y) * size_t(width_) + size_t(x)]);
+  block_max_[size_t(by) * size_t(blocks_x_) + size_t(bx)] = m;
+}
+
+void DepthTarget::draw_tile(int tx, int ty, const std::vector<SetupTriangle>* sub_chunks,
+                            const uint32_t* bin, size_t count, TileCounters& counters) {
+  const int ox = tx * kTile, oy = ty * kTile;
+  const int ex = std::min(ox + kTile, width_) - 1, ey = std::min(oy + kTile, height_) - 1;
+  for (size_t k = 0; k < count; ++k) {
+    const SetupTriangle& t = sub_chunks[bin[k] >> kLocalBits][bin[k] & ((1u << kLocalBits) - 1)];
+    const int x0 = std::max(t.x0, ox), x1 = std::min(t.x1, ex);
+    const int y0 = std::max(t.y0, oy), y1 = std::min(t.y1, ey);
+    if (x0 > x1 || y0 > y1) continue;
+    if (hiz_) {
+      // The whole triangle at once: behind the farthest depth of every block it overlaps.
+      double farthest = 0;
+      for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+        for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx)
+          farthest = std::max(farthest, block_max_[size_t(by) * size_t(blocks_x_) + size_t(bx)]);
+      if (t.min_depth >= farthest) {
+        for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+          for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx) {
+            ++block_rejects_[size_t(by) * size_t(blocks_x_) + size_t(bx)];
+            ++counters.blocks_rejected;
+          }
+        ++counters.triangles_rejected;
+        continue;
+      }
+    }
+    draw(t, x0, y0, x1, y1, counters);
+  }
+}
+
+void DepthTarget::draw(const SetupTriangle& t, int x0, int y0, int x1, int y1,
+                       TileCounters& counters) {
+  // E_i(p) = (x[i+1]-x[i])*(py-y[i]) - (y[i+1]-y[i])*(px-x[i]) at pixel centres, in
+  // sub-pixel units; a non-top-left edge needs E > 0, i.e. E - 1 >= 0 in integers.
+  int64_t dx[3], dy[3], bias[3];
+  for (int i = 0; i < 3; ++i) {
+    const int n = (i + 1) % 3;
+    dx[i] = t.x[n] - t.x[i];
+    dy[i] = t.y[n] - t.y[i];
+    bias[i] = t.top_left[i] ? 0 : 1;
+  }
+  auto edge = [&](int i, int x, int y) {
+    const int64_t px = int64_t(x) * kSub + kSub / 2, py = int64_t(y) * kSub + kSub / 2;
+    return dx[i] * (py - t.y[i]) - dy[i] * (px - t.x[i]) - bias[i];
+  };
+  std::array<double, 3> q;
+  // The pixels of one block (or of a small triangle's box): every edge tested unless `full`.
+  auto fill = [&](int bx0, int by0, int bx1, int by1, bool full) {
+    bool drawn = false;
+    int64_t row[3];
+    for (int i = 0; i < 3; ++i) row[i] = edge(i, bx0, by0);
+    for (int y = by0; y <= by1; ++y) {
+      int64_t e0 = row[0], e1 = row[1], e2 = row[2];
+      for (int x = bx0; x <= bx1; ++x) {
+        if (full || (e0 | e1 | e2) >= 0) {
+          const size_t i = size_t(y) * size_t(width_) + size_t(x);
+          ++fragments_[i];
+          ++counters.generated;
+          const double inv_w = t.inv_w(x + 0.5, y + 0.5, q);
+          const double depth = 1.0 / inv_w;
+          // The depth range clips what lies beyond far (and rounding just inside near).
+          if (depth < depth_[i] && depth >= near_ && depth <= far_) {
+            depth_[i] = depth;
+            object_[i] = t.object;
+            primitive_[i] = t.primitive;
+            for (int j = 0; j < 3; ++j) bary_[3 * i + size_t(j)] = float(q[size_t(j)] / inv_w);
+            drawn = true;
+          }
+        }
+        e0 -= dy[0] * kSub;
+        e1 -= dy[1] * kSub;
+        e2 -= dy[2] * kSub;
+      }
+      for (int i = 0; i < 3; ++i) row[i] += dx[i] * kSub;
+    }
+    return drawn;
+  };
+  // A small triangle (at most 2x2 centres): those centres directly, no block classification
+  // (draw_tile's whole-triangle hi-z test has been made); then its blocks' farthest depths.
+  if (x1 - x0 < 2 && y1 - y0 < 2) {
+    if (fill(x0, y0, x1, y1, false) && hiz_)
+      for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+        for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx) update_block_max(bx, by);
+    return;
+  }
+  for (int by = y0 / kBlock; by <= y1 / kBlock; ++by) {
+    for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx) {
+      const int cx0 = std::max(x0, bx * kBlock), cx1 = std::min(x1, bx * kBlock + kBlock - 1);
+      const int cy0 = std::max(y0, by * kBlock), cy1 = std::min(y1, by * kBlock + kBlock - 1);
+      const size_t b = size_t(by) * size_t(blocks_x_) + size_t(bx);
+      if (hiz_ && t.min_depth >= block_max_[b]) {
+        ++block_rejects_[b];
+        ++counters.blocks_rejected;
+        continue;
+      }
+      // Edge functions are linear: their extremes over the block's centres are at its corners.
+      bool full = true, outside = false;
+      for (int i = 0; i < 3 && !outside; ++i) {
+        const int64_t c[4] = {edge(i, cx0, cy0), edge(i, cx1, cy0), edge(i, cx0, cy1),
+                              edge(i, cx1, cy1)};
+        const int64_t lo = std::min({c[0], c[1], c[2], c[3]});
+        const int64_t hi = std::max({c[0], c[1], c[2], c[3]});
+        outside = hi < 0;
+        full &= lo >= 0;
+      }
+      if (outside) continue;
+      counters.blocks_full += full;
+      if (fill(cx0, cy0, cx1, cy1, full) && hiz_) update_block_max(bx, by);
+    }
+  }
+}
+
+}  // namespace rvr::soft

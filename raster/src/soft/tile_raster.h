@@ -1,0 +1,70 @@
+// softraster's back end: the z-buffer of the whole frame, kept across the chunks of triangles
+// streamed through it, and the loop that draws a tile's share of a chunk. Each tile is 8x8
+// blocks; a triangle's blocks are classified from the edge functions at their corners (outside,
+// partly or fully covered: a full block draws every pixel without an edge test), and hi-z keeps
+// the farthest depth of every block, so that a triangle behind everything drawn in a block (or
+// in all of its blocks) is not rasterized there at all.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "soft/triangle_setup.h"
+
+namespace rvr::soft {
+
+constexpr int kTile = 64;
+constexpr int kBlock = 8;
+
+struct TileCounters {
+  uint64_t generated = 0;           // fragments: covered pixel centres that were depth-tested
+  uint64_t blocks_rejected = 0;     // 8x8 blocks hi-z skipped (a triangle's, one by one)
+  uint64_t triangles_rejected = 0;  // triangles hi-z skipped in a whole tile at once
+  uint64_t blocks_full = 0;         // blocks drawn without edge tests
+};
+
+class DepthTarget {
+ public:
+  DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  int tiles_x() const { return tiles_x_; }
+  int tiles_y() const { return tiles_y_; }
+
+  // Draws the triangles bin[0..count) into tile (tx, ty), in that order; an entry is
+  // sub-chunk << kLocalBits | index in that sub-chunk's triangles. Tiles are independent: any
+  // thread may draw any tile, and the bytes do not change.
+  static constexpr uint32_t kLocalBits = 20;
+  void draw_tile(int tx, int ty, const std::vector<SetupTriangle>* sub_chunks, const uint32_t* bin,
+                 size_t count, TileCounters& counters);
+
+  // What the frame ended with, per pixel.
+  bool covered(size_t i) const { return object_[i] != 0xFFFFFFFFu; }
+  double depth(size_t i) const { return depth_[i]; }
+  uint32_t object(size_t i) const { return object_[i]; }
+  uint32_t primitive(size_t i) const { return primitive_[i]; }
+  // Perspective-correct barycentrics of the visible triangle at the pixel centre.
+  glm::vec3 barycentric(size_t i) const { return {bary_[3 * i], bary_[3 * i + 1], bary_[3 * i + 2]}; }
+  // Work at the pixel: fragments generated, plus each hi-z rejection of its block as 1/64.
+  float cost(size_t i) const;
+  size_t bytes() const;
+
+ private:
+  void draw(const SetupTriangle& t, int x0, int y0, int x1, int y1, TileCounters& counters);
+  size_t block_index(int x, int y) const {
+    return size_t(y / kBlock) * size_t(blocks_x_) + size_t(x / kBlock);
+  }
+  void update_block_max(int bx, int by);
+
+  int width_, height_, tiles_x_, tiles_y_, blocks_x_, blocks_y_;
+  double near_, far_;
+  bool hiz_;
+  std::vector<double> depth_;  // +inf until drawn
+  std::vector<uint32_t> object_, primitive_, fragments_;
+  std::vector<float> bary_;
+  std::vector<double> block_max_;        // farthest depth in each block (+inf: not all drawn)
+  std::vector<uint32_t> block_rejects_;  // hi-z rejections per block
+};
+
+}  // namespace rvr::soft

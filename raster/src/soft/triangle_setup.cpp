@@ -1,0 +1,185 @@
+#include "soft/triangle_setup.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace rvr::soft {
+
+namespace {
+
+// Snapping moves a vertex by at most half a sub-pixel step in x and in y.
+constexpr double kSnapDistance = 0.7072 / double(kSub);
+
+}  // namespace
+
+TriangleSetup::TriangleSetup(int width, int height, const glm::dmat4& view_projection)
+    : width_(width), height_(height), view_projection_(view_projection) {
+  const double gx = kGuardPixels / width, gy = kGuardPixels / height;
+  const glm::dvec4 frustum[6] = {{1, 0, 0, 1},  {-1, 0, 0, 1}, {0, 1, 0, 1},
+                                 {0, -1, 0, 1}, {0, 0, 1, 1},  {0, 0, -1, 1}};
+  // Near first: afterwards w >= near > 0, so the guard planes (scaled by w) are well defined.
+  const glm::dvec4 clip[5] = {{0, 0, 1, 1}, {1, 0, 0, gx}, {-1, 0, 0, gx}, {0, 1, 0, gy},
+                              {0, -1, 0, gy}};
+  std::copy(frustum, frustum + 6, frustum_);
+  std::copy(clip, clip + 5, clip_planes_);
+  poly_.reserve(16);
+  scratch_.reserve(16);
+}
+
+ProjectedVertex TriangleSetup::project(const glm::vec3& p) const {
+  ProjectedVertex v;
+  v.clip = view_projection_ * glm::dvec4(glm::dvec3(p), 1.0);
+  for (int i = 0; i < 6; ++i) v.reject |= uint32_t(glm::dot(frustum_[i], v.clip) < 0) << i;
+  for (int i = 0; i < 5; ++i) v.clip_planes |= uint32_t(glm::dot(clip_planes_[i], v.clip) < 0) << i;
+  if (v.clip_planes == 0) {  // in front of the near plane and inside the guard band
+    const glm::dvec4& k = v.clip;
+    // Viewport with y flipped: row 0 is the top.
+    v.sx = (k.x / k.w * 0.5 + 0.5) * width_;
+    v.sy = (0.5 - k.y / k.w * 0.5) * height_;
+    v.fx = std::llround(v.sx * double(kSub));
+    v.fy = std::llround(v.sy * double(kSub));
+    v.inv_w = 1.0 / k.w;
+  }
+  return v;
+}
+
+void TriangleSetup::add(const ProjectedVertex& a, const ProjectedVertex& b,
+                        const ProjectedVertex& c, uint32_t object, uint32_t primitive,
+                        std::vector<SetupTriangle>& out, size_t& clipped) {
+  // Trivial reject against the view frustum; then clip only where a plane is crossed.
+  if (a.reject & b.reject & c.reject) {
+    ++clipped;
+    return;
+  }
+  const ProjectedVertex* v[3] = {&a, &b, &c};
+  if (a.clip_planes | b.clip_planes | c.clip_planes) {
+    ++clipped;
+    clip_and_emit(v, object, primitive, out);
+    return;
+  }
+  // The common case: the triangle as it is. Its barycentrics are the unit vectors, so
+  // f_j = b_j / w is 1/w at vertex j and 0 elsewhere.
+  double sx[3], sy[3], f[3][3], w[3];
+  int64_t fx[3], fy[3];
+  for (int i = 0; i < 3; ++i) {
+    sx[i] = v[i]->sx;
+    sy[i] = v[i]->sy;
+    fx[i] = v[i]->fx;
+    fy[i] = v[i]->fy;
+    w[i] = v[i]->clip.w;
+    for (int j = 0; j < 3; ++j) f[i][j] = i == j ? v[i]->inv_w : 0.0 / v[i]->clip.w;
+  }
+  emit(sx, sy, fx, fy, f, w, object, primitive, out);
+}
+
+void TriangleSetup::clip_polygon(const Polygon& in, const glm::dvec4& plane, Polygon& out) {
+  out.clear();
+  for (size_t i = 0; i < in.size(); ++i) {
+    const ClipVertex& a = in[i];
+    const ClipVertex& b = in[(i + 1) % in.size()];
+    double da = glm::dot(plane, a.c), db = glm::dot(plane, b.c);
+    if (da >= 0) out.push_back(a);
+    if ((da >= 0) != (db >= 0)) {
+      double t = da / (da - db);
+      out.push_back({a.c + t * (b.c - a.c), a.b + t * (b.b - a.b)});
+    }
+  }
+}
+
+void TriangleSetup::clip_and_emit(const ProjectedVertex* pv[3], uint32_t object,
+                                  uint32_t primitive, std::vector<SetupTriangle>& out) {
+  Polygon& v = poly_;
+  v.resize(3);
+  for (int i = 0; i < 3; ++i) {
+    v[i].c = pv[i]->clip;
+    v[i].b = glm::dvec3(0.0);
+    v[i].b[i] = 1.0;
+  }
+  for (const glm::dvec4& plane : clip_planes_) {
+    bool outside = false;
+    for (const ClipVertex& c : v) outside |= glm::dot(plane, c.c) < 0;
+    if (!outside) continue;
+    clip_polygon(v, plane, scratch_);
+    std::swap(v, scratch_);
+    if (v.size() < 3) break;
+  }
+  // A convex polygon as a fan: the inner diagonals are shared edges, drawn once by the rule.
+  for (size_t i = 1; i + 1 < v.size(); ++i) {
+    const ClipVertex* cv[3] = {&v[0], &v[i], &v[i + 1]};
+    double sx[3], sy[3], f[3][3], w[3];
+    int64_t fx[3], fy[3];
+    for (int k = 0; k < 3; ++k) {
+      const glm::dvec4& c = cv[k]->c;
+      sx[k] = (c.x / c.w * 0.5 + 0.5) * width_;
+      sy[k] = (0.5 - c.y / c.w * 0.5) * height_;
+      fx[k] = std::llround(sx[k] * double(kSub));
+      fy[k] = std::llround(sy[k] * double(kSub));
+      w[k] = c.w;
+      for (int j = 0; j < 3; ++j) f[k][j] = cv[k]->b[j] / c.w;
+    }
+    emit(sx, sy, fx, fy, f, w, object, primitive, out);
+  }
+}
+
+void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int64_t fx[3],
+                         const int64_t fy[3], const double f_in[3][3], const double w[3],
+                         uint32_t object, uint32_t primitive,
+                         std::vector<SetupTriangle>& out) const {
+  int order[3] = {0, 1, 2};
+  int64_t area = (fx[1] - fx[0]) * (fy[2] - fy[0]) - (fy[1] - fy[0]) * (fx[2] - fx[0]);
+  if (area == 0) return;  // covers no pixel centre
+  if (area < 0) std::swap(order[1], order[2]);  // two-sided: either winding, oriented here
+  SetupTriangle t;
+  double sx[3], sy[3];
+  for (int i = 0; i < 3; ++i) {
+    t.x[i] = fx[order[i]];
+    t.y[i] = fy[order[i]];
+    sx[i] = sx_in[order[i]];
+    sy[i] = sy_in[order[i]];
+  }
+  int64_t min_x = std::min({t.x[0], t.x[1], t.x[2]}), max_x = std::max({t.x[0], t.x[1], t.x[2]});
+  int64_t min_y = std::min({t.y[0], t.y[1], t.y[2]}), max_y = std::max({t.y[0], t.y[1], t.y[2]});
+  // The pixels whose centres ((x + 1/2) kSub) lie in the bounding box: only they can be
+  // covered. Most triangles of a dense mesh hold none, and stop here.
+  auto first_centre = [](int64_t lo) { return int((lo - kSub / 2 + kSub - 1) >> kSubBits); };
+  auto last_centre = [](int64_t hi) { return int((hi - kSub / 2) >> kSubBits); };
+  t.x0 = std::max(0, first_centre(min_x));
+  t.y0 = std::max(0, first_centre(min_y));
+  t.x1 = std::min(width_ - 1, last_centre(max_x));
+  t.y1 = std::min(height_ - 1, last_centre(max_y));
+  if (t.x0 > t.x1 || t.y0 > t.y1) return;
+  for (int i = 0; i < 3; ++i) {
+    int64_t dx = t.x[(i + 1) % 3] - t.x[i], dy = t.y[(i + 1) % 3] - t.y[i];
+    // y points down: with positive area, top edges run right and left edges run up.
+    t.top_left[i] = (dy == 0 && dx > 0) || dy < 0;
+  }
+  double dx1 = sx[1] - sx[0], dy1 = sy[1] - sy[0], dx2 = sx[2] - sx[0], dy2 = sy[2] - sy[0];
+  double det = dx1 * dy2 - dx2 * dy1;
+  if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return;
+  t.ox = sx[0];
+  t.oy = sy[0];
+  for (int j = 0; j < 3; ++j) {
+    double f0 = f_in[order[0]][j], f1 = f_in[order[1]][j], f2 = f_in[order[2]][j];
+    t.q0[j] = f0;
+    t.qa[j] = ((f1 - f0) * dy2 - (f2 - f0) * dy1) / det;
+    t.qb[j] = ((f2 - f0) * dx1 - (f1 - f0) * dx2) / det;
+  }
+  // Inside the unsnapped triangle depth is at least the nearest vertex's. A covered centre may
+  // lie up to kSnapDistance outside it, where the clamped q_j sum to at most
+  // (1 + 2 d / altitude) / w_min; so no fragment is nearer than w_min / (1 + 2 d / altitude).
+  // Slivers (altitude -> 0) get 0: hi-z never rejects them.
+  double longest = 0;
+  for (int i = 0; i < 3; ++i) {
+    int n = (i + 1) % 3;
+    longest = std::max(longest, std::hypot(sx[n] - sx[i], sy[n] - sy[i]));
+  }
+  const double altitude = std::abs(det) / longest;
+  const double w_min = std::min({w[0], w[1], w[2]});
+  // Twice the bound's slack, for the rounding in computing it.
+  t.min_depth = altitude > 0 ? w_min / (1.0 + 4.0 * kSnapDistance / altitude) : 0.0;
+  t.object = object;
+  t.primitive = primitive;
+  out.push_back(t);
+}
+
+}  // namespace rvr::soft
