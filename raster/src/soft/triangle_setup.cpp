@@ -168,12 +168,12 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
   // lie up to kSnapDistance outside it, where the clamped q_j sum to at most
   // (1 + 2 d / altitude) / w_min; so no fragment is nearer than w_min / (1 + 2 d / altitude).
   // Slivers (altitude -> 0) get 0: hi-z never rejects them.
-  double longest = 0;
+  double longest2 = 0;
   for (int i = 0; i < 3; ++i) {
     int n = (i + 1) % 3;
-    longest = std::max(longest, std::hypot(sx[n] - sx[i], sy[n] - sy[i]));
+    longest2 = std::max(longest2, (sx[n] - sx[i]) * (sx[n] - sx[i]) + (sy[n] - sy[i]) * (sy[n] - sy[i]));
   }
-  const double altitude = std::abs(det) / longest;
+  const double altitude = std::abs(det) / std::sqrt(longest2);
   const double w_min = std::min({w[0], w[1], w[2]});
   // Twice the bound's slack, for the rounding in computing it.
   t.min_depth = altitude > 0 ? w_min / (1.0 + 4.0 * kSnapDistance / altitude) : 0.0;

@@ -1,0 +1,47 @@
+// softraster's triangle stream: every object's triangles, in submission order, set up, binned and
+// drawn into a DepthTarget through one view-projection. The camera pass and every face of every
+// shadow cube go through it.
+#pragma once
+
+#include <tbb/task_arena.h>
+
+#include <cstddef>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "rvr/shared/progress.h"
+#include "rvr/shared/scene.h"
+#include "soft/tile_raster.h"
+
+namespace rvr::soft {
+
+// What is drawn of one object; tessellated shapes point into meshes the renderer owns.
+struct DrawObject {
+  const TriangleMesh* mesh = nullptr;  // null: nothing to draw (a CSG object)
+  const Material* material = nullptr;
+  bool smooth = false;
+  bool use_primitive_id = false;
+};
+
+struct DrawList {
+  std::vector<DrawObject> objects;
+  std::vector<size_t> first;  // first[i]: submission index of object i's triangle 0
+  size_t triangles() const { return first.empty() ? 0 : first.back(); }
+};
+
+DrawList make_draw_list(std::vector<DrawObject> objects);
+
+struct DrawResult {
+  size_t clipped = 0, set_up = 0;
+  size_t peak_chunk_bytes = 0;
+  double setup_seconds = 0, bin_seconds = 0, raster_seconds = 0;
+  TileCounters counters;  // summed over tiles
+};
+
+// Draws every triangle of `list` into `target` (sized to the viewport) through
+// `view_projection`. `progress` (may be null) advances by triangles, with fragments as the rate.
+DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projection,
+                          DepthTarget& target, tbb::task_arena& arena, ProgressSink* progress);
+
+}  // namespace rvr::soft
