@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <new>
 #include <string>
@@ -21,6 +22,7 @@
 #include "rvr/shared/shading.h"
 #include "rvr/shared/tessellate.h"
 #include "soft/draw_triangles.h"
+#include "soft/shadow_cube.h"
 #include "soft/tile_raster.h"
 
 namespace rvr {
@@ -28,6 +30,12 @@ namespace rvr {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// Shadow maps as the GL raster plans them (gl_rasterizer.cpp): batches of cubes of at most
+// kShadowBatchBytes, and a texel budget above which the maps shrink, with a warning.
+constexpr size_t kShadowBatchBytes = size_t(64) << 20;
+constexpr double kShadowTexelBudget = 6.0 * 16.0 * 1024.0 * 1024.0 * 1.25;
+constexpr int kShadowMinSize = 64;
 using soft::DepthTarget;
 using soft::DrawList;
 using soft::DrawObject;
@@ -121,7 +129,33 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   const std::vector<LightSample> samples = options.mode == RenderMode::Visibility
                                                ? std::vector<LightSample>{}
                                                : light_samples(scene.lights);
+  const bool shadows = options.mode == RenderMode::Full && !samples.empty();
   const glm::vec3 eye = scene.camera.eye;
+  // The visible surface at pixel o (covered): position, normals, direction to the eye.
+  struct Surface {
+    const DrawObject* object;
+    uint32_t primitive;
+    glm::vec3 P, N, V, geometric;
+  };
+  auto surface_at = [&](size_t o) {
+    Surface s;
+    s.object = &list.objects[target.object(o)];
+    s.primitive = target.primitive(o);
+    const TriangleMesh& mesh = *s.object->mesh;
+    const glm::vec3 b = target.barycentric(o);
+    const glm::uvec3& tri = mesh.triangles[s.primitive];
+    const glm::vec3 &p0 = mesh.positions[tri.x], &p1 = mesh.positions[tri.y],
+                    &p2 = mesh.positions[tri.z];
+    s.P = b.x * p0 + b.y * p1 + b.z * p2;
+    s.geometric = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+    const glm::vec3 shading =
+        s.object->smooth ? glm::normalize(b.x * mesh.normals[tri.x] + b.y * mesh.normals[tri.y] +
+                                          b.z * mesh.normals[tri.z])
+                         : s.geometric;
+    s.V = glm::normalize(eye - s.P);
+    s.N = face_viewer(shading, s.geometric, s.V);
+    return s;
+  };
   if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
@@ -131,32 +165,106 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
           fb.set_background(o, scene.image.background);
           fb.cost[o] = target.cost(o);
           if (!target.covered(o)) continue;
-          const DrawObject& d = list.objects[target.object(o)];
-          const uint32_t primitive = target.primitive(o);
-          const glm::vec3 b = target.barycentric(o);
-          const glm::uvec3& tri = d.mesh->triangles[primitive];
-          const glm::vec3 &p0 = d.mesh->positions[tri.x], &p1 = d.mesh->positions[tri.y],
-                          &p2 = d.mesh->positions[tri.z];
-          const glm::vec3 P = b.x * p0 + b.y * p1 + b.z * p2;
-          const glm::vec3 g = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-          const glm::vec3 shading =
-              d.smooth ? glm::normalize(b.x * d.mesh->normals[tri.x] +
-                                        b.y * d.mesh->normals[tri.y] + b.z * d.mesh->normals[tri.z])
-                       : g;
-          const glm::vec3 V = glm::normalize(eye - P);
-          const glm::vec3 N = face_viewer(shading, g, V);
+          const Surface s = surface_at(o);
           fb.depth[o] = float(target.depth(o));
           fb.object_id[o] = target.object(o);
-          fb.primitive_id[o] = d.use_primitive_id ? primitive : 0u;
-          fb.normal[o] = N;
-          if (options.mode != RenderMode::Visibility)
-            fb.color[o] = shade_local(*d.material, P, N, V, scene.ambient, samples);
+          fb.primitive_id[o] = s.object->use_primitive_id ? s.primitive : 0u;
+          fb.normal[o] = s.N;
+          if (options.mode == RenderMode::Visibility) continue;
+          // With shadows the lights are added below, batch by batch of shadow cubes.
+          fb.color[o] =
+              shadows ? shade_base(*s.object->material, scene.ambient)
+                      : shade_local(*s.object->material, s.P, s.N, s.V, scene.ambient, samples);
         }
       }
       if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));
     });
   });
   out.stats["time.shade"] = seconds_since(t);
+
+  // --- shadows (full mode): a cube of distance maps per light sample, drawn by this z-buffer,
+  // in batches that fit kShadowBatchBytes; each batch then adds its samples' light.
+  if (shadows) {
+    if (options.shadow_map_size < 1)
+      return bad_input(fmt::format("shadow map size {} must be positive", options.shadow_map_size));
+    if (!(options.shadow_bias >= 0.0f) || !std::isfinite(options.shadow_bias))
+      return bad_input(fmt::format("shadow bias {} must be >= 0", options.shadow_bias));
+    t = Clock::now();
+    soft::ShadowSettings settings;
+    settings.size = std::min(options.shadow_map_size, soft::kMaxImageSide);
+    const double texels =
+        6.0 * double(samples.size()) * double(settings.size) * double(settings.size);
+    if (texels > kShadowTexelBudget) {
+      const int fit = int(std::sqrt(kShadowTexelBudget / (6.0 * double(samples.size()))));
+      settings.size = std::max(std::min(settings.size, kShadowMinSize), fit);
+    }
+    if (settings.size < options.shadow_map_size)
+      out.warnings.push_back(
+          fmt::format("shadow maps of {} texels per side for {} light samples ({} requested)",
+                      settings.size, samples.size(), options.shadow_map_size));
+    settings.bias = options.shadow_bias;
+    settings.pcf = options.shadow_pcf;
+    // Near and far only clip: the maps hold distances, so a near plane far below any feature
+    // size (1e-6 of the scene's reach from the lights) costs no precision.
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    bool any = false;
+    for (const DrawObject& d : list.objects)
+      if (d.mesh)
+        for (const glm::vec3& p : d.mesh->positions) {
+          lo = glm::min(lo, p);
+          hi = glm::max(hi, p);
+          any = true;
+        }
+    float reach = 0.0f;
+    for (const LightSample& ls : samples)
+      reach = std::max(
+          reach, glm::length(glm::max(glm::abs(ls.position - lo), glm::abs(ls.position - hi))));
+    if (!any) reach = 1.0f;
+    reach = std::max(reach, 1e-3f);
+    const float near_plane = 1e-6f * reach, far_plane = 2.0f * reach;
+    settings.projection =
+        glm::dmat4(glm::perspective(glm::radians(90.0f), 1.0f, near_plane, far_plane));
+    const size_t per_sample = 6 * size_t(settings.size) * size_t(settings.size) * sizeof(float);
+    const size_t batch = std::clamp<size_t>(kShadowBatchBytes / per_sample, 1, samples.size());
+    DepthTarget scratch(settings.size, settings.size, near_plane, far_plane, options.hiz,
+                        /*depth_only=*/true);
+    std::vector<soft::ShadowCube> cubes(batch);
+    DrawResult shadow_work;
+    double draw_seconds = 0;
+    if (progress) progress->begin("shadows", samples.size(), "light samples");
+    for (size_t first = 0; first < samples.size(); first += batch) {
+      const size_t end = std::min(samples.size(), first + batch);
+      auto t_draw = Clock::now();
+      for (size_t i = first; i < end; ++i)
+        cubes[i - first].build(list, samples[i].position, settings, scratch, arena, shadow_work);
+      draw_seconds += seconds_since(t_draw);
+      arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, fb.pixel_count()),
+                          [&](const tbb::blocked_range<size_t>& r) {
+                            for (size_t o = r.begin(); o != r.end(); ++o) {
+                              if (!target.covered(o)) continue;
+                              const Surface s = surface_at(o);
+                              add_light_samples(
+                                  *s.object->material, s.P, s.N, s.V, samples, first, end,
+                                  [&](size_t i, const glm::vec3& P, const glm::vec3& L) {
+                                    return cubes[i - first].visibility(P, L, s.geometric, settings);
+                                  },
+                                  fb.color[o]);
+                            }
+                          });
+      });
+      if (progress) progress->advance(end - first);
+    }
+    out.stats["time.shadows"] = seconds_since(t);
+    out.stats["time.shadow_maps"] = draw_seconds;
+    out.stats["shadows.map_size"] = double(settings.size);
+    out.stats["shadows.cubes"] = double(samples.size());
+    out.stats["shadows.triangles_setup"] = double(shadow_work.set_up);
+    out.stats["shadows.fragments"] = double(shadow_work.counters.generated);
+    out.stats["shadows.hiz_blocks_rejected"] = double(shadow_work.counters.blocks_rejected);
+    out.stats["memory.shadow_bytes"] =
+        double(batch * per_sample + scratch.bytes() + shadow_work.peak_chunk_bytes);
+  }
 
   const soft::TileCounters& sum = drawn.counters;
   uint64_t covered = 0;
@@ -181,8 +289,6 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
                                        skipped_csg.size(), names));
   }
   if (options.mode == RenderMode::Full) {
-    if (!scene.lights.empty())
-      out.warnings.push_back("shadows not rendered by softraster (no shadow maps yet)");
     if (mirror) out.warnings.push_back("mirror reflection not rendered by softraster");
     if (transparency) out.warnings.push_back("transparency not rendered by softraster");
     if (scene.camera.aperture_radius > 0.0f)

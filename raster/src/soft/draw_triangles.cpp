@@ -86,10 +86,9 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
         local.reserve(kSubChunk);
         size_t local_clipped = 0;
         const size_t begin = chunk + s * kSubChunk, end = std::min(chunk_end, begin + kSubChunk);
-        size_t object =
-            size_t(std::upper_bound(list.first.begin(), list.first.end(), begin) -
-                   list.first.begin()) -
-            1;
+        size_t object = size_t(std::upper_bound(list.first.begin(), list.first.end(), begin) -
+                               list.first.begin()) -
+                        1;
         for (size_t g = begin; g < end; ++g) {
           while (g >= list.first[object + 1]) ++object;
           const TriangleMesh& m = *list.objects[object].mesh;

@@ -6,9 +6,8 @@
 #include <tbb/task_arena.h>
 
 #include <cstddef>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "rvr/shared/progress.h"
 #include "rvr/shared/scene.h"

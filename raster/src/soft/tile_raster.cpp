@@ -6,7 +6,8 @@
 
 namespace rvr::soft {
 
-DepthTarget::DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz)
+DepthTarget::DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz,
+                         bool depth_only)
     : width_(width),
       height_(height),
       tiles_x_((width + kTile - 1) / kTile),
@@ -15,13 +16,20 @@ DepthTarget::DepthTarget(int width, int height, double near_plane, double far_pl
       blocks_y_((height + kBlock - 1) / kBlock),
       near_(near_plane),
       far_(far_plane),
-      hiz_(hiz) {
-  const size_t n = size_t(width) * size_t(height);
+      hiz_(hiz),
+      depth_only_(depth_only) {
+  clear();
+}
+
+void DepthTarget::clear() {
+  const size_t n = size_t(width_) * size_t(height_);
   depth_.assign(n, std::numeric_limits<double>::infinity());
-  object_.assign(n, 0xFFFFFFFFu);
-  primitive_.assign(n, 0xFFFFFFFFu);
-  fragments_.assign(n, 0);
-  bary_.assign(3 * n, 0.0f);
+  if (!depth_only_) {
+    object_.assign(n, 0xFFFFFFFFu);
+    primitive_.assign(n, 0xFFFFFFFFu);
+    fragments_.assign(n, 0);
+    bary_.assign(3 * n, 0.0f);
+  }
   block_max_.assign(size_t(blocks_x_) * size_t(blocks_y_), std::numeric_limits<double>::infinity());
   block_rejects_.assign(block_max_.size(), 0);
 }
@@ -102,16 +110,18 @@ void DepthTarget::draw(const SetupTriangle& t, int x0, int y0, int x1, int y1,
       for (int x = bx0; x <= bx1; ++x) {
         if (full || (e0 | e1 | e2) >= 0) {
           const size_t i = size_t(y) * size_t(width_) + size_t(x);
-          ++fragments_[i];
+          if (!depth_only_) ++fragments_[i];
           ++counters.generated;
           const double inv_w = t.inv_w(x + 0.5, y + 0.5, q);
           const double depth = 1.0 / inv_w;
           // The depth range clips what lies beyond far (and rounding just inside near).
           if (depth < depth_[i] && depth >= near_ && depth <= far_) {
             depth_[i] = depth;
-            object_[i] = t.object;
-            primitive_[i] = t.primitive;
-            for (int j = 0; j < 3; ++j) bary_[3 * i + size_t(j)] = float(q[size_t(j)] / inv_w);
+            if (!depth_only_) {
+              object_[i] = t.object;
+              primitive_[i] = t.primitive;
+              for (int j = 0; j < 3; ++j) bary_[3 * i + size_t(j)] = float(q[size_t(j)] / inv_w);
+            }
             drawn = true;
           }
         }

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "soft/triangle_setup.h"
@@ -25,7 +26,11 @@ struct TileCounters {
 
 class DepthTarget {
  public:
-  DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz);
+  // depth_only: keeps depths alone (shadow maps), no ids, barycentrics or per-pixel cost.
+  DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz,
+              bool depth_only = false);
+  // Back to nothing drawn, for the next pass through the same target.
+  void clear();
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -40,12 +45,17 @@ class DepthTarget {
                  size_t count, TileCounters& counters);
 
   // What the frame ended with, per pixel.
-  bool covered(size_t i) const { return object_[i] != 0xFFFFFFFFu; }
+  bool covered(size_t i) const {
+    return depth_only_ ? depth_[i] != std::numeric_limits<double>::infinity()
+                       : object_[i] != 0xFFFFFFFFu;
+  }
   double depth(size_t i) const { return depth_[i]; }
   uint32_t object(size_t i) const { return object_[i]; }
   uint32_t primitive(size_t i) const { return primitive_[i]; }
   // Perspective-correct barycentrics of the visible triangle at the pixel centre.
-  glm::vec3 barycentric(size_t i) const { return {bary_[3 * i], bary_[3 * i + 1], bary_[3 * i + 2]}; }
+  glm::vec3 barycentric(size_t i) const {
+    return {bary_[3 * i], bary_[3 * i + 1], bary_[3 * i + 2]};
+  }
   // Work at the pixel: fragments generated, plus each hi-z rejection of its block as 1/64.
   float cost(size_t i) const;
   size_t bytes() const;
@@ -59,7 +69,7 @@ class DepthTarget {
 
   int width_, height_, tiles_x_, tiles_y_, blocks_x_, blocks_y_;
   double near_, far_;
-  bool hiz_;
+  bool hiz_, depth_only_;
   std::vector<double> depth_;  // +inf until drawn
   std::vector<uint32_t> object_, primitive_, fragments_;
   std::vector<float> bary_;

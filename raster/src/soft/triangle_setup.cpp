@@ -18,8 +18,8 @@ TriangleSetup::TriangleSetup(int width, int height, const glm::dmat4& view_proje
   const glm::dvec4 frustum[6] = {{1, 0, 0, 1},  {-1, 0, 0, 1}, {0, 1, 0, 1},
                                  {0, -1, 0, 1}, {0, 0, 1, 1},  {0, 0, -1, 1}};
   // Near first: afterwards w >= near > 0, so the guard planes (scaled by w) are well defined.
-  const glm::dvec4 clip[5] = {{0, 0, 1, 1}, {1, 0, 0, gx}, {-1, 0, 0, gx}, {0, 1, 0, gy},
-                              {0, -1, 0, gy}};
+  const glm::dvec4 clip[5] = {
+      {0, 0, 1, 1}, {1, 0, 0, gx}, {-1, 0, 0, gx}, {0, 1, 0, gy}, {0, -1, 0, gy}};
   std::copy(frustum, frustum + 6, frustum_);
   std::copy(clip, clip + 5, clip_planes_);
   poly_.reserve(16);
@@ -86,8 +86,8 @@ void TriangleSetup::clip_polygon(const Polygon& in, const glm::dvec4& plane, Pol
   }
 }
 
-void TriangleSetup::clip_and_emit(const ProjectedVertex* pv[3], uint32_t object,
-                                  uint32_t primitive, std::vector<SetupTriangle>& out) {
+void TriangleSetup::clip_and_emit(const ProjectedVertex* pv[3], uint32_t object, uint32_t primitive,
+                                  std::vector<SetupTriangle>& out) {
   Polygon& v = poly_;
   v.resize(3);
   for (int i = 0; i < 3; ++i) {
@@ -127,7 +127,7 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
                          std::vector<SetupTriangle>& out) const {
   int order[3] = {0, 1, 2};
   int64_t area = (fx[1] - fx[0]) * (fy[2] - fy[0]) - (fy[1] - fy[0]) * (fx[2] - fx[0]);
-  if (area == 0) return;  // covers no pixel centre
+  if (area == 0) return;                        // covers no pixel centre
   if (area < 0) std::swap(order[1], order[2]);  // two-sided: either winding, oriented here
   SetupTriangle t;
   double sx[3], sy[3];
@@ -171,7 +171,8 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
   double longest2 = 0;
   for (int i = 0; i < 3; ++i) {
     int n = (i + 1) % 3;
-    longest2 = std::max(longest2, (sx[n] - sx[i]) * (sx[n] - sx[i]) + (sy[n] - sy[i]) * (sy[n] - sy[i]));
+    longest2 =
+        std::max(longest2, (sx[n] - sx[i]) * (sx[n] - sx[i]) + (sy[n] - sy[i]) * (sy[n] - sy[i]));
   }
   const double altitude = std::abs(det) / std::sqrt(longest2);
   const double w_min = std::min({w[0], w[1], w[2]});

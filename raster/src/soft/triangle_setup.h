@@ -7,9 +7,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "rvr/shared/scene.h"
 
@@ -54,11 +53,11 @@ struct SetupTriangle {
 // A vertex in clip space, projected when it lies in front of the near plane.
 struct ProjectedVertex {
   glm::dvec4 clip;
-  double sx = 0, sy = 0;    // screen position, y down
-  int64_t fx = 0, fy = 0;   // the same in fixed point
-  double inv_w = 0;         // 1 / clip.w
-  uint32_t reject = 0;      // bit p: outside frustum plane p (all three: the triangle is culled)
-  uint32_t clip_planes = 0; // bit p: outside near or guard plane p (any: the triangle is clipped)
+  double sx = 0, sy = 0;     // screen position, y down
+  int64_t fx = 0, fy = 0;    // the same in fixed point
+  double inv_w = 0;          // 1 / clip.w
+  uint32_t reject = 0;       // bit p: outside frustum plane p (all three: the triangle is culled)
+  uint32_t clip_planes = 0;  // bit p: outside near or guard plane p (any: the triangle is clipped)
 };
 
 class TriangleSetup {

@@ -24,16 +24,15 @@ inline float specular_power(float x, float s) {
   return std::pow(x, s);
 }
 
-// local = emission + ambient*diffuse + sum_l vis_l * (diffuse*max(0,N.Ld) +
-//         specular*max(0,N.H)^shininess) * I_l / |L_l - P|^2
-// N: unit normal facing the viewer; V: unit vector towards the viewer.
-// visibility(sample_index, P, L) returns vis_l in [0, 1] (1 in local mode).
+// Adds the light of samples [first, end) to `colour`: sum_l vis_l * (diffuse*max(0,N.Ld) +
+// specular*max(0,N.H)^shininess) * I_l / |L_l - P|^2, in sample order. A renderer that has the
+// visibility of only some samples at a time (shadow maps in batches) adds them batch by batch
+// and gets the same sum, term for term, as one pass over all of them.
 template <class Visibility>
-glm::vec3 shade_local(const Material& m, const glm::vec3& P, const glm::vec3& N, const glm::vec3& V,
-                      const glm::vec3& ambient, const std::vector<LightSample>& lights,
-                      Visibility&& visibility) {
-  glm::vec3 colour = m.emission + ambient * m.diffuse;
-  for (size_t i = 0; i < lights.size(); ++i) {
+void add_light_samples(const Material& m, const glm::vec3& P, const glm::vec3& N,
+                       const glm::vec3& V, const std::vector<LightSample>& lights, size_t first,
+                       size_t end, Visibility&& visibility, glm::vec3& colour) {
+  for (size_t i = first; i < end; ++i) {
     glm::vec3 to_light = lights[i].position - P;
     float dist2 = glm::dot(to_light, to_light);
     if (!(dist2 > 0.0f)) continue;
@@ -46,6 +45,23 @@ glm::vec3 shade_local(const Material& m, const glm::vec3& P, const glm::vec3& N,
     float vis = visibility(i, P, lights[i].position);
     colour += vis * brdf * lights[i].intensity / dist2;
   }
+}
+
+// The part of the equation without lights.
+inline glm::vec3 shade_base(const Material& m, const glm::vec3& ambient) {
+  return m.emission + ambient * m.diffuse;
+}
+
+// local = emission + ambient*diffuse + sum_l vis_l * (diffuse*max(0,N.Ld) +
+//         specular*max(0,N.H)^shininess) * I_l / |L_l - P|^2
+// N: unit normal facing the viewer; V: unit vector towards the viewer.
+// visibility(sample_index, P, L) returns vis_l in [0, 1] (1 in local mode).
+template <class Visibility>
+glm::vec3 shade_local(const Material& m, const glm::vec3& P, const glm::vec3& N, const glm::vec3& V,
+                      const glm::vec3& ambient, const std::vector<LightSample>& lights,
+                      Visibility&& visibility) {
+  glm::vec3 colour = shade_base(m, ambient);
+  add_light_samples(m, P, N, V, lights, 0, lights.size(), visibility, colour);
   return colour;
 }
 
