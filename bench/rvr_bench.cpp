@@ -1,6 +1,7 @@
 // rvr_bench: what each loop order costs. Names are stable (bench/README.md documents them):
 //   BM_Frame/<renderer>/<scene>/<n>/<width>   a whole frame, height = width * 3/4
-//   BM_DepthComplexity/<renderer>/<N>          occluders:N at 512x384
+//   BM_DepthComplexity/<renderer>/<N>          occluders:N at 512x384, front to back
+//   BM_DepthComplexityBackToFront/<renderer>/<N>  the same quads rearmost first
 //   BM_Effects/<effect>                        the tracer on cornell, one effect at a time
 //   BM_Trace/<accel>/<rays>/<scene>/<n>        one thread, rays only, no shading
 //   BM_Build/<accel>/<n>                       acceleration structure build
@@ -60,7 +61,10 @@ class FrameRenderer {
     bool tracer = name == "raytrace" || name == "raytrace_bvh2" || name == "raytrace_none" ||
                   name == "embree";
     if (!tracer) {
-      renderer_ = std::move(make_renderer(name).value());
+      // softraster_nohiz: softraster with hierarchical z off, the textbook z-buffer loop.
+      if (name == "softraster_nohiz") options_.hiz = false;
+      renderer_ =
+          std::move(make_renderer(name == "softraster_nohiz" ? "softraster" : name).value());
       return;
     }
     AccelKind accel = name == "embree"          ? AccelKind::Embree
@@ -97,6 +101,12 @@ void time_frames(benchmark::State& state, const std::string& renderer_name, cons
     benchmark::DoNotOptimize(out.buffers.color.data());
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
+  if (auto it = out.stats.find("memory.raster_bytes"); it != out.stats.end())
+    state.counters["raster_MiB"] = it->second / double(1 << 20);
+  if (auto it = out.stats.find("hiz.blocks_rejected"); it != out.stats.end())
+    state.counters["hiz_blocks_rejected"] = it->second;
+  if (auto it = out.stats.find("fragments.generated"); it != out.stats.end())
+    state.counters["fragments"] = it->second;
 }
 
 // A whole frame with one renderer.
@@ -115,8 +125,12 @@ void BM_Threads(benchmark::State& state, std::string renderer_name) {
   time_frames(state, renderer_name, scene, int(state.range(0)));
 }
 
-void BM_DepthComplexity(benchmark::State& state, std::string renderer_name) {
-  Scene scene = builtin("occluders:" + std::to_string(state.range(0)));
+// occluders:N, N quads one behind another, submitted front to back (hi-z skips the hidden ones)
+// or, with back_to_front, rearmost first (every quad is nearer than what is there: nothing to
+// skip).
+void BM_DepthComplexity(benchmark::State& state, std::string renderer_name, bool back_to_front) {
+  Scene scene = builtin((back_to_front ? "occluders_back:" : "occluders:") +
+                        std::to_string(state.range(0)));
   scene.image.width = 512;
   scene.image.height = 384;
   time_frames(state, renderer_name, scene);
@@ -456,12 +470,22 @@ void register_all() {
       }
     }
   }
+  // Ten million triangles, at 1024 wide only: the z-buffers' linear cost against the tracers'.
   for (std::string r : {"raster", "softraster", "raytrace", "embree"})
-    for (long n : {1L, 2L, 4L, 8L, 16L, 32L, 64L, 128L, 256L})
-      benchmark::RegisterBenchmark(("BM_DepthComplexity/" + r).c_str(), BM_DepthComplexity, r)
-          ->Arg(n)
+    for (std::string s : {"tessphere", "soup"})
+      benchmark::RegisterBenchmark(("BM_Frame/" + r + "/" + s).c_str(), BM_Frame, r, s)
+          ->Args({10000000L, 1024L})
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
+  for (bool back : {false, true})
+    for (std::string r : {"raster", "softraster", "softraster_nohiz", "raytrace", "embree"})
+      for (long n : {1L, 2L, 4L, 8L, 16L, 32L, 64L, 128L, 256L})
+        benchmark::RegisterBenchmark(
+            ((back ? "BM_DepthComplexityBackToFront/" : "BM_DepthComplexity/") + r).c_str(),
+            BM_DepthComplexity, r, back)
+            ->Arg(n)
+            ->Unit(benchmark::kMillisecond)
+            ->UseRealTime();
   for (std::string e :
        {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1", "mirror_depth_2",
         "mirror_depth_3", "mirror_depth_4", "mirror_depth_5", "glass", "dof_16"})

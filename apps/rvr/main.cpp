@@ -253,6 +253,13 @@ int run_render(const RenderArgs& a) {
     j["info"] = out.info;
     j["warnings"] = out.warnings;
     j["peak_memory_bytes"] = peak_memory_bytes();
+    // The scene's own vertex and index data, to read peak memory against.
+    double scene_bytes = 0;
+    for (const Object& o : scene.objects)
+      scene_bytes += double(o.mesh.positions.size() * sizeof(glm::vec3) +
+                            o.mesh.normals.size() * sizeof(glm::vec3) +
+                            o.mesh.triangles.size() * sizeof(glm::uvec3));
+    j["scene_mesh_bytes"] = scene_bytes;
     check(write_text_file(a.stats, j.dump(2) + "\n"));
   }
   if (!a.common.quiet) {

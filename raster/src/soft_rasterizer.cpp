@@ -163,7 +163,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
         for (int x = 0; x < w; ++x) {
           const size_t o = fb.index(x, y);
           fb.set_background(o, scene.image.background);
-          fb.cost[o] = target.cost(o);
+          fb.cost[o] = target.cost(x, y);
           if (!target.covered(o)) continue;
           const Surface s = surface_at(o);
           fb.depth[o] = float(target.depth(o));

@@ -32,6 +32,11 @@ void DepthTarget::clear() {
   }
   block_max_.assign(size_t(blocks_x_) * size_t(blocks_y_), std::numeric_limits<double>::infinity());
   block_rejects_.assign(block_max_.size(), 0);
+  block_empty_.resize(block_max_.size());
+  for (int by = 0; by < blocks_y_; ++by)
+    for (int bx = 0; bx < blocks_x_; ++bx)
+      block_empty_[size_t(by) * size_t(blocks_x_) + size_t(bx)] =
+          uint16_t((std::min(kBlock, width_ - bx * kBlock)) * (std::min(kBlock, height_ - by * kBlock)));
 }
 
 size_t DepthTarget::bytes() const {
@@ -41,12 +46,14 @@ size_t DepthTarget::bytes() const {
          block_rejects_.size() * sizeof(uint32_t);
 }
 
-float DepthTarget::cost(size_t i) const {
-  const int x = int(i % size_t(width_)), y = int(i / size_t(width_));
+float DepthTarget::cost(int x, int y) const {
+  const size_t i = size_t(y) * size_t(width_) + size_t(x);
   return float(fragments_[i]) + float(block_rejects_[block_index(x, y)]) / float(kBlock * kBlock);
 }
 
 void DepthTarget::update_block_max(int bx, int by) {
+  // While a pixel of the block is empty its farthest depth is +inf: nothing to scan.
+  if (block_empty_[size_t(by) * size_t(blocks_x_) + size_t(bx)] > 0) return;
   const int x0 = bx * kBlock, y0 = by * kBlock;
   const int x1 = std::min(x0 + kBlock, width_), y1 = std::min(y0 + kBlock, height_);
   double m = 0;
@@ -116,6 +123,8 @@ void DepthTarget::draw(const SetupTriangle& t, int x0, int y0, int x1, int y1,
           const double depth = 1.0 / inv_w;
           // The depth range clips what lies beyond far (and rounding just inside near).
           if (depth < depth_[i] && depth >= near_ && depth <= far_) {
+            if (depth_[i] == std::numeric_limits<double>::infinity())
+              --block_empty_[block_index(x, y)];
             depth_[i] = depth;
             if (!depth_only_) {
               object_[i] = t.object;

@@ -56,8 +56,8 @@ class DepthTarget {
   glm::vec3 barycentric(size_t i) const {
     return {bary_[3 * i], bary_[3 * i + 1], bary_[3 * i + 2]};
   }
-  // Work at the pixel: fragments generated, plus each hi-z rejection of its block as 1/64.
-  float cost(size_t i) const;
+  // Work at pixel (x, y): fragments generated, plus each hi-z rejection of its block as 1/64.
+  float cost(int x, int y) const;
   size_t bytes() const;
 
  private:
@@ -75,6 +75,7 @@ class DepthTarget {
   std::vector<float> bary_;
   std::vector<double> block_max_;        // farthest depth in each block (+inf: not all drawn)
   std::vector<uint32_t> block_rejects_;  // hi-z rejections per block
+  std::vector<uint16_t> block_empty_;    // pixels of each block nothing has been drawn in
 };
 
 }  // namespace rvr::soft
