@@ -129,8 +129,8 @@ void BM_Threads(benchmark::State& state, std::string renderer_name) {
 // or, with back_to_front, rearmost first (every quad is nearer than what is there: nothing to
 // skip).
 void BM_DepthComplexity(benchmark::State& state, std::string renderer_name, bool back_to_front) {
-  Scene scene = builtin((back_to_front ? "occluders_back:" : "occluders:") +
-                        std::to_string(state.range(0)));
+  Scene scene =
+      builtin((back_to_front ? "occluders_back:" : "occluders:") + std::to_string(state.range(0)));
   scene.image.width = 512;
   scene.image.height = 384;
   time_frames(state, renderer_name, scene);

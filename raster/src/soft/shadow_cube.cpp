@@ -1,9 +1,8 @@
 #include "soft/shadow_cube.h"
 
-#include <glm/gtc/matrix_transform.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 
 namespace rvr::soft {
@@ -38,13 +37,11 @@ int cube_face(const glm::vec3& d) {
 
 }  // namespace
 
-void ShadowCube::build(const DrawList& list, const glm::vec3& light,
-                       const ShadowSettings& settings, DepthTarget& scratch,
-                       tbb::task_arena& arena, DrawResult& work) {
+void ShadowCube::build(const DrawList& list, const glm::vec3& light, const ShadowSettings& settings,
+                       DepthTarget& scratch, tbb::task_arena& arena, DrawResult& work) {
   size_ = settings.size;
   const int n = size_;
-  const glm::dmat4 to_light =
-      glm::translate(glm::dmat4(1.0), -glm::dvec3(light));
+  const glm::dmat4 to_light = glm::translate(glm::dmat4(1.0), -glm::dvec3(light));
   for (int f = 0; f < 6; ++f) {
     scratch.clear();
     const glm::dmat4 view = glm::dmat4(glm::mat4(face_rotations()[size_t(f)])) * to_light;
@@ -93,9 +90,8 @@ float ShadowCube::visibility(const glm::vec3& P, const glm::vec3& L,
   // from the lookup direction; on a surface at angle theta to the light ray that changes the
   // distance by about dist * 0.7 * texel * tan(theta). Capped so grazing surfaces keep shadows.
   const float cos_theta = std::abs(glm::dot(n, d / std::max(dist, 1e-30f)));
-  const float tan_theta =
-      std::min(std::sqrt(std::max(0.0f, 1.0f - cos_theta * cos_theta)) / std::max(cos_theta, 1e-6f),
-               8.0f);
+  const float tan_theta = std::min(
+      std::sqrt(std::max(0.0f, 1.0f - cos_theta * cos_theta)) / std::max(cos_theta, 1e-6f), 8.0f);
   const float bias = settings.bias + 0.75f * texel * dist * tan_theta;
   const std::vector<float>& map = distance_[size_t(face)];
   auto lit = [&](int x, int y) {

@@ -7,9 +7,8 @@
 #pragma once
 
 #include <array>
-#include <vector>
-
 #include <glm/glm.hpp>
+#include <vector>
 
 #include "soft/draw_triangles.h"
 

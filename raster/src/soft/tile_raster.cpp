@@ -35,8 +35,8 @@ void DepthTarget::clear() {
   block_empty_.resize(block_max_.size());
   for (int by = 0; by < blocks_y_; ++by)
     for (int bx = 0; bx < blocks_x_; ++bx)
-      block_empty_[size_t(by) * size_t(blocks_x_) + size_t(bx)] =
-          uint16_t((std::min(kBlock, width_ - bx * kBlock)) * (std::min(kBlock, height_ - by * kBlock)));
+      block_empty_[size_t(by) * size_t(blocks_x_) + size_t(bx)] = uint16_t(
+          (std::min(kBlock, width_ - bx * kBlock)) * (std::min(kBlock, height_ - by * kBlock)));
 }
 
 size_t DepthTarget::bytes() const {

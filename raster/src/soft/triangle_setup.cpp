@@ -29,8 +29,16 @@ TriangleSetup::TriangleSetup(int width, int height, const glm::dmat4& view_proje
 ProjectedVertex TriangleSetup::project(const glm::vec3& p) const {
   ProjectedVertex v;
   v.clip = view_projection_ * glm::dvec4(glm::dvec3(p), 1.0);
-  for (int i = 0; i < 6; ++i) v.reject |= uint32_t(glm::dot(frustum_[i], v.clip) < 0) << i;
-  for (int i = 0; i < 5; ++i) v.clip_planes |= uint32_t(glm::dot(clip_planes_[i], v.clip) < 0) << i;
+  // The planes' dot products with their zero terms left out: adding a zero product changes no
+  // bit, so these are exactly glm::dot(plane, clip) (clip_polygon still uses glm::dot).
+  const glm::dvec4& c = v.clip;
+  const double gx = clip_planes_[1].w, gy = clip_planes_[3].w;
+  v.reject = uint32_t(c.x + c.w < 0) | uint32_t(-c.x + c.w < 0) << 1 |
+             uint32_t(c.y + c.w < 0) << 2 | uint32_t(-c.y + c.w < 0) << 3 |
+             uint32_t(c.z + c.w < 0) << 4 | uint32_t(-c.z + c.w < 0) << 5;
+  v.clip_planes = uint32_t(c.z + c.w < 0) | uint32_t(c.x + gx * c.w < 0) << 1 |
+                  uint32_t(-c.x + gx * c.w < 0) << 2 | uint32_t(c.y + gy * c.w < 0) << 3 |
+                  uint32_t(-c.y + gy * c.w < 0) << 4;
   if (v.clip_planes == 0) {  // in front of the near plane and inside the guard band
     const glm::dvec4& k = v.clip;
     // Viewport with y flipped: row 0 is the top.
