@@ -15,6 +15,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <new>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -114,7 +115,10 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   const size_t submitted = list.triangles();
   out.stats["time.setup"] = seconds_since(t);
 
-  DepthTarget target(w, h, scene.camera.near, scene.camera.far, options.hiz);
+  // Built inside the arena: its parallel clear uses the threads the options allow.
+  std::optional<DepthTarget> built;
+  arena.execute([&] { built.emplace(w, h, scene.camera.near, scene.camera.far, options.hiz); });
+  DepthTarget& target = *built;
   // The fraction in triangles, the speed in fragments.
   if (progress) progress->begin("draw", submitted, "triangles", "fragments");
   const DrawResult drawn = soft::draw_triangles(list, view_projection, target, arena, progress);
@@ -226,8 +230,12 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
         glm::dmat4(glm::perspective(glm::radians(90.0f), 1.0f, near_plane, far_plane));
     const size_t per_sample = 6 * size_t(settings.size) * size_t(settings.size) * sizeof(float);
     const size_t batch = std::clamp<size_t>(kShadowBatchBytes / per_sample, 1, samples.size());
-    DepthTarget scratch(settings.size, settings.size, near_plane, far_plane, options.hiz,
-                        /*depth_only=*/true);
+    std::optional<DepthTarget> scratch_built;
+    arena.execute([&] {
+      scratch_built.emplace(settings.size, settings.size, near_plane, far_plane, options.hiz,
+                            /*depth_only=*/true);
+    });
+    DepthTarget& scratch = *scratch_built;
     std::vector<soft::ShadowCube> cubes(batch);
     DrawResult shadow_work;
     double draw_seconds = 0;

@@ -43,7 +43,7 @@ void ShadowCube::build(const DrawList& list, const glm::vec3& light, const Shado
   const int n = size_;
   const glm::dmat4 to_light = glm::translate(glm::dmat4(1.0), -glm::dvec3(light));
   for (int f = 0; f < 6; ++f) {
-    scratch.clear();
+    arena.execute([&] { scratch.clear(); });
     const glm::dmat4 view = glm::dmat4(glm::mat4(face_rotations()[size_t(f)])) * to_light;
     DrawResult r = draw_triangles(list, settings.projection * view, scratch, arena, nullptr);
     work.set_up += r.set_up;

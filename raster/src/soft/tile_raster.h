@@ -10,6 +10,7 @@
 #include <limits>
 #include <vector>
 
+#include "rvr/shared/framebuffers.h"
 #include "soft/triangle_setup.h"
 
 namespace rvr::soft {
@@ -70,9 +71,9 @@ class DepthTarget {
   int width_, height_, tiles_x_, tiles_y_, blocks_x_, blocks_y_;
   double near_, far_;
   bool hiz_, depth_only_;
-  std::vector<double> depth_;  // +inf until drawn
-  std::vector<uint32_t> object_, primitive_, fragments_;
-  std::vector<float> bary_;
+  PixelVector<double> depth_;  // +inf until drawn
+  PixelVector<uint32_t> object_, primitive_, fragments_;
+  PixelVector<float> bary_;
   std::vector<double> block_max_;        // farthest depth in each block (+inf: not all drawn)
   std::vector<uint32_t> block_rejects_;  // hi-z rejections per block
   std::vector<uint16_t> block_empty_;    // pixels of each block nothing has been drawn in
