@@ -346,20 +346,9 @@ std::vector<RayPacket> make_tiles(const Scene& scene, std::vector<std::vector<in
   std::vector<RayPacket> tiles;
   for (int y0 = 0; y0 < 768; y0 += 8) {
     for (int x0 = 0; x0 < 1024; x0 += 8) {
-      RayPacket p;
-      p.origin[0] = f.eye.x;
-      p.origin[1] = f.eye.y;
-      p.origin[2] = f.eye.z;
-      p.tmin = scene.camera.near;
-      p.tmax = scene.camera.far;
-      p.count = 64;
+      RayPacket p = primary_ray_packet(f, x0, y0, 8, 8, scene.camera.near, scene.camera.far);
       std::vector<int> index;
-      for (int k = 0; k < 64; ++k) {
-        int x = x0 + k % 8, y = y0 + k / 8;
-        glm::vec3 d = camera_ray_direction(f, x + 0.5f, y + 0.5f);
-        for (int a = 0; a < 3; ++a) p.dir[a][k] = d[a];
-        index.push_back(y * 1024 + x);
-      }
+      for (int k = 0; k < 64; ++k) index.push_back((y0 + k / 8) * 1024 + x0 + k % 8);
       tiles.push_back(p);
       ray_index.push_back(index);
     }

@@ -43,6 +43,14 @@ struct QueryContext {
   HitRecord* hits;
 };
 
+// Lane i of a packet of N rays (N = 1 for a single ray).
+Ray lane_ray(RTCRayN* rays, unsigned N, unsigned i) {
+  return Ray{{RTCRayN_org_x(rays, N, i), RTCRayN_org_y(rays, N, i), RTCRayN_org_z(rays, N, i)},
+             {RTCRayN_dir_x(rays, N, i), RTCRayN_dir_y(rays, N, i), RTCRayN_dir_z(rays, N, i)},
+             RTCRayN_tnear(rays, N, i),
+             RTCRayN_tfar(rays, N, i)};
+}
+
 void set_ray(RTCRay& r, const Ray& ray) {
   r.org_x = ray.origin.x;
   r.org_y = ray.origin.y;
@@ -75,10 +83,7 @@ void EmbreeBackend::intersect(const RTCIntersectFunctionNArguments* args) {
   RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, N);
   for (unsigned i = 0; i < N; ++i) {
     if (!args->valid[i]) continue;
-    Ray ray{{RTCRayN_org_x(rays, N, i), RTCRayN_org_y(rays, N, i), RTCRayN_org_z(rays, N, i)},
-            {RTCRayN_dir_x(rays, N, i), RTCRayN_dir_y(rays, N, i), RTCRayN_dir_z(rays, N, i)},
-            RTCRayN_tnear(rays, N, i),
-            RTCRayN_tfar(rays, N, i)};
+    const Ray ray = lane_ray(rays, N, i);
     HitRecord h;
     if (!self->owner->hit_analytic(self->owner->analytic_[args->primID], ray, ray.tmax, h))
       continue;
@@ -101,10 +106,7 @@ void EmbreeBackend::occluded(const RTCOccludedFunctionNArguments* args) {
   RTCRayN* rays = args->ray;
   for (unsigned i = 0; i < N; ++i) {
     if (!args->valid[i]) continue;
-    Ray ray{{RTCRayN_org_x(rays, N, i), RTCRayN_org_y(rays, N, i), RTCRayN_org_z(rays, N, i)},
-            {RTCRayN_dir_x(rays, N, i), RTCRayN_dir_y(rays, N, i), RTCRayN_dir_z(rays, N, i)},
-            RTCRayN_tnear(rays, N, i),
-            RTCRayN_tfar(rays, N, i)};
+    const Ray ray = lane_ray(rays, N, i);
     HitRecord h;
     if (self->owner->hit_analytic(self->owner->analytic_[args->primID], ray, ray.tmax, h))
       RTCRayN_tfar(rays, N, i) = -std::numeric_limits<float>::infinity();

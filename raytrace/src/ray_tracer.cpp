@@ -84,17 +84,9 @@ class FrameTracer {
   // rays traced together as one packet, then each pixel shaded on its own.
   void render_block(int x0, int y0, int x1, int y1, FrameBuffers& fb, RayCounters& counters) const {
     const int w = x1 - x0;
-    RayPacket packet;
-    packet.origin[0] = frame_.eye.x;
-    packet.origin[1] = frame_.eye.y;
-    packet.origin[2] = frame_.eye.z;
-    packet.tmin = scene_.camera.near;
-    packet.tmax = scene_.camera.far;
-    packet.count = w * (y1 - y0);
-    for (int k = 0; k < packet.count; ++k) {
-      Ray r = primary_ray(float(x0 + k % w) + 0.5f, float(y0 + k / w) + 0.5f);
-      for (int a = 0; a < 3; ++a) packet.dir[a][k] = r.dir[a];
-    }
+    // t along a direction with forward component 1 is view depth: clip exactly as GL does.
+    const RayPacket packet =
+        primary_ray_packet(frame_, x0, y0, w, y1 - y0, scene_.camera.near, scene_.camera.far);
     HitRecord hits[kPacketRays];
     TraversalCounters work[kPacketRays];
     geometry_.closest_packet(packet, hits, work);

@@ -19,6 +19,7 @@
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/traversal_kernels.h"
 #include "rvr/raytrace/wide_bvh.h"
+#include "rvr/shared/camera.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
 
@@ -56,6 +57,12 @@ struct SurfaceHit {
 // Embree's build quality: HIGH (spatial splits; what the embree renderer uses) or MEDIUM (binned
 // SAH without spatial splits, the same kind of tree as ours).
 enum class EmbreeQuality { High, Medium };
+
+// The rays through the centres of pixels [x0, x0 + w) x [y0, y0 + h) (w * h <= kPacketRays),
+// row by row, from the camera's eye: what closest_packet takes for primary rays. t in
+// (tmin, tmax) is view depth, as for every primary ray.
+RayPacket primary_ray_packet(const CameraFrame& frame, int x0, int y0, int w, int h, float tmin,
+                             float tmax);
 
 class TraceGeometry {
  public:
