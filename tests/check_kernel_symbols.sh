@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The SIMD kernel objects may define no external code and exactly one kKernels table each.
+# The SIMD kernel objects may define no external code and exactly one kernel table each
+# (kKernels in raytrace, kFillKernels in raster).
 # External code (a weak copy of an inline function or template from a shared header, say) could
 # be picked by the linker for baseline code too, and would then run AVX2 or AVX-512 instructions
 # on any x86-64: a crash on older CPUs that no test here would see. Data the compiler adds itself
@@ -11,13 +12,13 @@ for object in "$@"; do
   symbols=$(nm -C --defined-only "$object")
   # External code: T (text), W (weak, here code: weak data is V), i (indirect function).
   code=$(printf '%s\n' "$symbols" | awk '$2 ~ /^[TWi]$/ { $1 = ""; print }')
-  tables=$(printf '%s\n' "$symbols" | grep -c ' [A-Z] rvr::isa_[a-z0-9]*::kKernels$' || true)
+  tables=$(printf '%s\n' "$symbols" | grep -cE ' [A-Z] rvr::(soft::)?isa_[a-z0-9]*::k(Fill)?Kernels$' || true)
   if [ "$tables" != 1 ] || [ -n "$code" ]; then
-    echo "FAIL: $object: $tables kKernels tables; external code symbols:"
+    echo "FAIL: $object: $tables kernel tables; external code symbols:"
     printf '%s\n' "$code"
     status=1
   else
-    echo "ok: $object: one kKernels table, no external code"
+    echo "ok: $object: one kernel table, no external code"
   fi
 done
 exit $status

@@ -23,6 +23,7 @@
 #include "rvr/shared/shading.h"
 #include "rvr/shared/tessellate.h"
 #include "soft/draw_triangles.h"
+#include "soft/fill_dispatch.h"
 #include "soft/shadow_cube.h"
 #include "soft/tile_raster.h"
 
@@ -58,6 +59,19 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
                                  h, soft::kMaxImageSide));
   RenderOutput out;
   ProgressSink* const progress = options.progress;
+  // The per-pixel kernels: RenderOptions::isa, else RVR_ISA, else the best this CPU runs.
+  Isa isa = Isa::Sse;
+  if (options.isa) {
+    isa = *options.isa;
+  } else {
+    Expected<Isa> selected = selected_isa();
+    if (!selected) return selected.error();
+    isa = *selected;
+  }
+  if (!cpu_supports(isa))
+    return bad_input(std::string("this CPU cannot run the ") + to_string(isa) + " kernels");
+  const soft::FillKernels& kernels = soft::fill_kernels(isa);
+  out.info["kernel"] = kernels.isa;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
 
   // --- setup: objects to triangles, transform, clip, bin (in submission order)
@@ -117,7 +131,8 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
 
   // Built inside the arena: its parallel clear uses the threads the options allow.
   std::optional<DepthTarget> built;
-  arena.execute([&] { built.emplace(w, h, scene.camera.near, scene.camera.far, options.hiz); });
+  arena.execute(
+      [&] { built.emplace(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels); });
   DepthTarget& target = *built;
   // The fraction in triangles, the speed in fragments.
   if (progress) progress->begin("draw", submitted, "triangles", "fragments");
@@ -233,7 +248,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     std::optional<DepthTarget> scratch_built;
     arena.execute([&] {
       scratch_built.emplace(settings.size, settings.size, near_plane, far_plane, options.hiz,
-                            /*depth_only=*/true);
+                            kernels, /*depth_only=*/true);
     });
     DepthTarget& scratch = *scratch_built;
     std::vector<soft::ShadowCube> cubes(batch);

@@ -10,7 +10,7 @@
 namespace rvr::soft {
 
 DepthTarget::DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz,
-                         bool depth_only)
+                         const FillKernels& kernels, bool depth_only)
     : width_(width),
       height_(height),
       tiles_x_((width + kTile - 1) / kTile),
@@ -20,7 +20,8 @@ DepthTarget::DepthTarget(int width, int height, double near_plane, double far_pl
       near_(near_plane),
       far_(far_plane),
       hiz_(hiz),
-      depth_only_(depth_only) {
+      depth_only_(depth_only),
+      kernels_(&kernels) {
   clear();
 }
 
@@ -53,6 +54,10 @@ void DepthTarget::clear() {
   block_max_.assign(size_t(blocks_x_) * size_t(blocks_y_), std::numeric_limits<double>::infinity());
   block_rejects_.assign(block_max_.size(), 0);
   block_empty_.resize(block_max_.size());
+  fill_target_ = {depth_.data(), object_.data(),    primitive_.data(),
+                  bary_.data(),  fragments_.data(), block_empty_.data(),
+                  width_,        blocks_x_,         near_,
+                  far_,          depth_only_};
   for (int by = 0; by < blocks_y_; ++by)
     for (int bx = 0; bx < blocks_x_; ++bx)
       block_empty_[size_t(by) * size_t(blocks_x_) + size_t(bx)] = uint16_t(
@@ -126,41 +131,26 @@ void DepthTarget::draw(const SetupTriangle& t, int x0, int y0, int x1, int y1,
     const int64_t px = int64_t(x) * kSub + kSub / 2, py = int64_t(y) * kSub + kSub / 2;
     return dx[i] * (py - t.y[i]) - dy[i] * (px - t.x[i]) - bias[i];
   };
-  std::array<double, 3> q;
-  // The pixels of one block (or of a small triangle's box): every edge tested unless `full`.
+  // The pixels of one block (or of a small triangle's box), through the SIMD kernel: every
+  // edge tested unless `full`.
   auto fill = [&](int bx0, int by0, int bx1, int by1, bool full) {
-    bool drawn = false;
-    int64_t row[3];
-    for (int i = 0; i < 3; ++i) row[i] = edge(i, bx0, by0);
-    for (int y = by0; y <= by1; ++y) {
-      int64_t e0 = row[0], e1 = row[1], e2 = row[2];
-      for (int x = bx0; x <= bx1; ++x) {
-        if (full || (e0 | e1 | e2) >= 0) {
-          const size_t i = size_t(y) * size_t(width_) + size_t(x);
-          if (!depth_only_) ++fragments_[i];
-          ++counters.generated;
-          const double inv_w = t.inv_w(x + 0.5, y + 0.5, q);
-          const double depth = 1.0 / inv_w;
-          // The depth range clips what lies beyond far (and rounding just inside near).
-          if (depth < depth_[i] && depth >= near_ && depth <= far_) {
-            if (depth_[i] == std::numeric_limits<double>::infinity())
-              --block_empty_[block_index(x, y)];
-            depth_[i] = depth;
-            if (!depth_only_) {
-              object_[i] = t.object;
-              primitive_[i] = t.primitive;
-              for (int j = 0; j < 3; ++j) bary_[3 * i + size_t(j)] = float(q[size_t(j)] / inv_w);
-            }
-            drawn = true;
-          }
-        }
-        e0 -= dy[0] * kSub;
-        e1 -= dy[1] * kSub;
-        e2 -= dy[2] * kSub;
-      }
-      for (int i = 0; i < 3; ++i) row[i] += dx[i] * kSub;
+    FillTriangle f;
+    for (int i = 0; i < 3; ++i) {
+      f.row0[i] = edge(i, bx0, by0);
+      f.step_x[i] = -dy[i] * kSub;
+      f.step_y[i] = dx[i] * kSub;
+      f.q0[i] = t.q0[size_t(i)];
+      f.qa[i] = t.qa[size_t(i)];
+      f.qb[i] = t.qb[size_t(i)];
     }
-    return drawn;
+    f.ox = t.ox;
+    f.oy = t.oy;
+    f.object = t.object;
+    f.primitive = t.primitive;
+    FillResult r;
+    kernels_->fill(f, fill_target_, bx0, by0, bx1, by1, full, r);
+    counters.generated += r.generated;
+    return r.drawn;
   };
   // A small triangle (at most 2x2 centres): those centres directly, no block classification
   // (draw_tile's whole-triangle hi-z test has been made); then its blocks' farthest depths.

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rvr/shared/framebuffers.h"
+#include "soft/fill_kernel.h"
 #include "soft/triangle_setup.h"
 
 namespace rvr::soft {
@@ -28,8 +29,9 @@ struct TileCounters {
 class DepthTarget {
  public:
   // depth_only: keeps depths alone (shadow maps), no ids, barycentrics or per-pixel cost.
+  // `kernels`: the per-pixel loop of the instruction set chosen for this render.
   DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz,
-              bool depth_only = false);
+              const FillKernels& kernels, bool depth_only = false);
   // Back to nothing drawn, for the next pass through the same target.
   void clear();
 
@@ -71,6 +73,8 @@ class DepthTarget {
   int width_, height_, tiles_x_, tiles_y_, blocks_x_, blocks_y_;
   double near_, far_;
   bool hiz_, depth_only_;
+  const FillKernels* kernels_;
+  FillTarget fill_target_;     // pointers into the arrays below, for the kernels
   PixelVector<double> depth_;  // +inf until drawn
   PixelVector<uint32_t> object_, primitive_, fragments_;
   PixelVector<float> bary_;

@@ -175,9 +175,9 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
         const int64_t px = int64_t(x) * kSub + kSub / 2, py = int64_t(y) * kSub + kSub / 2;
         bool inside = true;
         for (int i = 0; i < 3; ++i)
-          inside &= edge_dx[i] * (py - t.y[i]) - edge_dy[i] * (px - t.x[i]) -
-                        (t.top_left[i] ? 0 : 1) >=
-                    0;
+          inside &=
+              edge_dx[i] * (py - t.y[i]) - edge_dy[i] * (px - t.x[i]) - (t.top_left[i] ? 0 : 1) >=
+              0;
         covers = inside;
       }
     }

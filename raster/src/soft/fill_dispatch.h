@@ -1,0 +1,12 @@
+// The per-pixel kernels of one instruction set (shared/isa.h picks which).
+#pragma once
+
+#include "rvr/shared/isa.h"
+#include "soft/fill_kernel.h"
+
+namespace rvr::soft {
+
+// The caller must have checked cpu_supports(isa).
+const FillKernels& fill_kernels(Isa isa);
+
+}  // namespace rvr::soft

@@ -1,0 +1,4 @@
+// softraster's per-pixel kernels compiled for avx2 (flags in raster/CMakeLists.txt).
+#define RVR_KERNEL_NS isa_avx2
+#define RVR_KERNEL_NAME "avx2"
+#include "fill_kernels.inl"

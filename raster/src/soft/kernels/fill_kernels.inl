@@ -1,0 +1,123 @@
+// softraster's per-pixel loop for one instruction set; included once per kernel translation
+// unit, which defines RVR_KERNEL_NS. Lane k of a group handles pixel x + k of a row: its edge
+// functions are the row's plus k steps (integer adds, exact), its depth the scalar formula of
+// SetupTriangle::inv_w in the same order of double operations (no FMA: these units build with
+// -ffp-contract=off), so the bytes do not depend on the kernel.
+#include <immintrin.h>
+
+#include <cstdint>
+
+#include "soft/fill_kernel.h"
+
+#ifndef RVR_KERNEL_NS
+#error "define RVR_KERNEL_NS before including this file"
+#endif
+
+namespace rvr::soft {
+namespace RVR_KERNEL_NS {
+namespace {
+
+#if defined(__AVX2__)
+constexpr int kLanes = 4;
+using VD = __m256d;
+using VI = __m256i;
+inline VD splat(double x) { return _mm256_set1_pd(x); }
+inline VD add(VD a, VD b) { return _mm256_add_pd(a, b); }
+inline VD sub(VD a, VD b) { return _mm256_sub_pd(a, b); }
+inline VD mul(VD a, VD b) { return _mm256_mul_pd(a, b); }
+inline VD divide(VD a, VD b) { return _mm256_div_pd(a, b); }
+// max(v, 0) = v > 0 ? v : +0, as std::max(0.0, v) (NaN and -0 give +0).
+inline VD clamp0(VD v) { return _mm256_max_pd(v, _mm256_setzero_pd()); }
+inline VD lane_offsets() { return _mm256_setr_pd(0.0, 1.0, 2.0, 3.0); }
+inline VI isplat(int64_t x) { return _mm256_set1_epi64x(x); }
+inline VI iadd(VI a, VI b) { return _mm256_add_epi64(a, b); }
+inline VI ior(VI a, VI b) { return _mm256_or_si256(a, b); }
+inline VI iload(const int64_t* p) { return _mm256_loadu_si256(reinterpret_cast<const VI*>(p)); }
+inline unsigned sign_mask(VI v) { return unsigned(_mm256_movemask_pd(_mm256_castsi256_pd(v))); }
+inline void store(double* p, VD v) { _mm256_storeu_pd(p, v); }
+#else
+constexpr int kLanes = 2;
+using VD = __m128d;
+using VI = __m128i;
+inline VD splat(double x) { return _mm_set1_pd(x); }
+inline VD add(VD a, VD b) { return _mm_add_pd(a, b); }
+inline VD sub(VD a, VD b) { return _mm_sub_pd(a, b); }
+inline VD mul(VD a, VD b) { return _mm_mul_pd(a, b); }
+inline VD divide(VD a, VD b) { return _mm_div_pd(a, b); }
+inline VD clamp0(VD v) { return _mm_max_pd(v, _mm_setzero_pd()); }
+inline VD lane_offsets() { return _mm_setr_pd(0.0, 1.0); }
+inline VI isplat(int64_t x) { return _mm_set1_epi64x(x); }
+inline VI iadd(VI a, VI b) { return _mm_add_epi64(a, b); }
+inline VI ior(VI a, VI b) { return _mm_or_si128(a, b); }
+inline VI iload(const int64_t* p) { return _mm_loadu_si128(reinterpret_cast<const VI*>(p)); }
+inline unsigned sign_mask(VI v) { return unsigned(_mm_movemask_pd(_mm_castsi128_pd(v))); }
+inline void store(double* p, VD v) { _mm_storeu_pd(p, v); }
+#endif
+
+inline unsigned lowest_bit(unsigned m) { return unsigned(__builtin_ctz(m)); }
+
+void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x1, int y1,
+          bool full, FillResult& result) {
+  // Edge function offsets of the lanes: k steps to the right.
+  int64_t offsets[3][kLanes];
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < kLanes; ++k) offsets[i][k] = t.step_x[i] * k;
+  const VI lane_edge[3] = {iload(offsets[0]), iload(offsets[1]), iload(offsets[2])};
+  const VI group_step[3] = {isplat(t.step_x[0] * kLanes), isplat(t.step_x[1] * kLanes),
+                            isplat(t.step_x[2] * kLanes)};
+  const VD q0[3] = {splat(t.q0[0]), splat(t.q0[1]), splat(t.q0[2])};
+  const VD qa[3] = {splat(t.qa[0]), splat(t.qa[1]), splat(t.qa[2])};
+  const VD qb[3] = {splat(t.qb[0]), splat(t.qb[1]), splat(t.qb[2])};
+  const VD ox = splat(t.ox);
+  int64_t row[3] = {t.row0[0], t.row0[1], t.row0[2]};
+  alignas(32) double depth_lane[kLanes], q_lane[3][kLanes];
+  for (int y = y0; y <= y1; ++y) {
+    VI e[3] = {iadd(isplat(row[0]), lane_edge[0]), iadd(isplat(row[1]), lane_edge[1]),
+               iadd(isplat(row[2]), lane_edge[2])};
+    const VD dy = splat(double(y) + 0.5 - t.oy);  // (py - oy), as the scalar formula
+    for (int x = x0; x <= x1; x += kLanes) {
+      const int n = x1 - x + 1 < kLanes ? x1 - x + 1 : kLanes;
+      unsigned mask = (1u << n) - 1;
+      if (!full) mask &= ~sign_mask(ior(ior(e[0], e[1]), e[2]));
+      if (mask) {
+        const VD dx = add(add(splat(double(x)), lane_offsets()), splat(0.5));  // px = x + k + 0.5
+        const VD rel = sub(dx, ox);
+        VD q[3], s;
+        for (int j = 0; j < 3; ++j) q[j] = clamp0(add(add(q0[j], mul(qa[j], rel)), mul(qb[j], dy)));
+        s = add(add(q[0], q[1]), q[2]);
+        store(depth_lane, divide(splat(1.0), s));
+        if (!target.depth_only)
+          for (int j = 0; j < 3; ++j) store(q_lane[j], divide(q[j], s));
+        for (; mask; mask &= mask - 1) {
+          const int k = int(lowest_bit(mask));
+          const int px = x + k;
+          const size_t i = size_t(y) * size_t(target.width) + size_t(px);
+          if (!target.depth_only) ++target.fragments[i];
+          ++result.generated;
+          const double depth = depth_lane[k];
+          // The depth range clips what lies beyond far (and rounding just inside near).
+          if (depth < target.depth[i] && depth >= target.near_plane && depth <= target.far_plane) {
+            if (target.depth[i] == __builtin_inf())
+              --target.block_empty[size_t(y >> 3) * size_t(target.blocks_x) + size_t(px >> 3)];
+            target.depth[i] = depth;
+            if (!target.depth_only) {
+              target.object[i] = t.object;
+              target.primitive[i] = t.primitive;
+              for (int j = 0; j < 3; ++j) target.bary[3 * i + size_t(j)] = float(q_lane[j][k]);
+            }
+            result.drawn = true;
+          }
+        }
+      }
+      for (int i = 0; i < 3; ++i) e[i] = iadd(e[i], group_step[i]);
+    }
+    for (int i = 0; i < 3; ++i) row[i] += t.step_y[i];
+  }
+}
+
+}  // namespace
+
+extern const FillKernels kFillKernels = {RVR_KERNEL_NAME, fill};
+
+}  // namespace RVR_KERNEL_NS
+}  // namespace rvr::soft
