@@ -71,11 +71,6 @@ size_t DepthTarget::bytes() const {
          block_rejects_.size() * sizeof(uint32_t);
 }
 
-float DepthTarget::cost(int x, int y) const {
-  const size_t i = size_t(y) * size_t(width_) + size_t(x);
-  return float(fragments_[i]) + float(block_rejects_[block_index(x, y)]) / float(kBlock * kBlock);
-}
-
 void DepthTarget::update_block_max(int bx, int by) {
   // While a pixel of the block is empty its farthest depth is +inf: nothing to scan.
   if (block_empty_[size_t(by) * size_t(blocks_x_) + size_t(bx)] > 0) return;

@@ -60,7 +60,10 @@ class DepthTarget {
     return {bary_[3 * i], bary_[3 * i + 1], bary_[3 * i + 2]};
   }
   // Work at pixel (x, y): fragments generated, plus each hi-z rejection of its block as 1/64.
-  float cost(int x, int y) const;
+  float cost(int x, int y) const {
+    return float(fragments_[size_t(y) * size_t(width_) + size_t(x)]) +
+           float(block_rejects_[block_index(x, y)]) / float(kBlock * kBlock);
+  }
   size_t bytes() const;
 
  private:

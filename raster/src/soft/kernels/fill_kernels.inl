@@ -55,6 +55,8 @@ inline void store(double* p, VD v) { _mm_storeu_pd(p, v); }
 #endif
 
 inline unsigned lowest_bit(unsigned m) { return unsigned(__builtin_ctz(m)); }
+// Set bits of a 4-bit mask (no popcnt instruction in the baseline kernel).
+constexpr uint8_t kBits[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
 
 void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x1, int y1,
           bool full, FillResult& result) {
@@ -86,26 +88,34 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
         for (int j = 0; j < 3; ++j) q[j] = clamp0(add(add(q0[j], mul(qa[j], rel)), mul(qb[j], dy)));
         s = add(add(q[0], q[1]), q[2]);
         store(depth_lane, divide(splat(1.0), s));
-        if (!target.depth_only)
-          for (int j = 0; j < 3; ++j) store(q_lane[j], divide(q[j], s));
-        for (; mask; mask &= mask - 1) {
-          const int k = int(lowest_bit(mask));
-          const int px = x + k;
-          const size_t i = size_t(y) * size_t(target.width) + size_t(px);
+        result.generated += kBits[mask];  // mask < 16
+        // The depth test first: the barycentrics' divisions only for groups that pass it.
+        unsigned passed = 0;
+        for (unsigned m = mask; m; m &= m - 1) {
+          const int k = int(lowest_bit(m));
+          const size_t i = size_t(y) * size_t(target.width) + size_t(x + k);
           if (!target.depth_only) ++target.fragments[i];
-          ++result.generated;
           const double depth = depth_lane[k];
           // The depth range clips what lies beyond far (and rounding just inside near).
-          if (depth < target.depth[i] && depth >= target.near_plane && depth <= target.far_plane) {
-            if (target.depth[i] == __builtin_inf())
-              --target.block_empty[size_t(y >> 3) * size_t(target.blocks_x) + size_t(px >> 3)];
-            target.depth[i] = depth;
-            if (!target.depth_only) {
-              target.object[i] = t.object;
-              target.primitive[i] = t.primitive;
-              for (int j = 0; j < 3; ++j) target.bary[3 * i + size_t(j)] = float(q_lane[j][k]);
-            }
-            result.drawn = true;
+          if (depth < target.depth[i] && depth >= target.near_plane && depth <= target.far_plane)
+            passed |= 1u << k;
+        }
+        if (passed) {
+          result.drawn = true;
+          if (!target.depth_only)
+            for (int j = 0; j < 3; ++j) store(q_lane[j], divide(q[j], s));
+        }
+        for (; passed; passed &= passed - 1) {
+          const int k = int(lowest_bit(passed));
+          const int px = x + k;
+          const size_t i = size_t(y) * size_t(target.width) + size_t(px);
+          if (target.depth[i] == __builtin_inf())
+            --target.block_empty[size_t(y >> 3) * size_t(target.blocks_x) + size_t(px >> 3)];
+          target.depth[i] = depth_lane[k];
+          if (!target.depth_only) {
+            target.object[i] = t.object;
+            target.primitive[i] = t.primitive;
+            for (int j = 0; j < 3; ++j) target.bary[3 * i + size_t(j)] = float(q_lane[j][k]);
           }
         }
       }
