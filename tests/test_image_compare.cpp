@@ -343,7 +343,7 @@ TEST(Compare, LoneMismatchIsExcusedButAWrongRegionCountsItsInterior) {
   b.primitive_id[b.index(4, 4)] = 3;  // same object, another primitive: still a mismatch
   auto m = compare_buffers(a, b);
   EXPECT_EQ(m.visibility.mismatched_pixels, 1u);
-  // cli.md: its neighbours lie on the boundary it draws in b, so it is not off the edges.
+  // docs/cli.md: its neighbours lie on the boundary it draws in b, so it is not off the edges.
   EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
   EXPECT_DOUBLE_EQ(m.visibility.id_agreement, 80.0 / 81.0);
   // A 5x5 wrong region: only its centre has no boundary pixel among its 8 neighbours.

@@ -1,6 +1,6 @@
 // metrics.json and report.html of `rvr compare`.
 //
-// metrics.json holds exactly the fields cli.md requires, plus a few extras ("command",
+// metrics.json holds the fields docs/cli.md lists: the required ones plus a few extras ("command",
 // "heat_map_scale", "depth_diff_scale", "compared", "files", and "image" per renderer). JSON
 // has no infinity or NaN: an infinite PSNR (identical colour) is written as 999.0, any other
 // non-finite number as null.

@@ -36,7 +36,7 @@ struct ReportInput {
   std::string out_dir;
 };
 
-// The metrics.json document (cli.md), as text.
+// The metrics.json document (docs/cli.md), as text.
 std::string metrics_json(const ReportInput& input);
 
 // RFC 4648 base64 (for data URIs).

@@ -67,7 +67,7 @@ Expected<GlStrings> current_gl_strings() {
 }
 
 Status check_gl_driver(const GlStrings& strings) {
-  // softpipe renders an all-black image without any GL error (PLATFORM-NOTES.md).
+  // softpipe renders an all-black image without any GL error (docs/platform-notes.md).
   if (strings.renderer.find("softpipe") != std::string::npos)
     return internal_error(
         fmt::format("GL driver '{}' cannot render correctly; unset GALLIUM_DRIVER to use llvmpipe",

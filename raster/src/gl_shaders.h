@@ -104,7 +104,7 @@ int cube_face(vec3 d) {
   return d.z >= 0.0 ? 4 : 5;
 }
 
-// vis_l of DESIGN.md from sample i's shadow cube: 1 when |P - L| - bias <= the stored distance
+// vis_l of docs/design.md from sample i's shadow cube: 1 when |P - L| - bias <= the stored distance
 // of P's texel, else 0; with PCF the mean of that test over the 3x3 texels around it (clamped
 // to the face: no filtering across cube edges).
 float shadow_visibility(int i, vec3 P, vec3 L, vec3 geometric_normal) {

@@ -177,7 +177,7 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) 
   }
   const int w = a.width, h = a.height;
 
-  // Visibility, as cli.md defines it: a mismatch is off the edges when none of its 8
+  // Visibility, as docs/cli.md defines it: a mismatch is off the edges when none of its 8
   // neighbours lies on an object or primitive boundary in either id image. (A boundary pixel
   // always has a 4-neighbour that is one too, so dilating the union of both boundary masks
   // over the 3x3 neighbourhood, the pixel itself included, is the same test.) A lone wrong

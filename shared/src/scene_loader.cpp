@@ -1,11 +1,11 @@
-// Loading and validating rvr-scene/1 files (see shared/spec/scene-format.md).
+// Loading and validating rvr-scene/1 files (see docs/scene-format.md).
 //
 // Errors are reported as "FILE: json.path: what is wrong" or, for JSON syntax,
 // "FILE:LINE:COL: JSON syntax: what". Internally the reader throws a LoadError and the public
 // functions turn it (and anything else, e.g. std::bad_alloc) into an rvr::Error: no exception
 // escapes.
 //
-// Decisions beyond the spec's table:
+// Decisions the format's key table leaves open (all documented in docs/scene-format.md):
 // - `transform` is accepted on every object type. On `mesh` and `triangle` it is a full affine
 //   map (normals by the inverse transpose). On the analytic shapes (`sphere`, `plane`, `csg`)
 //   it moves centres/points and turns normals; the scale must then be uniform in magnitude

@@ -15,7 +15,7 @@ struct VisibilityMetrics {
   double id_agreement = 1.0;  // fraction of pixels with the same object AND primitive id
   size_t mismatched_pixels = 0;
   // Mismatched pixels none of whose 8 neighbours lies on an object or primitive boundary in
-  // either id image (cli.md): a silhouette or shared edge may fall either way by a pixel,
+  // either id image (docs/cli.md): a silhouette or shared edge may fall either way by a pixel,
   // nothing else may. A lone wrong pixel is excused (it draws a boundary around itself); a
   // wrong region counts its interior.
   size_t mismatched_off_edge = 0;

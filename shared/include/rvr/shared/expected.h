@@ -7,7 +7,7 @@
 
 namespace rvr {
 
-// Exit status the CLI uses for an error (see cli.md).
+// Exit status the CLI uses for an error (see docs/cli.md).
 enum class ErrorKind { BadInput = 2, Internal = 3 };
 
 struct Error {

@@ -1,4 +1,4 @@
-// The one shading equation of DESIGN.md (local part). The GLSL in raster/ mirrors it line for
+// The one shading equation of docs/design.md (local part). The GLSL in raster/ mirrors it line for
 // line; keep the two in step.
 #pragma once
 
