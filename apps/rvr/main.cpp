@@ -24,6 +24,7 @@
 #include "rvr/shared/isa.h"
 #include "rvr/shared/limits.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/scene_writer.h"
 #include "terminal_progress.h"
 
 namespace {
@@ -409,7 +410,41 @@ int run_diff(const DiffArgs& d) {
 
 // ----------------------------------------------------------------------------- scenes/info
 
-int run_scenes() {
+struct ScenesArgs {
+  std::string export_name;  // --export NAME
+  std::string out;          // -o FILE (default: stdout)
+};
+
+// --export: the built-in scene as an rvr-scene/1 document. Meshes other than single
+// triangles have no inline form in the format: they go to PLY files next to -o FILE.
+int export_scene(const ScenesArgs& a) {
+  std::string name = a.export_name;
+  if (name.rfind("builtin:", 0) == 0) name = name.substr(8);
+  Scene scene = take(make_builtin_scene(name));
+  std::filesystem::path out(a.out);
+  std::string prefix = a.out.empty() ? name : out.stem().string();
+  SceneDocument doc = take(write_scene(scene, prefix));
+  if (a.out.empty()) {
+    if (!doc.mesh_files.empty()) {
+      fail(bad_input(fmt::format(
+          "builtin:{}: has {} mesh{} of more than one triangle, which rvr-scene/1 reads only "
+          "from mesh files: give -o FILE.json to write {} as PLY next to it",
+          name, doc.mesh_files.size(), doc.mesh_files.size() == 1 ? "" : "es",
+          doc.mesh_files.size() == 1 ? "it" : "them")));
+    }
+    std::fwrite(doc.json.data(), 1, doc.json.size(), stdout);
+    return std::fflush(stdout) == 0 ? 0 : 3;
+  }
+  for (const SceneMeshFile& m : doc.mesh_files) {
+    check(write_text_file((out.parent_path() / m.name).string(), m.bytes));
+  }
+  check(write_text_file(a.out, doc.json));
+  return 0;
+}
+
+int run_scenes(const ScenesArgs& a) {
+  if (!a.export_name.empty()) return export_scene(a);
+  if (!a.out.empty()) fail(bad_input("scenes: -o needs --export NAME"));
   for (const BuiltinSceneInfo& s : builtin_scenes())
     std::printf("builtin:%-14s %s\n", s.name.c_str(), s.description.c_str());
   return 0;
@@ -532,7 +567,14 @@ int run(int argc, char** argv) {
   diff_cmd->add_option("-o,--output", diff.out, "heat map of the difference (.png)");
   diff_cmd->add_option("--fail-above", diff.fail_above, "exit 1 when the RMSE is above this");
 
-  CLI::App* scenes_cmd = app.add_subcommand("scenes", "list the built-in scenes");
+  ScenesArgs scenes;
+  CLI::App* scenes_cmd =
+      app.add_subcommand("scenes", "list the built-in scenes, or write one as rvr-scene/1 JSON");
+  scenes_cmd->add_option("--export", scenes.export_name,
+                         "write built-in scene NAME (e.g. cornell, tessphere:2000) as JSON");
+  scenes_cmd->add_option("-o,--output", scenes.out,
+                         "with --export: write FILE (and its meshes as FILE-stem.meshI.ply "
+                         "beside it) instead of stdout");
   CLI::App* info_cmd = app.add_subcommand("info", "versions and machine facts for bug reports");
   std::string info_gl;
   info_cmd->add_option("--gl", info_gl, "GL back end to describe: osmesa | egl (default as render)")
@@ -553,7 +595,7 @@ int run(int argc, char** argv) {
   if (render_cmd->parsed()) return run_render(render);
   if (compare_cmd->parsed()) return run_compare(compare, join_args(argc, argv));
   if (diff_cmd->parsed()) return run_diff(diff);
-  if (scenes_cmd->parsed()) return run_scenes();
+  if (scenes_cmd->parsed()) return run_scenes(scenes);
   if (info_cmd->parsed()) return run_info(info_gl);
   return 2;
 }

@@ -1,0 +1,303 @@
+// Writing a Scene as rvr-scene/1 (the inverse of scene_loader.cpp for what the format can
+// express). Internally a WriteError is thrown and turned into an rvr::Error at the boundary.
+#include "rvr/shared/scene_writer.h"
+
+#include <fmt/format.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <stdexcept>
+
+#include "rvr/shared/scene_loader.h"
+
+namespace rvr {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+struct WriteError {
+  std::string what;
+};
+
+[[noreturn]] void fail(std::string what) {
+  throw WriteError{std::move(what)};
+}
+
+// The shortest decimal that reads back (decimal -> double -> float, as the loader does) to
+// exactly f; whole numbers as JSON integers; -0 stays -0.
+json num(float f, const std::string& path) {
+  if (!std::isfinite(f)) fail(fmt::format("{}: {} is not finite", path, f));
+  if (f == 0.0f) return std::signbit(f) ? json(-0.0) : json(0);
+  char buf[64];
+  auto [end, ec] = std::to_chars(buf, buf + sizeof buf - 1, f);
+  double d = double(f);
+  if (ec == std::errc()) {
+    *end = '\0';
+    double shortest = std::strtod(buf, nullptr);
+    // Kept unless it reads back otherwise (double rounding) or lies past FLT_MAX, which the
+    // loader refuses even where it would round to FLT_MAX: 3.4028235e38 does.
+    if (float(shortest) == f && std::abs(shortest) <= double(std::numeric_limits<float>::max())) {
+      d = shortest;
+    }
+  }
+  if (d == std::floor(d) && std::abs(d) < 9.0e15) return json(int64_t(d));
+  return json(d);
+}
+
+json vec(const glm::vec3& v, const std::string& path) {
+  return json::array({num(v.x, path + "[0]"), num(v.y, path + "[1]"), num(v.z, path + "[2]")});
+}
+
+json material_json(const Material& m, const std::string& path) {
+  json o = json::object();
+  o["diffuse"] = vec(m.diffuse, path + ".diffuse");
+  o["specular"] = vec(m.specular, path + ".specular");
+  o["emission"] = vec(m.emission, path + ".emission");
+  o["shininess"] = num(m.shininess, path + ".shininess");
+  o["mirror"] = num(m.mirror, path + ".mirror");
+  o["transparency"] = num(m.transparency, path + ".transparency");
+  o["ior"] = num(m.ior, path + ".ior");
+  return o;
+}
+
+bool same_material(const Material& a, const Material& b) {
+  return a.diffuse == b.diffuse && a.specular == b.specular && a.emission == b.emission &&
+         a.shininess == b.shininess && a.mirror == b.mirror && a.transparency == b.transparency &&
+         a.ior == b.ior;
+}
+
+json sphere_members(json o, const Sphere& s, const std::string& path) {
+  o["center"] = vec(s.center, path + ".center");
+  o["radius"] = num(s.radius, path + ".radius");
+  return o;
+}
+
+// A csg node below the object: a leaf is a sphere, an inner node a nested csg.
+json csg_node(const CsgNode& n, const std::string& path, int depth) {
+  if (depth > 64) fail(path + ": csg tree nested deeper than 64 levels");
+  if (n.is_leaf) return sphere_members(json{{"type", "sphere"}}, n.sphere, path);
+  if (!n.a || !n.b) fail(path + ": csg node without two children");
+  static const char* kOps[] = {"union", "intersection", "difference"};
+  json o = json::object();
+  if (depth > 1) o["type"] = "csg";
+  o["op"] = kOps[int(n.op)];
+  o["a"] = csg_node(*n.a, path + ".a", depth + 1);
+  o["b"] = csg_node(*n.b, path + ".b", depth + 1);
+  return o;
+}
+
+// Indented like dump(2), but an array of scalars, or of arrays of scalars, on one line.
+bool flat(const json& v) {
+  if (!v.is_array()) return !v.is_object();
+  for (const json& e : v) {
+    if (e.is_object() || (e.is_array() && !flat(e))) return false;
+  }
+  return true;
+}
+
+void print(const json& v, int indent, std::string& out) {
+  if (v.is_array() && flat(v)) {
+    out += '[';
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (i) out += ", ";
+      print(v[i], indent, out);
+    }
+    out += ']';
+  } else if (v.is_array() || v.is_object()) {
+    if (v.empty()) {
+      out += v.is_array() ? "[]" : "{}";
+      return;
+    }
+    out += v.is_array() ? "[\n" : "{\n";
+    size_t i = 0;
+    for (auto it = v.begin(); it != v.end(); ++it, ++i) {
+      out.append(size_t(indent + 2), ' ');
+      if (v.is_object()) out += json(it.key()).dump() + ": ";
+      print(*it, indent + 2, out);
+      out += i + 1 < v.size() ? ",\n" : "\n";
+    }
+    out.append(size_t(indent), ' ');
+    out += v.is_array() ? ']' : '}';
+  } else {
+    out += v.dump();
+  }
+}
+
+void put_u8(std::string& out, uint8_t v) {
+  out.push_back(char(v));
+}
+void put_i32(std::string& out, int32_t v) {
+  char b[4];
+  std::memcpy(b, &v, 4);  // x86 and every platform rvr builds on are little-endian
+  out.append(b, 4);
+}
+void put_f32(std::string& out, float v) {
+  char b[4];
+  std::memcpy(b, &v, 4);
+  out.append(b, 4);
+}
+
+std::string ply(const TriangleMesh& mesh, const std::string& path) {
+  if (mesh.positions.size() > uint64_t(INT32_MAX)) fail(path + ": too many vertices for PLY");
+  bool smooth = mesh.smooth();
+  if (smooth && mesh.normals.size() != mesh.positions.size()) {
+    fail(path + ": normals and positions differ in number");
+  }
+  std::string out = fmt::format(
+      "ply\nformat binary_little_endian 1.0\ncomment written by rvr scenes --export\n"
+      "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n",
+      mesh.positions.size());
+  if (smooth) out += "property float nx\nproperty float ny\nproperty float nz\n";
+  out += fmt::format("element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+                     mesh.triangles.size());
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isfinite(mesh.positions[i][k])) fail(path + ": a vertex is not finite");
+      put_f32(out, mesh.positions[i][k]);
+    }
+    if (smooth) {
+      for (int k = 0; k < 3; ++k) put_f32(out, mesh.normals[i][k]);
+    }
+  }
+  for (const glm::uvec3& t : mesh.triangles) {
+    put_u8(out, 3);
+    for (int k = 0; k < 3; ++k) {
+      if (t[k] >= mesh.positions.size()) fail(path + ": a vertex index is out of range");
+      put_i32(out, int32_t(t[k]));
+    }
+  }
+  return out;
+}
+
+SceneDocument write(const Scene& scene, const std::string& mesh_prefix) {
+  SceneDocument doc;
+  json root = json::object();
+  root["format"] = "rvr-scene/1";
+
+  const ImageSettings& im = scene.image;
+  root["image"] = {{"width", im.width},
+                   {"height", im.height},
+                   {"background", vec(im.background, "image.background")},
+                   {"samples_per_pixel", im.samples_per_pixel}};
+
+  const Camera& c = scene.camera;
+  root["camera"] = {{"eye", vec(c.eye, "camera.eye")},
+                    {"target", vec(c.target, "camera.target")},
+                    {"up", vec(c.up, "camera.up")},
+                    {"fov_y_deg", num(c.fov_y_deg, "camera.fov_y_deg")},
+                    {"near", num(c.near, "camera.near")},
+                    {"far", num(c.far, "camera.far")},
+                    {"aperture_radius", num(c.aperture_radius, "camera.aperture_radius")},
+                    {"focus_distance", num(c.focus_distance, "camera.focus_distance")}};
+  root["ambient"] = vec(scene.ambient, "ambient");
+
+  if (scene.materials.empty() || !same_material(scene.materials[0], default_material())) {
+    fail("materials[0]: is not the built-in default material, which a file cannot redefine");
+  }
+  json materials = json::object();
+  std::set<std::string> names;
+  for (size_t i = 1; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    std::string path = fmt::format("materials[{}]", i);
+    if (m.name.empty()) fail(path + ": has no name");
+    if (!names.insert(m.name).second) fail(path + ": duplicate material name '" + m.name + "'");
+    materials[m.name] = material_json(m, path);
+  }
+  root["materials"] = std::move(materials);
+
+  json lights = json::array();
+  for (size_t i = 0; i < scene.lights.size(); ++i) {
+    const Light& l = scene.lights[i];
+    std::string path = fmt::format("lights[{}]", i);
+    if (l.type == LightType::Point) {
+      lights.push_back({{"type", "point"},
+                        {"position", vec(l.position, path + ".position")},
+                        {"intensity", vec(l.intensity, path + ".intensity")}});
+    } else {
+      lights.push_back({{"type", "area"},
+                        {"corner", vec(l.corner, path + ".corner")},
+                        {"edge_u", vec(l.edge_u, path + ".edge_u")},
+                        {"edge_v", vec(l.edge_v, path + ".edge_v")},
+                        {"intensity", vec(l.intensity, path + ".intensity")},
+                        {"samples", l.samples}});
+    }
+  }
+  root["lights"] = std::move(lights);
+
+  json objects = json::array();
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const Object& o = scene.objects[i];
+    std::string path = fmt::format("objects[{}]", i);
+    if (o.material >= scene.materials.size()) fail(path + ": material index out of range");
+    json j = json::object();
+    j["type"] = "";  // first in the object; set below
+    j["name"] = o.name;
+    switch (o.type) {
+      case ObjectType::Sphere:
+        j["type"] = "sphere";
+        j = sphere_members(std::move(j), o.sphere, path);
+        break;
+      case ObjectType::Plane:
+        j["type"] = "plane";
+        j["point"] = vec(o.plane.point, path + ".point");
+        j["normal"] = vec(o.plane.normal, path + ".normal");
+        j["half_size"] = num(o.plane.half_size, path + ".half_size");
+        break;
+      case ObjectType::Triangles: {
+        const TriangleMesh& mesh = o.mesh;
+        if (mesh.triangles.empty()) fail(path + ": a mesh with no triangles");
+        if (mesh.triangles.size() == 1 && !mesh.smooth()) {
+          j["type"] = "triangle";
+          json verts = json::array();
+          for (int k = 0; k < 3; ++k) {
+            uint32_t v = mesh.triangles[0][k];
+            if (v >= mesh.positions.size()) fail(path + ": a vertex index is out of range");
+            verts.push_back(vec(mesh.positions[v], fmt::format("{}.vertices[{}]", path, k)));
+          }
+          j["vertices"] = std::move(verts);
+        } else {
+          std::string file = fmt::format("{}.mesh{}.ply", mesh_prefix, i);
+          j["type"] = "mesh";
+          j["file"] = file;
+          j["smooth"] = mesh.smooth();
+          doc.mesh_files.push_back({file, ply(mesh, path)});
+        }
+        break;
+      }
+      case ObjectType::Csg: {
+        if (!o.csg || o.csg->is_leaf) fail(path + ": a csg object needs an operation at its root");
+        json tree = csg_node(*o.csg, path, 1);
+        j["type"] = "csg";
+        for (auto& [k, v] : tree.items()) j[k] = v;
+        break;
+      }
+    }
+    if (o.material != 0) j["material"] = scene.materials[o.material].name;
+    objects.push_back(std::move(j));
+  }
+  root["objects"] = std::move(objects);
+  print(root, 0, doc.json);
+  doc.json += '\n';
+  return doc;
+}
+
+}  // namespace
+
+Expected<SceneDocument> write_scene(const Scene& scene, const std::string& mesh_prefix) {
+  std::string source = scene.source.empty() ? "scene" : scene.source;
+  try {
+    return write(scene, mesh_prefix);
+  } catch (const WriteError& e) {
+    return bad_input(source + ": " + e.what);
+  } catch (const std::exception& e) {
+    return internal_error(source + ": internal error while writing the scene: " + e.what());
+  }
+}
+
+}  // namespace rvr
