@@ -51,7 +51,8 @@ std::string object_label(const Object& o, size_t index) {
   return o.name.empty() ? fmt::format("csg#{}", index) : o.name;
 }
 
-Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options) {
+Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options,
+                                   std::optional<DepthTarget>& kept) {
   const int w = scene.image.width, h = scene.image.height;
   if (w < 1 || h < 1) return bad_input(fmt::format("image size {}x{} is empty", w, h));
   if (w > soft::kMaxImageSide || h > soft::kMaxImageSide)
@@ -129,11 +130,14 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   const size_t submitted = list.triangles();
   out.stats["time.setup"] = seconds_since(t);
 
-  // Built inside the arena: its parallel clear uses the threads the options allow.
-  std::optional<DepthTarget> built;
-  arena.execute(
-      [&] { built.emplace(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels); });
-  DepthTarget& target = *built;
+  // Built (or cleared) inside the arena: its parallel clear uses the threads the options allow.
+  arena.execute([&] {
+    if (kept && kept->same_setup(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels))
+      kept->clear();
+    else
+      kept.emplace(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels);
+  });
+  DepthTarget& target = *kept;
   // The fraction in triangles, the speed in fragments.
   if (progress) progress->begin("draw", submitted, "triangles", "fragments");
   const DrawResult drawn = soft::draw_triangles(list, view_projection, target, arena, progress);
@@ -327,10 +331,18 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
 
 }  // namespace
 
+struct SoftRasterizer::Frame {
+  std::optional<DepthTarget> target;
+};
+
+SoftRasterizer::SoftRasterizer() : frame_(std::make_unique<Frame>()) {}
+SoftRasterizer::~SoftRasterizer() = default;
+
 Expected<RenderOutput> SoftRasterizer::render(const Scene& scene, const RenderOptions& options) {
   try {
-    return render_impl(scene, options);
+    return render_impl(scene, options, frame_->target);
   } catch (const std::bad_alloc&) {
+    frame_->target.reset();  // possibly half resized
     return internal_error(fmt::format("out of memory rendering {}x{} with {} objects",
                                       scene.image.width, scene.image.height, scene.objects.size()));
   }

@@ -1,9 +1,8 @@
 #include "soft/tile_raster.h"
 
+#include <emmintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-
-#include <emmintrin.h>
 
 #include <algorithm>
 #include <array>
@@ -46,12 +45,10 @@ void DepthTarget::clear() {
                       if (depth_only_) return;
                       std::fill(object_.begin() + std::ptrdiff_t(r.begin()),
                                 object_.begin() + std::ptrdiff_t(r.end()), 0xFFFFFFFFu);
-                      std::fill(primitive_.begin() + std::ptrdiff_t(r.begin()),
-                                primitive_.begin() + std::ptrdiff_t(r.end()), 0xFFFFFFFFu);
+                      // Primitive ids and barycentrics are read only where an object was
+                      // drawn, and written with it: not cleared.
                       std::fill(fragments_.begin() + std::ptrdiff_t(r.begin()),
                                 fragments_.begin() + std::ptrdiff_t(r.end()), 0u);
-                      std::fill(bary_.begin() + std::ptrdiff_t(3 * r.begin()),
-                                bary_.begin() + std::ptrdiff_t(3 * r.end()), 0.0f);
                     });
   block_max_.assign(size_t(blocks_x_) * size_t(blocks_y_), std::numeric_limits<double>::infinity());
   block_rejects_.assign(block_max_.size(), 0);

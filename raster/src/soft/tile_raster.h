@@ -34,6 +34,12 @@ class DepthTarget {
               const FillKernels& kernels, bool depth_only = false);
   // Back to nothing drawn, for the next pass through the same target.
   void clear();
+  // Whether this target was made with these arguments (and can be cleared instead of rebuilt).
+  bool same_setup(int width, int height, double near_plane, double far_plane, bool hiz,
+                  const FillKernels& kernels) const {
+    return width == width_ && height == height_ && near_plane == near_ && far_plane == far_ &&
+           hiz == hiz_ && &kernels == kernels_ && !depth_only_;
+  }
 
   int width() const { return width_; }
   int height() const { return height_; }

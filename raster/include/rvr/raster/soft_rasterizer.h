@@ -4,6 +4,7 @@
 // in submission order), then each visible pixel is shaded once with rvr::shade_local.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "rvr/shared/expected.h"
@@ -13,8 +14,17 @@ namespace rvr {
 
 class SoftRasterizer : public Renderer {
  public:
+  SoftRasterizer();
+  ~SoftRasterizer() override;
   std::string name() const override { return "softraster"; }
   Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options) override;
+
+  struct Frame;
+
+ private:
+  // The z-buffer state of the last render, cleared and reused by the next one of the same size
+  // (as a GL context keeps its framebuffer): tens of MB not reallocated and faulted in again.
+  std::unique_ptr<Frame> frame_;
 };
 
 }  // namespace rvr
