@@ -7,6 +7,8 @@
 //   BM_Build/<accel>/<n>                       acceleration structure build
 //   BM_Threads/<renderer>/<threads>            tessphere:100000 at 1024x768 on 1 or 2 threads
 // Scenes and acceleration structures are built outside the timed loops (FrameRenderer).
+// Renderers and their variants (raytrace_bvh2, softraster_nohiz) come from the renderer table,
+// rvr/renderers/registry.h.
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
@@ -14,12 +16,13 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <random>
 #include <string>
 
-#include "renderers.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/raytrace/trace_geometry.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/isa.h"
 #include "rvr/shared/scene_loader.h"
@@ -52,40 +55,35 @@ void add_counters(benchmark::State& state, const RenderOutput& out, double pixel
   state.counters["pixels/s"] = C(pixels, C::kIsIterationInvariantRate);
 }
 
-// Renders frames of one scene with one renderer. For the tracers the scene's geometry and BVH
-// are built once, here, outside the timed loop; rasterizers have nothing to build beforehand.
+// Renders frames of one scene with one renderer of the table, or a variant of one. What the
+// renderer builds beforehand (the tracers' BVH) is built here, outside the timed loop.
 class FrameRenderer {
  public:
   FrameRenderer(const std::string& name, const Scene& scene, const RenderOptions& options)
-      : scene_(scene), options_(options) {
-    bool tracer = name == "raytrace" || name == "raytrace_bvh2" || name == "raytrace_none" ||
-                  name == "embree";
-    if (!tracer) {
-      // softraster_nohiz: softraster with hierarchical z off, the textbook z-buffer loop.
-      if (name == "softraster_nohiz") options_.hiz = false;
-      renderer_ =
-          std::move(make_renderer(name == "softraster_nohiz" ? "softraster" : name).value());
-      return;
-    }
-    AccelKind accel = name == "embree"          ? AccelKind::Embree
-                      : name == "raytrace_none" ? AccelKind::None
-                      : name == "raytrace_bvh2" ? AccelKind::Bvh2
-                                                : AccelKind::Bvh;
-    geometry_ = std::make_unique<TraceGeometry>(scene, options.spheres, options.sphere_segments,
-                                                accel, options.triangle_test);
-  }
-  RenderOutput frame() {
-    if (geometry_) return tracer_.render(scene_, options_, *geometry_).value();
-    return renderer_->render(scene_, options_).value();
-  }
+      : prepared_(
+            prepare_renderer(find_renderer_choice(name).value(), scene, {}, options).value()) {}
+  RenderOutput frame() { return prepared_->render().value(); }
 
  private:
-  const Scene& scene_;
-  RenderOptions options_;
-  std::unique_ptr<Renderer> renderer_;
-  RayTracer tracer_;
-  std::unique_ptr<TraceGeometry> geometry_;
+  std::unique_ptr<PreparedRenderer> prepared_;
 };
+
+// Every renderer of the table, each followed by its variants of one kind, if any: the sweeps
+// that vary an early rejection include the renderers without it.
+std::vector<RendererChoice> choices_with(std::optional<VariantOf> of) {
+  std::vector<RendererChoice> chosen;
+  for (const RendererChoice& c : renderer_choices())
+    if (!c.variant || (of && c.variant->of == *of)) chosen.push_back(c);
+  return chosen;
+}
+
+// The chapter's loop, every object for every ray: O(pixels x triangles).
+bool every_object_every_ray(const RendererChoice& c) {
+  RendererConfig config;
+  RenderOptions options;
+  c.apply(config, options);
+  return options.accel == AccelKind::None;
+}
 
 // Times whole frames of `scene` (already sized) in local mode. The first frame (GL shader JIT,
 // TBB threads) is not timed.
@@ -445,11 +443,12 @@ void BM_Build(benchmark::State& state, std::string accel) {
 }
 
 void register_all() {
-  for (std::string r :
-       {"raster", "softraster", "raytrace", "raytrace_bvh2", "raytrace_none", "embree"}) {
+  // raster, softraster, raytrace, raytrace_bvh2, raytrace_none, embree.
+  for (const RendererChoice& c : choices_with(VariantOf::Accelerator)) {
+    const std::string& r = c.name;
     for (std::string s : {"tessphere", "soup"}) {
       for (long n : {100L, 1000L, 10000L, 100000L, 1000000L}) {
-        if (r == "raytrace_none" && n > 1000) continue;  // O(pixels x triangles)
+        if (every_object_every_ray(c) && n > 1000) continue;
         for (long w : {256L, 1024L, 2048L}) {
           benchmark::RegisterBenchmark(("BM_Frame/" + r + "/" + s).c_str(), BM_Frame, r, s)
               ->Args({n, w})
@@ -460,18 +459,20 @@ void register_all() {
     }
   }
   // Ten million triangles, at 1024 wide only: the z-buffers' linear cost against the tracers'.
-  for (std::string r : {"raster", "softraster", "raytrace", "embree"})
+  for (const RendererInfo& info : renderers())
     for (std::string s : {"tessphere", "soup"})
-      benchmark::RegisterBenchmark(("BM_Frame/" + r + "/" + s).c_str(), BM_Frame, r, s)
+      benchmark::RegisterBenchmark(("BM_Frame/" + info.name + "/" + s).c_str(), BM_Frame, info.name,
+                                   s)
           ->Args({10000000L, 1024L})
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
+  // raster, softraster, softraster_nohiz, raytrace, embree.
   for (bool back : {false, true})
-    for (std::string r : {"raster", "softraster", "softraster_nohiz", "raytrace", "embree"})
+    for (const RendererChoice& c : choices_with(VariantOf::HierarchicalZ))
       for (long n : {1L, 2L, 4L, 8L, 16L, 32L, 64L, 128L, 256L})
         benchmark::RegisterBenchmark(
-            ((back ? "BM_DepthComplexityBackToFront/" : "BM_DepthComplexity/") + r).c_str(),
-            BM_DepthComplexity, r, back)
+            ((back ? "BM_DepthComplexityBackToFront/" : "BM_DepthComplexity/") + c.name).c_str(),
+            BM_DepthComplexity, c.name, back)
             ->Arg(n)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
@@ -498,6 +499,7 @@ void register_all() {
                                    scene)
           ->Arg(scene == "soup" ? 1000000 : 100000)
           ->Unit(benchmark::kMillisecond);
+  // Our own loops (raster's threads are llvmpipe's, embree's partly Embree's).
   for (std::string r : {"raytrace", "softraster"})
     for (long threads : {1L, 2L})
       benchmark::RegisterBenchmark(("BM_Threads/" + r).c_str(), BM_Threads, r)

@@ -1,13 +1,13 @@
 // Conformance: every renderer x every built-in scene, in local mode with spheres traced as the
 // raster's tessellation, must agree with a renderer of the other loop order on what is seen.
-// A new renderer is one line in kRenderers.
+// Every renderer of the table (rvr/renderers/registry.h) and every variant of one is a case.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
 #include <set>
 
-#include "renderers.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/scene_loader.h"
@@ -17,29 +17,31 @@ using namespace rvr;
 namespace {
 
 struct RendererCase {
-  const char* label;
-  const char* name;       // registry name
-  AccelKind accel;        // for tracers
-  const char* reference;  // a renderer of the other loop order
+  RendererChoice choice;  // "raster", "raster_egl", "raytrace_bvh2", ...
+  std::string reference;  // the table's first renderer of the other loop order
   double max_work;        // pixels x triangles; beyond it both images shrink (brute force is
                           // O(pixels x triangles), and the agreement rules hold at any size)
-  GlBackend gl = GlBackend::Default;  // for the raster: where its GL context comes from
 };
 
 // Test names in ctest: "raster vs raytrace".
 void PrintTo(const RendererCase& r, std::ostream* os) {
-  *os << r.label << " vs " << r.reference;
+  *os << r.choice.name << " vs " << r.reference;
 }
 
-const RendererCase kRenderers[] = {
-    {"raster", "raster", AccelKind::Bvh, "raytrace", 0, GlBackend::OsMesa},
-    {"raster_egl", "raster", AccelKind::Bvh, "raytrace", 0, GlBackend::Egl},
-    {"softraster", "softraster", AccelKind::Bvh, "raytrace", 0},
-    {"raytrace", "raytrace", AccelKind::Bvh, "raster", 0},
-    {"raytrace_bvh2", "raytrace", AccelKind::Bvh2, "raster", 0},
-    {"raytrace_none", "raytrace", AccelKind::None, "raster", 1.6e9},
-    {"embree", "embree", AccelKind::Embree, "raster", 0},
-};
+std::vector<RendererCase> renderer_cases() {
+  std::vector<RendererCase> cases;
+  for (const RendererChoice& c : renderer_choices()) {
+    std::string reference;
+    for (const RendererInfo& r : renderers())
+      if (reference.empty() && r.order != c.info->order) reference = r.name;
+    RendererConfig config;
+    RenderOptions options;
+    c.apply(config, options);
+    // Every object for every ray: the image shrinks beyond 1.6e9 ray-triangle tests.
+    cases.push_back({c, reference, options.accel == AccelKind::None ? 1.6e9 : 0.0});
+  }
+  return cases;
+}
 
 // Every built-in scene, sized for the test. `csg` is the one exception, by the format's rule:
 // a csg object has no z-buffer form, so rasterizers skip it (with a warning; tested in
@@ -69,16 +71,20 @@ constexpr double kMaxDepthRelError = 1e-3;
 constexpr double kMinPsnr = 40.0;
 constexpr int kSegments = 48;
 
-RenderOutput render_with(const char* name, AccelKind accel, const Scene& scene, SphereMode spheres,
+// Renders with a table entry or variant, by name: its changes go over these settings.
+RenderOutput render_with(const std::string& name, const Scene& scene, SphereMode spheres,
                          int segments, GlBackend gl = GlBackend::Default,
                          RenderMode mode = RenderMode::Local) {
-  auto renderer = make_renderer(name, gl);
-  EXPECT_TRUE(renderer.ok());
+  Expected<RendererChoice> choice = find_renderer_choice(name);
+  EXPECT_TRUE(choice.ok()) << name;
+  RendererConfig config{gl};
   RenderOptions options;
   options.mode = mode;
   options.spheres = spheres;
   options.sphere_segments = segments;
-  options.accel = accel;
+  choice->apply(config, options);
+  auto renderer = choice->info->create(config);
+  EXPECT_TRUE(renderer.ok());
   Expected<RenderOutput> out = renderer.value()->render(scene, options);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().message);
   return std::move(out).value();
@@ -124,8 +130,11 @@ TEST_P(Conformance, AgreesWithTheOtherLoopOrder) {
     scene->image.height = std::max(1, int(scene->image.height * scale));
   }
 
-  RenderOutput a = render_with(r.name, r.accel, *scene, SphereMode::Mesh, kSegments, r.gl);
-  RenderOutput b = render_with(r.reference, AccelKind::Bvh, *scene, SphereMode::Mesh, kSegments);
+  // The raster pins OSMesa unless its variant asks for EGL, so that raster and raster_egl test
+  // both back ends (the default falls back to EGL when OSMesa is missing).
+  RenderOutput a =
+      render_with(r.choice.name, *scene, SphereMode::Mesh, kSegments, GlBackend::OsMesa);
+  RenderOutput b = render_with(r.reference, *scene, SphereMode::Mesh, kSegments);
   ComparisonMetrics m = compare_buffers(a.buffers, b.buffers);
 
   // Something must be seen, or agreement means nothing.
@@ -143,11 +152,11 @@ TEST_P(Conformance, AgreesWithTheOtherLoopOrder) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryRendererEveryScene, Conformance,
-                         ::testing::Combine(::testing::ValuesIn(kRenderers),
+                         ::testing::Combine(::testing::ValuesIn(renderer_cases()),
                                             ::testing::ValuesIn(kScenes)),
                          [](const ::testing::TestParamInfo<Conformance::ParamType>& info) {
-                           std::string s = std::string(std::get<0>(info.param).label) + "_" +
-                                           std::get<1>(info.param);
+                           std::string s =
+                               std::get<0>(info.param).choice.name + "_" + std::get<1>(info.param);
                            for (char& c : s)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return s;
@@ -162,10 +171,10 @@ class GlBackends : public ::testing::TestWithParam<const char*> {};
 TEST_P(GlBackends, OsMesaAndEglRenderIdenticalBuffers) {
   Expected<Scene> scene = make_builtin_scene(GetParam());
   ASSERT_TRUE(scene.ok());
-  RenderOutput osmesa = render_with("raster", AccelKind::Bvh, *scene, SphereMode::Mesh, kSegments,
+  RenderOutput osmesa = render_with("raster", *scene, SphereMode::Mesh, kSegments,
                                     GlBackend::OsMesa, RenderMode::Full);
-  RenderOutput egl = render_with("raster", AccelKind::Bvh, *scene, SphereMode::Mesh, kSegments,
-                                 GlBackend::Egl, RenderMode::Full);
+  RenderOutput egl =
+      render_with("raster", *scene, SphereMode::Mesh, kSegments, GlBackend::Egl, RenderMode::Full);
   const FrameBuffers& a = osmesa.buffers;
   const FrameBuffers& b = egl.buffers;
   ASSERT_EQ(a.pixel_count(), b.pixel_count());
@@ -204,9 +213,8 @@ TEST(AnalyticSpheres, MismatchesStayOnSilhouettesAndShrinkWithSegments) {
 
   size_t previous = SIZE_MAX;
   for (int segments : {12, 24, 48, 96}) {
-    RenderOutput traced =
-        render_with("raytrace", AccelKind::Bvh, s, SphereMode::Analytic, segments);
-    RenderOutput raster = render_with("raster", AccelKind::Bvh, s, SphereMode::Analytic, segments);
+    RenderOutput traced = render_with("raytrace", s, SphereMode::Analytic, segments);
+    RenderOutput raster = render_with("raster", s, SphereMode::Analytic, segments);
     ComparisonMetrics m = compare_buffers(traced.buffers, raster.buffers);
     size_t mismatched = m.visibility.mismatched_pixels;
 

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "renderers.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/scene_loader.h"
 #include "scene_builders.h"
 
@@ -60,9 +60,10 @@ TEST(NoNan, AnyRendererAnySceneAnyMode) {
     scene.image.width = 64;  // small: this is about values, not pictures
     scene.image.height = 48;
     scene.image.samples_per_pixel = std::min(scene.image.samples_per_pixel, 4);
-    for (const std::string& r : renderer_names()) {
+    for (const RendererInfo& info : renderers()) {
+      const std::string& r = info.name;
       for (RenderMode mode : {RenderMode::Visibility, RenderMode::Local, RenderMode::Full}) {
-        auto renderer = make_renderer(r);
+        auto renderer = info.create({});
         ASSERT_TRUE(renderer.ok());
         RenderOptions options;
         options.mode = mode;

@@ -20,7 +20,7 @@
 #include <utility>
 #include <vector>
 
-#include "renderers.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/progress.h"
 #include "rvr/shared/scene_loader.h"
 #include "terminal_progress.h"
@@ -98,16 +98,15 @@ TEST(ProgressSink, EveryRendererAndRasterOnEglDrawsTheSameWhenWatched) {
   Scene scene = load_scene("builtin:spheres").value();
   scene.image.width = 70;  // not a multiple of any tile size
   scene.image.height = 37;
-  const std::pair<const char*, GlBackend> renderers[] = {{"raytrace", GlBackend::Default},
-                                                         {"softraster", GlBackend::Default},
-                                                         {"embree", GlBackend::Default},
-                                                         {"raster", GlBackend::OsMesa},
-                                                         {"raster", GlBackend::Egl}};
-  for (const auto& [name, gl] : renderers) {
-    const std::string label = std::string(name) + " " + to_string(gl);
-    std::unique_ptr<Renderer> renderer = make_renderer(name, gl).value();
+  // Every renderer of the table; the raster on OSMesa, and on EGL as its GL-context variant.
+  for (const RendererChoice& c : renderer_choices()) {
+    if (c.variant && c.variant->of != VariantOf::GlContext) continue;
+    RendererConfig config{GlBackend::OsMesa};
     RenderOptions options;
     options.mode = RenderMode::Full;
+    c.apply(config, options);
+    const std::string& label = c.name;
+    std::unique_ptr<Renderer> renderer = c.info->create(config).value();
     RenderOutput plain = renderer->render(scene, options).value();
     ProgressSink sink;
     options.progress = &sink;
@@ -115,13 +114,13 @@ TEST(ProgressSink, EveryRendererAndRasterOnEglDrawsTheSameWhenWatched) {
     EXPECT_EQ(plain.buffers.color, watched.buffers.color) << label;
     EXPECT_EQ(plain.buffers.object_id, watched.buffers.object_id) << label;
     ProgressSnapshot s = sink.snapshot();  // the last phase
-    if (std::string(name) == "raster") {
+    if (c.info->name == "raster") {
       EXPECT_EQ(s.phase, "readback") << label;
       continue;
     }
     EXPECT_GT(s.total, 0u) << label;
     EXPECT_EQ(s.done, s.total) << label;
-    if (std::string(name) != "softraster") {
+    if (c.info->order == LoopOrder::PixelMajor) {
       EXPECT_EQ(s.phase, "trace");
       EXPECT_EQ(s.total, 70u * 37u);
       EXPECT_EQ(s.rate_unit, "rays");

@@ -7,9 +7,9 @@
 #include <glm/glm.hpp>
 #include <limits>
 
-#include "renderers.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/scene_loader.h"
 #include "scene_builders.h"

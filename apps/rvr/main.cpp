@@ -15,10 +15,11 @@
 #include <optional>
 #include <thread>
 
-#include "renderers.h"
 #include "report.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/compare_renderers.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/isa.h"
@@ -292,9 +293,13 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   Scene scene = load(a.common, options, load_seconds);
   options.progress = progress.sink();
 
-  std::vector<std::unique_ptr<Renderer>> renderers;
-  for (const std::string& name : a.renderers)
-    renderers.push_back(take(make_renderer(name, gl_backend(a.common))));
+  CompareOptions compare;
+  compare.config.gl = gl_backend(a.common);
+  compare.on_phase = [&](const std::string& label, const std::string& phase) {
+    progress.begin(label, phase);
+  };
+  // Everything is computed before the first file is written.
+  CompareResult result = take(compare_renderers(scene, a.renderers, options, compare));
 
   ReportInput report;
   report.scene = scene.source;
@@ -303,52 +308,35 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   report.mode = to_string(options.mode);
   report.command_line = command_line;
   report.out_dir = a.out_dir;
-  std::vector<FrameBuffers> buffers;
-  for (size_t i = 0; i < renderers.size(); ++i) {
-    progress.begin(fmt::format("{}/{} {}", i + 1, renderers.size(), a.renderers[i]), "render");
-    auto start = Clock::now();
-    RenderOutput out = take(renderers[i]->render(scene, options));
+  report.metrics = result.metrics;
+  report.heat_map_scale = compare.heat_map_scale;
+  report.depth_diff_scale = compare.depth_diff_scale;
+  for (const ComparedRenderer& c : result.renderers) {
     ReportRenderer r;
-    r.name = a.renderers[i];
+    r.name = c.name;
     r.image_file = r.name + ".png";
-    r.seconds = seconds_since(start);
-    r.warnings = out.warnings;
-    r.stats = out.stats;
-    r.info = out.info;
+    r.seconds = c.seconds;
+    r.warnings = c.output.warnings;
+    r.stats = c.output.stats;
+    r.info = c.output.info;
     r.stats["time.load"] = load_seconds;
-    report.renderers.push_back(r);
-    buffers.push_back(std::move(out.buffers));
-  }
-  progress.begin("", "compare");
-  report.metrics = compare_buffers(buffers[0], buffers[1]);
-
-  // Everything is computed before the first file is written.
-  std::vector<Image> images, cost_images;
-  for (size_t i = 0; i < buffers.size(); ++i) {
-    const FrameBuffers& fb = buffers[i];
-    ReportRenderer& r = report.renderers[i];
-    images.push_back(color_image(fb));
-    double total = 0;
-    for (float c : fb.cost) total += c;
-    float scale = 0;
-    cost_images.push_back(cost_image(fb, &scale));
-    if (total > 0) {
+    if (c.has_cost) {
       r.cost_file = r.name + ".cost.png";
-      r.cost_scale = scale;
-      r.cost_mean = total / double(std::max<size_t>(1, fb.pixel_count()));
+      r.cost_scale = c.cost_scale;
+      r.cost_mean = c.cost_mean;
     }
+    report.renderers.push_back(r);
   }
-  for (size_t i = 0; i < buffers.size(); ++i) {
-    check(write_image(a.out_dir + "/" + report.renderers[i].image_file, images[i]));
+
+  for (size_t i = 0; i < result.renderers.size(); ++i) {
+    check(write_image(a.out_dir + "/" + report.renderers[i].image_file, result.renderers[i].image));
     if (!report.renderers[i].cost_file.empty())
-      check(write_image(a.out_dir + "/" + report.renderers[i].cost_file, cost_images[i], false));
+      check(write_image(a.out_dir + "/" + report.renderers[i].cost_file,
+                        result.renderers[i].cost_image, false));
   }
-  check(write_image(a.out_dir + "/diff.png",
-                    diff_heat_map(images[0], images[1], report.heat_map_scale), false));
-  check(write_image(a.out_dir + "/id_mismatch.png", id_mismatch_image(buffers[0], buffers[1]),
-                    false));
-  check(write_image(a.out_dir + "/depth_diff.png",
-                    depth_diff_image(buffers[0], buffers[1], report.depth_diff_scale), false));
+  check(write_image(a.out_dir + "/diff.png", result.diff, false));
+  check(write_image(a.out_dir + "/id_mismatch.png", result.id_mismatch, false));
+  check(write_image(a.out_dir + "/depth_diff.png", result.depth_diff, false));
   check(write_text_file(a.out_dir + "/metrics.json", metrics_json(report)));
   check(write_text_file(a.out_dir + "/report.html", take(report_html(report))));
 
@@ -497,7 +485,7 @@ int run_info(const std::string& gl_name) {
   std::printf("cpu: %s, %u hardware threads\n", cpu_model().c_str(),
               std::thread::hardware_concurrency());
   std::printf("renderers: ");
-  for (const std::string& n : renderer_names()) std::printf("%s ", n.c_str());
+  for (const RendererInfo& r : renderers()) std::printf("%s ", r.name.c_str());
   std::printf("\n");
   std::printf("simd: baseline build %s; the CPU has %s\n", built_simd(), cpu_simd().c_str());
   std::printf("kernels: %s; compiled: sse avx2 avx512; this CPU runs:",
@@ -521,6 +509,17 @@ int run_info(const std::string& gl_name) {
   return 0;
 }
 
+// -r's help: each renderer of the table on a line, with its loop order and what it is.
+std::string renderer_help() {
+  std::string help = "one of:";
+  for (const RendererInfo& r : renderers()) {
+    help += fmt::format("\n  {:<11}[{}] {}", r.name,
+                        r.order == LoopOrder::TriangleMajor ? "triangle-major" : "pixel-major",
+                        r.description);
+  }
+  return help;
+}
+
 std::string join_args(int argc, char** argv) {
   std::string s;
   for (int i = 0; i < argc; ++i) {
@@ -539,10 +538,7 @@ int run(int argc, char** argv) {
   RenderArgs render;
   CLI::App* render_cmd = app.add_subcommand("render", "render a scene with one renderer");
   add_common_options(*render_cmd, render.common);
-  std::string renderer_list;
-  for (const std::string& name : renderer_names())
-    renderer_list += (renderer_list.empty() ? "" : " | ") + name;
-  render_cmd->add_option("-r,--renderer", render.renderer, renderer_list)->required();
+  render_cmd->add_option("-r,--renderer", render.renderer, renderer_help())->required();
   render_cmd->add_option("-o,--output", render.out, "output image (.png, .exr)");
   render_cmd->add_option("--aov", render.aovs, "extra outputs: depth,id,normal,cost")
       ->delimiter(',')
@@ -552,7 +548,10 @@ int run(int argc, char** argv) {
   CompareArgs compare;
   CLI::App* compare_cmd = app.add_subcommand("compare", "render with two renderers and compare");
   add_common_options(*compare_cmd, compare.common);
-  compare_cmd->add_option("-r,--renderers", compare.renderers, "renderers, first two compared")
+  compare_cmd
+      ->add_option(
+          "-r,--renderers", compare.renderers,
+          "renderers, first two compared (default raster,raytrace): " + renderer_name_list())
       ->delimiter(',');
   compare_cmd->add_option("-o,--output", compare.out_dir, "output folder (default rvr-out)");
   compare_cmd
