@@ -249,6 +249,46 @@ TEST(SoftRasterizer, ManyChunksSameBytesBoundedMemory) {
   EXPECT_LT(memory[1], 1.05 * memory[0]) << memory[0] << " then " << memory[1];
 }
 
+// One SoftRasterizer keeps its z-buffer state between renders and clears it: what it draws
+// does not depend on what it drew before (another scene, another size, hi-z on or off, many
+// triangles where the next has few).
+TEST(SoftRasterizer, ReusedRendererDrawsWhatAFreshOneDraws) {
+  auto same = [](const RenderOutput& a, const RenderOutput& b) {
+    auto eq = [](const auto& x, const auto& y) {
+      return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
+    };
+    return eq(a.buffers.color, b.buffers.color) && eq(a.buffers.depth, b.buffers.depth) &&
+           eq(a.buffers.object_id, b.buffers.object_id) &&
+           eq(a.buffers.primitive_id, b.buffers.primitive_id) &&
+           eq(a.buffers.normal, b.buffers.normal) && eq(a.buffers.cost, b.buffers.cost);
+  };
+  struct Case {
+    const char* scene;
+    bool hiz;
+    int width;
+  };
+  const Case cases[] = {{"soup:20000", true, 160},    {"spheres", true, 160},
+                        {"occluders:8", true, 160},   {"spheres", false, 160},
+                        {"tessphere:5000", true, 96}, {"soup:20000", true, 160},
+                        {"cornell", true, 160}};
+  SoftRasterizer reused;
+  for (const Case& c : cases) {
+    Expected<Scene> scene = make_builtin_scene(c.scene);
+    ASSERT_TRUE(scene.ok());
+    scene->image.width = c.width;
+    scene->image.height = c.width * 3 / 4;
+    RenderOptions options;
+    options.mode = RenderMode::Local;
+    options.hiz = c.hiz;
+    Expected<RenderOutput> again = reused.render(*scene, options);
+    SoftRasterizer fresh_renderer;
+    Expected<RenderOutput> fresh = fresh_renderer.render(*scene, options);
+    ASSERT_TRUE(again.ok() && fresh.ok());
+    EXPECT_TRUE(same(*again, *fresh)) << c.scene << (c.hiz ? "" : " no hi-z") << " " << c.width;
+    EXPECT_EQ(again->stats.at("fragments.generated"), fresh->stats.at("fragments.generated"));
+  }
+}
+
 TEST(SoftRasterizer, WarnsAboutWhatItCannotDraw) {
   Expected<Scene> scene = make_builtin_scene("csg");
   ASSERT_TRUE(scene.ok());
