@@ -10,6 +10,17 @@ namespace {
 // Snapping moves a vertex by at most half a sub-pixel step in x and in y.
 constexpr double kSnapDistance = 0.7072 / double(kSub);
 
+// std::llround (halves away from zero) without the library call, which baseline x86-64 cannot
+// inline: x minus its truncation is exact for |x| < 2^52 (screen positions in sub-pixels inside
+// the guard band are far smaller), so the comparisons decide exactly as llround does.
+inline int64_t round_half_away(double x) {
+  int64_t i = int64_t(x);
+  const double fraction = x - double(i);
+  if (fraction >= 0.5) ++i;
+  if (fraction <= -0.5) --i;
+  return i;
+}
+
 }  // namespace
 
 TriangleSetup::TriangleSetup(int width, int height, const glm::dmat4& view_projection)
@@ -44,8 +55,8 @@ ProjectedVertex TriangleSetup::project(const glm::vec3& p) const {
     // Viewport with y flipped: row 0 is the top.
     v.sx = (k.x / k.w * 0.5 + 0.5) * width_;
     v.sy = (0.5 - k.y / k.w * 0.5) * height_;
-    v.fx = std::llround(v.sx * double(kSub));
-    v.fy = std::llround(v.sy * double(kSub));
+    v.fx = round_half_away(v.sx * double(kSub));
+    v.fy = round_half_away(v.sy * double(kSub));
     v.inv_w = 1.0 / k.w;
   }
   return v;
@@ -121,8 +132,8 @@ void TriangleSetup::clip_and_emit(const ProjectedVertex* pv[3], uint32_t object,
       const glm::dvec4& c = cv[k]->c;
       sx[k] = (c.x / c.w * 0.5 + 0.5) * width_;
       sy[k] = (0.5 - c.y / c.w * 0.5) * height_;
-      fx[k] = std::llround(sx[k] * double(kSub));
-      fy[k] = std::llround(sy[k] * double(kSub));
+      fx[k] = round_half_away(sx[k] * double(kSub));
+      fy[k] = round_half_away(sy[k] * double(kSub));
       w[k] = c.w;
       for (int j = 0; j < 3; ++j) f[k][j] = cv[k]->b[j] / c.w;
     }
