@@ -3,6 +3,7 @@
 //   BM_DepthComplexity/<renderer>/<N>          occluders:N at 512x384, front to back
 //   BM_DepthComplexityBackToFront/<renderer>/<N>  the same quads rearmost first
 //   BM_Effects/<effect>                        the tracer on cornell, one effect at a time
+//   BM_Effects/hybrid/<effect>                 the same frames with the hybrid
 //   BM_Trace/<accel>/<rays>/<scene>/<n>        one thread, rays only, no shading
 //   BM_Build/<accel>/<n>                       acceleration structure build
 //   BM_Threads/<renderer>/<threads>            tessphere:100000 at 1024x768 on 1 or 2 threads
@@ -134,14 +135,13 @@ void BM_DepthComplexity(benchmark::State& state, std::string renderer_name, bool
   time_frames(state, renderer_name, scene);
 }
 
-// The tracer on cornell with exactly one effect switched on.
-void BM_Effects(benchmark::State& state, std::string effect) {
-  Scene scene = builtin("cornell");
+// Cornell with exactly one effect switched on (BM_Effects): the scene and options.
+void effect_scene(const std::string& effect, Scene& scene, RenderOptions& options) {
+  scene = builtin("cornell");
   for (Material& m : scene.materials) m.mirror = m.transparency = 0.0f;
   Light point{LightType::Point, {2.78f, 5.3f, 2.795f}, {}, {}, {}, glm::vec3(12.0f), 1};
   Light area = scene.lights[0];
   scene.lights = {point};
-  RenderOptions options;
   options.mode = RenderMode::Full;
   if (effect == "primary") {
     options.mode = RenderMode::Local;
@@ -162,6 +162,13 @@ void BM_Effects(benchmark::State& state, std::string effect) {
     scene.camera.focus_distance = 9.5f;
     scene.image.samples_per_pixel = 16;
   }  // "hard_shadows": the point light in full mode
+}
+
+// The tracer on cornell with exactly one effect switched on.
+void BM_Effects(benchmark::State& state, std::string effect) {
+  Scene scene;
+  RenderOptions options;
+  effect_scene(effect, scene, options);
   RayTracer tracer;
   RenderOutput out = tracer.render(scene, options).value();
   for (auto _ : state) {
@@ -169,6 +176,28 @@ void BM_Effects(benchmark::State& state, std::string effect) {
     benchmark::DoNotOptimize(out.buffers.color.data());
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
+}
+
+// The same frames with another renderer of the table (the hybrid: the z-buffer finds the
+// primary hits, the tracer does the effect), built afresh each frame as the tracer's are. The
+// split of its time: zbuffer_ms (visibility pass) and trace_ms (hits rebuilt, shading, rays).
+void BM_EffectsWith(benchmark::State& state, std::string renderer_name, std::string effect) {
+  Scene scene;
+  RenderOptions options;
+  effect_scene(effect, scene, options);
+  std::unique_ptr<Renderer> renderer = make_renderer(renderer_name).value();
+  RenderOutput out = renderer->render(scene, options).value();
+  double zbuffer = 0, trace = 0;
+  for (auto _ : state) {
+    out = renderer->render(scene, options).value();
+    benchmark::DoNotOptimize(out.buffers.color.data());
+    zbuffer += out.stats["time.zbuffer"];
+    trace += out.stats["time.trace"];
+  }
+  add_counters(state, out, double(scene.image.width) * scene.image.height);
+  double frames = double(std::max<benchmark::IterationCount>(state.iterations(), 1));
+  state.counters["zbuffer_ms"] = 1e3 * zbuffer / frames;
+  state.counters["trace_ms"] = 1e3 * trace / frames;
 }
 
 std::vector<Ray> make_rays(const Scene& scene, const std::string& kind) {
@@ -478,10 +507,16 @@ void register_all() {
             ->UseRealTime();
   for (std::string e :
        {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1", "mirror_depth_2",
-        "mirror_depth_3", "mirror_depth_4", "mirror_depth_5", "glass", "dof_16"})
+        "mirror_depth_3", "mirror_depth_4", "mirror_depth_5", "glass", "dof_16"}) {
     benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
+    // Beside the tracer's: the hybrid on the same frames.
+    benchmark::RegisterBenchmark(("BM_Effects/hybrid/" + e).c_str(), BM_EffectsWith,
+                                 std::string("hybrid"), e)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  }
   for (std::string a : {"bvh", "bvh2", "embree"})
     for (std::string rays : {"primary", "random"}) {
       benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/tessphere").c_str(), BM_Trace,

@@ -1,6 +1,9 @@
 // Conformance: every renderer x every built-in scene, in local mode with spheres traced as the
 // raster's tessellation, must agree with a renderer of the other loop order on what is seen.
 // Every renderer of the table (rvr/renderers/registry.h) and every variant of one is a case.
+// The reference is the table's first renderer of another loop order: raytrace for the
+// z-buffers, raster for the tracers and for the hybrids (whose visibility is a z-buffer's and
+// whose hits are the tracer's: both must hold).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -18,7 +21,7 @@ namespace {
 
 struct RendererCase {
   RendererChoice choice;  // "raster", "raster_egl", "raytrace_bvh2", ...
-  std::string reference;  // the table's first renderer of the other loop order
+  std::string reference;  // the table's first renderer of another loop order
   double max_work;        // pixels x triangles; beyond it both images shrink (brute force is
                           // O(pixels x triangles), and the agreement rules hold at any size)
 };

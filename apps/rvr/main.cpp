@@ -513,9 +513,7 @@ int run_info(const std::string& gl_name) {
 std::string renderer_help() {
   std::string help = "one of:";
   for (const RendererInfo& r : renderers()) {
-    help += fmt::format("\n  {:<11}[{}] {}", r.name,
-                        r.order == LoopOrder::TriangleMajor ? "triangle-major" : "pixel-major",
-                        r.description);
+    help += fmt::format("\n  {:<12}[{}] {}", r.name, short_name(r.order), r.description);
   }
   return help;
 }

@@ -51,6 +51,10 @@ class PixelRng {
 
 struct RayCounters {
   uint64_t primary = 0, shadow = 0, reflection = 0, refraction = 0;
+  // render_visible: pixels whose hit was rebuilt from the given ids, traced instead (missed or
+  // empty), and won by a CSG object.
+  // Of those traced, the ones whose named primitive the ray missed (silhouettes, edges).
+  uint64_t rebuilt = 0, fallback_traced = 0, fallback_missed = 0, csg_pixels = 0;
   TraversalCounters traversal;
 
   uint64_t rays() const { return primary + shadow + reflection + refraction; }
@@ -59,6 +63,10 @@ struct RayCounters {
     shadow += o.shadow;
     reflection += o.reflection;
     refraction += o.refraction;
+    rebuilt += o.rebuilt;
+    fallback_traced += o.fallback_traced;
+    fallback_missed += o.fallback_missed;
+    csg_pixels += o.csg_pixels;
     traversal.nodes_visited += o.traversal.nodes_visited;
     traversal.primitive_tests += o.traversal.primitive_tests;
   }
@@ -94,6 +102,49 @@ class FrameTracer {
       counters.traversal.nodes_visited += work[k].nodes_visited;
       counters.traversal.primitive_tests += work[k].primitive_tests;
       render_pixel(x0 + k % w, y0 + k / w, hits[k], work[k], fb, counters);
+    }
+  }
+
+  // The same pixels with their primary hits rebuilt from `visible`'s ids (render_visible).
+  void render_block_visible(int x0, int y0, int x1, int y1, const PrimaryVisibility& visible,
+                            FrameBuffers& fb, RayCounters& counters) const {
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        size_t i = size_t(y) * size_t(visible.width) + size_t(x);
+        // The very ray the packet would carry: same origin, direction and clip range.
+        Ray ray = primary_ray(float(x) + 0.5f, float(y) + 0.5f);
+        HitRecord hit;
+        TraversalCounters work;
+        if (visible.object_id[i] != kNoId &&
+            geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i], hit,
+                                        work)) {
+          counters.rebuilt++;
+          if (geometry_.has_csg()) {
+            // No z-buffer draws CSG: the ray meets the CSG objects alone; the nearer hit wins,
+            // ties by primitive index as in closest().
+            HitRecord csg;
+            if (geometry_.closest_csg(ray, csg, work) &&
+                (csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive))) {
+              hit = csg;
+              counters.csg_pixels++;
+            }
+          }
+        } else {
+          // Nothing drawn, or the z-buffer's polygon covers the centre where the exact surface
+          // does not (silhouettes, shared edges): the tracer decides.
+          counters.fallback_traced++;
+          counters.fallback_missed += visible.object_id[i] != kNoId;
+          hit = HitRecord{};
+          geometry_.closest(ray, hit, work);
+          if (hit.primitive != kNoPrimitive && geometry_.has_csg()) {
+            SurfaceHit s = geometry_.surface(ray, hit);
+            if (scene_.objects[s.object].type == ObjectType::Csg) counters.csg_pixels++;
+          }
+        }
+        counters.traversal.nodes_visited += work.nodes_visited;
+        counters.traversal.primitive_tests += work.primitive_tests;
+        render_pixel(x, y, hit, work, fb, counters);
+      }
     }
   }
 
@@ -275,8 +326,33 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
   return out;
 }
 
-Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& requested,
+Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& options,
                                          const TraceGeometry& geometry) {
+  return render_frame(scene, options, geometry, nullptr);
+}
+
+Expected<RenderOutput> RayTracer::render_visible(const Scene& scene, const RenderOptions& options,
+                                                 const TraceGeometry& geometry,
+                                                 const PrimaryVisibility& visible) {
+  const size_t n = size_t(std::max(scene.image.width, 0)) * size_t(std::max(scene.image.height, 0));
+  if (visible.width != scene.image.width || visible.height != scene.image.height ||
+      visible.object_id.size() != n || visible.primitive_id.size() != n)
+    return Error{"visibility buffer is " + std::to_string(visible.width) + "x" +
+                     std::to_string(visible.height) + ", the image " +
+                     std::to_string(scene.image.width) + "x" + std::to_string(scene.image.height),
+                 ErrorKind::Internal};
+  Expected<RenderOutput> out = render_frame(scene, options, geometry, &visible);
+  if (!out.ok()) return out;
+  if (scene.image.samples_per_pixel > 1 && options.mode == RenderMode::Full)
+    out.value().warnings.push_back(
+        "supersampling and depth of field samples are traced, not z-buffered, yet: the "
+        "visibility buffer gives the pixel-centre hit (AOVs) only");
+  return out;
+}
+
+Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderOptions& requested,
+                                               const TraceGeometry& geometry,
+                                               const PrimaryVisibility* visible) {
   RenderOptions options = requested;
   options.accel = geometry.accel();
   RenderOutput out;
@@ -303,9 +379,13 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
             int x1 = std::min(x0 + kTileSize, w), y1 = std::min(y0 + kTileSize, h);
             const uint64_t rays_before = local.rays();
             for (int by = y0; by < y1; by += kPacketSide)
-              for (int bx = x0; bx < x1; bx += kPacketSide)
-                tracer.render_block(bx, by, std::min(bx + kPacketSide, x1),
-                                    std::min(by + kPacketSide, y1), out.buffers, local);
+              for (int bx = x0; bx < x1; bx += kPacketSide) {
+                int bx1 = std::min(bx + kPacketSide, x1), by1 = std::min(by + kPacketSide, y1);
+                if (visible)
+                  tracer.render_block_visible(bx, by, bx1, by1, *visible, out.buffers, local);
+                else
+                  tracer.render_block(bx, by, bx1, by1, out.buffers, local);
+              }
             if (progress)
               progress->advance(uint64_t(x1 - x0) * uint64_t(y1 - y0), local.rays() - rays_before);
           }
@@ -320,6 +400,12 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
   out.stats["rays.shadow"] = double(total.shadow);
   out.stats["rays.reflection"] = double(total.reflection);
   out.stats["rays.refraction"] = double(total.refraction);
+  if (visible) {
+    out.stats["hybrid.rebuilt"] = double(total.rebuilt);
+    out.stats["hybrid.fallback_traced"] = double(total.fallback_traced);
+    out.stats["hybrid.fallback_missed"] = double(total.fallback_missed);
+    out.stats["hybrid.csg_pixels"] = double(total.csg_pixels);
+  }
   if (options.accel != AccelKind::Embree) {  // Embree does not count its traversal steps
     out.stats["bvh.nodes_visited"] = double(total.traversal.nodes_visited);
     out.stats["primitive_tests"] = double(total.traversal.primitive_tests);

@@ -103,9 +103,12 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
   triangle_in_mesh_.reserve(total_triangles);
 
   object_first_triangle_.assign(n_objects, 0);
+  object_analytic_.assign(n_objects, kNoPrimitive);
+  object_names_triangles_.assign(n_objects, 0);
   auto add_mesh = [&](uint32_t object, const TriangleMesh& mesh, bool report_triangle_ids) {
     object_mesh_[object] = &mesh;
     object_first_triangle_[object] = uint32_t(triangles_.size());
+    object_names_triangles_[object] = report_triangle_ids ? 1 : 0;
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
       const glm::uvec3& t = mesh.triangles[i];
       triangles_.push_back(
@@ -129,22 +132,28 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
               std::make_unique<TriangleMesh>(tessellate_sphere(o.sphere, sphere_segments)));
           add_mesh(id, *owned_meshes_.back(), false);
         } else {
+          object_analytic_[id] = uint32_t(analytic_.size());
           analytic_.push_back({Kind::Sphere, id, o.sphere, {}, {}, {}, nullptr, {}});
         }
         break;
       case ObjectType::Plane: {
         auto [u, v] = plane_axes(o.plane.normal);
+        object_analytic_[id] = uint32_t(analytic_.size());
         analytic_.push_back({Kind::Square, id, {}, o.plane, u, v, nullptr, {}});
         break;
       }
       case ObjectType::Csg: {
         std::vector<Sphere> leaves;
         collect_leaves(o.csg.get(), leaves);
+        object_analytic_[id] = uint32_t(analytic_.size());
         analytic_.push_back({Kind::Csg, id, {}, {}, {}, {}, o.csg.get(), std::move(leaves)});
         break;
       }
     }
   }
+
+  for (size_t k = 0; k < analytic_.size(); ++k)
+    if (analytic_[k].kind == Kind::Csg) csg_primitives_.push_back(uint32_t(triangles_.size() + k));
 
   if (accel_ == AccelKind::Embree) {
     embree_.reset(make_embree_backend(*this, error_.message));
@@ -536,6 +545,66 @@ SurfaceHit TraceGeometry::surface(const Ray& ray, const HitRecord& hit) const {
   }
   s.material = object_material_[s.object];
   return s;
+}
+
+bool TraceGeometry::intersect_visible(const Ray& ray, uint32_t object, uint32_t primitive,
+                                      HitRecord& hit, TraversalCounters& counters) const {
+  if (object >= object_analytic_.size()) return false;
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  hit = HitRecord{};
+  if (uint32_t a = object_analytic_[object]; a != kNoPrimitive) {
+    counters.primitive_tests++;
+    if (!hit_analytic(analytic_[a], ray, ray.tmax, hit)) return false;
+    hit.primitive = n_triangles + a;
+    return true;
+  }
+  const TriangleMesh* mesh = object_mesh_[object];
+  if (!mesh) return false;
+  // A mesh names its triangle; a tessellated sphere reports 0, so all of its triangles are tried.
+  uint32_t first = object_first_triangle_[object];
+  uint32_t count = uint32_t(mesh->triangles.size());
+  const bool named = object_names_triangles_[object] != 0;
+  uint32_t begin = first, end = first + count;
+  if (named) {
+    if (primitive >= count) return false;
+    begin = first + primitive;
+    end = begin + 1;
+  }
+  bool found = false;
+  for (uint32_t p = begin; p < end; ++p) {
+    Ray r = ray;
+    // As query(): after the first hit, a tie at the same t is kept by the lower index.
+    if (found) r.tmax = tie_limit(hit.t);
+    TriangleHit th;
+    counters.primitive_tests++;
+    bool ok = triangle_test_ == TriangleTest::Chapter
+                  ? intersect_triangle_chapter(r, triangles_[p], th)
+                  : intersect_triangle_mt(r, triangles_[p], th);
+    if (!ok || (found && !nearer(th.t, p, hit.t, hit.primitive))) continue;
+    hit = HitRecord{};
+    hit.t = th.t;
+    hit.u = th.u;
+    hit.v = th.v;
+    hit.primitive = p;
+    found = true;
+  }
+  return found;
+}
+
+bool TraceGeometry::closest_csg(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  bool found = false;
+  for (uint32_t p : csg_primitives_) {
+    HitRecord h;
+    counters.primitive_tests++;
+    if (!hit_analytic(analytic_[p - n_triangles], ray, found ? tie_limit(hit.t) : ray.tmax, h))
+      continue;
+    if (found && !nearer(h.t, p, hit.t, hit.primitive)) continue;
+    hit = h;
+    hit.primitive = p;
+    found = true;
+  }
+  return found;
 }
 
 }  // namespace rvr

@@ -3,7 +3,9 @@
 // rvr info), the conformance, progress and NaN tests and the benchmarks all pick it up from here.
 #include "rvr/renderers/registry.h"
 
+#include "prepared_hybrid.h"
 #include "prepared_tracer.h"
+#include "rvr/hybrid/hybrid_renderer.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
@@ -26,8 +28,27 @@ std::string joined(const std::vector<std::string>& names) {
 }  // namespace
 
 const char* to_string(LoopOrder order) {
-  return order == LoopOrder::TriangleMajor ? "for each triangle, for each pixel"
-                                           : "for each pixel, for each object";
+  switch (order) {
+    case LoopOrder::TriangleMajor:
+      return "for each triangle, for each pixel";
+    case LoopOrder::PixelMajor:
+      return "for each pixel, for each object";
+    case LoopOrder::Hybrid:
+      return "for each triangle, for each pixel; then for each pixel, its rays";
+  }
+  return "";
+}
+
+const char* short_name(LoopOrder order) {
+  switch (order) {
+    case LoopOrder::TriangleMajor:
+      return "triangle-major";
+    case LoopOrder::PixelMajor:
+      return "pixel-major";
+    case LoopOrder::Hybrid:
+      return "hybrid";
+  }
+  return "";
 }
 
 // The table, in the order the renderers are documented; a new renderer is one entry here.
@@ -72,6 +93,27 @@ const std::vector<RendererInfo>& renderers() {
           .create = [](const RendererConfig&) { return make<RayTracer>(AccelKind::Embree); },
           .prepare = [](const Scene& s, const RendererConfig&,
                         const RenderOptions& o) { return prepare_tracer(s, o, AccelKind::Embree); },
+      },
+      {
+          .name = "hybrid",
+          .order = LoopOrder::Hybrid,
+          .description = "the GL z-buffer's ids for what the eye sees, the tracer for the rest",
+          .create =
+              [](const RendererConfig& c) { return make<HybridRenderer>(ZBufferKind::Gl, c.gl); },
+          .prepare =
+              [](const Scene& s, const RendererConfig& c, const RenderOptions& o) {
+                return prepare_hybrid(s, o, ZBufferKind::Gl, c.gl);
+              },
+      },
+      {
+          .name = "hybrid_soft",
+          .order = LoopOrder::Hybrid,
+          .description = "hybrid with softraster as the z-buffer",
+          .create = [](const RendererConfig&) { return make<HybridRenderer>(ZBufferKind::Soft); },
+          .prepare =
+              [](const Scene& s, const RendererConfig& c, const RenderOptions& o) {
+                return prepare_hybrid(s, o, ZBufferKind::Soft, c.gl);
+              },
       },
   };
   return table;

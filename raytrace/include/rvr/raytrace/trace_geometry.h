@@ -91,6 +91,18 @@ class TraceGeometry {
   bool occluded(const Ray& ray) const;
   SurfaceHit surface(const Ray& ray, const HitRecord& hit) const;
 
+  // The hit of `ray` with one thing a visibility buffer named, by the same intersection code as
+  // closest(): for a mesh object triangle `primitive` of it; for a sphere or square the object
+  // (a sphere traced as its tessellation: the nearest of its triangles, since a z-buffer does
+  // not report which). False when the ray misses it in (tmin, tmax) or the ids name nothing.
+  // counters.primitive_tests counts the tests made.
+  bool intersect_visible(const Ray& ray, uint32_t object, uint32_t primitive, HitRecord& hit,
+                         TraversalCounters& counters) const;
+  // True when the scene holds CSG objects (which no z-buffer draws).
+  bool has_csg() const { return !csg_primitives_.empty(); }
+  // Closest hit among the CSG objects only, with closest()'s tie rule.
+  bool closest_csg(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
+
   size_t primitive_count() const { return triangles_.size() + analytic_.size(); }
   size_t triangle_count() const { return triangles_.size(); }
   // Triangle p (a unified primitive index below triangle_count()).
@@ -147,6 +159,9 @@ class TraceGeometry {
   std::vector<std::unique_ptr<TriangleMesh>> owned_meshes_;  // tessellated spheres
   std::vector<uint32_t> object_material_;
   std::vector<uint32_t> object_first_triangle_;  // unified index of each object's triangle 0
+  std::vector<uint32_t> object_analytic_;        // index into analytic_, or kNoPrimitive
+  std::vector<uint32_t> csg_primitives_;         // unified indices of the CSG objects
+  std::vector<uint8_t> object_names_triangles_;  // 1: its ids name triangles (not a sphere's)
   // bvh2: leaf slots of bvh_ hold a primitive index and, for triangles, a copy in leaf order for
   // locality. bvh: bvh_ is over analytic_ only (slot -> analytic index), wide_ over triangles_.
   Bvh bvh_;

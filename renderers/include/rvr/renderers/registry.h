@@ -14,12 +14,14 @@
 
 namespace rvr {
 
-// The two loop orders the project compares.
+// The loop orders the project compares.
 enum class LoopOrder {
   TriangleMajor,  // for each triangle, for each covered pixel: the z-buffers
   PixelMajor,     // for each pixel, for each object: the tracers
+  Hybrid,         // a z-buffer for primary visibility, then rays per pixel: the hybrids
 };
-const char* to_string(LoopOrder order);  // "for each triangle, for each pixel", ...
+const char* to_string(LoopOrder order);   // "for each triangle, for each pixel", ...
+const char* short_name(LoopOrder order);  // "triangle-major", "pixel-major", "hybrid"
 
 // What a renderer is made with, beside the per-frame RenderOptions.
 struct RendererConfig {
@@ -55,13 +57,14 @@ struct RendererInfo {
   std::vector<RendererVariant> variants = {};
 };
 
-// The table, in the order the renderers are documented: raster, softraster, raytrace, embree.
+// The table, in the order the renderers are documented: raster, softraster, raytrace, embree,
+// hybrid, hybrid_soft.
 const std::vector<RendererInfo>& renderers();
 
 // Null for a name not in the table.
 const RendererInfo* find_renderer(const std::string& name);
 
-// "raster, softraster, raytrace, embree".
+// "raster, softraster, raytrace, embree, hybrid, hybrid_soft".
 std::string renderer_name_list();
 
 // A bad name is a BadInput error listing the known ones.
@@ -80,7 +83,7 @@ struct RendererChoice {
 };
 
 // Every entry followed by its variants, in table order: raster, raster_egl, softraster,
-// softraster_nohiz, raytrace, raytrace_bvh2, raytrace_none, embree.
+// softraster_nohiz, raytrace, raytrace_bvh2, raytrace_none, embree, hybrid, hybrid_soft.
 std::vector<RendererChoice> renderer_choices();
 
 // An entry or a variant by its name; a bad name is a BadInput error listing the known ones.

@@ -1,0 +1,20 @@
+// What another renderer saw first: per pixel the object and primitive id a visibility buffer
+// (a z-buffer's ids, FrameBuffers::object_id / primitive_id) holds. Plain data, no raster type:
+// the tracer rebuilds each pixel's primary hit from it (RayTracer::render_visible).
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+namespace rvr {
+
+struct PrimaryVisibility {
+  int width = 0;
+  int height = 0;
+  // Row-major, y = 0 the top row; kNoId where nothing was drawn. primitive_id is the triangle in
+  // the object for meshes, 0 for analytic shapes (spheres, squares), as every renderer reports.
+  std::span<const uint32_t> object_id;
+  std::span<const uint32_t> primitive_id;
+};
+
+}  // namespace rvr

@@ -1,0 +1,141 @@
+// The hybrids (a z-buffer's ids for primary visibility, the tracer for everything after) against
+// the tracer, in full mode on every built-in scene: the image must be the tracer's except where
+// the z-buffer's silhouettes and shared edges fall the other way.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "rvr/renderers/registry.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/scene_loader.h"
+
+using namespace rvr;
+
+namespace {
+
+// The contract, as the conformance suite's: ids may differ only where an edge falls
+// either way by a pixel; colour to 40 dB (a pixel whose id differs shades another surface).
+constexpr double kMinAgreement = 0.999;
+constexpr double kMinPsnr = 40.0;
+
+// Every built-in scene at its default size parameter, shrunk to keep the suite fast.
+std::vector<std::string> scene_names() {
+  std::vector<std::string> names;
+  for (const BuiltinSceneInfo& b : builtin_scenes())
+    names.push_back(b.name.substr(0, b.name.find(':')));
+  return names;
+}
+
+Scene small_scene(const std::string& name) {
+  Scene scene = make_builtin_scene(name).value();
+  scene.image.width = 128;
+  scene.image.height = 96;
+  return scene;
+}
+
+RenderOutput render_full(const std::string& renderer, const Scene& scene, int threads = 0) {
+  RenderOptions options;
+  options.mode = RenderMode::Full;
+  options.threads = threads;
+  auto r = make_renderer(renderer, GlBackend::OsMesa);
+  EXPECT_TRUE(r.ok()) << renderer;
+  Expected<RenderOutput> out = r.value()->render(scene, options);
+  EXPECT_TRUE(out.ok()) << renderer << ": " << (out.ok() ? "" : out.error().message);
+  return std::move(out).value();
+}
+
+bool same_bytes(const PixelVector<glm::vec3>& a, const PixelVector<glm::vec3>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
+}
+
+class HybridFullMode : public ::testing::TestWithParam<std::tuple<const char*, std::string>> {};
+
+}  // namespace
+
+TEST_P(HybridFullMode, IsTheTracersImageButOnEdges) {
+  const auto& [hybrid, scene_name] = GetParam();
+  Scene scene = small_scene(scene_name);
+  RenderOutput traced = render_full("raytrace", scene);
+  RenderOutput mixed = render_full(hybrid, scene);
+  ComparisonMetrics m = compare_buffers(mixed.buffers, traced.buffers);
+
+  EXPECT_GE(m.visibility.id_agreement, kMinAgreement)
+      << m.visibility.mismatched_pixels << " mismatched pixels";
+  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
+  EXPECT_GE(m.color.psnr_db, kMinPsnr);
+  // Where the primary hits are the same, everything after them is the tracer's own code on the
+  // same rays: the same bytes, not merely close ones.
+  if (m.visibility.mismatched_pixels == 0) {
+    EXPECT_TRUE(same_bytes(mixed.buffers.color, traced.buffers.color)) << "ids agree everywhere";
+  }
+  size_t differing = 0;
+  const FrameBuffers& a = mixed.buffers;
+  const FrameBuffers& b = traced.buffers;
+  for (size_t i = 0; i < a.pixel_count(); ++i) {
+    if (a.object_id[i] != b.object_id[i] || a.primitive_id[i] != b.primitive_id[i]) continue;
+    differing += std::memcmp(&a.color[i], &b.color[i], sizeof(a.color[i])) != 0 ||
+                 std::memcmp(&a.depth[i], &b.depth[i], sizeof(float)) != 0;
+  }
+  // Pixels whose ids agree but whose colour or depth bytes do not: a shared edge between two
+  // triangles of one tessellated sphere (both report primitive 0) may still differ there.
+  EXPECT_LE(double(differing), 0.001 * double(a.pixel_count())) << differing << " pixels";
+
+  // Every pixel is rebuilt from the ids or traced; the time splits into the two passes.
+  EXPECT_EQ(mixed.stats.at("hybrid.rebuilt") + mixed.stats.at("hybrid.fallback_traced"),
+            double(a.pixel_count()));
+  EXPECT_GT(mixed.stats.at("time.zbuffer"), 0.0);
+  EXPECT_GT(mixed.stats.at("time.trace"), 0.0);
+  EXPECT_EQ(mixed.stats.at("rays.shadow") > 0, traced.stats.at("rays.shadow") > 0);
+  RecordProperty("id_agreement", std::to_string(m.visibility.id_agreement));
+  RecordProperty("psnr_db", std::to_string(m.color.psnr_db));
+  std::printf(
+      "%s %s: id agreement %.6f, %zu mismatched, PSNR %.2f dB, rebuilt %.0f, traced %.0f "
+      "(missed %.0f), csg %.0f, zbuffer %.2f ms, trace %.2f ms (raytrace render %.2f ms)\n",
+      hybrid, scene_name.c_str(), m.visibility.id_agreement, m.visibility.mismatched_pixels,
+      m.color.psnr_db, mixed.stats.at("hybrid.rebuilt"), mixed.stats.at("hybrid.fallback_traced"),
+      mixed.stats.at("hybrid.fallback_missed"), mixed.stats.at("hybrid.csg_pixels"),
+      1e3 * mixed.stats.at("time.zbuffer"), 1e3 * mixed.stats.at("time.trace"),
+      1e3 * traced.stats.at("time.render"));
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryBuiltinScene, HybridFullMode,
+                         ::testing::Combine(::testing::Values("hybrid", "hybrid_soft"),
+                                            ::testing::ValuesIn(scene_names())),
+                         [](const ::testing::TestParamInfo<HybridFullMode::ParamType>& info) {
+                           return std::string(std::get<0>(info.param)) + "_" +
+                                  std::get<1>(info.param);
+                         });
+
+// CSG has no z-buffer form: the tracer finds it for the pixels where it is nearer.
+TEST(Hybrid, TracesCsgWhereTheZBufferDrawsNothing) {
+  Scene scene = small_scene("csg");
+  for (const char* hybrid : {"hybrid", "hybrid_soft"}) {
+    RenderOutput out = render_full(hybrid, scene);
+    EXPECT_GT(out.stats.at("hybrid.csg_pixels"), 0.0) << hybrid;
+    bool noted = false;
+    for (const std::string& w : out.warnings) noted |= w.find("csg") != std::string::npos;
+    EXPECT_TRUE(noted) << hybrid;
+  }
+}
+
+// Deterministic: the same bytes on one thread as on every core.
+TEST(Hybrid, SameBytesForAnyThreadCount) {
+  Scene scene = small_scene("cornell");
+  for (const char* hybrid : {"hybrid", "hybrid_soft"}) {
+    RenderOutput one = render_full(hybrid, scene, 1);
+    RenderOutput all = render_full(hybrid, scene, 0);
+    EXPECT_TRUE(same_bytes(one.buffers.color, all.buffers.color)) << hybrid;
+    EXPECT_EQ(one.buffers.object_id, all.buffers.object_id) << hybrid;
+  }
+}
+
+// Supersampled scenes: the extra samples are traced, and the output says so.
+TEST(Hybrid, WarnsThatSupersamplesAreTraced) {
+  Scene scene = small_scene("dof");
+  ASSERT_GT(scene.image.samples_per_pixel, 1);
+  RenderOutput out = render_full("hybrid", scene);
+  bool warned = false;
+  for (const std::string& w : out.warnings)
+    warned |= w.find("traced, not z-buffered") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
