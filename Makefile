@@ -7,7 +7,7 @@ PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-d
 	clang-14 libclang-rt-14-dev python3-glad libegl-dev libegl-mesa0 chromium python3-websocket \
 	python3-jsonschema
 
-.PHONY: all deps build demo test sanitize fuzz bench clean format
+.PHONY: all deps build demo test check sanitize fuzz bench clean format
 
 all: build
 
@@ -27,6 +27,10 @@ demo: build
 
 test: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# The edit loop: only the tests labelled `fast` (under 2 minutes); `make test` runs them all.
+check: build
+	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L fast
 
 # The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer (any UB fails the
 # test), in its own build folder: -O2 with line tables and assertions on (no NDEBUG). Leaks
@@ -54,7 +58,7 @@ sanitize: deps
 	cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 		-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" \
 		-DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
-		-DRVR_LINK_OSMESA=ON
+		-DRVR_LINK_OSMESA=ON -DRVR_TEST_TIMEOUT_SCALE=10
 	cmake --build $(SANITIZE_DIR) -j $(JOBS) --target $(SANITIZE_TARGETS)
 	cd $(SANITIZE_DIR) && \
 		ASAN_OPTIONS=detect_leaks=1:$(SANITIZE_ASAN) LSAN_OPTIONS=$(SANITIZE_LSAN) \

@@ -44,8 +44,10 @@ class Cli : public ::testing::Test {
 
   RunResult run(const std::string& args, const std::string& env = "") {
     fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    std::string cmd = env + " " + std::string(RVR_BINARY) + " " + args + " >" + out.string() +
-                      " 2>" + err.string() + " </dev/null";
+    // Bounded: a hang ends as status 124 (timeout's) instead of stalling the suite.
+    std::string cmd = env + " timeout -k 10 " + std::to_string(RVR_PROCESS_TIMEOUT) + " " +
+                      std::string(RVR_BINARY) + " " + args + " >" + out.string() + " 2>" +
+                      err.string() + " </dev/null";
     int raw = std::system(cmd.c_str());
     RunResult r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

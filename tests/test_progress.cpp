@@ -306,7 +306,11 @@ TEST_F(ProgressCli, RedirectedStderrGetsOnlyTheSummary) {
   std::string cmd = std::string(RVR_BINARY);
   for (const std::string& a : long_render((dir_ / "a.png").string())) cmd += " " + a;
   cmd += " 2>" + (dir_ / "err.txt").string() + " >/dev/null </dev/null";
-  ASSERT_EQ(std::system(("TERM=xterm " + cmd).c_str()), 0);
+  // Bounded: a hang fails (timeout's status 124) instead of stalling the suite.
+  ASSERT_EQ(
+      std::system(
+          ("TERM=xterm timeout -k 10 " + std::to_string(RVR_PROCESS_TIMEOUT) + " " + cmd).c_str()),
+      0);
   std::ifstream in(dir_ / "err.txt");
   std::stringstream ss;
   ss << in.rdbuf();
