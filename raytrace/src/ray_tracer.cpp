@@ -23,6 +23,8 @@ constexpr int kTileSize = 16;
 // Primary rays go as packets of kPacketSide x kPacketSide pixel-centre rays (kPacketRays).
 constexpr int kPacketSide = 8;
 static_assert(kPacketSide * kPacketSide == kPacketRays);
+// render_visible: a block with at least this many pixels to trace traces them as one packet.
+constexpr int kPacketFallbacks = 8;
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
@@ -108,43 +110,74 @@ class FrameTracer {
   // The same pixels with their primary hits rebuilt from `visible`'s ids (render_visible).
   void render_block_visible(int x0, int y0, int x1, int y1, const PrimaryVisibility& visible,
                             FrameBuffers& fb, RayCounters& counters) const {
-    for (int y = y0; y < y1; ++y) {
-      for (int x = x0; x < x1; ++x) {
-        size_t i = size_t(y) * size_t(visible.width) + size_t(x);
-        // The very ray the packet would carry: same origin, direction and clip range.
-        Ray ray = primary_ray(float(x) + 0.5f, float(y) + 0.5f);
-        HitRecord hit;
-        TraversalCounters work;
-        if (visible.object_id[i] != kNoId &&
-            geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i], hit,
-                                        work)) {
-          counters.rebuilt++;
-          if (geometry_.has_csg()) {
-            // No z-buffer draws CSG: the ray meets the CSG objects alone; the nearer hit wins,
-            // ties by primitive index as in closest().
-            HitRecord csg;
-            if (geometry_.closest_csg(ray, csg, work) &&
-                (csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive))) {
-              hit = csg;
-              counters.csg_pixels++;
-            }
-          }
-        } else {
-          // Nothing drawn, or the z-buffer's polygon covers the centre where the exact surface
-          // does not (silhouettes, shared edges): the tracer decides.
-          counters.fallback_traced++;
-          counters.fallback_missed += visible.object_id[i] != kNoId;
-          hit = HitRecord{};
-          geometry_.closest(ray, hit, work);
-          if (hit.primitive != kNoPrimitive && geometry_.has_csg()) {
-            SurfaceHit s = geometry_.surface(ray, hit);
-            if (scene_.objects[s.object].type == ObjectType::Csg) counters.csg_pixels++;
-          }
-        }
-        counters.traversal.nodes_visited += work.nodes_visited;
-        counters.traversal.primitive_tests += work.primitive_tests;
-        render_pixel(x, y, hit, work, fb, counters);
+    const int w = x1 - x0, n = w * (y1 - y0);
+    HitRecord hits[kPacketRays];
+    TraversalCounters work[kPacketRays];
+    bool traced[kPacketRays];
+    int n_traced = 0;
+    for (int k = 0; k < n; ++k) {
+      const int x = x0 + k % w, y = y0 + k / w;
+      const size_t i = size_t(y) * size_t(visible.width) + size_t(x);
+      // The very ray the packet would carry: same origin, direction and clip range.
+      const Ray ray = primary_ray(float(x) + 0.5f, float(y) + 0.5f);
+      HitRecord& hit = hits[k];
+      traced[k] = visible.object_id[i] == kNoId ||
+                  !geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i],
+                                               hit, work[k]);
+      if (traced[k]) {
+        // Nothing drawn, or the z-buffer's polygon covers the centre where the exact surface
+        // does not (silhouettes, shared edges): the tracer decides, below.
+        n_traced++;
+        counters.fallback_missed += visible.object_id[i] != kNoId;
+        continue;
       }
+      counters.rebuilt++;
+      if (geometry_.has_csg()) {
+        // No z-buffer draws CSG: the ray meets the CSG objects alone; the nearer hit wins, ties
+        // by primitive index as in closest().
+        HitRecord csg;
+        if (geometry_.closest_csg(ray, csg, work[k]) &&
+            (csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive))) {
+          hit = csg;
+          counters.csg_pixels++;
+        }
+      }
+    }
+    counters.fallback_traced += uint64_t(n_traced);
+    if (n_traced >= kPacketFallbacks) {
+      // Many to trace (an empty background): the whole block as one packet, as render_block
+      // traces it; its hits are closest()'s, so which way is taken changes no pixel.
+      const RayPacket packet =
+          primary_ray_packet(frame_, x0, y0, w, y1 - y0, scene_.camera.near, scene_.camera.far);
+      HitRecord packet_hits[kPacketRays];
+      TraversalCounters packet_work[kPacketRays];
+      geometry_.closest_packet(packet, packet_hits, packet_work);
+      for (int k = 0; k < n; ++k) {
+        if (traced[k]) {
+          hits[k] = packet_hits[k];
+          work[k] = packet_work[k];
+        } else {  // traversed for nothing, but traversed: counted, not charged to the pixel
+          counters.traversal.nodes_visited += packet_work[k].nodes_visited;
+          counters.traversal.primitive_tests += packet_work[k].primitive_tests;
+        }
+      }
+    } else if (n_traced > 0) {
+      for (int k = 0; k < n; ++k) {
+        if (!traced[k]) continue;
+        hits[k] = HitRecord{};
+        geometry_.closest(primary_ray(float(x0 + k % w) + 0.5f, float(y0 + k / w) + 0.5f), hits[k],
+                          work[k]);
+      }
+    }
+    for (int k = 0; k < n; ++k) {
+      const int x = x0 + k % w, y = y0 + k / w;
+      if (traced[k] && hits[k].primitive != kNoPrimitive && geometry_.has_csg()) {
+        SurfaceHit s = geometry_.surface(primary_ray(float(x) + 0.5f, float(y) + 0.5f), hits[k]);
+        if (scene_.objects[s.object].type == ObjectType::Csg) counters.csg_pixels++;
+      }
+      counters.traversal.nodes_visited += work[k].nodes_visited;
+      counters.traversal.primitive_tests += work[k].primitive_tests;
+      render_pixel(x, y, hits[k], work[k], fb, counters);
     }
   }
 
