@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "base64.h"
 #include "report.h"
 #include "rvr/shared/image_io.h"
 

@@ -39,9 +39,6 @@ struct ReportInput {
 // The metrics.json document (docs/cli.md), as text.
 std::string metrics_json(const ReportInput& input);
 
-// RFC 4648 base64 (for data URIs).
-std::string base64(const std::string& bytes);
-
 // A self-contained report.html: images from out_dir embedded as data URIs, no network.
 Expected<std::string> report_html(const ReportInput& input);
 

@@ -1,0 +1,113 @@
+// metrics.json of `rvr compare`.
+//
+// metrics.json holds the fields docs/cli.md lists: the required ones plus a few extras ("command",
+// "heat_map_scale", "depth_diff_scale", "compared", "files", and "image" per renderer). JSON
+// has no infinity or NaN: an infinite PSNR (identical colour) is written as 999.0, any other
+// non-finite number as null.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "report.h"
+#include "report_text.h"
+
+namespace rvr {
+namespace {
+
+using namespace report;
+
+using ordered_json = nlohmann::ordered_json;
+
+constexpr double kPsnrIdentical = 999.0;  // stands for +inf in metrics.json
+
+ordered_json number(double v) {
+  return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr);
+}
+
+// The float as it reads (0.1), not as its double widening prints (0.10000000149011612).
+ordered_json float_number(float v) {
+  return number(std::isfinite(v) ? std::strtod(fmt("%.7g", v).c_str(), nullptr) : v);
+}
+
+ordered_json psnr_number(double v) {
+  if (std::isinf(v) && v > 0) return kPsnrIdentical;
+  return number(v);
+}
+
+}  // namespace
+
+std::string metrics_json(const ReportInput& input) {
+  try {
+    ordered_json doc;
+    doc["scene"] = input.scene;
+    doc["width"] = input.width;
+    doc["height"] = input.height;
+    doc["mode"] = input.mode;
+
+    ordered_json renderers = ordered_json::object();
+    ordered_json compared = ordered_json::array();
+    for (const auto& r : input.renderers) {
+      std::string key = r.name;
+      for (int k = 2; renderers.contains(key); ++k) key = r.name + "-" + std::to_string(k);
+      ordered_json stats = ordered_json::object();
+      for (const auto& [name, value] : r.stats) stats[name] = number(value);
+      renderers[key] = {{"seconds", number(r.seconds)},
+                        {"warnings", r.warnings},
+                        {"stats", stats},
+                        {"info", r.info},
+                        {"image", r.image_file}};
+      if (!r.cost_file.empty())
+        renderers[key]["cost"] = {
+            {"image", r.cost_file}, {"mean", number(r.cost_mean)}, {"scale", number(r.cost_scale)}};
+      if (compared.size() < 2) compared.push_back(key);
+    }
+    doc["renderers"] = renderers;
+
+    const auto& v = input.metrics.visibility;
+    doc["visibility"] = {{"pixels", v.pixels},
+                         {"id_agreement", number(v.id_agreement)},
+                         {"mismatched_pixels", v.mismatched_pixels},
+                         {"mismatched_off_edge", v.mismatched_off_edge}};
+    const auto& d = input.metrics.depth;
+    doc["depth"] = {{"max_rel_error", number(d.max_rel_error)},
+                    {"mean_rel_error", number(d.mean_rel_error)}};
+    const auto& c = input.metrics.color;
+    doc["color"] = {{"rmse", number(c.rmse)},
+                    {"psnr_db", psnr_number(c.psnr_db)},
+                    {"max_abs", number(c.max_abs)},
+                    {"ssim", number(c.ssim)}};
+
+    // Extras.
+    doc["compared"] = compared;
+    doc["command"] = input.command_line;
+    doc["heat_map_scale"] = float_number(input.heat_map_scale);
+    doc["depth_diff_scale"] = {{"low", float_number(input.depth_diff_scale.low)},
+                               {"high", float_number(input.depth_diff_scale.high)},
+                               {"map", "log10"}};
+    doc["files"] = {{"diff", "diff.png"},
+                    {"depth_diff", "depth_diff.png"},
+                    {"id_mismatch", "id_mismatch.png"},
+                    {"report", "report.html"}};
+    // Invalid UTF-8 in a path or command line must not make dump() throw.
+    return doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  } catch (const std::exception& e) {
+    // Only allocation failure can get here; still hand back valid JSON.
+    ordered_json err = {{"error", std::string("metrics_json failed: ") + e.what()}};
+    return err.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  }
+}
+
+}  // namespace rvr

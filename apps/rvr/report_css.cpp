@@ -1,0 +1,54 @@
+// The report's stylesheet (see report_css.h).
+#include "report_css.h"
+
+namespace rvr::report {
+
+const char* const kCss = R"(
+body{font:15px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:0;
+  background:#f6f7f9;color:#1d2330}
+main{max-width:1400px;margin:0 auto;padding:24px}
+h1{font-size:24px;margin:0 0 4px} h2{font-size:18px;margin:28px 0 10px;
+  border-bottom:1px solid #d8dce3;padding-bottom:4px}
+pre.cmd{background:#1d2330;color:#e8ecf3;padding:10px 12px;border-radius:6px;
+  overflow-x:auto;white-space:pre-wrap;word-break:break-all}
+.meta span{display:inline-block;margin-right:18px;color:#4a5366}
+.badges{margin:10px 0}
+.badge{display:inline-block;padding:3px 10px;border-radius:12px;margin:0 6px 6px 0;
+  font-weight:600;font-size:13px}
+.good{background:#d9f2e1;color:#135c2c} .bad{background:#fbdcdc;color:#8a1616}
+.neutral{background:#e3e8f0;color:#2b3447}
+.warn{background:#fff4d6;border:1px solid #e6b400;border-left:6px solid #e6b400;
+  padding:10px 14px;border-radius:6px;margin:14px 0}
+.warn h2{border:0;margin:0 0 6px;padding:0}
+.grid{display:grid;grid-template-columns:repeat(auto-fill,minmax(360px,1fr));gap:16px}
+figure{margin:0;background:#fff;padding:8px;border-radius:6px;
+  box-shadow:0 1px 3px rgba(0,0,0,.12);min-width:0}
+figure img{display:block;width:100%;height:auto;image-rendering:pixelated}
+figcaption{font-size:13px;color:#4a5366;margin-top:6px}
+.flip{position:relative;display:block;width:100%;user-select:none}
+.flip img{display:block;width:100%;height:auto;image-rendering:pixelated}
+.flip img.top{position:absolute;left:0;top:0}
+.flipctl{display:flex;align-items:center;gap:10px;margin-top:6px;font-size:13px}
+.flipctl input{flex:1}
+button{font:inherit;font-size:13px;padding:2px 10px;border-radius:4px;
+  border:1px solid #9aa3b5;background:#fff;cursor:pointer}
+table{border-collapse:collapse;background:#fff;box-shadow:0 1px 3px rgba(0,0,0,.12);
+  border-radius:6px;overflow:hidden;margin-bottom:8px}
+th,td{padding:5px 12px;border-bottom:1px solid #e6e9ef;text-align:left;vertical-align:top}
+th{background:#eef1f6;font-weight:600} td.num{text-align:right;font-variant-numeric:tabular-nums;
+  white-space:nowrap}
+.scroll{overflow-x:auto;max-width:100%} .nowrap{white-space:nowrap}
+td.why{color:#4a5366;font-size:13px;max-width:560px}
+details{margin:6px 0} summary{cursor:pointer;color:#2b3447}
+footer{margin-top:30px;color:#7a8394;font-size:12px}
+svg.bar{display:block;margin-top:4px;font-size:11px;fill:#4a5366}
+.sw{display:inline-block;width:11px;height:11px;border:1px solid #9aa3b5;
+  vertical-align:-1px;margin-right:4px}
+svg.chart{display:block;width:100%;max-width:1000px;background:#fff;border-radius:6px;
+  box-shadow:0 1px 3px rgba(0,0,0,.12);font-size:12px}
+svg.chart text{fill:#1d2330} svg.chart text.tick{fill:#4a5366;font-size:11px}
+svg.chart text.name{font-weight:600} svg.chart text.seg{font-size:11px}
+.legend{display:flex;flex-wrap:wrap;gap:14px;margin:8px 0 14px;font-size:13px;color:#4a5366}
+)";
+
+}  // namespace rvr::report

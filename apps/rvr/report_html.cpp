@@ -1,0 +1,292 @@
+// report.html of `rvr compare`.
+//
+// report.html is one self-contained file: the images are embedded as base64 data URIs, the CSS
+// and the few lines of script are inline, nothing is fetched from anywhere.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "colour_bar.h"
+#include "data_uri.h"
+#include "report.h"
+#include "report_css.h"
+#include "report_script.h"
+#include "report_text.h"
+#include "timing_chart.h"
+
+namespace rvr {
+namespace {
+
+using namespace report;
+
+// A colour swatch as the captions use it.
+std::string swatch(const float rgb[3]) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "<span class=\"sw\" style=\"background:#%02x%02x%02x\"></span>",
+                int(std::lround(rgb[0] * 255)), int(std::lround(rgb[1] * 255)),
+                int(std::lround(rgb[2] * 255)));
+  return buf;
+}
+
+struct MetricRow {
+  std::string group, name, value, why;
+  bool flagged = false;
+};
+
+}  // namespace
+
+Expected<std::string> report_html(const ReportInput& input) {
+  try {
+    const auto& vis = input.metrics.visibility;
+    const auto& dep = input.metrics.depth;
+    const auto& col = input.metrics.color;
+    const std::string name_a = input.renderers.size() > 0 ? input.renderers[0].name : "A";
+    const std::string name_b = input.renderers.size() > 1 ? input.renderers[1].name : "B";
+
+    // Every image first, so a missing file fails before any HTML is built.
+    std::vector<std::string> render_uris;
+    for (const auto& r : input.renderers) {
+      auto uri = data_uri(input.out_dir, r.image_file);
+      if (!uri) return uri.error();
+      render_uris.push_back(std::move(uri.value()));
+    }
+    std::vector<std::string> cost_uris;
+    for (const auto& r : input.renderers) {
+      if (r.cost_file.empty()) {
+        cost_uris.emplace_back();
+        continue;
+      }
+      auto uri = data_uri(input.out_dir, r.cost_file);
+      if (!uri) return uri.error();
+      cost_uris.push_back(std::move(uri.value()));
+    }
+    auto diff_uri = data_uri(input.out_dir, "diff.png");
+    if (!diff_uri) return diff_uri.error();
+    auto mismatch_uri = data_uri(input.out_dir, "id_mismatch.png");
+    if (!mismatch_uri) return mismatch_uri.error();
+    auto depth_uri = data_uri(input.out_dir, "depth_diff.png");
+    if (!depth_uri) return depth_uri.error();
+
+    std::ostringstream h;
+    const std::string title = "rvr compare: " + name_a + " vs " + name_b + " on " + input.scene;
+    h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+      << "<title>" << escape_html(title) << "</title>\n<style>" << kCss << "</style>\n"
+      << "</head>\n<body>\n<main>\n";
+
+    h << "<h1>" << escape_html(title) << "</h1>\n";
+    h << "<div class=\"meta\"><span><b>scene</b> " << escape_html(input.scene)
+      << "</span><span><b>size</b> " << input.width << "&times;" << input.height
+      << "</span><span><b>mode</b> " << escape_html(input.mode) << "</span><span><b>pixels</b> "
+      << vis.pixels << "</span></div>\n";
+    if (!input.command_line.empty())
+      h << "<pre class=\"cmd\">" << escape_html(input.command_line) << "</pre>\n";
+
+    // Verdict badges.
+    h << "<div class=\"badges\">"
+      << "<span class=\"badge " << (vis.mismatched_off_edge == 0 ? "good" : "bad") << "\">"
+      << "mismatched off edges: " << vis.mismatched_off_edge << "</span>"
+      << "<span class=\"badge neutral\">id agreement " << fmt("%.4f", vis.id_agreement * 100.0)
+      << "%</span>"
+      << "<span class=\"badge neutral\">PSNR "
+      << (std::isinf(col.psnr_db) && col.psnr_db > 0 ? std::string("&infin; (identical)")
+                                                     : fmt("%.2f dB", col.psnr_db))
+      << "</span><span class=\"badge neutral\">SSIM " << fmt("%.5f", col.ssim) << "</span></div>\n";
+
+    // Warnings, prominently.
+    size_t warning_count = 0;
+    for (const auto& r : input.renderers) warning_count += r.warnings.size();
+    if (warning_count > 0) {
+      h << "<div class=\"warn\"><h2>&#9888; Warnings (" << warning_count << ")</h2><ul>\n";
+      for (const auto& r : input.renderers)
+        for (const auto& w : r.warnings)
+          h << "<li><b>" << escape_html(r.name) << "</b>: " << escape_html(w) << "</li>\n";
+      h << "</ul></div>\n";
+    }
+
+    // Renders side by side.
+    h << "<h2>Renders</h2>\n<div class=\"grid\">\n";
+    for (size_t i = 0; i < input.renderers.size(); ++i) {
+      const auto& r = input.renderers[i];
+      h << "<figure><img src=\"" << render_uris[i] << "\" alt=\"" << escape_html(r.name)
+        << "\"><figcaption><b>" << escape_html(r.name) << "</b> &middot; "
+        << escape_html(r.image_file) << " &middot; " << fmt_seconds(r.seconds)
+        << "</figcaption></figure>\n";
+    }
+    h << "</div>\n";
+
+    if (input.renderers.size() >= 2) {
+      h << "<h2>Flip</h2>\n<div class=\"grid\"><figure><div class=\"flip\">"
+        << "<img src=\"" << render_uris[0] << "\" alt=\"" << escape_html(name_a) << "\">"
+        << "<img id=\"flip-top\" class=\"top\" src=\"" << render_uris[1] << "\" alt=\""
+        << escape_html(name_b) << "\"></div>"
+        << "<div class=\"flipctl\"><span>" << escape_html(name_a)
+        << "</span><input id=\"flip-range\" type=\"range\" min=\"0\" max=\"100\" value=\"50\" "
+        << "aria-label=\"slider between the two renders\"><span>" << escape_html(name_b)
+        << "</span><button id=\"flip-button\" type=\"button\">flip</button></div>"
+        << "<figcaption>Left of the cut: " << escape_html(name_a)
+        << "; right of it: " << escape_html(name_b)
+        << ". Drag the slider, or flip between the whole images.</figcaption></figure></div>\n";
+    }
+
+    // Heat maps. The depth scale's decades as ticks of its colour bar.
+    const double low = input.depth_diff_scale.low, high = input.depth_diff_scale.high;
+    std::vector<std::pair<double, std::string>> depth_ticks;
+    if (low > 0 && high > low) {
+      const double decades = std::log10(high / low);
+      // The ends are floats: 1e-2f is 0.0099999998, still a tick.
+      for (double e = std::ceil(std::log10(low) - 1e-6); e <= std::log10(high) + 1e-6; e += 1)
+        depth_ticks.push_back({(e - std::log10(low)) / decades, short_number(std::pow(10.0, e))});
+    }
+    h << "<h2>Differences</h2>\n<div class=\"grid\">\n"
+      << "<figure><img src=\"" << diff_uri.value()
+      << "\" alt=\"colour difference heat map\"><figcaption><b>diff.png</b>: per pixel, the "
+         "largest |difference| over R, G, B of the linear colours, on the inferno colour map "
+         "(black = 0, yellow-white &ge; "
+      << fmt("%g", input.heat_map_scale) << ")."
+      << inferno_bar("bar-diff", "colour difference scale",
+                     {{0.0, "0"},
+                      {0.5, fmt("%g", input.heat_map_scale / 2)},
+                      {1.0, "&ge; " + fmt("%g", input.heat_map_scale)}})
+      << "</figcaption></figure>\n"
+      << "<figure><img src=\"" << mismatch_uri.value()
+      << "\" alt=\"object id mismatches\"><figcaption><b>id_mismatch.png</b>: pixels whose "
+         "object id differs, in red, over a grey version of "
+      << escape_html(name_a) << ".</figcaption></figure>\n"
+      << "<figure><img src=\"" << depth_uri.value()
+      << "\" alt=\"relative depth difference\"><figcaption><b>depth_diff.png</b>: relative "
+         "view-depth difference |d<sub>A</sub> &minus; d<sub>B</sub>| / max(d<sub>A</sub>, "
+         "d<sub>B</sub>) of "
+      << escape_html(name_a) << " and " << escape_html(name_b)
+      << " where both hit something (whatever the ids), on a <b>log scale</b>: black &le; "
+      << short_number(low) << ", each decade an equal stretch of the colour map, yellow-white "
+      << "&ge; " << short_number(high) << ". <span class=\"nowrap\">"
+      << swatch(kDepthDiffBackground) << "background in both</span>; <span class=\"nowrap\">"
+      << swatch(kDepthDiffHitVsBackground) << "background in one, a hit in the other</span>."
+      << inferno_bar("bar-depth", "relative depth difference scale, logarithmic", depth_ticks)
+      << "</figcaption></figure>\n</div>\n";
+
+    // Work per pixel: what each loop order pays where.
+    h << "<h2>Work per pixel</h2>\n<div class=\"grid\">\n";
+    for (size_t i = 0; i < input.renderers.size(); ++i) {
+      const auto& r = input.renderers[i];
+      if (r.cost_file.empty()) {
+        h << "<figure><figcaption><b>" << escape_html(r.name)
+          << "</b>: no per-pixel work reported.</figcaption></figure>\n";
+        continue;
+      }
+      h << "<figure><img src=\"" << cost_uris[i] << "\" alt=\"" << escape_html(r.name)
+        << " work per pixel\"><figcaption><b>" << escape_html(r.cost_file) << "</b>: "
+        << (r.stats.count("fragments.generated") ? "fragments generated per pixel (overdraw)"
+                                                 : "BVH nodes visited + primitive tests per pixel")
+        << "; mean " << fmt("%.3g", r.cost_mean) << ", yellow-white &ge; "
+        << fmt("%g", r.cost_scale) << " (the 99th percentile).</figcaption></figure>\n";
+    }
+    h << "</div>\n";
+
+    // Metrics.
+    const bool identical = std::isinf(col.psnr_db) && col.psnr_db > 0;
+    std::vector<MetricRow> rows = {
+        {"visibility", "pixels", std::to_string(vis.pixels), "width &times; height."},
+        {"visibility", "id_agreement", fmt("%.6f", vis.id_agreement),
+         "Fraction of pixels where both renders see the same object and the same primitive."},
+        {"visibility", "mismatched_pixels", std::to_string(vis.mismatched_pixels),
+         "Pixels whose (object, primitive) id differs."},
+        {"visibility", "mismatched_off_edge", std::to_string(vis.mismatched_off_edge),
+         "Mismatches with no id boundary within one pixel in both renders: not a silhouette or "
+         "edge tie, so a real disagreement. Should be 0.",
+         vis.mismatched_off_edge != 0},
+        {"depth", "max_rel_error", fmt("%.3g", dep.max_rel_error),
+         "Largest |d<sub>A</sub> &minus; d<sub>B</sub>| / max(d<sub>A</sub>, d<sub>B</sub>) of "
+         "view-axis depth over pixels where the ids agree (background excluded)."},
+        {"depth", "mean_rel_error", fmt("%.3g", dep.mean_rel_error),
+         "Mean of the same relative depth error."},
+        {"color", "rmse", fmt("%.4g", col.rmse),
+         "Root mean square difference of linear RGB over every pixel and channel."},
+        {"color", "psnr_db",
+         identical ? std::string("&infin; (999 in metrics.json)") : fmt("%.2f", col.psnr_db),
+         "20&middot;log<sub>10</sub>(1 / rmse), peak value 1; higher is closer. Identical images "
+         "have infinite PSNR, written as 999 in metrics.json."},
+        {"color", "max_abs", fmt("%.4g", col.max_abs),
+         "Largest absolute difference of one channel of one pixel (linear)."},
+        {"color", "ssim", fmt("%.5f", col.ssim),
+         "Structural similarity of the luminance of the colours clamped to [0, 1], 11&times;11 "
+         "Gaussian window (&sigma; 1.5), averaged over the image; 1 = identical."},
+    };
+    h << "<h2>Metrics</h2>\n<table><thead><tr><th>group</th><th>metric</th><th>value</th>"
+         "<th>meaning</th></tr></thead><tbody>\n";
+    for (const auto& row : rows)
+      h << "<tr><td>" << row.group << "</td><td><code>" << row.name << "</code></td><td class=\"num"
+        << (row.flagged ? " bad" : "") << "\">" << row.value << "</td><td class=\"why\">" << row.why
+        << "</td></tr>\n";
+    h << "</tbody></table>\n";
+
+    // Timings: seconds and every "time.*" stat, one row per renderer.
+    std::set<std::string> time_keys;
+    for (const auto& r : input.renderers)
+      for (const auto& [k, v] : r.stats)
+        if (k.rfind("time.", 0) == 0) time_keys.insert(k);
+    h << "<h2>Timings</h2>\n"
+      << timing_chart(input.renderers)
+      << "<p class=\"why\" style=\"color:#4a5366;font-size:13px\">Each bar: the scene load "
+         "(shared, outside the render call), the phases the renderer reports (time.* below) "
+         "and, as <i>other</i>, the rest of its render call.</p>\n"
+      << "<div class=\"scroll\"><table><thead><tr><th>renderer</th><th>seconds</th>"
+         "<th>relative</th>";
+    for (const auto& k : time_keys) h << "<th>" << escape_html(k) << "</th>";
+    h << "<th>warnings</th></tr></thead><tbody>\n";
+    const double base = input.renderers.empty() ? 0.0 : input.renderers[0].seconds;
+    for (const auto& r : input.renderers) {
+      h << "<tr><td><b>" << escape_html(r.name) << "</b></td><td class=\"num\">"
+        << fmt_seconds(r.seconds) << "</td><td class=\"num\">"
+        << (base > 0 ? fmt("%.2f&times;", r.seconds / base) : std::string("n/a")) << "</td>";
+      for (const auto& k : time_keys) {
+        auto it = r.stats.find(k);
+        h << "<td class=\"num\">" << (it == r.stats.end() ? "&ndash;" : fmt_seconds(it->second))
+          << "</td>";
+      }
+      h << "<td class=\"num\">" << r.warnings.size() << "</td></tr>\n";
+    }
+    h << "</tbody></table></div>\n<p class=\"why\" style=\"color:#4a5366;font-size:13px\">seconds: "
+         "wall-clock time of the render call; relative: divided by the first renderer's; "
+         "time.*: the phases each renderer reports.</p>\n";
+
+    // All counters, folded away.
+    for (const auto& r : input.renderers) {
+      if (r.stats.empty()) continue;
+      h << "<details><summary>All statistics of <b>" << escape_html(r.name) << "</b> ("
+        << r.stats.size() << ")</summary><table><tbody>\n";
+      for (const auto& [k, v] : r.info)
+        h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">"
+          << escape_html(v) << "</td></tr>\n";
+      for (const auto& [k, v] : r.stats)
+        h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">"
+          << fmt("%.6g", v) << "</td></tr>\n";
+      h << "</tbody></table></details>\n";
+    }
+
+    h << "<footer>Written by rvr compare. Colour metrics use linear RGB with peak 1; the "
+         "heat map scale is "
+      << fmt("%g", input.heat_map_scale) << ".</footer>\n</main>\n";
+    if (input.renderers.size() >= 2) h << "<script>" << kScript << "</script>\n";
+    h << "</body>\n</html>\n";
+    return h.str();
+  } catch (const std::exception& e) {
+    return internal_error(std::string("cannot build report.html: ") + e.what());
+  }
+}
+
+}  // namespace rvr
