@@ -1,0 +1,64 @@
+// rvr info: version, CPU, SIMD, GL and the renderers.
+#include <fmt/format.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <thread>
+
+#include "cli_exit.h"
+#include "commands.h"
+#include "cpu_probe.h"
+#include "report.h"
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/compare_renderers.h"
+#include "rvr/renderers/registry.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/image_io.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/limits.h"
+#include "rvr/shared/scene_loader.h"
+#include "rvr/shared/scene_writer.h"
+#include "terminal_progress.h"
+
+namespace rvr::cli {
+
+int run_info(const std::string& gl_name) {
+  std::printf("rvr %s\n", kVersion);
+  std::printf("cpu: %s, %u hardware threads\n", cpu_model().c_str(),
+              std::thread::hardware_concurrency());
+  std::printf("renderers: ");
+  for (const RendererInfo& r : renderers()) std::printf("%s ", r.name.c_str());
+  std::printf("\n");
+  std::printf("simd: baseline build %s; the CPU has %s\n", built_simd(), cpu_simd().c_str());
+  std::printf("kernels: %s; compiled: sse avx2 avx512; this CPU runs:",
+              describe_isa_choice().c_str());
+  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512})
+    if (cpu_supports(isa)) std::printf(" %s", to_string(isa));
+  std::printf(" (RVR_ISA=sse|avx2|avx512 forces one)\n");
+  std::printf("embree: %s\nopenimageio: %s\ntbb: %s\n", embree_version().c_str(),
+              openimageio_version().c_str(), tbb_version().c_str());
+  CommonOptions gl_choice;
+  gl_choice.gl = gl_name;
+  Expected<GlInfo> gl = query_gl_info(gl_backend(gl_choice));
+  if (!gl) fail(gl.error());
+  for (const std::string& w : gl->warnings) std::printf("gl warning: %s\n", w.c_str());
+  std::printf("gl backend: %s\nGL_VERSION: %s\nGL_RENDERER: %s\nGL_VENDOR: %s\nGLSL: %s\n",
+              gl->backend.c_str(), gl->version.c_str(), gl->renderer.c_str(), gl->vendor.c_str(),
+              gl->glsl_version.c_str());
+  const char* lp_threads = std::getenv("LP_NUM_THREADS");
+  std::printf("llvmpipe threads: %s\n",
+              lp_threads ? lp_threads : "every core (LP_NUM_THREADS not set)");
+  return 0;
+}
+
+}  // namespace rvr::cli

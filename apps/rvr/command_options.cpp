@@ -1,0 +1,131 @@
+// The options render and compare share (see commands.h).
+#include <fmt/format.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <thread>
+
+#include "cli_exit.h"
+#include "commands.h"
+#include "report.h"
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/compare_renderers.h"
+#include "rvr/renderers/registry.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/image_io.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/limits.h"
+#include "rvr/shared/scene_loader.h"
+#include "rvr/shared/scene_writer.h"
+#include "terminal_progress.h"
+
+namespace rvr::cli {
+
+void add_common_options(CLI::App& cmd, CommonOptions& o) {
+  cmd.add_option("scene", o.scene, "scene file or builtin:NAME (default builtin:cornell)");
+  cmd.add_option("--mode", o.mode, "visibility | local | full")
+      ->check(CLI::IsMember({"visibility", "local", "full"}));
+  cmd.add_option("--width", o.width, "image width (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  cmd.add_option("--height", o.height, "image height (overrides the scene)")
+      ->check(CLI::Range(1, 16384));
+  cmd.add_option("--spp", o.spp, "samples per pixel (overrides the scene)")
+      ->check(CLI::Range(1, 65536));
+  cmd.add_option("--threads", o.threads, "worker threads, 0 = every core")
+      ->check(CLI::Range(0, 1024));
+  cmd.add_option("--accel", o.accel,
+                 "tracer acceleration: bvh (wide SIMD BVH, default) | bvh2 (binary, one box at a "
+                 "time) | none (every object for every ray)")
+      ->check(CLI::IsMember({"bvh", "bvh2", "none"}));
+  cmd.add_option("--spheres", o.spheres,
+                 "tracer spheres: analytic | mesh (the raster's tessellation)")
+      ->check(CLI::IsMember({"analytic", "mesh"}));
+  cmd.add_option("--sphere-segments", o.sphere_segments, "sphere tessellation: longitudes")
+      ->check(CLI::Range(3, 4096));
+  cmd.add_option("--triangle-test", o.triangle_test,
+                 "tracer ray-triangle test: mt (Moller-Trumbore) | chapter (plane, then edges)")
+      ->check(CLI::IsMember({"mt", "chapter"}));
+  cmd.add_option("--max-depth", o.max_depth, "recursion limit for bounce rays")
+      ->check(CLI::Range(0, 64));
+  cmd.add_option("--seed", o.seed, "seed of the per-pixel random streams");
+  cmd.add_option("--gl", o.gl,
+                 "raster GL back end: osmesa | egl (default osmesa, egl when OSMesa is missing)")
+      ->check(CLI::IsMember({"osmesa", "egl"}));
+  cmd.add_option("--shadow-map-size", o.shadow_map_size, "raster shadow maps: texels per side")
+      ->check(CLI::Range(16, 8192));
+  cmd.add_option("--shadow-bias", o.shadow_bias, "raster shadow maps: depth bias (scene units)")
+      ->check(CLI::Range(0.0f, 10.0f));
+  cmd.add_flag("--shadow-pcf", o.shadow_pcf, "raster shadow maps: 3x3 percentage-closer filtering");
+  cmd.add_option("--hiz", o.hiz,
+                 "softraster: hierarchical z, each 8x8 block's farthest depth rejecting what lies "
+                 "behind it: on | off (the textbook z-buffer)")
+      ->check(CLI::IsMember({"on", "off"}));
+  cmd.add_flag("--quiet,-q", o.quiet, "no progress output");
+  cmd.add_option("--max-samples", o.limits.max_samples,
+                 "refuse more than N pixels x samples (default 2^30)")
+      ->check(CLI::PositiveNumber);
+  cmd.add_option("--max-triangles", o.limits.max_triangles,
+                 "refuse more than N triangles, tessellation included (default 50000000)")
+      ->check(CLI::PositiveNumber);
+  cmd.add_option("--max-memory-mb", o.max_memory_mb,
+                 "refuse renders estimated to need more MiB (default 3/4 of physical memory)")
+      ->check(CLI::PositiveNumber);
+}
+
+GlBackend gl_backend(const CommonOptions& o) {
+  if (o.gl == "osmesa") return GlBackend::OsMesa;
+  if (o.gl == "egl") return GlBackend::Egl;
+  return GlBackend::Default;
+}
+
+RenderMode parse_mode(const std::string& s) {
+  if (s == "visibility") return RenderMode::Visibility;
+  if (s == "full") return RenderMode::Full;
+  return RenderMode::Local;
+}
+
+RenderOptions render_options(const CommonOptions& o, const std::string& default_mode) {
+  RenderOptions r;
+  r.mode = parse_mode(o.mode.empty() ? default_mode : o.mode);
+  r.spheres = o.spheres == "mesh" ? SphereMode::Mesh : SphereMode::Analytic;
+  r.sphere_segments = o.sphere_segments;
+  r.threads = o.threads;
+  r.max_depth = o.max_depth;
+  r.seed = o.seed;
+  r.accel = o.accel == "none"   ? AccelKind::None
+            : o.accel == "bvh2" ? AccelKind::Bvh2
+                                : AccelKind::Bvh;
+  r.triangle_test =
+      o.triangle_test == "chapter" ? TriangleTest::Chapter : TriangleTest::MollerTrumbore;
+  r.shadow_map_size = o.shadow_map_size;
+  r.shadow_bias = o.shadow_bias;
+  r.shadow_pcf = o.shadow_pcf;
+  r.hiz = o.hiz == "on";
+  return r;
+}
+
+Scene load(const CommonOptions& o, const RenderOptions& options, double& load_seconds) {
+  take(selected_isa());  // a bad RVR_ISA is refused before any work
+  auto start = Clock::now();
+  Scene scene = take(load_scene(o.scene));
+  if (o.width) scene.image.width = *o.width;
+  if (o.height) scene.image.height = *o.height;
+  if (o.spp) scene.image.samples_per_pixel = *o.spp;
+  load_seconds = seconds_since(start);
+  Limits limits = o.limits;
+  limits.max_memory_bytes = std::min<uint64_t>(o.max_memory_mb, uint64_t(1) << 40) << 20;
+  check(check_limits(scene, options, limits));
+  return scene;
+}
+
+}  // namespace rvr::cli

@@ -1,0 +1,108 @@
+// rvr render: one renderer, one image, its AOVs and --stats.
+#include <fmt/format.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <thread>
+
+#include "cli_exit.h"
+#include "commands.h"
+#include "report.h"
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/compare_renderers.h"
+#include "rvr/renderers/registry.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/image_io.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/limits.h"
+#include "rvr/shared/scene_loader.h"
+#include "rvr/shared/scene_writer.h"
+#include "terminal_progress.h"
+
+namespace rvr::cli {
+
+namespace {
+
+double peak_memory_bytes() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return double(usage.ru_maxrss) * 1024.0;
+}
+
+nlohmann::json finite_or_null(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+}  // namespace
+
+int run_render(const RenderArgs& a) {
+  std::vector<std::string> outputs{a.out, a.stats};
+  const std::string base = std::filesystem::path(a.out).replace_extension().string();
+  for (const std::string& aov : a.aovs)
+    outputs.push_back(base + "." + aov + (aov == "cost" ? ".png" : ".exr"));
+  if (std::count(a.aovs.begin(), a.aovs.end(), "cost")) outputs.push_back(base + ".cost.exr");
+  refuse_overwriting_inputs({a.common.scene}, outputs);
+  TerminalProgress progress(progress_wanted(a.common.quiet));
+  progress.begin("", "load");
+  RenderOptions options = render_options(a.common, "full");
+  double load_seconds = 0;
+  Scene scene = load(a.common, options, load_seconds);
+  std::unique_ptr<Renderer> renderer = take(make_renderer(a.renderer, gl_backend(a.common)));
+  options.progress = progress.sink();
+  progress.begin(a.renderer, "render");
+  auto start = Clock::now();
+  RenderOutput out = take(renderer->render(scene, options));
+  double render_seconds = seconds_since(start);
+
+  progress.begin(a.renderer, "write");
+  auto write_start = Clock::now();
+  check(write_image(a.out, color_image(out.buffers)));
+  if (!a.aovs.empty()) check(write_aovs(a.out, out.buffers, a.aovs));
+  double write_seconds = seconds_since(write_start);
+  progress.stop();  // before the warnings and the summary
+
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const std::string& w : out.warnings)
+    std::fprintf(stderr, "warning: %s: %s\n", a.renderer.c_str(), w.c_str());
+  if (!a.stats.empty()) {
+    nlohmann::json j;
+    j["renderer"] = a.renderer;
+    j["scene"] = scene.source;
+    j["width"] = scene.image.width;
+    j["height"] = scene.image.height;
+    j["mode"] = to_string(options.mode);
+    j["time"] = {{"load", load_seconds}, {"render", render_seconds}, {"write", write_seconds}};
+    nlohmann::json counters = nlohmann::json::object();
+    for (const auto& [k, v] : out.stats) counters[k] = finite_or_null(v);
+    j["stats"] = counters;
+    j["info"] = out.info;
+    j["warnings"] = out.warnings;
+    j["peak_memory_bytes"] = peak_memory_bytes();
+    // The scene's own vertex and index data, to read peak memory against.
+    double scene_bytes = 0;
+    for (const Object& o : scene.objects)
+      scene_bytes += double(o.mesh.positions.size() * sizeof(glm::vec3) +
+                            o.mesh.normals.size() * sizeof(glm::vec3) +
+                            o.mesh.triangles.size() * sizeof(glm::uvec3));
+    j["scene_mesh_bytes"] = scene_bytes;
+    check(write_text_file(a.stats, j.dump(2) + "\n"));
+  }
+  if (!a.common.quiet) {
+    std::fprintf(stderr, "%s: %s %dx%d %s in %.3f s -> %s\n", a.renderer.c_str(),
+                 scene.source.c_str(), scene.image.width, scene.image.height,
+                 to_string(options.mode), render_seconds, a.out.c_str());
+  }
+  return 0;
+}
+
+}  // namespace rvr::cli

@@ -1,0 +1,73 @@
+// rvr scenes: the built-in scenes, listed or exported as scene files.
+#include <fmt/format.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <thread>
+
+#include "cli_exit.h"
+#include "commands.h"
+#include "report.h"
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/compare_renderers.h"
+#include "rvr/renderers/registry.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/image_io.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/limits.h"
+#include "rvr/shared/scene_loader.h"
+#include "rvr/shared/scene_writer.h"
+#include "terminal_progress.h"
+
+namespace rvr::cli {
+
+namespace {
+
+// --export: the built-in scene as an rvr-scene/1 document. Meshes other than single
+// triangles have no inline form in the format: they go to PLY files next to -o FILE.
+int export_scene(const ScenesArgs& a) {
+  std::string name = a.export_name;
+  if (name.rfind("builtin:", 0) == 0) name = name.substr(8);
+  Scene scene = take(make_builtin_scene(name));
+  std::filesystem::path out(a.out);
+  std::string prefix = a.out.empty() ? name : out.stem().string();
+  SceneDocument doc = take(write_scene(scene, prefix));
+  if (a.out.empty()) {
+    if (!doc.mesh_files.empty()) {
+      fail(bad_input(fmt::format(
+          "builtin:{}: has {} mesh{} of more than one triangle, which rvr-scene/1 reads only "
+          "from mesh files: give -o FILE.json to write {} as PLY next to it",
+          name, doc.mesh_files.size(), doc.mesh_files.size() == 1 ? "" : "es",
+          doc.mesh_files.size() == 1 ? "it" : "them")));
+    }
+    std::fwrite(doc.json.data(), 1, doc.json.size(), stdout);
+    return std::fflush(stdout) == 0 ? 0 : 3;
+  }
+  for (const SceneMeshFile& m : doc.mesh_files) {
+    check(write_text_file((out.parent_path() / m.name).string(), m.bytes));
+  }
+  check(write_text_file(a.out, doc.json));
+  return 0;
+}
+
+}  // namespace
+
+int run_scenes(const ScenesArgs& a) {
+  if (!a.export_name.empty()) return export_scene(a);
+  if (!a.out.empty()) fail(bad_input("scenes: -o needs --export NAME"));
+  for (const BuiltinSceneInfo& s : builtin_scenes())
+    std::printf("builtin:%-14s %s\n", s.name.c_str(), s.description.c_str());
+  return 0;
+}
+
+}  // namespace rvr::cli

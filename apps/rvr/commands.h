@@ -1,0 +1,93 @@
+// What the commands of rvr share: the options of render and compare, the arguments of each
+// command and its entry point. Private to apps/rvr.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/shared/limits.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
+
+namespace rvr::cli {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr const char* kVersion = "0.1.0";
+
+inline double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Options shared by render and compare.
+struct CommonOptions {
+  std::string scene = "builtin:cornell";
+  std::string mode;
+  std::optional<int> width, height, spp;
+  int threads = 0;
+  std::string accel = "bvh";
+  std::string spheres = "analytic";
+  int sphere_segments = 64;
+  std::string triangle_test = "mt";
+  int max_depth = 5;
+  uint64_t seed = 0;
+  std::string gl;  // empty: osmesa, falling back to egl when OSMesa is missing
+  int shadow_map_size = 1024;
+  float shadow_bias = 0.01f;
+  bool shadow_pcf = false;
+  std::string hiz = "on";
+  bool quiet = false;
+  Limits limits;
+  uint64_t max_memory_mb = 0;
+};
+
+void add_common_options(CLI::App& cmd, CommonOptions& o);
+GlBackend gl_backend(const CommonOptions& o);
+RenderMode parse_mode(const std::string& s);
+RenderOptions render_options(const CommonOptions& o, const std::string& default_mode);
+Scene load(const CommonOptions& o, const RenderOptions& options, double& load_seconds);
+
+// Refuses, before any work, an output that would overwrite one of the inputs.
+void refuse_overwriting_inputs(const std::vector<std::string>& inputs,
+                               const std::vector<std::string>& outputs);
+
+struct RenderArgs {
+  CommonOptions common;
+  std::string renderer;
+  std::string out = "render.png";
+  std::vector<std::string> aovs;
+  std::string stats;
+};
+
+int run_render(const RenderArgs& a);
+
+struct CompareArgs {
+  CommonOptions common;
+  std::vector<std::string> renderers{"raster", "raytrace"};
+  std::string out_dir = "rvr-out";
+  std::optional<double> fail_below_agreement;
+};
+
+int run_compare(const CompareArgs& a, const std::string& command_line);
+
+struct DiffArgs {
+  std::string a, b, out;
+  std::optional<double> fail_above;
+};
+
+int run_diff(const DiffArgs& d);
+
+struct ScenesArgs {
+  std::string export_name;  // --export NAME
+  std::string out;          // -o FILE (default: stdout)
+};
+
+int run_scenes(const ScenesArgs& a);
+
+int run_info(const std::string& gl_name);
+
+}  // namespace rvr::cli
