@@ -12,16 +12,13 @@
 #include "rvr/shared/limits.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
+#include "rvr/shared/timer.h"
 
 namespace rvr::cli {
 
 using Clock = std::chrono::steady_clock;
 
 constexpr const char* kVersion = "0.1.0";
-
-inline double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Options shared by render and compare.
 struct CommonOptions {

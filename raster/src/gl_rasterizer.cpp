@@ -23,16 +23,13 @@
 #include "gl_shaders.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/tessellate.h"
+#include "rvr/shared/timer.h"
 
 namespace rvr {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // One corner of a triangle. Triangles are expanded (not indexed) so every corner can carry its
 // triangle's geometric normal, and gl_PrimitiveID counts triangles from 0 in each object's draw.

@@ -22,6 +22,7 @@
 #include "rvr/shared/camera.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/tessellate.h"
+#include "rvr/shared/timer.h"
 #include "soft/draw_triangles.h"
 #include "soft/fill_dispatch.h"
 #include "soft/shadow_cube.h"
@@ -42,10 +43,6 @@ using soft::DepthTarget;
 using soft::DrawList;
 using soft::DrawObject;
 using soft::DrawResult;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 std::string object_label(const Object& o, size_t index) {
   return o.name.empty() ? fmt::format("csg#{}", index) : o.name;

@@ -4,6 +4,8 @@
 #include <chrono>
 #include <memory>
 
+#include "rvr/shared/timer.h"
+
 namespace rvr {
 
 Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<std::string>& names,
@@ -30,7 +32,7 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
     if (!out) return out.error();
     ComparedRenderer r;
     r.name = names[i];
-    r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    r.seconds = seconds_since(start);
     r.output = std::move(out).value();
     result.renderers.push_back(std::move(r));
   }

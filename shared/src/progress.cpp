@@ -2,6 +2,8 @@
 
 #include <utility>
 
+#include "rvr/shared/timer.h"
+
 namespace rvr {
 
 void ProgressSink::begin(std::string phase, uint64_t total, std::string unit,
@@ -30,7 +32,7 @@ ProgressSnapshot ProgressSink::snapshot() const {
     s.rate_unit = rate_unit_;
     s.rate_done = rate_done_.load(std::memory_order_relaxed);
   }
-  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  s.seconds = seconds_since(start_);
   return s;
 }
 

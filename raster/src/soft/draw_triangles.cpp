@@ -7,15 +7,13 @@
 #include <atomic>
 #include <chrono>
 
+#include "rvr/shared/timer.h"
 #include "soft/triangle_setup.h"
 
 namespace rvr::soft {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // Triangles stream through in chunks of kChunk (in submission order), each set up by kSubChunk at
 // a time in parallel, binned, and drawn into every tile before the next: memory holds one chunk,
