@@ -17,12 +17,12 @@
 #include <type_traits>
 #include <vector>
 
+#include "draw_list_prep.h"
 #include "gl_check.h"
 #include "gl_context.h"
 #include "gl_program.h"
 #include "gl_shaders.h"
 #include "rvr/shared/camera.h"
-#include "rvr/shared/tessellate.h"
 #include "rvr/shared/timer.h"
 
 namespace rvr {
@@ -147,10 +147,6 @@ Status append_mesh(const TriangleMesh& mesh, const std::string& name, std::vecto
     }
   }
   return ok_status();
-}
-
-std::string object_label(const Object& o, size_t index) {
-  return o.name.empty() ? fmt::format("csg#{}", index) : o.name;
 }
 
 }  // namespace
@@ -528,13 +524,9 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
     DrawItem d;
     d.object = uint32_t(i);
     d.first = GLint(vertices.size());
-    d.material = o.material < scene.materials.size() ? &scene.materials[o.material] : nullptr;
-    if (!d.material) {
-      if (!scene.materials.empty())
-        return bad_input(
-            fmt::format("object '{}': material index {} out of range", o.name, o.material));
-      d.material = &fallback;  // a hand-made scene with no material list: the built-in grey
-    }
+    Expected<const Material*> material = object_material(scene, o, fallback);
+    if (!material) return material.error();
+    d.material = *material;
     switch (o.type) {
       case ObjectType::Triangles:
         RVR_TRY(append_mesh(o.mesh, o.name, vertices));
@@ -542,12 +534,9 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
         d.use_primitive_id = true;
         break;
       case ObjectType::Sphere:
-        RVR_TRY(
-            append_mesh(tessellate_sphere(o.sphere, options.sphere_segments), o.name, vertices));
-        d.smooth = true;
-        break;
       case ObjectType::Plane:
-        RVR_TRY(append_mesh(tessellate_plane(o.plane), o.name, vertices));
+        RVR_TRY(append_mesh(tessellate_shape(o, options.sphere_segments), o.name, vertices));
+        d.smooth = o.type == ObjectType::Sphere;
         break;
       case ObjectType::Csg:
         skipped_csg.push_back(object_label(o, i));
@@ -857,12 +846,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   out.stats["pixels.covered"] = double(covered);
   out.stats["overdraw"] = covered > 0 ? generated / double(covered) : 0.0;
 
-  if (!skipped_csg.empty()) {
-    std::string names;
-    for (const std::string& s : skipped_csg) names += (names.empty() ? "" : ", ") + s;
-    out.warnings.push_back(fmt::format("csg objects have no z-buffer form: skipped {} ({})",
-                                       skipped_csg.size(), names));
-  }
+  if (!skipped_csg.empty()) out.warnings.push_back(skipped_csg_warning(skipped_csg));
   if (options.mode == RenderMode::Full) {
     // What a z-buffer cannot do, named for this scene only (shadows it does, with shadow maps).
     std::string mirrors = material_names(draws, [](const Material& m) { return m.mirror > 0.0f; });

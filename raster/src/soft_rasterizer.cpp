@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
+#include "draw_list_prep.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/shading.h"
-#include "rvr/shared/tessellate.h"
 #include "rvr/shared/timer.h"
 #include "soft/draw_triangles.h"
 #include "soft/fill_dispatch.h"
@@ -43,10 +43,6 @@ using soft::DepthTarget;
 using soft::DrawList;
 using soft::DrawObject;
 using soft::DrawResult;
-
-std::string object_label(const Object& o, size_t index) {
-  return o.name.empty() ? fmt::format("csg#{}", index) : o.name;
-}
 
 Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options,
                                    std::optional<DepthTarget>& kept) {
@@ -83,25 +79,17 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
     DrawObject& d = objects[i];
-    if (o.material < scene.materials.size()) {
-      d.material = &scene.materials[o.material];
-    } else if (scene.materials.empty()) {
-      d.material = &fallback;  // a hand-made scene with no material list: the built-in grey
-    } else {
-      return bad_input(
-          fmt::format("object '{}': material index {} out of range", o.name, o.material));
-    }
+    Expected<const Material*> material = object_material(scene, o, fallback);
+    if (!material) return material.error();
+    d.material = *material;
     switch (o.type) {
       case ObjectType::Triangles:
         d.mesh = &o.mesh;
         d.use_primitive_id = true;
         break;
       case ObjectType::Sphere:
-        tessellated.push_back(tessellate_sphere(o.sphere, options.sphere_segments));
-        d.mesh = &tessellated.back();
-        break;
       case ObjectType::Plane:
-        tessellated.push_back(tessellate_plane(o.plane));
+        tessellated.push_back(tessellate_shape(o, options.sphere_segments));
         d.mesh = &tessellated.back();
         break;
       case ObjectType::Csg:
@@ -306,12 +294,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   out.stats["memory.raster_bytes"] = double(target.bytes() + drawn.peak_chunk_bytes);
   out.info["hiz"] = options.hiz ? "on" : "off";
 
-  if (!skipped_csg.empty()) {
-    std::string names;
-    for (const std::string& s : skipped_csg) names += (names.empty() ? "" : ", ") + s;
-    out.warnings.push_back(fmt::format("csg objects have no z-buffer form: skipped {} ({})",
-                                       skipped_csg.size(), names));
-  }
+  if (!skipped_csg.empty()) out.warnings.push_back(skipped_csg_warning(skipped_csg));
   if (options.mode == RenderMode::Full) {
     if (mirror) out.warnings.push_back("mirror reflection not rendered by softraster");
     if (transparency) out.warnings.push_back("transparency not rendered by softraster");
