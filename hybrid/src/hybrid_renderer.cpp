@@ -5,15 +5,13 @@
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/timer.h"
 
 namespace rvr {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 bool starts_with(const std::string& s, const char* prefix) {
   return s.rfind(prefix, 0) == 0;

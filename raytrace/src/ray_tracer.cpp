@@ -15,6 +15,7 @@
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/shading.h"
+#include "rvr/shared/timer.h"
 
 namespace rvr {
 namespace {
@@ -27,9 +28,6 @@ static_assert(kPacketSide * kPacketSide == kPacketRays);
 constexpr int kPacketFallbacks = 8;
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // One random stream per pixel, seeded from (seed, x, y): the image does not depend on which
 // thread renders which tile.
