@@ -87,14 +87,35 @@ def depth_complexity(rows, context, out):
 
 
 def effects(rows, context, out):
-    times = {parts(b)[1]: ms(b) for b in rows if parts(b)[0] == "BM_Effects"}
-    if "primary" not in times:
+    """Each effect's frame time relative to the tracer's primary-rays-only frame: the tracer
+    (BM_Effects/<effect>) and, beside it, the hybrid (BM_Effects/hybrid/<effect>): where the
+    hybrid's bar is lower, the z-buffer's primary visibility paid off."""
+    tracer, hybrid = {}, {}
+    for b in rows:
+        p = parts(b)
+        if p[0] != "BM_Effects":
+            continue
+        if len(p) == 2:
+            tracer[p[1]] = ms(b)
+        elif len(p) == 3 and p[1] == "hybrid":
+            hybrid[p[2]] = ms(b)
+    if "primary" not in tracer:
         return
-    names = list(times)
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    ax.bar(names, [times[n] / times["primary"] for n in names], color="tab:orange")
-    ax.set_ylabel("cost relative to primary rays only")
-    ax.set_title("What each tracer effect costs on cornell (640x480)\n" + subtitle(context))
+    names = list(tracer)
+    xs = range(len(names))
+    width = 0.4 if hybrid else 0.8
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    ax.bar([x - (width / 2 if hybrid else 0) for x in xs],
+           [tracer[n] / tracer["primary"] for n in names], width, color="tab:orange",
+           label="raytrace")
+    if hybrid:
+        ax.bar([x + width / 2 for x in xs], [hybrid.get(n, 0) / tracer["primary"] for n in names],
+               width, color="tab:blue", label="hybrid (GL z-buffer + rays)")
+        ax.legend()
+    ax.set_xticks(list(xs))
+    ax.set_xticklabels(names)
+    ax.set_ylabel("frame time / tracer's primary-only frame")
+    ax.set_title("What each effect costs on cornell (640x480)\n" + subtitle(context))
     ax.tick_params(axis="x", rotation=40)
     ax.grid(True, axis="y", alpha=0.3)
     fig.tight_layout()
