@@ -77,12 +77,16 @@ TEST_P(HybridFullMode, IsTheTracersImageButOnEdges) {
                  std::memcmp(&a.depth[i], &b.depth[i], sizeof(float)) != 0;
   }
   // Pixels whose ids agree but whose colour or depth bytes do not: a shared edge between two
-  // triangles of one tessellated sphere (both report primitive 0) may still differ there.
-  EXPECT_LE(double(differing), 0.001 * double(a.pixel_count())) << differing << " pixels";
+  // triangles of one tessellated sphere (both report primitive 0) may still differ there. With
+  // several samples per pixel each sample's hit comes from its own z-buffer pass, and each pass
+  // may disagree with the tracer on its own edges as the centre pass does: 0.1% per pass.
+  const double passes = mixed.stats.at("hybrid.zbuffer_passes");
+  EXPECT_EQ(passes, scene.image.samples_per_pixel > 1 ? scene.image.samples_per_pixel + 1 : 1);
+  EXPECT_LE(double(differing), 0.001 * passes * double(a.pixel_count())) << differing << " pixels";
 
-  // Every pixel is rebuilt from the ids or traced; the time splits into the two passes.
+  // Every pixel of every pass is rebuilt from the ids or traced; the time splits into the two.
   EXPECT_EQ(mixed.stats.at("hybrid.rebuilt") + mixed.stats.at("hybrid.fallback_traced"),
-            double(a.pixel_count()));
+            passes * double(a.pixel_count()));
   EXPECT_GT(mixed.stats.at("time.zbuffer"), 0.0);
   EXPECT_GT(mixed.stats.at("time.trace"), 0.0);
   EXPECT_EQ(mixed.stats.at("rays.shadow") > 0, traced.stats.at("rays.shadow") > 0);
@@ -129,13 +133,29 @@ TEST(Hybrid, SameBytesForAnyThreadCount) {
   }
 }
 
-// Supersampled scenes: the extra samples are traced, and the output says so.
-TEST(Hybrid, WarnsThatSupersamplesAreTraced) {
+// Supersampling and depth of field by z-buffer passes (the accumulation buffer): each pass is
+// drawn through its sample's place in the pixel and lens point, so the z-buffer names the very
+// primitive each sample's ray meets. A pass drawn through the pixel centres and the pinhole
+// instead would still give the tracer's colours (a missed primitive is traced), but would miss
+// its named primitive on every defocused or off-centre edge: fallback_missed tells them apart.
+TEST(Hybrid, SupersamplesComeFromZBufferPassesThroughTheirLensPoints) {
   Scene scene = small_scene("dof");
-  ASSERT_GT(scene.image.samples_per_pixel, 1);
-  RenderOutput out = render_full("hybrid", scene);
-  bool warned = false;
-  for (const std::string& w : out.warnings)
-    warned |= w.find("traced, not z-buffered") != std::string::npos;
-  EXPECT_TRUE(warned);
+  const int spp = scene.image.samples_per_pixel;
+  ASSERT_GT(spp, 1);
+  ASSERT_GT(scene.camera.aperture_radius, 0.0f);
+  RenderOutput traced = render_full("raytrace", scene);
+  for (const char* hybrid : {"hybrid", "hybrid_soft"}) {
+    RenderOutput out = render_full(hybrid, scene);
+    const double samples = double(out.buffers.pixel_count()) * double(spp + 1);
+    EXPECT_EQ(out.stats.at("hybrid.zbuffer_passes"), double(spp + 1)) << hybrid;
+    EXPECT_EQ(out.stats.at("rays.primary"), traced.stats.at("rays.primary")) << hybrid;
+    // Measured: 1 of 208,896 samples (a silhouette); a pass through the wrong camera misses
+    // on every out-of-focus edge, thousands of samples at this size.
+    EXPECT_LE(out.stats.at("hybrid.fallback_missed"), 1e-4 * samples) << hybrid;
+    EXPECT_GT(out.stats.at("hybrid.rebuilt"), 0.5 * samples) << hybrid;
+    ComparisonMetrics m = compare_buffers(out.buffers, traced.buffers);
+    EXPECT_GE(m.color.psnr_db, 60.0) << hybrid;  // the tracer's own samples but on rare edges
+    for (const std::string& w : out.warnings)
+      EXPECT_EQ(w.find("traced, not z-buffered"), std::string::npos) << w;
+  }
 }

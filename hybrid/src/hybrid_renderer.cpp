@@ -1,10 +1,12 @@
 #include "rvr/hybrid/hybrid_renderer.h"
 
 #include <chrono>
+#include <vector>
 
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/image_sample.h"
 #include "rvr/shared/timer.h"
 
 namespace rvr {
@@ -59,13 +61,46 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   const FrameBuffers& ids = zbuffer->buffers;
   PrimaryVisibility visible{ids.width, ids.height, ids.object_id, ids.primitive_id};
 
+  // Several samples per pixel: one more z-buffer pass per sample (the accumulation buffer),
+  // each drawn through that sample's place in the pixel and lens point, its hits rebuilt and
+  // shaded by the tracer and summed; the centre pass gives the AOVs, as in the tracer.
+  const int spp = scene.image.samples_per_pixel;
+  const bool passes = spp > 1 && options.mode != RenderMode::Visibility;
   auto t_trace = Clock::now();
   RayTracer tracer;
-  Expected<RenderOutput> out = tracer.render_visible(scene, options, geometry, visible);
-  const double trace_seconds = seconds_since(t_trace);
+  Expected<RenderOutput> out =
+      tracer.render_visible(scene, options, geometry, visible,
+                            passes ? VisibleSamples::FromPasses : VisibleSamples::Traced);
+  double trace_seconds = seconds_since(t_trace);
+  double zbuffer_pass_seconds = zbuffer_seconds;
   if (!out) return out;
   RenderOutput& o = out.value();
-  o.stats["time.zbuffer"] = zbuffer_seconds;
+  if (passes) {
+    FrameBuffers& fb = o.buffers;
+    std::vector<glm::vec3> sum(fb.pixel_count(), glm::vec3(0.0f));
+    for (int k = 0; k < spp; ++k) {
+      visibility_options.image_sample =
+          image_sample(scene.camera, options.seed, k, spp, options.mode == RenderMode::Full);
+      auto t_pass = Clock::now();
+      Expected<RenderOutput> pass = rasterizer_->render(scene, visibility_options);
+      zbuffer_pass_seconds += seconds_since(t_pass);
+      if (!pass) return pass.error();
+      const FrameBuffers& pass_ids = pass->buffers;
+      const PrimaryVisibility pass_visible{pass_ids.width, pass_ids.height, pass_ids.object_id,
+                                           pass_ids.primitive_id};
+      t_pass = Clock::now();
+      auto pass_stats = tracer.add_visible_sample(scene, options, geometry, pass_visible, k, sum);
+      trace_seconds += seconds_since(t_pass);
+      if (!pass_stats) return pass_stats.error();
+      for (const auto& [key, value] : pass_stats.value()) o.stats[key] += value;
+    }
+    // The tracer's own average: the same float operations in the same order.
+    for (size_t i = 0; i < sum.size(); ++i) fb.color[i] = sum[i] / float(spp);
+    o.stats["hybrid.zbuffer_passes"] = double(spp + 1);
+  } else {
+    o.stats["hybrid.zbuffer_passes"] = 1.0;
+  }
+  o.stats["time.zbuffer"] = zbuffer_pass_seconds;
   o.stats["time.trace"] = trace_seconds;
   for (const auto& [key, value] : zbuffer->stats) o.stats["zbuffer." + key] = value;
   for (const auto& [key, value] : zbuffer->info) o.info["zbuffer." + key] = value;

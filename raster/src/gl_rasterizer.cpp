@@ -23,6 +23,7 @@
 #include "gl_program.h"
 #include "gl_shaders.h"
 #include "rvr/shared/camera.h"
+#include "rvr/shared/image_sample.h"
 #include "rvr/shared/timer.h"
 
 namespace rvr {
@@ -624,8 +625,13 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   // --- scene passes: z-buffer visibility, ids, depth, normal, shading
   double shadow_time = 0.0;
   t = Clock::now();
-  const glm::mat4 view = view_matrix(scene.camera);
-  const glm::mat4 projection = projection_matrix(scene.camera, w, h);
+  // One accumulation-buffer pass (the hybrid's): the camera as that sample sees it.
+  const glm::mat4 view = options.image_sample
+                             ? sample_view_matrix(scene.camera, *options.image_sample)
+                             : view_matrix(scene.camera);
+  const glm::mat4 projection =
+      options.image_sample ? sample_projection_matrix(scene.camera, w, h, *options.image_sample)
+                           : projection_matrix(scene.camera, w, h);
   const float inf = std::numeric_limits<float>::infinity();
   const glm::vec4 background(scene.image.background, 1.0f);
   const glm::vec4 zero(0.0f);

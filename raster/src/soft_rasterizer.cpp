@@ -21,6 +21,7 @@
 
 #include "draw_list_prep.h"
 #include "rvr/shared/camera.h"
+#include "rvr/shared/image_sample.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/timer.h"
 #include "soft/draw_triangles.h"
@@ -109,8 +110,13 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     transparency |= d.material->transparency > 0.0f;
   }
 
+  // One accumulation-buffer pass (the hybrid's): the camera as that sample sees it.
   const glm::dmat4 view_projection =
-      glm::dmat4(projection_matrix(scene.camera, w, h)) * glm::dmat4(view_matrix(scene.camera));
+      options.image_sample
+          ? glm::dmat4(sample_projection_matrix(scene.camera, w, h, *options.image_sample)) *
+                glm::dmat4(sample_view_matrix(scene.camera, *options.image_sample))
+          : glm::dmat4(projection_matrix(scene.camera, w, h)) *
+                glm::dmat4(view_matrix(scene.camera));
   const DrawList list = soft::make_draw_list(std::move(objects));
   const size_t submitted = list.triangles();
   out.stats["time.setup"] = seconds_since(t);

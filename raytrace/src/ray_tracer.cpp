@@ -11,9 +11,11 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/shared/camera.h"
+#include "rvr/shared/image_sample.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/timer.h"
 
@@ -35,6 +37,12 @@ class PixelRng {
  public:
   PixelRng(uint64_t seed, int x, int y)
       : state_(seed * 0x9E3779B97F4A7C15ull ^ (uint64_t(uint32_t(x)) << 32 | uint32_t(y))) {
+    next();
+  }
+  // Sample k's own stream: a sample's random numbers do not depend on the samples before it,
+  // so the hybrid can trace sample k of every pixel in its own pass and draw the same numbers.
+  PixelRng(uint64_t seed, int x, int y, int k) : PixelRng(seed, x, y) {
+    state_ ^= (uint64_t(uint32_t(k)) + 1) * 0xD1B54A32D192ED03ull;
     next();
   }
   uint64_t next() {
@@ -86,7 +94,46 @@ class FrameTracer {
         options_(options),
         geometry_(geometry),
         lights_(light_samples(scene.lights)),
-        frame_(make_camera_frame(scene.camera, scene.image.width, scene.image.height)) {}
+        frame_(make_camera_frame(scene.camera, scene.image.width, scene.image.height)),
+        thin_lens_(options.mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f) {}
+
+  // render_visible for the hybrid's accumulation-buffer passes: the pixel-centre pass keeps the
+  // centre's colour; the passes add the samples (add_visible_sample).
+  void keep_centre_colour() { centre_only_ = true; }
+
+  // Sample k of each pixel of [x0, x1) x [y0, y1): its ray intersected with the primitive that
+  // `visible` (a z-buffer drawn through image_sample k) names there, else traced; the CSG
+  // objects intersected besides, as in render_block_visible. Its colour is added to sum.
+  void sample_block_visible(int x0, int y0, int x1, int y1, const PrimaryVisibility& visible, int k,
+                            const ImageSample& sample, glm::vec3* sum,
+                            RayCounters& counters) const {
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) {
+        const size_t i = size_t(y) * size_t(visible.width) + size_t(x);
+        const Ray ray = sample_ray(x, y, sample);
+        PixelRng rng(options_.seed, x, y, k);
+        counters.primary++;
+        HitRecord hit;
+        const bool rebuilt =
+            visible.object_id[i] != kNoId &&
+            geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i], hit,
+                                        counters.traversal);
+        if (rebuilt) {
+          counters.rebuilt++;
+          HitRecord csg;
+          if (geometry_.has_csg() && geometry_.closest_csg(ray, csg, counters.traversal) &&
+              (csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive))) {
+            hit = csg;
+            counters.csg_pixels++;
+          }
+        } else {
+          counters.fallback_traced++;
+          counters.fallback_missed += visible.object_id[i] != kNoId;
+          if (!geometry_.closest(ray, hit, counters.traversal)) hit = HitRecord{};
+        }
+        sum[i] += shade_hit(ray, hit, 0, counters, &rng);
+      }
+  }
 
   // The pixels [x0, x1) x [y0, y1) of one tile (at most kPacketSide on a side): their centre
   // rays traced together as one packet, then each pixel shaded on its own.
@@ -205,7 +252,7 @@ class FrameTracer {
     int spp = scene_.image.samples_per_pixel;
     if (options_.mode == RenderMode::Visibility) {
       fb.color[i] = scene_.image.background;
-    } else if (spp <= 1) {
+    } else if (spp <= 1 || centre_only_) {
       fb.color[i] = centre_colour;
     } else {
       fb.color[i] = supersample(x, y, spp, counters);
@@ -225,41 +272,29 @@ class FrameTracer {
     return r;
   }
 
-  // Stratified jitter: the pixel split into an m x m grid (m = floor(sqrt(spp))), one sample
-  // per cell, the rest uniformly placed. With an aperture, each sample also takes a point on
-  // the lens (a thin lens: every ray through one image point meets at the focus plane).
+  // The samples of image_sample (the same place in every pixel, and with an aperture the same
+  // lens point: the accumulation buffer's passes), each with its own random stream.
   glm::vec3 supersample(int x, int y, int spp, RayCounters& counters) const {
-    PixelRng rng(options_.seed, x, y);
-    int m = int(std::sqrt(double(spp)));
     glm::vec3 sum(0.0f);
     for (int k = 0; k < spp; ++k) {
-      float jx = rng.uniform(), jy = rng.uniform();
-      if (k < m * m) {
-        jx = (float(k % m) + jx) / float(m);
-        jy = (float(k / m) + jy) / float(m);
-      }
-      Ray ray = primary_ray(float(x) + jx, float(y) + jy);
-      if (options_.mode == RenderMode::Full && scene_.camera.aperture_radius > 0.0f) {
-        ray = through_lens(ray, k, spp, rng);
-      }
+      const Ray ray =
+          sample_ray(x, y, image_sample(scene_.camera, options_.seed, k, spp, thin_lens_));
+      PixelRng rng(options_.seed, x, y, k);
       counters.primary++;
       sum += trace(ray, 0, counters, &rng);
     }
     return sum / float(spp);
   }
 
-  // Moves the ray's origin to a point on the lens disk (stratified in angle per sample, radius
-  // by the square root of a uniform number: uniform over the disk) and aims it at the point the
-  // pinhole ray meets at the focus distance. The direction keeps forward component 1, so t stays
-  // view depth and near/far clip as before.
-  Ray through_lens(const Ray& pinhole, int k, int spp, PixelRng& rng) const {
-    const float pi = 3.14159265358979f;
-    float radius = scene_.camera.aperture_radius * std::sqrt(rng.uniform());
-    float angle = 2.0f * pi * (float(k) + rng.uniform()) / float(spp);
-    glm::vec3 lens =
-        frame_.eye + radius * (std::cos(angle) * frame_.right + std::sin(angle) * frame_.up);
-    glm::vec3 focus = frame_.eye + scene_.camera.focus_distance * pinhole.dir;
-    Ray r = pinhole;
+  // The ray of one sample of pixel (x, y). With a lens, its origin is the sample's point on the
+  // lens disk, aimed at the point the pinhole ray meets at the focus distance (a thin lens:
+  // every ray through one image point meets there). The direction keeps forward component 1, so
+  // t stays view depth and near/far clip as before.
+  Ray sample_ray(int x, int y, const ImageSample& sample) const {
+    Ray r = primary_ray(float(x) + sample.jx, float(y) + sample.jy);
+    if (!thin_lens_) return r;
+    const glm::vec3 lens = frame_.eye + sample.lens_x * frame_.right + sample.lens_y * frame_.up;
+    const glm::vec3 focus = frame_.eye + scene_.camera.focus_distance * r.dir;
     r.origin = lens;
     r.dir = (focus - lens) / scene_.camera.focus_distance;
     return r;
@@ -268,6 +303,13 @@ class FrameTracer {
   glm::vec3 trace(const Ray& ray, int depth, RayCounters& counters, PixelRng* rng) const {
     HitRecord hit;
     if (!geometry_.closest(ray, hit, counters.traversal)) return scene_.image.background;
+    return shade_hit(ray, hit, depth, counters, rng);
+  }
+
+  // The colour a ray brings back from its closest hit (primitive kNoPrimitive: it missed).
+  glm::vec3 shade_hit(const Ray& ray, const HitRecord& hit, int depth, RayCounters& counters,
+                      PixelRng* rng) const {
+    if (hit.primitive == kNoPrimitive) return scene_.image.background;
     SurfaceHit s = geometry_.surface(ray, hit);
     glm::vec3 V = -glm::normalize(ray.dir);
     return shade(ray, s, face_viewer(s.shading_normal, s.geometric_normal, V), V, depth, counters,
@@ -325,6 +367,8 @@ class FrameTracer {
   const TraceGeometry& geometry_;
   std::vector<LightSample> lights_;
   CameraFrame frame_;
+  const bool thin_lens_;  // full mode with an aperture: samples look through the lens
+  bool centre_only_ = false;
 };
 
 }  // namespace
@@ -359,12 +403,12 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
 
 Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& options,
                                          const TraceGeometry& geometry) {
-  return render_frame(scene, options, geometry, nullptr);
+  return render_frame(scene, options, geometry, nullptr, false);
 }
 
-Expected<RenderOutput> RayTracer::render_visible(const Scene& scene, const RenderOptions& options,
-                                                 const TraceGeometry& geometry,
-                                                 const PrimaryVisibility& visible) {
+namespace {
+
+std::optional<Error> check_visibility_size(const Scene& scene, const PrimaryVisibility& visible) {
   const size_t n = size_t(std::max(scene.image.width, 0)) * size_t(std::max(scene.image.height, 0));
   if (visible.width != scene.image.width || visible.height != scene.image.height ||
       visible.object_id.size() != n || visible.primitive_id.size() != n)
@@ -372,18 +416,70 @@ Expected<RenderOutput> RayTracer::render_visible(const Scene& scene, const Rende
                      std::to_string(visible.height) + ", the image " +
                      std::to_string(scene.image.width) + "x" + std::to_string(scene.image.height),
                  ErrorKind::Internal};
-  Expected<RenderOutput> out = render_frame(scene, options, geometry, &visible);
-  if (!out.ok()) return out;
-  if (scene.image.samples_per_pixel > 1 && options.mode == RenderMode::Full)
-    out.value().warnings.push_back(
-        "supersampling and depth of field samples are traced, not z-buffered, yet: the "
-        "visibility buffer gives the pixel-centre hit (AOVs) only");
-  return out;
+  return std::nullopt;
+}
+
+}  // namespace
+
+Expected<RenderOutput> RayTracer::render_visible(const Scene& scene, const RenderOptions& options,
+                                                 const TraceGeometry& geometry,
+                                                 const PrimaryVisibility& visible,
+                                                 VisibleSamples samples) {
+  if (auto error = check_visibility_size(scene, visible)) return *error;
+  return render_frame(scene, options, geometry, &visible, samples == VisibleSamples::FromPasses);
+}
+
+Expected<std::map<std::string, double>> RayTracer::add_visible_sample(
+    const Scene& scene, const RenderOptions& options, const TraceGeometry& geometry,
+    const PrimaryVisibility& visible, int k, std::span<glm::vec3> sum) {
+  if (auto error = check_visibility_size(scene, visible)) return *error;
+  const int w = scene.image.width, h = scene.image.height;
+  const int spp = scene.image.samples_per_pixel;
+  if (sum.size() != size_t(w) * size_t(h) || k < 0 || k >= spp)
+    return Error{"sample " + std::to_string(k) + " of " + std::to_string(spp) + " into " +
+                     std::to_string(sum.size()) + " pixels",
+                 ErrorKind::Internal};
+  RenderOptions resolved = options;
+  resolved.accel = geometry.accel();
+  FrameTracer tracer(scene, resolved, geometry);
+  const ImageSample sample =
+      image_sample(scene.camera, options.seed, k, spp, options.mode == RenderMode::Full);
+  tbb::combinable<RayCounters> counters;
+  const int tiles_x = (w + kTileSize - 1) / kTileSize;
+  const int tiles_y = (h + kTileSize - 1) / kTileSize;
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
+        [&](const tbb::blocked_range<int>& range) {
+          RayCounters& local = counters.local();
+          for (int tile = range.begin(); tile != range.end(); ++tile) {
+            const int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
+            tracer.sample_block_visible(x0, y0, std::min(x0 + kTileSize, w),
+                                        std::min(y0 + kTileSize, h), visible, k, sample, sum.data(),
+                                        local);
+          }
+        },
+        tbb::simple_partitioner());
+  });
+  RayCounters total;
+  counters.combine_each([&](const RayCounters& c) { total.add(c); });
+  return std::map<std::string, double>{
+      {"rays.primary", double(total.primary)},
+      {"rays.shadow", double(total.shadow)},
+      {"rays.reflection", double(total.reflection)},
+      {"rays.refraction", double(total.refraction)},
+      {"hybrid.rebuilt", double(total.rebuilt)},
+      {"hybrid.fallback_traced", double(total.fallback_traced)},
+      {"hybrid.fallback_missed", double(total.fallback_missed)},
+      {"hybrid.csg_pixels", double(total.csg_pixels)},
+      {"bvh.nodes_visited", double(total.traversal.nodes_visited)},
+      {"primitive_tests", double(total.traversal.primitive_tests)}};
 }
 
 Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderOptions& requested,
                                                const TraceGeometry& geometry,
-                                               const PrimaryVisibility* visible) {
+                                               const PrimaryVisibility* visible, bool centre_only) {
   RenderOptions options = requested;
   options.accel = geometry.accel();
   RenderOutput out;
@@ -393,6 +489,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   auto t_render = Clock::now();
   out.buffers.allocate(w, h);  // every pixel is written below, in parallel
   FrameTracer tracer(scene, options, geometry);
+  if (centre_only) tracer.keep_centre_colour();
   tbb::combinable<RayCounters> counters;
   const int tiles_x = (w + kTileSize - 1) / kTileSize;
   const int tiles_y = (h + kTileSize - 1) / kTileSize;

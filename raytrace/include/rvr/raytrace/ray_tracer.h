@@ -1,6 +1,9 @@
 // The CPU ray tracer: "for each pixel, for each object", over a BVH or the plain loop.
 #pragma once
 
+#include <glm/glm.hpp>
+#include <map>
+#include <span>
 #include <string>
 
 #include "rvr/raytrace/primary_visibility.h"
@@ -14,6 +17,10 @@ std::string embree_version();
 // The widest of Embree's kernels it runs on this CPU, e.g. "AVX2".
 std::string embree_kernel_isa();
 std::string tbb_version();
+
+// Where render_visible takes a pixel's samples from when the scene asks for several: traced by
+// the tracer itself, or from the caller's accumulation-buffer passes (add_visible_sample).
+enum class VisibleSamples { Traced, FromPasses };
 
 class RayTracer : public Renderer {
  public:
@@ -37,14 +44,28 @@ class RayTracer : public Renderer {
   // intersected for every pixel, the nearer hit kept: the same image as render() wherever the
   // ids agree with its own. Stats add hybrid.rebuilt, hybrid.fallback_traced (of which
   // hybrid.fallback_missed: the named primitive was missed) and hybrid.csg_pixels.
+  // With VisibleSamples::FromPasses and several samples per pixel, the colour is the centre
+  // ray's only; the caller adds the samples with add_visible_sample and divides by their count.
   Expected<RenderOutput> render_visible(const Scene& scene, const RenderOptions& options,
                                         const TraceGeometry& geometry,
-                                        const PrimaryVisibility& visible);
+                                        const PrimaryVisibility& visible,
+                                        VisibleSamples samples = VisibleSamples::Traced);
+  // One pass of the hybrid's accumulation buffer: sample k (of image.samples_per_pixel) of every
+  // pixel, its ray (image_sample k: place in the pixel, lens point) intersected with what
+  // `visible` names there (a z-buffer drawn with RenderOptions::image_sample = that sample),
+  // else traced, CSG as render_visible. Each colour is added to sum (row-major per pixel): the
+  // sums of passes k = 0..spp-1 in order, divided by spp, are render()'s colours bit for bit
+  // wherever the ids agree with its own hits. Returns the pass's ray and hybrid counters.
+  Expected<std::map<std::string, double>> add_visible_sample(const Scene& scene,
+                                                             const RenderOptions& options,
+                                                             const TraceGeometry& geometry,
+                                                             const PrimaryVisibility& visible,
+                                                             int k, std::span<glm::vec3> sum);
 
  private:
   Expected<RenderOutput> render_frame(const Scene& scene, const RenderOptions& options,
                                       const TraceGeometry& geometry,
-                                      const PrimaryVisibility* visible);
+                                      const PrimaryVisibility* visible, bool centre_only);
 
   AccelKind forced_ = AccelKind::Bvh;
   bool has_forced_ = false;

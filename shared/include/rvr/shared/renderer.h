@@ -10,6 +10,7 @@
 
 #include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
+#include "rvr/shared/image_sample.h"
 #include "rvr/shared/isa.h"
 #include "rvr/shared/progress.h"
 #include "rvr/shared/scene.h"
@@ -46,6 +47,10 @@ struct RenderOptions {
   bool shadow_pcf = false;
   // softraster: hierarchical z (each 8x8 block's farthest depth rejects triangles behind it).
   bool hiz = true;
+  // Rasterizers: draw what this one sample of every pixel sees (its place in the pixel, its lens
+  // point) instead of the pixel centres through a pinhole: one pass of an accumulation buffer.
+  // The hybrid sets it for its visibility passes; unset, nothing changes.
+  std::optional<ImageSample> image_sample;
   // Where to report work done (per tile or chunk, never per ray); null: nobody is watching.
   // Reporting must change neither the image nor the order of work.
   ProgressSink* progress = nullptr;
