@@ -2,7 +2,7 @@
 """Charts from an rvr_bench JSON file (Google Benchmark's --benchmark_out format).
 
 usage: plot.py RESULTS.json OUT_DIR
-Writes frame_vs_triangles.png, depth_complexity.png, effects.png, ours_vs_embree.png,
+Writes frame_vs_triangles.png, depth_complexity.png, effects.png, hybrid_wins.png, ours_vs_embree.png,
 threads.png and targets.md (issue 4's ratios, measured in this one run), and prints the ratios.
 """
 import json
@@ -86,33 +86,48 @@ def depth_complexity(rows, context, out):
     fig.savefig(out / "depth_complexity.png", dpi=100)
 
 
-def effects(rows, context, out):
-    """Each effect's frame time relative to the tracer's primary-rays-only frame: the tracer
-    (BM_Effects/<effect>) and, beside it, the hybrid (BM_Effects/hybrid/<effect>): where the
-    hybrid's bar is lower, the z-buffer's primary visibility paid off."""
-    tracer, hybrid = {}, {}
+def effect_rows(rows):
+    """BM_Effects medians in ms: {renderer: {effect: ms}}, renderer raytrace, hybrid, hybrid_soft."""
+    table = defaultdict(dict)
     for b in rows:
         p = parts(b)
         if p[0] != "BM_Effects":
             continue
         if len(p) == 2:
-            tracer[p[1]] = ms(b)
-        elif len(p) == 3 and p[1] == "hybrid":
-            hybrid[p[2]] = ms(b)
+            table["raytrace"][p[1]] = ms(b)
+        elif len(p) == 3:
+            table[p[1]][p[2]] = ms(b)
+    # Registration order (the JSON's is the random interleaving's): cheapest effect first.
+    order = ["primary", "hard_shadows", "area_light_4x4"] + [f"mirror_depth_{d}" for d in range(1, 6)]
+    order += ["glass", "dof_16"]
+    rank = {n: i for i, n in enumerate(order)}
+    return {r: dict(sorted(e.items(), key=lambda kv: rank.get(kv[0], len(order))))
+            for r, e in table.items()}
+
+
+HYBRIDS = [("hybrid", "tab:blue", "hybrid (GL z-buffer + rays)"),
+           ("hybrid_soft", "tab:green", "hybrid_soft (softraster + rays)")]
+
+
+def effects(rows, context, out):
+    """Each effect's frame time relative to the tracer's primary-rays-only frame: the tracer
+    (BM_Effects/<effect>) and, beside it, the hybrids (BM_Effects/hybrid[_soft]/<effect>): where a
+    hybrid's bar is lower, the z-buffer's primary visibility paid off."""
+    table = effect_rows(rows)
+    tracer = table.get("raytrace", {})
     if "primary" not in tracer:
         return
     names = list(tracer)
-    xs = range(len(names))
-    width = 0.4 if hybrid else 0.8
-    fig, ax = plt.subplots(figsize=(9, 4.5))
-    ax.bar([x - (width / 2 if hybrid else 0) for x in xs],
-           [tracer[n] / tracer["primary"] for n in names], width, color="tab:orange",
-           label="raytrace")
-    if hybrid:
-        ax.bar([x + width / 2 for x in xs], [hybrid.get(n, 0) / tracer["primary"] for n in names],
-               width, color="tab:blue", label="hybrid (GL z-buffer + rays)")
-        ax.legend()
-    ax.set_xticks(list(xs))
+    series = [("raytrace", "tab:orange", "raytrace")] + [h for h in HYBRIDS if table.get(h[0])]
+    width = 0.8 / len(series)
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    for i, (key, colour, label) in enumerate(series):
+        offset = (i - (len(series) - 1) / 2) * width
+        ax.bar([x + offset for x in range(len(names))],
+               [table[key].get(n, 0) / tracer["primary"] for n in names], width, color=colour,
+               label=label)
+    ax.legend()
+    ax.set_xticks(list(range(len(names))))
     ax.set_xticklabels(names)
     ax.set_ylabel("frame time / tracer's primary-only frame")
     ax.set_title("What each effect costs on cornell (640x480)\n" + subtitle(context))
@@ -120,6 +135,61 @@ def effects(rows, context, out):
     ax.grid(True, axis="y", alpha=0.3)
     fig.tight_layout()
     fig.savefig(out / "effects.png", dpi=100)
+
+
+def hybrid_wins(rows, context, out):
+    """Where the third loop order wins: each hybrid's frame time over the tracer's on the same
+    frame, per effect (cornell 640x480) and against triangle count (1024x768, local mode).
+    Below 1 the hybrid is faster, and the bar or point says by how much."""
+    table = effect_rows(rows)
+    frames = defaultdict(dict)  # (renderer, scene) -> {n: ms}
+    for b in rows:
+        p = parts(b)
+        if p[0] == "BM_Frame" and len(p) == 5 and p[4] == "1024":
+            frames[(p[1], p[2])][int(p[3])] = ms(b)
+    hybrids = [h for h in HYBRIDS if table.get(h[0]) or any(k[0] == h[0] for k in frames)]
+    if not hybrids or not (table.get("raytrace") or any(k[0] == "raytrace" for k in frames)):
+        return
+    fig, axes = plt.subplots(1, 2, figsize=(13, 4.8))
+    ax = axes[0]
+    tracer = table.get("raytrace", {})
+    names = [n for n in tracer if any(n in table.get(h[0], {}) for h in hybrids)]
+    width = 0.8 / len(hybrids)
+    for i, (key, colour, label) in enumerate(hybrids):
+        offset = (i - (len(hybrids) - 1) / 2) * width
+        ratios = [table.get(key, {}).get(n, float("nan")) / tracer[n] for n in names]
+        bars = ax.bar([x + offset for x in range(len(names))], ratios, width, color=colour,
+                      label=label)
+        ax.bar_label(bars, labels=[f"{r:.2f}" for r in ratios], fontsize=7, rotation=90,
+                     padding=2)
+    ax.axhline(1.0, color="black", linewidth=1)
+    ax.set_xticks(list(range(len(names))))
+    ax.set_xticklabels(names)
+    ax.tick_params(axis="x", rotation=40)
+    ax.set_ylabel("hybrid time / raytrace time (below 1: the hybrid wins)")
+    ax.set_title("per effect, cornell 640x480 (full mode)")
+    ax.grid(True, axis="y", alpha=0.3)
+    ax.legend(fontsize=8)
+    ax = axes[1]
+    for key, colour, label in hybrids:
+        for scene, style in (("tessphere", "-"), ("soup", "--")):
+            ours, base = frames.get((key, scene), {}), frames.get(("raytrace", scene), {})
+            pts = sorted((n, ours[n] / base[n]) for n in ours if n in base)
+            if pts:
+                ax.plot([n for n, _ in pts], [r for _, r in pts], style, marker="o", color=colour,
+                        label=f"{key} {scene}")
+    ax.axhline(1.0, color="black", linewidth=1)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("triangles")
+    ax.set_title("per frame vs triangles, 1024x768 (local mode)")
+    ax.grid(True, which="both", alpha=0.3)
+    if ax.get_legend_handles_labels()[1]:
+        ax.legend(fontsize=8)
+    fig.suptitle("Where the hybrid (z-buffer for primary visibility, rays for the rest) wins (" +
+                 subtitle(context) + ")")
+    fig.tight_layout()
+    fig.savefig(out / "hybrid_wins.png", dpi=100)
 
 
 def ours_vs_embree(rows, context, out):
@@ -251,7 +321,8 @@ def main():
     context, rows = load(sys.argv[1])
     out = Path(sys.argv[2])
     out.mkdir(parents=True, exist_ok=True)
-    for chart in (frame_vs_triangles, depth_complexity, effects, ours_vs_embree, threads, targets):
+    for chart in (frame_vs_triangles, depth_complexity, effects, hybrid_wins, ours_vs_embree, threads,
+                  targets):
         chart(rows, context, out)
     print(f"wrote charts to {out}/")
 

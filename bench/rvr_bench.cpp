@@ -3,7 +3,7 @@
 //   BM_DepthComplexity/<renderer>/<N>          occluders:N at 512x384, front to back
 //   BM_DepthComplexityBackToFront/<renderer>/<N>  the same quads rearmost first
 //   BM_Effects/<effect>                        the tracer on cornell, one effect at a time
-//   BM_Effects/hybrid/<effect>                 the same frames with the hybrid
+//   BM_Effects/hybrid[_soft]/<effect>          the same frames with the hybrids
 //   BM_Trace/<accel>/<rays>/<scene>/<n>        one thread, rays only, no shading
 //   BM_Build/<accel>/<n>                       acceleration structure build
 //   BM_Threads/<renderer>/<threads>            tessphere:100000 at 1024x768 on 1 or 2 threads
@@ -511,11 +511,11 @@ void register_all() {
     benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-    // Beside the tracer's: the hybrid on the same frames.
-    benchmark::RegisterBenchmark(("BM_Effects/hybrid/" + e).c_str(), BM_EffectsWith,
-                                 std::string("hybrid"), e)
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
+    // Beside the tracer's: the hybrids (GL's z-buffer, softraster's) on the same frames.
+    for (std::string h : {"hybrid", "hybrid_soft"})
+      benchmark::RegisterBenchmark(("BM_Effects/" + h + "/" + e).c_str(), BM_EffectsWith, h, e)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
   }
   for (std::string a : {"bvh", "bvh2", "embree"})
     for (std::string rays : {"primary", "random"}) {
