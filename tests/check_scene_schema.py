@@ -135,6 +135,7 @@ EDGE_VALID = [
     ("object name any string", setter("objects", 0, "name", "")),
     ("material name with spaces",
      lambda d: (d["materials"].update({"a b": {}}), d["objects"][0].update(material="a b"))),
+    ("a mesh keeping its file's materials", setter("objects", 3, "material", "from_file")),
 ]
 
 # Refused by the schema AND by the loader.
@@ -162,6 +163,7 @@ INVALID = [
     ("unknown material key", setter("materials", "white", "colour", [1, 1, 1])),
     ("materials as an array", setter("materials", [])),
     ("empty material name", setter("materials", "", {})),
+    ("a material named from_file (reserved)", setter("materials", "from_file", {})),
     ("mirror above 1", setter("materials", "mirror", "mirror", 1.5)),
     ("negative shininess", setter("materials", "mirror", "shininess", -1)),
     ("ior below 1", setter("materials", "glass", "ior", 0.9)),
@@ -205,6 +207,7 @@ LOADER_ONLY = [
     ("degenerate triangle", setter("objects", 2, "vertices", [[0, 0, 0], [1, 0, 0], [2, 0, 0]])),
     ("non-uniform scale on a sphere", setter("objects", 0, "transform", {"scale": [1, 2, 1]})),
     ("missing mesh file", setter("objects", 3, "file", "no/such/file.obj")),
+    ("from_file on a sphere", setter("objects", 0, "material", "from_file")),
 ]
 
 

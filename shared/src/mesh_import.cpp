@@ -2,6 +2,7 @@
 #include "mesh_import.h"
 
 #include <assimp/DefaultIOSystem.h>
+#include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
@@ -15,6 +16,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <stdexcept>
 
 #include "mesh_repair.h"
@@ -158,12 +161,17 @@ std::string ply_header_problem(const fs::path& p, bool named_ply) {
       continue;
     }
     if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
+    // Assimp skips header lines it does not know, and exporters write them: Blender puts a
+    // free-text "Created by Blender ..." line after `format` without the `comment` keyword.
+    // Only the lines that shape the body (format, element, property) are checked.
+    static const std::set<std::string> kShaping = {"format", "element", "property", "end_header"};
+    if (!kShaping.count(w[0])) continue;
     if (w[0] == "end_header") {
       if (w.size() != 1) return bad("text after end_header");
       break;
     }
     if (w[0] == "format") {
-      if (have_format || w.size() != 3 || w[2] != "1.0") return bad("bad format line");
+      if (have_format || w.size() != 3) return bad("bad format line");
       if (w[1] == "binary_little_endian" || w[1] == "binary_big_endian") {
         binary = true;
       } else if (w[1] != "ascii") {
@@ -188,8 +196,6 @@ std::string ply_header_problem(const fs::path& p, bool named_ply) {
       } else {
         return bad("a property needs a known type and a name");
       }
-    } else {
-      return bad("unknown keyword");
     }
   }
   if (!have_format) return "PLY header has no format line";
@@ -224,46 +230,50 @@ std::string raw_mesh_problem(const aiScene* ai) {
   return {};
 }
 
-}  // namespace
-
-TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
-                         const std::string& path, bool smooth, size_t* skipped_primitives) {
+fs::path resolve(const std::string& file, const std::string& base_dir, const std::string& path) {
   if (file.empty()) fail(path, "must not be empty");
   if (file.find('\0') != std::string::npos) fail(path, "must not contain a NUL character");
   fs::path full = fs::path(file);
   if (full.is_relative()) full = fs::path(base_dir.empty() ? "." : base_dir) / full;
+  return full;
+}
+
+[[noreturn]] void import_failed(const Assimp::Importer& importer, const std::string& file,
+                                const std::string& path) {
+  std::string reason = importer.GetErrorString();
+  std::replace(reason.begin(), reason.end(), '\n', ' ');
+  fail(path, "cannot read " + quote_json(file) + ": " +
+                 (reason.empty() ? "the importer gave no reason" : reason));
+}
+
+// Reads the file with the pre-checks, validation only, and checks what the reader made.
+// Assimp's readers can make broken data from broken files (faces with no indices, indices past
+// the vertices) and its post-processing steps assert on that, which aborts the process (found
+// by fuzzing; tests/fuzz/regressions/mesh). So: read with validation only, check what the
+// reader made ourselves, then post-process (post_process below).
+const aiScene* read_checked(Assimp::Importer& importer, const fs::path& full,
+                            const std::string& file, const std::string& path) {
   std::string prefix = "cannot read " + quote_json(file) + ": ";
   if (std::string problem = file_status(full); !problem.empty()) fail(path, prefix + problem);
-
   std::string ext = full.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (std::string problem = ply_header_problem(full, ext == ".ply"); !problem.empty()) {
     fail(path, prefix + problem);
   }
-
-  Assimp::Importer importer;
   importer.SetIOHandler(new BudgetIOSystem);  // the importer owns it
-  // Two stages. Assimp's readers can make broken data from broken files (faces with no
-  // indices, indices past the vertices) and its post-processing steps assert on that, which
-  // aborts the process (found by fuzzing; tests/fuzz/regressions/mesh). So: read with
-  // validation only, check what the reader made ourselves, then post-process.
   const aiScene* ai = importer.ReadFile(full.string(), aiProcess_ValidateDataStructure);
-  auto import_failed = [&] {
-    std::string reason = importer.GetErrorString();
-    std::replace(reason.begin(), reason.end(), '\n', ' ');
-    fail(path, prefix + (reason.empty() ? "the importer gave no reason" : reason));
-  };
-  if (!ai) import_failed();
+  if (!ai) import_failed(importer, file, path);
   if (std::string problem = raw_mesh_problem(ai); !problem.empty()) {
     fail(path, quote_json(file) + ": " + problem);
   }
-  unsigned flags =
-      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
-  if (smooth) flags |= aiProcess_GenSmoothNormals;  // ignored where the file has normals
-  ai = importer.ApplyPostProcessing(flags);
-  if (!ai) import_failed();
+  return ai;
+}
 
+const aiScene* post_process(Assimp::Importer& importer, unsigned flags, const std::string& file,
+                            const std::string& path) {
+  const aiScene* ai = importer.ApplyPostProcessing(flags);
+  if (!ai) import_failed(importer, file, path);
   size_t faces = 0, vertices = 0;
   for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
     faces += ai->mMeshes[m]->mNumFaces;
@@ -273,47 +283,245 @@ TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
     fail(path, fmt::format("{} has {} faces, more than the limit of {} triangles", quote_json(file),
                            faces, kMaxMeshTriangles));
   }
+  return ai;
+}
 
-  TriangleMesh mesh;
-  mesh.positions.reserve(vertices);
-  mesh.triangles.reserve(faces);
-  if (smooth) mesh.normals.reserve(vertices);
-  for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
-    const aiMesh* am = ai->mMeshes[m];
-    if (!am->mVertices) continue;
-    uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+// Appends mesh m's vertices (with normals when `normals`: the file's, or zero to be repaired)
+// and triangles; other faces are counted in `skipped`.
+void append_mesh(TriangleMesh& mesh, const aiScene* ai, unsigned m, bool normals,
+                 const std::string& file, const std::string& path, size_t* skipped) {
+  const aiMesh* am = ai->mMeshes[m];
+  if (!am->mVertices) return;
+  uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+  for (unsigned v = 0; v < am->mNumVertices; ++v) {
+    const aiVector3D& p = am->mVertices[v];
+    glm::vec3 pos(p.x, p.y, p.z);
+    if (!finite(pos)) {
+      fail(path, fmt::format("{}: vertex {} of mesh {} has a non-finite coordinate",
+                             quote_json(file), v, m));
+    }
+    mesh.positions.push_back(pos);
+    if (normals) {
+      glm::vec3 n(0.0f);  // missing: repaired later from the faces
+      if (am->mNormals) n = glm::vec3(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
+      mesh.normals.push_back(n);
+    }
+  }
+  for (unsigned f = 0; f < am->mNumFaces; ++f) {
+    const aiFace& face = am->mFaces[f];
+    if (face.mNumIndices != 3) {
+      ++*skipped;
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) {
+      if (face.mIndices[k] >= am->mNumVertices) {
+        fail(path, fmt::format("{}: face {} of mesh {} has a vertex index out of range",
+                               quote_json(file), f, m));
+      }
+    }
+    mesh.triangles.emplace_back(base + face.mIndices[0], base + face.mIndices[1],
+                                base + face.mIndices[2]);
+  }
+}
+
+// Colours from files: negative or non-finite components become 0.
+glm::vec3 file_colour(const aiColor3D& c) {
+  auto clean = [](float x) { return std::isfinite(x) && x > 0.0f ? x : 0.0f; };
+  return {clean(c.r), clean(c.g), clean(c.b)};
+}
+
+// The material of an imported mesh; empty when the file has none of its own (no material,
+// Assimp's stand-in "DefaultMaterial", or the unnamed one its PLY, OFF and STL readers make)
+// and no vertex colours either. A mesh with vertex colours (PLY, OFF) takes their mean as its
+// diffuse colour.
+std::optional<Material> part_material(const aiScene* ai, const aiMesh* am, bool* textured) {
+  const aiMaterial* mat =
+      am->mMaterialIndex < ai->mNumMaterials ? ai->mMaterials[am->mMaterialIndex] : nullptr;
+  aiString name;
+  bool stand_in = !mat || mat->Get(AI_MATKEY_NAME, name) != AI_SUCCESS || name.length == 0 ||
+                  std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0;
+  std::optional<glm::vec3> vertex_colour;
+  if (am->mColors[0] && am->mNumVertices > 0) {
+    glm::dvec3 sum(0.0);
     for (unsigned v = 0; v < am->mNumVertices; ++v) {
-      const aiVector3D& p = am->mVertices[v];
-      glm::vec3 pos(p.x, p.y, p.z);
-      if (!finite(pos)) {
-        fail(path, fmt::format("{}: vertex {} of mesh {} has a non-finite coordinate",
-                               quote_json(file), v, m));
-      }
-      mesh.positions.push_back(pos);
-      if (smooth) {
-        glm::vec3 n(0.0f);  // missing: repaired below from the faces
-        if (am->mNormals) n = glm::vec3(am->mNormals[v].x, am->mNormals[v].y, am->mNormals[v].z);
-        mesh.normals.push_back(n);
-      }
+      const aiColor4D& c = am->mColors[0][v];
+      sum += glm::dvec3(file_colour(aiColor3D(c.r, c.g, c.b)));
     }
-    for (unsigned f = 0; f < am->mNumFaces; ++f) {
-      const aiFace& face = am->mFaces[f];
-      if (face.mNumIndices != 3) {
-        ++*skipped_primitives;
-        continue;
-      }
-      for (int k = 0; k < 3; ++k) {
-        if (face.mIndices[k] >= am->mNumVertices) {
-          fail(path, fmt::format("{}: face {} of mesh {} has a vertex index out of range",
-                                 quote_json(file), f, m));
-        }
-      }
-      mesh.triangles.emplace_back(base + face.mIndices[0], base + face.mIndices[1],
-                                  base + face.mIndices[2]);
+    vertex_colour = glm::min(glm::vec3(sum / double(am->mNumVertices)), glm::vec3(1.0f));
+  }
+  if (stand_in) {
+    if (!vertex_colour) return std::nullopt;
+    Material m = default_material();
+    m.diffuse = *vertex_colour;
+    m.name = "vertex colours";
+    return m;
+  }
+  Material m = default_material();
+  m.name = name.length > 0 ? name.C_Str() : "material";
+  aiColor3D c;
+  // glTF's baseColorFactor is the base colour; older formats give a diffuse colour.
+  if (mat->Get(AI_MATKEY_BASE_COLOR, c) == AI_SUCCESS ||
+      mat->Get(AI_MATKEY_COLOR_DIFFUSE, c) == AI_SUCCESS) {
+    m.diffuse = glm::min(file_colour(c), glm::vec3(1.0f));
+  }
+  if (mat->Get(AI_MATKEY_COLOR_SPECULAR, c) == AI_SUCCESS) {
+    m.specular = glm::min(file_colour(c), glm::vec3(1.0f));
+    float strength = 1.0f;
+    if (mat->Get(AI_MATKEY_SHININESS_STRENGTH, strength) == AI_SUCCESS && std::isfinite(strength) &&
+        strength >= 0.0f) {
+      m.specular = glm::min(m.specular * strength, glm::vec3(1.0f));
     }
+  }
+  if (mat->Get(AI_MATKEY_COLOR_EMISSIVE, c) == AI_SUCCESS) m.emission = file_colour(c);
+  float shininess = 0.0f;
+  if (mat->Get(AI_MATKEY_SHININESS, shininess) == AI_SUCCESS && std::isfinite(shininess) &&
+      shininess > 0.0f) {
+    m.shininess = std::min(shininess, 1e4f);
+  }
+  if (vertex_colour) m.diffuse = *vertex_colour;
+  *textured = mat->GetTextureCount(aiTextureType_DIFFUSE) > 0 ||
+              mat->GetTextureCount(aiTextureType_BASE_COLOR) > 0;
+  return m;
+}
+
+// The node's transform to world space (the product of its ancestors').
+aiMatrix4x4 world_transform(const aiNode* node) {
+  aiMatrix4x4 t;
+  for (; node; node = node->mParent) t = node->mTransformation * t;
+  return t;
+}
+
+const aiNode* find_node(const aiScene* ai, const aiString& name) {
+  return ai->mRootNode ? ai->mRootNode->FindNode(name) : nullptr;
+}
+
+glm::vec3 to_glm(const aiVector3D& v) {
+  return {v.x, v.y, v.z};
+}
+
+// The first camera, in world space; empty when the file has none or it is unusable.
+// `gltf`: Assimp's glTF reader stores yfov x aspect as the horizontal angle.
+void read_camera(const aiScene* ai, bool gltf, ImportedModel& model) {
+  if (ai->mNumCameras == 0 || !ai->mCameras || !ai->mCameras[0]) return;
+  const aiCamera& cam = *ai->mCameras[0];
+  aiMatrix4x4 t = world_transform(find_node(ai, cam.mName));
+  aiMatrix3x3 turn(t);
+  // A glTF camera sits at its node's origin (the format has no other place for it); Assimp's
+  // glTF reader (5.2) also copies the node's translation into mPosition, which would count it
+  // twice.
+  glm::vec3 eye = to_glm(t * (gltf ? aiVector3D(0.0f) : cam.mPosition));
+  glm::vec3 forward = to_glm(turn * cam.mLookAt);
+  glm::vec3 up = to_glm(turn * cam.mUp);
+  if (!finite(eye) || !finite(forward) || !finite(up) || glm::length(forward) == 0.0f ||
+      glm::length(glm::cross(forward, up)) < 1e-6f * glm::length(forward) * glm::length(up)) {
+    model.warnings.push_back(
+        "the file's camera is unusable (zero or parallel directions); "
+        "framing the model instead");
+    return;
+  }
+  Camera c;
+  c.eye = eye;
+  c.target = eye + glm::normalize(forward);
+  c.up = glm::normalize(up);
+  model.camera_aspect = std::isfinite(cam.mAspect) && cam.mAspect > 0.0f ? cam.mAspect : 0.0f;
+  // Assimp gives the horizontal angle: half of it by its documentation, the whole of it from
+  // its Collada and FBX readers, taken as the whole; its glTF reader (5.2) stores
+  // yfov x aspect, undone as such.
+  float aspect = model.camera_aspect > 0.0f ? model.camera_aspect : 4.0f / 3.0f;
+  float fov_y = gltf ? cam.mHorizontalFOV / aspect
+                     : 2.0f * std::atan(std::tan(0.5f * cam.mHorizontalFOV) / aspect);
+  if (std::isfinite(fov_y) && fov_y > 1e-3f && fov_y < 3.1f) c.fov_y_deg = glm::degrees(fov_y);
+  if (std::isfinite(cam.mClipPlaneNear) && cam.mClipPlaneNear > 0.0f &&
+      std::isfinite(cam.mClipPlaneFar) && cam.mClipPlaneFar > cam.mClipPlaneNear) {
+    c.near = cam.mClipPlaneNear;
+    c.far = cam.mClipPlaneFar;
+  }
+  c.focus_distance = 1.0f;
+  model.camera = c;
+}
+
+// Point lights (spot lights as point lights, their cone ignored), in world space.
+void read_lights(const aiScene* ai, ImportedModel& model) {
+  size_t skipped = 0;
+  for (unsigned i = 0; i < ai->mNumLights && ai->mLights; ++i) {
+    const aiLight* l = ai->mLights[i];
+    if (!l) continue;
+    if (l->mType != aiLightSource_POINT && l->mType != aiLightSource_SPOT) {
+      ++skipped;
+      continue;
+    }
+    Light light;
+    light.type = LightType::Point;
+    light.position = to_glm(world_transform(find_node(ai, l->mName)) * l->mPosition);
+    light.intensity = file_colour(l->mColorDiffuse);
+    if (!finite(light.position)) continue;
+    if (l->mAttenuationQuadratic == 0.0f && l->mAttenuationLinear == 0.0f) {
+      model.unattenuated_lights.push_back(model.lights.size());
+    }
+    model.lights.push_back(light);
+  }
+  if (skipped > 0) {
+    model.warnings.push_back(fmt::format(
+        "ignored {} light{} that {} not point or spot lights (directional, area, ambient)", skipped,
+        skipped == 1 ? "" : "s", skipped == 1 ? "is" : "are"));
+  }
+}
+
+}  // namespace
+
+TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
+                         const std::string& path, bool smooth, size_t* skipped_primitives) {
+  fs::path full = resolve(file, base_dir, path);
+  Assimp::Importer importer;
+  read_checked(importer, full, file, path);
+  unsigned flags =
+      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
+  if (smooth) flags |= aiProcess_GenSmoothNormals;  // ignored where the file has normals
+  const aiScene* ai = post_process(importer, flags, file, path);
+  TriangleMesh mesh;
+  for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
+    append_mesh(mesh, ai, m, smooth, file, path, skipped_primitives);
   }
   if (mesh.triangles.empty()) fail(path, quote_json(file) + " contains no triangles");
   return mesh;
+}
+
+ImportedModel import_model(const std::string& file, const std::string& base_dir,
+                           const std::string& path) {
+  fs::path full = resolve(file, base_dir, path);
+  Assimp::Importer importer;
+  ImportedModel model;
+  const aiScene* raw = read_checked(importer, full, file, path);
+  // Cameras and lights hang off nodes, whose transforms PreTransformVertices removes: read
+  // them first.
+  std::string ext = full.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  read_camera(raw, ext == ".gltf" || ext == ".glb", model);
+  read_lights(raw, model);
+  // The file's normals where it has them (smooth shading); flat faces where it has none.
+  const aiScene* ai = post_process(
+      importer,
+      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices,
+      file, path);
+  size_t textured = 0;
+  for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
+    const aiMesh* am = ai->mMeshes[m];
+    ModelPart part;
+    part.name = am->mName.length > 0 ? am->mName.C_Str() : fmt::format("mesh{}", m);
+    append_mesh(part.mesh, ai, m, am->mNormals != nullptr, file, path, &model.skipped_primitives);
+    if (part.mesh.triangles.empty()) continue;
+    part.material = part_material(ai, am, &part.textured);
+    textured += part.textured;
+    model.parts.push_back(std::move(part));
+  }
+  if (model.parts.empty()) fail(path, quote_json(file) + " contains no triangles");
+  if (textured > 0) {
+    model.warnings.push_back(fmt::format(
+        "{} mesh{} colour textures, which are not sampled: rendered with the base colour factor",
+        textured, textured == 1 ? " has" : "es have"));
+  }
+  return model;
 }
 
 }  // namespace rvr::scene_load

@@ -35,6 +35,7 @@
 #include "json_fields.h"
 #include "mesh_import.h"
 #include "mesh_repair.h"
+#include "rvr/shared/camera_framing.h"
 #include "scene_json_errors.h"
 #include "scene_json_parse.h"
 #include "scene_transforms.h"
@@ -50,6 +51,9 @@ constexpr int kMaxImageSize = 16384;
 constexpr int kMaxSamplesPerPixel = 4096;
 constexpr int kMaxLightSamples = 64;
 constexpr const char* kFormat = "rvr-scene/1";
+// A mesh object's material that keeps the mesh file's own materials; no material may be
+// named so.
+constexpr const char* kFromFile = "from_file";
 
 // ------------------------------------------------------------------------------------------
 // The scene reader.
@@ -158,6 +162,11 @@ class Reader {
     for (const std::string& name : names) {
       std::string p = key_path(path, name);
       if (name.empty()) fail(path, "material names must not be empty");
+      if (name == kFromFile) {
+        fail(p,
+             "the name \"from_file\" is reserved (a mesh's \"material\": \"from_file\" "
+             "keeps the file's own materials)");
+      }
       scene_.materials.push_back(read_material(v.at(name), p, name));
       material_index_[name] = static_cast<uint32_t>(scene_.materials.size() - 1);
     }
@@ -236,10 +245,12 @@ class Reader {
 
   void read_objects(const json& v) {
     if (!v.is_array()) fail("objects", "must be an array, got " + describe(v));
-    for (size_t i = 0; i < v.size(); ++i) scene_.objects.push_back(read_object(v[i], i));
+    for (size_t i = 0; i < v.size(); ++i) read_object(v[i], i);
   }
 
-  Object read_object(const json& v, size_t index) {
+  // Appends the object to the scene: one, or for a mesh with "material": "from_file" one per
+  // material of the file.
+  void read_object(const json& v, size_t index) {
     static const std::vector<std::string> kTypes = {"sphere", "plane", "triangle", "mesh", "csg"};
     std::string path = index_path("objects", index);
     check_object(v, path);
@@ -267,18 +278,28 @@ class Reader {
     Object o;
     o.name = type + "#" + std::to_string(index);
     if (const json* n = find(v, "name")) o.name = string(*n, key_path(path, "name"));
+    bool from_file = false;
     if (const json* m = find(v, "material")) {
       std::string mp = key_path(path, "material");
       const std::string& name = string(*m, mp);
+      if (name == kFromFile) {
+        if (type != "mesh") {
+          fail(mp, "\"from_file\" keeps a mesh file's own materials: only for mesh objects");
+        }
+        from_file = true;
+      }
       auto it = material_index_.find(name);
-      if (it == material_index_.end()) {
+      if (from_file) {
+        // the file's materials, read below
+      } else if (it == material_index_.end()) {
         std::vector<std::string> known;
         for (const auto& [k, idx] : material_index_) known.push_back(k);
         std::string s = suggestion(name, known);
         fail(mp, "unknown material " + quote_json(name) +
                      (s.empty() ? "" : " (did you mean '" + s + "'?)"));
+      } else {
+        o.material = it->second;
       }
-      o.material = it->second;
     }
     Transform t;
     if (const json* tr = find(v, "transform"))
@@ -310,6 +331,10 @@ class Reader {
       const std::string& file = string(require(v, path, "file"), fp);
       bool smooth = false;
       if (const json* s = find(v, "smooth")) smooth = boolean(*s, key_path(path, "smooth"));
+      if (from_file) {
+        read_mesh_from_file(o, file, fp, t, label);
+        return;
+      }
       size_t skipped = 0, dropped = 0, repaired = 0;
       o.mesh = import_mesh(file, base_dir_, fp, smooth, &skipped);
       size_t total = o.mesh.triangles.size();
@@ -335,7 +360,60 @@ class Reader {
       o.type = ObjectType::Csg;
       o.csg = read_csg_inner(v, path, 1, t);
     }
-    return o;
+    scene_.objects.push_back(std::move(o));
+  }
+
+  // "material": "from_file": one object per mesh of the file, each with the file's material
+  // (the default one where the file gives none), named NAME/MESH. The file's own normals
+  // shade smoothly, as in a model file given as the scene; `smooth` is not used.
+  void read_mesh_from_file(const Object& proto, const std::string& file, const std::string& fp,
+                           const Transform& t, const std::string& label) {
+    ImportedModel model = import_model(file, base_dir_, fp);
+    size_t before = scene_.objects.size(), dropped = 0, repaired = 0;
+    for (ModelPart& part : model.parts) {
+      Object o = proto;
+      o.name = proto.name + "/" + part.name;
+      o.mesh = std::move(part.mesh);
+      finish_mesh(o.mesh, t, proto.name, &dropped, &repaired);
+      if (o.mesh.triangles.empty()) continue;
+      o.material = 0;
+      if (part.material) {
+        part.material->name = file_material_name(file, part.material->name);
+        scene_.materials.push_back(*part.material);
+        o.material = static_cast<uint32_t>(scene_.materials.size() - 1);
+      }
+      scene_.objects.push_back(std::move(o));
+    }
+    if (scene_.objects.size() == before) {
+      fail(fp, quote_json(file) + ": all triangles are degenerate (zero area)");
+    }
+    for (const std::string& w : model.warnings) scene_.warnings.push_back(label + ": " + w);
+    if (model.skipped_primitives > 0) {
+      scene_.warnings.push_back(
+          fmt::format("{}: ignored {} point/line primitives", label, model.skipped_primitives));
+    }
+    if (dropped > 0) {
+      scene_.warnings.push_back(fmt::format("{}: dropped {} degenerate triangle{}", label, dropped,
+                                            dropped == 1 ? "" : "s"));
+    }
+    if (repaired > 0) {
+      scene_.warnings.push_back(
+          fmt::format("{}: replaced {} zero or non-finite vertex normal{} by face normals", label,
+                      repaired, repaired == 1 ? "" : "s"));
+    }
+  }
+
+  // A file's material named after the file, unique among the scene's materials (rvr-scene/1
+  // names are unique, so that an exported scene reads back).
+  std::string file_material_name(const std::string& file, const std::string& material) {
+    std::string wanted = file + ":" + material;
+    std::string name = wanted;
+    for (int i = 2;; ++i) {
+      bool taken = std::any_of(scene_.materials.begin(), scene_.materials.end(),
+                               [&](const Material& m) { return m.name == name; });
+      if (!taken) return name;
+      name = fmt::format("{}#{}", wanted, i);
+    }
   }
 
   static Sphere read_sphere(const json& v, const std::string& path) {
@@ -528,11 +606,42 @@ Expected<Scene> load_scene_file(const std::string& path) {
   }
 }
 
-Expected<Scene> load_scene(const std::string& spec) {
-  static const std::string kBuiltin = "builtin:";
-  if (spec.rfind(kBuiltin, 0) != 0) return load_scene_file(spec);
+namespace {
+
+// Whether a file whose extension says nothing (neither .json nor a model format) starts like
+// JSON: its first character other than white space (and a UTF-8 byte order mark) is '{' or '['.
+// An empty or unreadable file counts as JSON, so that its error stays the scene reader's.
+bool starts_like_json(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return true;
+  char head[512];
+  size_t n = std::fread(head, 1, sizeof head, f);
+  std::fclose(f);
+  size_t i = n >= 3 && std::memcmp(head, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
+  while (i < n && std::strchr(" \t\r\n", head[i])) ++i;
+  return i == n || head[i] == '{' || head[i] == '[';
+}
+
+// A path: a model file by its extension; a scene file by .json; otherwise a model file when
+// Assimp recognises the content, else a scene file (whose error is reported). `model` says
+// which it was.
+Expected<Scene> load_path(const std::string& path, const SceneOverrides& overrides, bool* model) {
+  *model = true;
+  if (is_model_file_name(path)) return load_model_scene(path, overrides);
+  std::error_code ec;
+  std::string ext = fs::path(path).extension().string();
+  bool named_json = ext == ".json" || ext == ".JSON";
+  if (!named_json && fs::is_regular_file(path, ec) && !starts_like_json(path)) {
+    Expected<Scene> scene = load_model_scene(path, overrides);
+    if (scene.ok()) return scene;
+  }
+  *model = false;
+  return load_scene_file(path);
+}
+
+Expected<Scene> load_builtin(const std::string& spec, const std::string& name) {
   try {
-    Expected<Scene> scene = make_builtin_scene(spec.substr(kBuiltin.size()));
+    Expected<Scene> scene = make_builtin_scene(name);
     if (scene.ok() && scene->source.empty()) scene->source = spec;
     return scene;
   } catch (const std::bad_alloc&) {
@@ -542,6 +651,31 @@ Expected<Scene> load_scene(const std::string& spec) {
   } catch (...) {
     return internal_error(spec + ": internal error while building the scene");
   }
+}
+
+// Scene files and built-in scenes: the image size, then the framing.
+void apply_overrides(Scene& scene, const SceneOverrides& overrides) {
+  if (overrides.width) scene.image.width = *overrides.width;
+  if (overrides.height) scene.image.height = *overrides.height;
+  if (overrides.view_from && !scene.objects.empty()) {
+    frame_camera(scene, scene_bounds(scene), *overrides.view_from);
+  }
+}
+
+}  // namespace
+
+Expected<Scene> load_scene(const std::string& spec, const SceneOverrides& overrides) {
+  if (overrides.view_from && !(std::isfinite(glm::length(*overrides.view_from)) &&
+                               glm::length(*overrides.view_from) > 0.0f)) {
+    return bad_input(spec + ": the view direction must be finite and non-zero");
+  }
+  static const std::string kBuiltin = "builtin:";
+  bool model = false;
+  Expected<Scene> scene = spec.rfind(kBuiltin, 0) == 0
+                              ? load_builtin(spec, spec.substr(kBuiltin.size()))
+                              : load_path(spec, overrides, &model);
+  if (scene.ok() && !model) apply_overrides(*scene, overrides);
+  return scene;
 }
 
 }  // namespace rvr

@@ -1,6 +1,8 @@
 // Loading and validating rvr-scene/1 files and built-in scenes.
 #pragma once
 
+#include <glm/glm.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,8 +20,28 @@ Expected<Scene> load_scene_file(const std::string& path);
 Expected<Scene> parse_scene(const std::string& json_text, const std::string& source,
                             const std::string& base_dir);
 
-// "builtin:NAME" or a path.
-Expected<Scene> load_scene(const std::string& spec);
+// What the command line may change in a scene as it is loaded.
+struct SceneOverrides {
+  std::optional<int> width, height;  // the image size (before the camera is framed)
+  // Frame the scene from this direction (from the centre towards the eye; see
+  // camera_framing.h), replacing the camera of the scene or model file.
+  std::optional<glm::vec3> view_from;
+};
+
+// "builtin:NAME" or a path: a scene file, or a model file in any format Assimp reads (see
+// load_model_scene).
+Expected<Scene> load_scene(const std::string& spec, const SceneOverrides& overrides = {});
+
+// Whether `path` names a model file by its extension: one Assimp reads, other than .json.
+// (Files with an extension Assimp does not know are read as scenes unless their content is a
+// model Assimp recognises; see docs/scene-format.md.)
+bool is_model_file_name(const std::string& path);
+
+// A model file as a scene (docs/scene-format.md, "Model files as scenes"): one object per
+// mesh with the file's own material; the file's first camera, else one framing the model from
+// default_view_from() (overrides.view_from replaces either); the file's point lights, else a
+// key light near the camera and ambient.
+Expected<Scene> load_model_scene(const std::string& path, const SceneOverrides& overrides = {});
 
 struct BuiltinSceneInfo {
   std::string name;         // e.g. "occluders:N"
