@@ -39,6 +39,12 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
       ->check(CLI::Range(1, 16384));
   cmd.add_option("--height", o.height, "image height (overrides the scene)")
       ->check(CLI::Range(1, 16384));
+  cmd.add_option("--image", o.image, "image size WxH, e.g. 800x600 (overrides the scene)")
+      ->excludes(cmd.get_option("--width"))
+      ->excludes(cmd.get_option("--height"));
+  cmd.add_option("--camera-from", o.camera_from,
+                 "X,Y,Z: look at the scene's (or model's) bounding sphere from this direction, "
+                 "framing it (replaces the scene's camera)");
   cmd.add_option("--spp", o.spp, "samples per pixel (overrides the scene)")
       ->check(CLI::Range(1, 65536));
   cmd.add_option("--threads", o.threads, "worker threads, 0 = every core")
@@ -114,12 +120,42 @@ RenderOptions render_options(const CommonOptions& o, const std::string& default_
   return r;
 }
 
+namespace {
+
+// "X,Y,Z" as three finite numbers, not all zero.
+glm::vec3 parse_direction(const std::string& text) {
+  glm::vec3 d;
+  char end = 0;
+  if (std::sscanf(text.c_str(), " %f , %f , %f %c", &d.x, &d.y, &d.z, &end) != 3 ||
+      !std::isfinite(d.x) || !std::isfinite(d.y) || !std::isfinite(d.z) ||
+      !(glm::length(d) > 0.0f)) {
+    fail(bad_input("--camera-from: expected a direction X,Y,Z (not all zero), got '" + text + "'"));
+  }
+  return d;
+}
+
+// "WxH", each in [1, 16384].
+std::pair<int, int> parse_image_size(const std::string& text) {
+  int w = 0, h = 0;
+  char end = 0;
+  if (std::sscanf(text.c_str(), " %d x %d %c", &w, &h, &end) != 2 || w < 1 || h < 1 || w > 16384 ||
+      h > 16384) {
+    fail(bad_input("--image: expected WIDTHxHEIGHT, each 1 to 16384, got '" + text + "'"));
+  }
+  return {w, h};
+}
+
+}  // namespace
+
 Scene load(const CommonOptions& o, const RenderOptions& options, double& load_seconds) {
   take(selected_isa());  // a bad RVR_ISA is refused before any work
+  SceneOverrides overrides;
+  overrides.width = o.width;
+  overrides.height = o.height;
+  if (!o.image.empty()) std::tie(overrides.width, overrides.height) = parse_image_size(o.image);
+  if (!o.camera_from.empty()) overrides.view_from = parse_direction(o.camera_from);
   auto start = Clock::now();
-  Scene scene = take(load_scene(o.scene));
-  if (o.width) scene.image.width = *o.width;
-  if (o.height) scene.image.height = *o.height;
+  Scene scene = take(load_scene(o.scene, overrides));
   if (o.spp) scene.image.samples_per_pixel = *o.spp;
   load_seconds = seconds_since(start);
   Limits limits = o.limits;

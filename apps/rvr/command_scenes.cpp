@@ -33,22 +33,28 @@ namespace rvr::cli {
 
 namespace {
 
-// --export: the built-in scene as an rvr-scene/1 document. Meshes other than single
-// triangles have no inline form in the format: they go to PLY files next to -o FILE.
+// --export: the built-in scene, or the scene built from a model file (or read from a scene
+// file), as an rvr-scene/1 document. Meshes other than single triangles have no inline form in
+// the format: they go to PLY files next to -o FILE.
 int export_scene(const ScenesArgs& a) {
   std::string name = a.export_name;
   if (name.rfind("builtin:", 0) == 0) name = name.substr(8);
-  Scene scene = take(make_builtin_scene(name));
+  std::error_code ec;
+  bool is_file = a.export_name.rfind("builtin:", 0) != 0 &&
+                 std::filesystem::is_regular_file(a.export_name, ec);
+  if (is_file) refuse_overwriting_inputs({a.export_name}, {a.out});
+  Scene scene = is_file ? take(load_scene(a.export_name)) : take(make_builtin_scene(name));
+  if (is_file) name = std::filesystem::path(a.export_name).stem().string();
   std::filesystem::path out(a.out);
   std::string prefix = a.out.empty() ? name : out.stem().string();
   SceneDocument doc = take(write_scene(scene, prefix));
   if (a.out.empty()) {
     if (!doc.mesh_files.empty()) {
       fail(bad_input(fmt::format(
-          "builtin:{}: has {} mesh{} of more than one triangle, which rvr-scene/1 reads only "
+          "{}: has {} mesh{} of more than one triangle, which rvr-scene/1 reads only "
           "from mesh files: give -o FILE.json to write {} as PLY next to it",
-          name, doc.mesh_files.size(), doc.mesh_files.size() == 1 ? "" : "es",
-          doc.mesh_files.size() == 1 ? "it" : "them")));
+          is_file ? a.export_name : "builtin:" + name, doc.mesh_files.size(),
+          doc.mesh_files.size() == 1 ? "" : "es", doc.mesh_files.size() == 1 ? "it" : "them")));
     }
     std::fwrite(doc.json.data(), 1, doc.json.size(), stdout);
     return std::fflush(stdout) == 0 ? 0 : 3;

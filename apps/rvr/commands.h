@@ -25,6 +25,8 @@ struct CommonOptions {
   std::string scene = "builtin:cornell";
   std::string mode;
   std::optional<int> width, height, spp;
+  std::string image;        // --image WxH
+  std::string camera_from;  // --camera-from X,Y,Z
   int threads = 0;
   std::string accel = "bvh";
   std::string spheres = "analytic";

@@ -94,7 +94,8 @@ int run(int argc, char** argv) {
   CLI::App* scenes_cmd =
       app.add_subcommand("scenes", "list the built-in scenes, or write one as rvr-scene/1 JSON");
   scenes_cmd->add_option("--export", scenes.export_name,
-                         "write built-in scene NAME (e.g. cornell, tessphere:2000) as JSON");
+                         "write built-in scene NAME (e.g. cornell, tessphere:2000), or the scene "
+                         "built from a model FILE, as JSON");
   scenes_cmd->add_option("-o,--output", scenes.out,
                          "with --export: write FILE (and its meshes as FILE-stem.meshI.ply "
                          "beside it) instead of stdout");
