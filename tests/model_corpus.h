@@ -1,0 +1,349 @@
+// Model files as real exporters write them, quirks included, written by the tests themselves
+// (nothing binary in the repository): the unit cube [0,1]^3 in most formats, with a known colour
+// where the format has one. Shared by test_model_import (the loader against Assimp as the
+// oracle) and test_model_compare (rvr compare on bare model files).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace rvr::test {
+
+namespace corpus {
+
+// The unit cube: vertex v at ((v >> 2) & 1, (v >> 1) & 1, v & 1); quads counter-clockwise seen
+// from outside (their normals point out).
+inline std::array<float, 3> cube_vertex(int v) {
+  return {float((v >> 2) & 1), float((v >> 1) & 1), float(v & 1)};
+}
+inline const std::array<std::array<int, 4>, 6>& cube_quads() {
+  static const std::array<std::array<int, 4>, 6> q = {
+      {{0, 1, 3, 2}, {4, 6, 7, 5}, {0, 4, 5, 1}, {2, 3, 7, 6}, {0, 2, 6, 4}, {1, 5, 7, 3}}};
+  return q;
+}
+// Each quad as the two triangles (a, b, c) and (a, c, d).
+inline std::vector<std::array<int, 3>> cube_triangles() {
+  std::vector<std::array<int, 3>> t;
+  for (const auto& q : cube_quads()) {
+    t.push_back({q[0], q[1], q[2]});
+    t.push_back({q[0], q[2], q[3]});
+  }
+  return t;
+}
+
+inline std::string num(float x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", double(x));
+  return b;
+}
+
+inline void write_file(const std::filesystem::path& p, const std::string& bytes) {
+  std::ofstream(p, std::ios::binary) << bytes;
+}
+
+template <class T>
+void put(std::string& s, T v) {
+  char b[sizeof(T)];
+  std::memcpy(b, &v, sizeof(T));
+  s.append(b, sizeof(T));
+}
+
+// OBJ text of the cube as quads, `usemtl` first when `material` is not empty.
+inline std::string obj_cube(const std::string& header, const std::string& material,
+                            const char* eol = "\n") {
+  std::string s = header;
+  for (int v = 0; v < 8; ++v) {
+    auto p = cube_vertex(v);
+    s += "v " + num(p[0]) + " " + num(p[1]) + " " + num(p[2]) + eol;
+  }
+  if (!material.empty()) s += "usemtl " + material + eol;
+  for (const auto& q : cube_quads()) {
+    s += "f";
+    for (int i : q) s.append(1, ' ').append(std::to_string(i + 1));
+    s += eol;
+  }
+  return s;
+}
+
+// The PLY header Blender 2.7x writes: a free-text "Created by Blender" line after `format`
+// with no `comment` keyword; vertex colours.
+inline std::string blender_ply_cube(int r, int g, int b) {
+  std::string s =
+      "ply\nformat ascii 1.0\nCreated by Blender 2.79 (sub 0) - www.blender.org, source file: "
+      "'cube.blend'\nelement vertex 8\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 6\n"
+      "property list uchar uint vertex_indices\nend_header\n";
+  for (int v = 0; v < 8; ++v) {
+    auto p = cube_vertex(v);
+    s += num(p[0]) + " " + num(p[1]) + " " + num(p[2]) + " " + std::to_string(r) + " " +
+         std::to_string(g) + " " + std::to_string(b) + "\n";
+  }
+  for (const auto& q : cube_quads()) {
+    s += "4";
+    for (int i : q) s.append(1, ' ').append(std::to_string(i));
+    s += "\n";
+  }
+  return s;
+}
+
+// Binary STL whose 80-byte header starts with "solid" (SolidWorks and others do this, which
+// trips readers that decide ASCII by the first word).
+inline std::string binary_stl_cube() {
+  std::string s = "solid exported as binary by a CAD package";
+  s.resize(80, ' ');
+  auto tris = cube_triangles();
+  put<uint32_t>(s, uint32_t(tris.size()));
+  for (const auto& t : tris) {
+    for (int k = 0; k < 3; ++k) put<float>(s, 0.0f);  // normal left to the reader
+    for (int i : t)
+      for (float c : cube_vertex(i)) put<float>(s, c);
+    put<uint16_t>(s, 0);
+  }
+  return s;
+}
+
+inline std::string ascii_stl_cube() {
+  std::string s = "solid cube\n";
+  for (const auto& t : cube_triangles()) {
+    s += "  facet normal 0 0 0\n    outer loop\n";
+    for (int i : t) {
+      auto p = cube_vertex(i);
+      s += "      vertex " + num(p[0]) + " " + num(p[1]) + " " + num(p[2]) + "\n";
+    }
+    s += "    endloop\n  endfacet\n";
+  }
+  return s + "endsolid cube\n";
+}
+
+inline std::string off_cube_with_comments() {
+  std::string s = "OFF\n# written by a mesh tool\n8 6 0\n";
+  for (int v = 0; v < 8; ++v) {
+    auto p = cube_vertex(v);
+    s += num(p[0]) + " " + num(p[1]) + " " + num(p[2]) + "\n";
+  }
+  for (const auto& q : cube_quads()) {
+    s += "4";
+    for (int i : q) s.append(1, ' ').append(std::to_string(i));
+    s += "\n";
+  }
+  return s;
+}
+
+// glTF 2.0 of the cube as triangles: baseColorFactor, emissiveFactor, optionally a
+// perspective camera and a KHR_lights_punctual point light on nodes of their own. The buffer
+// is embedded as base64 (.gltf) or is the GLB's BIN chunk.
+struct GltfExtras {
+  std::array<float, 4> base_color{0.1f, 0.2f, 0.9f, 1.0f};
+  std::array<float, 3> emissive{0.0f, 0.0f, 0.0f};
+  bool camera = false;
+  std::array<float, 3> camera_at{0.5f, 0.5f, 4.0f};  // looking down -z, y up
+  float yfov = 0.7f;
+  float aspect = 1.5f;
+  bool light = false;
+  std::array<float, 3> light_at{2.0f, 3.0f, 2.5f};
+  std::array<float, 3> light_color{1.0f, 0.9f, 0.8f};
+  float light_intensity = 20.0f;
+  bool texture = false;  // a baseColorTexture (an image file that need not exist)
+};
+
+inline std::string gltf_buffer() {
+  std::string b;
+  for (int v = 0; v < 8; ++v)
+    for (float c : cube_vertex(v)) put<float>(b, c);
+  for (const auto& t : cube_triangles())
+    for (int i : t) put<uint16_t>(b, uint16_t(i));
+  return b;  // 96 bytes of positions, 72 of indices
+}
+
+inline std::string base64(const std::string& in) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    uint32_t n = uint8_t(in[i]) << 16 | uint8_t(in[i + 1]) << 8 | uint8_t(in[i + 2]);
+    for (int s = 18; s >= 0; s -= 6) out += k[(n >> s) & 63];
+  }
+  if (i + 1 == in.size()) {
+    uint32_t n = uint8_t(in[i]) << 16;
+    out += std::string{k[(n >> 18) & 63], k[(n >> 12) & 63], '=', '='};
+  } else if (i + 2 == in.size()) {
+    uint32_t n = uint8_t(in[i]) << 16 | uint8_t(in[i + 1]) << 8;
+    out += std::string{k[(n >> 18) & 63], k[(n >> 12) & 63], k[(n >> 6) & 63], '='};
+  }
+  return out;
+}
+
+inline std::string gltf_json(const GltfExtras& e, bool glb) {
+  auto vec = [](const auto& a) {
+    std::string s = "[";
+    for (size_t i = 0; i < a.size(); ++i) s.append(i ? "," : "").append(num(a[i]));
+    return s + "]";
+  };
+  std::string buffer = gltf_buffer();
+  std::string nodes = R"({"name":"cube","mesh":0})", scene_nodes = "0", extensions;
+  if (e.camera) {
+    nodes += R"(,{"name":"cam","camera":0,"translation":)" + vec(e.camera_at) + "}";
+    scene_nodes += ",1";
+  }
+  if (e.light) {
+    nodes += R"(,{"name":"lamp","translation":)" + vec(e.light_at) +
+             R"(,"extensions":{"KHR_lights_punctual":{"light":0}}})";
+    scene_nodes += e.camera ? ",2" : ",1";
+    extensions = R"("extensionsUsed":["KHR_lights_punctual"],"extensions":{"KHR_lights_punctual":)"
+                 R"({"lights":[{"type":"point","color":)" +
+                 vec(e.light_color) + R"(,"intensity":)" + num(e.light_intensity) + "}]}},";
+  }
+  std::string material = R"({"name":"paint","pbrMetallicRoughness":{"baseColorFactor":)" +
+                         vec(e.base_color) + R"(,"metallicFactor":0)" +
+                         (e.texture ? R"(,"baseColorTexture":{"index":0})" : "") +
+                         R"(},"emissiveFactor":)" + vec(e.emissive) + "}";
+  std::string s = R"({"asset":{"version":"2.0","generator":"rvr test corpus"},)" + extensions +
+                  R"("scene":0,"scenes":[{"nodes":[)" + scene_nodes + "]}],\"nodes\":[" + nodes +
+                  "],";
+  s += R"("meshes":[{"name":"cube","primitives":[{"attributes":{"POSITION":0},"indices":1,)"
+       R"("material":0,"mode":4}]}],)";
+  s += "\"materials\":[" + material + "],";
+  if (e.texture) {
+    s += R"("textures":[{"source":0}],"images":[{"uri":"paint.png"}],)";
+  }
+  if (e.camera) {
+    s += R"("cameras":[{"type":"perspective","perspective":{"yfov":)" + num(e.yfov) +
+         R"(,"aspectRatio":)" + num(e.aspect) + R"(,"znear":0.1,"zfar":100}}],)";
+  }
+  s += R"("accessors":[{"bufferView":0,"componentType":5126,"count":8,"type":"VEC3",)"
+       R"("min":[0,0,0],"max":[1,1,1]},{"bufferView":1,"componentType":5123,"count":36,)"
+       R"("type":"SCALAR"}],)";
+  s += R"("bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":96},)"
+       R"({"buffer":0,"byteOffset":96,"byteLength":72}],)";
+  s += "\"buffers\":[{\"byteLength\":" + std::to_string(buffer.size());
+  if (!glb) s += ",\"uri\":\"data:application/octet-stream;base64," + base64(buffer) + "\"";
+  return s + "}]}";
+}
+
+inline std::string glb(const GltfExtras& e) {
+  std::string json = gltf_json(e, true), bin = gltf_buffer();
+  while (json.size() % 4) json += ' ';
+  while (bin.size() % 4) bin += '\0';
+  std::string s = "glTF";
+  put<uint32_t>(s, 2);
+  put<uint32_t>(s, uint32_t(12 + 8 + json.size() + 8 + bin.size()));
+  put<uint32_t>(s, uint32_t(json.size()));
+  s += "JSON";
+  s += json;
+  put<uint32_t>(s, uint32_t(bin.size()));
+  s += std::string("BIN\0", 4);
+  s += bin;
+  return s;
+}
+
+// 3DS (3D Studio) of the cube with one material of diffuse colour (r, g, b) bytes.
+inline std::string chunk3ds(uint16_t id, const std::string& body) {
+  std::string s;
+  put<uint16_t>(s, id);
+  put<uint32_t>(s, uint32_t(6 + body.size()));
+  return s + body;
+}
+
+inline std::string cube_3ds(uint8_t r, uint8_t g, uint8_t b) {
+  std::string rgb;
+  put<uint8_t>(rgb, r);
+  put<uint8_t>(rgb, g);
+  put<uint8_t>(rgb, b);
+  std::string material = chunk3ds(0xAFFF, chunk3ds(0xA000, std::string("paint\0", 6)) +
+                                              chunk3ds(0xA020, chunk3ds(0x0011, rgb)));
+  std::string verts;
+  put<uint16_t>(verts, 8);
+  for (int v = 0; v < 8; ++v)
+    for (float c : cube_vertex(v)) put<float>(verts, c);
+  auto tris = cube_triangles();
+  std::string faces, group = std::string("paint\0", 6);
+  put<uint16_t>(faces, uint16_t(tris.size()));
+  put<uint16_t>(group, uint16_t(tris.size()));
+  for (size_t f = 0; f < tris.size(); ++f) {
+    for (int i : tris[f]) put<uint16_t>(faces, uint16_t(i));
+    put<uint16_t>(faces, 0);
+    put<uint16_t>(group, uint16_t(f));
+  }
+  std::string mesh =
+      chunk3ds(0x4100, chunk3ds(0x4110, verts) + chunk3ds(0x4120, faces + chunk3ds(0x4130, group)));
+  std::string object = chunk3ds(0x4000, std::string("cube\0", 5) + mesh);
+  std::string version;
+  put<uint32_t>(version, 3);
+  std::string editor = chunk3ds(0x3D3D, chunk3ds(0x3D3E, version) + material + object);
+  return chunk3ds(0x4D4D, chunk3ds(0x0002, version) + editor);
+}
+
+// Collada 1.4 of the cube (a <polylist> of quads) with a material's diffuse colour, a
+// camera and a point light with constant attenuation (the Collada default: no falloff).
+struct DaeExtras {
+  std::array<float, 3> diffuse{0.9f, 0.6f, 0.1f};
+  std::array<float, 3> camera_at{0.5f, 0.5f, 5.0f};  // looking down -z
+  float yfov_deg = 40.0f;
+  float aspect = 1.5f;
+  std::array<float, 3> light_at{3.0f, 4.0f, 5.0f};
+  std::array<float, 3> light_color{1.0f, 1.0f, 1.0f};
+};
+
+inline std::string dae_cube(const DaeExtras& e) {
+  auto three = [](const std::array<float, 3>& a) {
+    return num(a[0]) + " " + num(a[1]) + " " + num(a[2]);
+  };
+  std::string positions, indices;
+  for (int v = 0; v < 8; ++v) {
+    auto p = cube_vertex(v);
+    positions += three(p) + " ";
+  }
+  for (const auto& q : cube_quads())
+    for (int i : q) indices += std::to_string(i) + " ";
+  return R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><up_axis>Y_UP</up_axis></asset>
+  <library_cameras><camera id="cam" name="cam"><optics><technique_common><perspective>
+    <yfov>)" +
+         num(e.yfov_deg) + "</yfov><aspect_ratio>" + num(e.aspect) +
+         R"(</aspect_ratio><znear>0.1</znear><zfar>100</zfar>
+  </perspective></technique_common></optics></camera></library_cameras>
+  <library_lights><light id="lamp" name="lamp"><technique_common><point>
+    <color>)" +
+         three(e.light_color) +
+         R"(</color><constant_attenuation>1</constant_attenuation>
+    <linear_attenuation>0</linear_attenuation><quadratic_attenuation>0</quadratic_attenuation>
+  </point></technique_common></light></library_lights>
+  <library_effects><effect id="paint-fx"><profile_COMMON><technique sid="common"><phong>
+    <diffuse><color>)" +
+         three(e.diffuse) +
+         R"( 1</color></diffuse>
+  </phong></technique></profile_COMMON></effect></library_effects>
+  <library_materials><material id="paint" name="paint"><instance_effect url="#paint-fx"/></material></library_materials>
+  <library_geometries><geometry id="cube-mesh" name="cube"><mesh>
+    <source id="cube-pos"><float_array id="cube-pos-array" count="24">)" +
+         positions + R"(</float_array>
+      <technique_common><accessor source="#cube-pos-array" count="8" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+      </accessor></technique_common></source>
+    <vertices id="cube-verts"><input semantic="POSITION" source="#cube-pos"/></vertices>
+    <polylist material="paint" count="6"><input semantic="VERTEX" source="#cube-verts" offset="0"/>
+      <vcount>4 4 4 4 4 4</vcount><p>)" +
+         indices + R"(</p></polylist>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="cube-node" name="cube"><instance_geometry url="#cube-mesh"><bind_material><technique_common>
+      <instance_material symbol="paint" target="#paint"/></technique_common></bind_material></instance_geometry></node>
+    <node id="cam-node" name="cam-node"><translate>)" +
+         three(e.camera_at) + R"(</translate><instance_camera url="#cam"/></node>
+    <node id="lamp-node" name="lamp-node"><translate>)" +
+         three(e.light_at) + R"(</translate><instance_light url="#lamp"/></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+}
+
+}  // namespace corpus
+
+}  // namespace rvr::test

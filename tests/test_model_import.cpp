@@ -1,0 +1,362 @@
+// Model files as scenes (docs/scene-format.md, "Model files as scenes"): a corpus of real
+// exporters' quirks, each checked against Assimp called directly as the independent oracle
+// (Assimp loads it with N triangles => rvr loads it with N triangles), and the camera, lights
+// and colours taken from the files, checked against the values written into them.
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <assimp/Importer.hpp>
+#include <cmath>
+#include <filesystem>
+#include <glm/gtc/constants.hpp>
+#include <string>
+
+#include "model_corpus.h"
+#include "rvr/shared/camera.h"
+#include "rvr/shared/camera_framing.h"
+#include "rvr/shared/scene_loader.h"
+
+namespace fs = std::filesystem;
+namespace corpus = rvr::test::corpus;
+
+namespace {
+
+class ModelFiles : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("rvr_models_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string write(const std::string& name, const std::string& bytes) {
+    corpus::write_file(dir_ / name, bytes);
+    return (dir_ / name).string();
+  }
+
+  fs::path dir_;
+};
+
+// The oracle: Assimp on its own, triangulating, nothing of rvr's. -1 when it refuses the file.
+long assimp_triangles(const std::string& path) {
+  Assimp::Importer importer;
+  const aiScene* ai = importer.ReadFile(path, aiProcess_Triangulate);
+  if (!ai) return -1;
+  long n = 0;
+  for (unsigned m = 0; m < ai->mNumMeshes; ++m)
+    for (unsigned f = 0; f < ai->mMeshes[m]->mNumFaces; ++f)
+      n += ai->mMeshes[m]->mFaces[f].mNumIndices == 3;
+  return n;
+}
+
+// Loads `path` as the scene and as a `mesh` object of a scene file, and expects both to have
+// as many triangles as Assimp finds (and as the corpus wrote, so a file Assimp reads
+// differently from what the test meant shows up too).
+void expect_loads_like_assimp(const std::string& path, long written_triangles) {
+  SCOPED_TRACE(path);
+  long oracle = assimp_triangles(path);
+  ASSERT_EQ(oracle, written_triangles) << "Assimp reads the corpus file differently";
+  rvr::Expected<rvr::Scene> as_scene = rvr::load_scene(path);
+  ASSERT_TRUE(as_scene.ok()) << as_scene.error().message;
+  EXPECT_EQ(long(as_scene->triangle_count()), oracle);
+  std::string scene_json = R"({"camera":{"eye":[3,3,3],"target":[0,0,0],"up":[0,1,0]},)"
+                           R"("objects":[{"type":"mesh","file":")" +
+                           fs::path(path).filename().string() + R"("}]})";
+  rvr::Expected<rvr::Scene> as_object =
+      rvr::parse_scene(scene_json, "inline.json", fs::path(path).parent_path().string());
+  ASSERT_TRUE(as_object.ok()) << as_object.error().message;
+  EXPECT_EQ(long(as_object->triangle_count()), oracle);
+}
+
+const rvr::Material& material_of(const rvr::Scene& s, size_t object = 0) {
+  return s.materials.at(s.objects.at(object).material);
+}
+
+void expect_near3(const glm::vec3& got, const glm::vec3& want, float tol) {
+  EXPECT_NEAR(got.x, want.x, tol);
+  EXPECT_NEAR(got.y, want.y, tol);
+  EXPECT_NEAR(got.z, want.z, tol);
+}
+
+// Colours written as bytes read back within half a step of 1/255.
+constexpr float kByteTolerance = 0.5f / 255.0f + 1e-6f;
+// Decimal colours and positions written with %g (6 significant digits).
+constexpr float kTextTolerance = 1e-5f;
+
+TEST_F(ModelFiles, BlenderPlyHeaderWithFreeTextLineLoads) {
+  // Refused before issue 15 with "PLY header line 3: unknown keyword".
+  std::string p = write("blender.ply", corpus::blender_ply_cube(200, 30, 20));
+  expect_loads_like_assimp(p, 12);
+  rvr::Scene s = rvr::load_scene(p).value();
+  // No material in PLY: the vertex colours' mean is the diffuse colour.
+  expect_near3(material_of(s).diffuse, glm::vec3(200, 30, 20) / 255.0f, kByteTolerance);
+}
+
+TEST_F(ModelFiles, ObjWithMissingMtllibLoadsWithTheDefaultMaterial) {
+  std::string p = write("nomtl.obj", corpus::obj_cube("mtllib not_here.mtl\n", "Red"));
+  expect_loads_like_assimp(p, 12);
+  // `usemtl Red` without its library names no colour: grey (Assimp's 0.6, or rvr's default).
+  glm::vec3 d = material_of(rvr::load_scene(p).value()).diffuse;
+  EXPECT_EQ(d.r, d.g);
+  EXPECT_EQ(d.g, d.b);
+}
+
+TEST_F(ModelFiles, ObjWithCrlfLineEnds) {
+  expect_loads_like_assimp(write("crlf.obj", corpus::obj_cube("# CRLF\r\n", "", "\r\n")), 12);
+}
+
+TEST_F(ModelFiles, ObjWithNegativeIndices) {
+  std::string s;
+  for (int v = 0; v < 8; ++v) {
+    auto p = corpus::cube_vertex(v);
+    s += "v " + corpus::num(p[0]) + " " + corpus::num(p[1]) + " " + corpus::num(p[2]) + "\n";
+  }
+  for (const auto& q : corpus::cube_quads()) {
+    s += "f";
+    for (int i : q)
+      s.append(1, ' ').append(std::to_string(i - 8));  // -8 is the first of the 8 above
+    s += "\n";
+  }
+  expect_loads_like_assimp(write("negative.obj", s), 12);
+}
+
+TEST_F(ModelFiles, ObjWithQuadsAndNgonsAndNoNormals) {
+  // A quad, a pentagon and a hexagon (convex, in z = 0): 2 + 3 + 4 triangles.
+  std::string s;
+  int base = 1;
+  for (int sides : {4, 5, 6}) {
+    for (int k = 0; k < sides; ++k) {
+      float a = 2.0f * glm::pi<float>() * float(k) / float(sides);
+      s += "v " + corpus::num(3.0f * float(sides) + std::cos(a)) + " " + corpus::num(std::sin(a)) +
+           " 0\n";
+    }
+    s += "f";
+    for (int k = 0; k < sides; ++k) s.append(1, ' ').append(std::to_string(base + k));
+    s += "\n";
+    base += sides;
+  }
+  expect_loads_like_assimp(write("ngons.obj", s), 9);
+}
+
+TEST_F(ModelFiles, MtlColoursSpecularEmissionAndShininess) {
+  write("paint.mtl",
+        "newmtl paint\nKd 0.8 0.2 0.1\nKs 0.5 0.4 0.3\nKe 0.3 0.1 0\nNs 64\nillum 2\n");
+  std::string p = write("painted.obj", corpus::obj_cube("mtllib paint.mtl\n", "paint"));
+  expect_loads_like_assimp(p, 12);
+  rvr::Scene s = rvr::load_scene(p).value();
+  const rvr::Material& m = material_of(s);
+  expect_near3(m.diffuse, {0.8f, 0.2f, 0.1f}, kTextTolerance);
+  expect_near3(m.specular, {0.5f, 0.4f, 0.3f}, kTextTolerance);
+  expect_near3(m.emission, {0.3f, 0.1f, 0.0f}, kTextTolerance);
+  EXPECT_NEAR(m.shininess, 64.0f, kTextTolerance);
+}
+
+TEST_F(ModelFiles, BinaryStlWhoseHeaderStartsWithSolid) {
+  expect_loads_like_assimp(write("cad.stl", corpus::binary_stl_cube()), 12);
+}
+
+TEST_F(ModelFiles, AsciiStl) {
+  expect_loads_like_assimp(write("ascii.stl", corpus::ascii_stl_cube()), 12);
+}
+
+TEST_F(ModelFiles, OffWithComments) {
+  expect_loads_like_assimp(write("comments.off", corpus::off_cube_with_comments()), 12);
+}
+
+// glTF and GLB: baseColorFactor, emissiveFactor, the camera (node translation, yfov,
+// aspectRatio) and a KHR_lights_punctual point light (node translation, colour x intensity).
+void expect_gltf_contents(const rvr::Scene& s, const corpus::GltfExtras& e) {
+  const rvr::Material& m = material_of(s);
+  expect_near3(m.diffuse, {e.base_color[0], e.base_color[1], e.base_color[2]}, kTextTolerance);
+  expect_near3(m.emission, {e.emissive[0], e.emissive[1], e.emissive[2]}, kTextTolerance);
+  expect_near3(s.camera.eye, {e.camera_at[0], e.camera_at[1], e.camera_at[2]}, kTextTolerance);
+  // A glTF camera looks down its node's -z with +y up.
+  expect_near3(glm::normalize(s.camera.target - s.camera.eye), {0, 0, -1}, 1e-5f);
+  expect_near3(s.camera.up, {0, 1, 0}, 1e-5f);
+  // yfov in radians; Assimp keeps a horizontal angle, so the round trip through tan and the
+  // aspect costs a little float precision: 0.01 degree.
+  EXPECT_NEAR(s.camera.fov_y_deg, e.yfov * 180.0f / glm::pi<float>(), 0.01f);
+  EXPECT_NEAR(float(s.image.width) / float(s.image.height), e.aspect, 0.01f);
+  ASSERT_EQ(s.lights.size(), 1u);
+  expect_near3(s.lights[0].position, {e.light_at[0], e.light_at[1], e.light_at[2]}, kTextTolerance);
+  // glTF point lights fall off with the inverse square, as rvr's: intensity in candela.
+  glm::vec3 want =
+      glm::vec3(e.light_color[0], e.light_color[1], e.light_color[2]) * e.light_intensity;
+  expect_near3(s.lights[0].intensity, want, 1e-4f);
+}
+
+TEST_F(ModelFiles, GltfBaseColourCameraAndPunctualLight) {
+  corpus::GltfExtras e;
+  e.camera = e.light = true;
+  e.emissive = {0.2f, 0.1f, 0.0f};
+  std::string p = write("cube.gltf", corpus::gltf_json(e, false));
+  expect_loads_like_assimp(p, 12);
+  expect_gltf_contents(rvr::load_scene(p).value(), e);
+}
+
+TEST_F(ModelFiles, GlbBaseColourCameraAndPunctualLight) {
+  corpus::GltfExtras e;
+  e.camera = e.light = true;
+  e.base_color = {0.9f, 0.8f, 0.1f, 1.0f};
+  std::string p = write("cube.glb", corpus::glb(e));
+  expect_loads_like_assimp(p, 12);
+  expect_gltf_contents(rvr::load_scene(p).value(), e);
+}
+
+TEST_F(ModelFiles, TexturedMeshUsesItsFactorAndWarns) {
+  corpus::GltfExtras e;
+  e.texture = true;
+  std::string p = write("textured.gltf", corpus::gltf_json(e, false));
+  expect_loads_like_assimp(p, 12);
+  rvr::Scene s = rvr::load_scene(p).value();
+  expect_near3(material_of(s).diffuse, {e.base_color[0], e.base_color[1], e.base_color[2]},
+               kTextTolerance);
+  bool warned = false;
+  for (const std::string& w : s.warnings) warned |= w.find("not sampled") != std::string::npos;
+  EXPECT_TRUE(warned);
+}
+
+TEST_F(ModelFiles, ThreeDsMaterialColour) {
+  std::string p = write("cube.3ds", corpus::cube_3ds(40, 200, 60));
+  expect_loads_like_assimp(p, 12);
+  rvr::Scene s = rvr::load_scene(p).value();
+  expect_near3(material_of(s).diffuse, glm::vec3(40, 200, 60) / 255.0f, kByteTolerance);
+}
+
+TEST_F(ModelFiles, ColladaCameraLightAndColour) {
+  corpus::DaeExtras e;
+  std::string p = write("cube.dae", corpus::dae_cube(e));
+  expect_loads_like_assimp(p, 12);
+  rvr::Scene s = rvr::load_scene(p).value();
+  expect_near3(material_of(s).diffuse, {e.diffuse[0], e.diffuse[1], e.diffuse[2]}, kTextTolerance);
+  expect_near3(s.camera.eye, {e.camera_at[0], e.camera_at[1], e.camera_at[2]}, kTextTolerance);
+  expect_near3(glm::normalize(s.camera.target - s.camera.eye), {0, 0, -1}, 1e-5f);
+  // yfov in degrees, through Assimp's horizontal angle and back: float precision.
+  EXPECT_NEAR(s.camera.fov_y_deg, e.yfov_deg, 0.01f);
+  EXPECT_NEAR(float(s.image.width) / float(s.image.height), e.aspect, 0.01f);
+  ASSERT_EQ(s.lights.size(), 1u);
+  expect_near3(s.lights[0].position, {e.light_at[0], e.light_at[1], e.light_at[2]}, kTextTolerance);
+  // No falloff in the file: the same irradiance at the model's centre (the cube's, 0.5^3)
+  // as rvr's inverse-square light, colour x distance^2.
+  glm::vec3 d = glm::vec3(e.light_at[0], e.light_at[1], e.light_at[2]) - glm::vec3(0.5f);
+  EXPECT_NEAR(s.lights[0].intensity.x, glm::dot(d, d), 1e-3f);
+}
+
+// A model without a camera: the default three-quarter view from above (35 degrees round from
+// +z towards +x, 30 up), and every vertex of the model inside the image and between near and
+// far, checked by projecting the vertices through the camera.
+TEST_F(ModelFiles, DefaultCameraFramesTheModelFromThreeQuartersAbove) {
+  std::string p = write("bare.obj", corpus::obj_cube("", ""));
+  rvr::Scene s = rvr::load_scene(p).value();
+  const float az = 35.0f * glm::pi<float>() / 180.0f, el = 30.0f * glm::pi<float>() / 180.0f;
+  glm::vec3 from(std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el));
+  expect_near3(s.camera.target, glm::vec3(0.5f), 1e-6f);
+  expect_near3(glm::normalize(s.camera.eye - s.camera.target), from, 1e-5f);
+  rvr::CameraFrame f = rvr::make_camera_frame(s.camera, s.image.width, s.image.height);
+  float largest = 0.0f;
+  for (int v = 0; v < 8; ++v) {
+    auto c = corpus::cube_vertex(v);
+    glm::vec3 d = glm::vec3(c[0], c[1], c[2]) - f.eye;
+    float depth = glm::dot(d, f.forward);
+    EXPECT_GT(depth, s.camera.near);
+    EXPECT_LT(depth, s.camera.far);
+    float x = glm::dot(d, f.right) / (depth * f.tan_half_fov_y * f.aspect);
+    float y = glm::dot(d, f.up) / (depth * f.tan_half_fov_y);
+    EXPECT_LT(std::abs(x), 1.0f);
+    EXPECT_LT(std::abs(y), 1.0f);
+    largest = std::max({largest, std::abs(x), std::abs(y)});
+  }
+  // Framed, not lost in the middle: the bounding sphere (radius sqrt(3)/2) fills the height
+  // with a 10 % margin, so the cube's farthest corner reaches at least half way out.
+  EXPECT_GT(largest, 0.5f);
+  // The default lights: one point light and ambient.
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_GT(s.ambient.x, 0.0f);
+}
+
+TEST_F(ModelFiles, CameraFromAndImageSizeOverrides) {
+  std::string p = write("bare.obj", corpus::obj_cube("", ""));
+  rvr::SceneOverrides o;
+  o.view_from = glm::vec3(0, 0, 2);
+  o.width = 300;
+  o.height = 100;
+  rvr::Scene s = rvr::load_scene(p, o).value();
+  EXPECT_EQ(s.image.width, 300);
+  EXPECT_EQ(s.image.height, 100);
+  expect_near3(glm::normalize(s.camera.eye - s.camera.target), {0, 0, 1}, 1e-6f);
+  // Straight down: +y cannot be up, -z is.
+  o.view_from = glm::vec3(0, 5, 0);
+  rvr::Scene down = rvr::load_scene(p, o).value();
+  expect_near3(glm::normalize(down.camera.eye - down.camera.target), {0, 1, 0}, 1e-6f);
+  EXPECT_GT(glm::length(glm::cross(down.camera.up, glm::vec3(0, 1, 0))), 0.99f);
+  o.view_from = glm::vec3(0);
+  EXPECT_FALSE(rvr::load_scene(p, o).ok());
+}
+
+TEST_F(ModelFiles, SceneFileMeshMayKeepTheFilesMaterials) {
+  write("paint.mtl", "newmtl paint\nKd 0.8 0.2 0.1\n");
+  write("painted.obj", corpus::obj_cube("mtllib paint.mtl\n", "paint"));
+  auto scene_with = [&](const std::string& material) {
+    std::string text = R"({"camera":{"eye":[3,3,3],"target":[0,0,0],"up":[0,1,0]},)"
+                       R"("materials":{"blue":{"diffuse":[0,0,1]}},)"
+                       R"("objects":[{"type":"mesh","file":"painted.obj","material":")" +
+                       material + R"(","transform":{"translate":[1,0,0]}}]})";
+    return rvr::parse_scene(text, "inline.json", dir_.string());
+  };
+  rvr::Scene from_file = scene_with("from_file").value();
+  ASSERT_EQ(from_file.objects.size(), 1u);
+  expect_near3(material_of(from_file).diffuse, {0.8f, 0.2f, 0.1f}, kTextTolerance);
+  // The transform applies to the file's meshes.
+  float min_x = 1e9f;
+  for (const glm::vec3& v : from_file.objects[0].mesh.positions) min_x = std::min(min_x, v.x);
+  EXPECT_FLOAT_EQ(min_x, 1.0f);
+  rvr::Scene named = scene_with("blue").value();
+  expect_near3(material_of(named).diffuse, {0, 0, 1}, 0.0f);
+  // Only meshes have a file to keep materials from; the name is reserved.
+  auto sphere = rvr::parse_scene(
+      R"({"camera":{"eye":[3,3,3],"target":[0,0,0],"up":[0,1,0]},)"
+      R"("objects":[{"type":"sphere","center":[0,0,0],"radius":1,"material":"from_file"}]})",
+      "s.json", dir_.string());
+  ASSERT_FALSE(sphere.ok());
+  EXPECT_NE(sphere.error().message.find("objects[0].material"), std::string::npos);
+  auto reserved = rvr::parse_scene(R"({"camera":{"eye":[3,3,3],"target":[0,0,0],"up":[0,1,0]},)"
+                                   R"("materials":{"from_file":{"diffuse":[1,0,0]}}})",
+                                   "r.json", dir_.string());
+  ASSERT_FALSE(reserved.ok());
+  EXPECT_NE(reserved.error().message.find("reserved"), std::string::npos);
+}
+
+TEST_F(ModelFiles, ErrorsNameTheFileOnOneLine) {
+  std::string broken = write("broken.obj", "v 0 0 0\nf 1 2 3\n");  // indices past the vertices
+  auto bad = rvr::load_scene(broken);
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().message.rfind(broken + ": ", 0), 0u) << bad.error().message;
+  EXPECT_EQ(bad.error().message.find('\n'), std::string::npos) << bad.error().message;
+  // Scene files keep their errors: bad JSON is a JSON syntax error whatever the extension.
+  for (const char* name : {"bad.json", "bad.txt", "bad"}) {
+    std::string p = write(name, "{\"camera\": }");
+    auto r = rvr::load_scene(p);
+    ASSERT_FALSE(r.ok()) << name;
+    EXPECT_NE(r.error().message.find("JSON syntax"), std::string::npos) << r.error().message;
+  }
+  std::string garbage = write("garbage.txt", "hello");
+  auto g = rvr::load_scene(garbage);
+  ASSERT_FALSE(g.ok());
+  EXPECT_NE(g.error().message.find("JSON syntax"), std::string::npos) << g.error().message;
+}
+
+TEST_F(ModelFiles, ModelContentIsRecognisedWhateverTheExtension) {
+  // A PLY named .dat: Assimp picks its reader by content, and so does rvr.
+  std::string p = write("scan.dat", corpus::blender_ply_cube(10, 10, 10));
+  auto s = rvr::load_scene(p);
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  EXPECT_EQ(s->triangle_count(), 12u);
+}
+
+}  // namespace
