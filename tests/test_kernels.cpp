@@ -1,14 +1,19 @@
 // The SIMD kernels (sse, avx2, avx512: each this CPU can run) of the tracer and of softraster, and
 // thread counts, change nothing in what is rendered: every buffer, the cost AOV included, is the
 // same bytes for every built-in scene in every mode, with analytic and tessellated spheres (the
-// tracer) and with hierarchical z on and off (softraster).
+// tracer) and with hierarchical z on and off (softraster). softraster's batched setup kernels
+// also set up every triangle exactly as its scalar setup does.
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <glm/gtc/matrix_transform.hpp>
+#include <random>
 
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/scene_loader.h"
+#include "soft/fill_dispatch.h"
+#include "soft/triangle_setup.h"
 
 using namespace rvr;
 
@@ -125,6 +130,95 @@ TEST_P(Kernels, SoftrasterRendersTheSameBytesWithEveryKernelAndThreadCount) {
         }
       }
     }
+  }
+}
+
+namespace {
+
+// Every field, doubles bit for bit ("" when all agree).
+std::string setup_difference(const soft::SetupTriangle& a, const soft::SetupTriangle& b) {
+  auto same = [](const auto& x, const auto& y) { return std::memcmp(&x, &y, sizeof(x)) == 0; };
+  if (!same(a.x, b.x) || !same(a.y, b.y)) return "fixed-point vertices";
+  if (!same(a.top_left, b.top_left)) return "top-left edges";
+  if (!same(a.q0, b.q0) || !same(a.qa, b.qa) || !same(a.qb, b.qb)) return "perspective planes";
+  if (!same(a.ox, b.ox) || !same(a.oy, b.oy)) return "plane origin";
+  if (a.x0 != b.x0 || a.y0 != b.y0 || a.x1 != b.x1 || a.y1 != b.y1) return "pixel box";
+  if (!same(a.min_depth, b.min_depth)) return "hi-z bound";
+  if (a.object != b.object || a.primitive != b.primitive) return "ids";
+  return "";
+}
+
+}  // namespace
+
+// The batched setup kernels against TriangleSetup::add, the scalar setup (the oracle: the code
+// softraster used before the kernels, still used for clipped triangles), on random triangles
+// that need no clipping: sub-pixel ones (most hold no centre), a few pixels (the small-box
+// coverage test), large ones, slivers, degenerate ones (repeated or collinear vertices), both
+// windings, depths from 0.2 to 200.
+TEST(SoftrasterSetup, EveryKernelSetsUpTrianglesAsTheScalarSetupDoes) {
+  const int width = 101, height = 75;
+  const glm::dmat4 view_projection =
+      glm::dmat4(glm::perspective(0.9f, float(width) / float(height), 0.1f, 500.0f));
+  const soft::TriangleSetup scalar(width, height, view_projection);
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::uniform_real_distribution<float> log_depth(std::log(0.2f), std::log(200.0f));
+  std::uniform_int_distribution<int> kind(0, 5);
+  std::vector<soft::ProjectedVertex> vertices;
+  while (vertices.size() < 3 * 20000) {
+    const float z = -std::exp(log_depth(rng));
+    const glm::vec3 centre(unit(rng) * -z * 0.6f, unit(rng) * -z * 0.45f, z);
+    // Pixels are about |z| / 100 wide here.
+    const float sizes[6] = {0.003f, 0.01f, 0.03f, 0.3f, 0.01f, 0.01f};
+    const int k = kind(rng);
+    const float s = sizes[k] * -z;
+    glm::vec3 p[3];
+    for (glm::vec3& v : p) v = centre + s * glm::vec3(unit(rng), unit(rng), unit(rng) * 0.1f);
+    if (k == 4) p[2] = p[0];                          // two vertices the same
+    if (k == 5) p[2] = p[0] + 0.37f * (p[1] - p[0]);  // collinear
+    soft::ProjectedVertex v[3] = {scalar.project(p[0]), scalar.project(p[1]), scalar.project(p[2])};
+    if (v[0].clip_planes | v[1].clip_planes | v[2].clip_planes) continue;
+    if (v[0].reject & v[1].reject & v[2].reject) continue;
+    vertices.insert(vertices.end(), v, v + 3);
+  }
+  const size_t count = vertices.size() / 3;
+  soft::TriangleSetup reference_setup = scalar;
+  std::vector<soft::SetupTriangle> expected;
+  size_t clipped = 0;
+  for (size_t i = 0; i < count; ++i)
+    reference_setup.add(vertices[3 * i], vertices[3 * i + 1], vertices[3 * i + 2], 7, uint32_t(i),
+                        expected, clipped);
+  ASSERT_EQ(clipped, 0u);
+  // The sample reaches every branch of the setup: dropped and kept, small and large boxes.
+  ASSERT_GT(expected.size(), count / 10);
+  ASSERT_LT(expected.size(), count * 9 / 10);
+  for (Isa isa : runnable_isas()) {
+    const soft::FillKernels& kernels = soft::fill_kernels(isa);
+    std::vector<soft::SetupTriangle> got(count);
+    size_t n = 0;
+    // Batches of every fill from 1 to kSetupBatch, so partial vectors are exercised.
+    for (size_t i = 0, fill = 1; i < count; fill = fill % soft::kSetupBatch + 1) {
+      soft::SetupBatch batch;
+      for (; batch.count < int(fill) && i < count; ++i, ++batch.count) {
+        const int k = batch.count;
+        for (int v = 0; v < 3; ++v) {
+          const soft::ProjectedVertex& p = vertices[3 * i + size_t(v)];
+          batch.fx[v][k] = p.fx;
+          batch.fy[v][k] = p.fy;
+          batch.sx[v][k] = p.sx;
+          batch.sy[v][k] = p.sy;
+          batch.w[v][k] = p.clip.w;
+          batch.inv_w[v][k] = p.inv_w;
+        }
+        batch.object[k] = 7;
+        batch.primitive[k] = uint32_t(i);
+      }
+      n += size_t(kernels.setup(batch, width, height, got.data() + n));
+    }
+    ASSERT_EQ(n, expected.size()) << kernels.isa;
+    for (size_t i = 0; i < n; ++i)
+      ASSERT_EQ(setup_difference(got[i], expected[i]), "")
+          << kernels.isa << ": set-up triangle " << i << " (input " << expected[i].primitive << ")";
   }
 }
 

@@ -8,6 +8,7 @@
 #include <chrono>
 
 #include "rvr/shared/timer.h"
+#include "soft/setup_kernel.h"
 #include "soft/triangle_setup.h"
 
 namespace rvr::soft {
@@ -21,8 +22,9 @@ using Clock = std::chrono::steady_clock;
 constexpr size_t kChunk = size_t(1) << 16;
 constexpr size_t kSubChunk = 4096;
 
-// A thread's setup state: its own clipping scratch and a cache of projected vertices (a mesh's
-// neighbouring triangles share them, so most are projected once, not once per triangle).
+// A thread's setup state: its own clipping scratch, a cache of projected vertices (a mesh's
+// neighbouring triangles share them, so most are projected once, not once per triangle) and
+// the batch of unclipped triangles waiting for the setup kernel.
 struct SetupWorker {
   static constexpr size_t kCacheSize = 4096;
   explicit SetupWorker(const TriangleSetup& prototype)
@@ -36,9 +38,19 @@ struct SetupWorker {
     }
     return cache[slot];
   }
+  // Sets up the waiting batch into `out` (after what is there: submission order).
+  void flush(const FillKernels& kernels, int width, int height, std::vector<SetupTriangle>& out) {
+    if (batch.count == 0) return;
+    const size_t at = out.size();
+    out.resize(at + size_t(batch.count));
+    const int kept = kernels.setup(batch, width, height, out.data() + at);
+    out.resize(at + size_t(kept));
+    batch.count = 0;
+  }
   TriangleSetup setup;
   std::vector<uint64_t> keys;
   std::vector<ProjectedVertex> cache;
+  SetupBatch batch;
 };
 
 }  // namespace
@@ -60,6 +72,8 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
   const size_t submitted = list.triangles();
   const size_t tile_count = size_t(target.tiles_x()) * size_t(target.tiles_y());
   const int tiles_x = target.tiles_x();
+  const int width = target.width(), height = target.height();
+  const FillKernels& kernels = target.kernels();
   const TriangleSetup prototype(target.width(), target.height(), view_projection);
   tbb::enumerable_thread_specific<SetupWorker> workers(prototype);
   std::vector<std::vector<SetupTriangle>> sub_out((kChunk + kSubChunk - 1) / kSubChunk);
@@ -93,12 +107,37 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
           const uint32_t primitive = uint32_t(g - list.first[object]);
           const glm::uvec3& tri = m.triangles[primitive];
           const uint32_t o = uint32_t(object);
-          // Copies: the next lookups may evict an entry.
-          const ProjectedVertex a = worker.vertex(o, tri.x, m.positions[tri.x]);
-          const ProjectedVertex b = worker.vertex(o, tri.y, m.positions[tri.y]);
-          const ProjectedVertex c = worker.vertex(o, tri.z, m.positions[tri.z]);
-          worker.setup.add(a, b, c, o, primitive, local, local_clipped);
+          // The vertices straight into the batch's next slot (a later lookup may evict them).
+          SetupBatch& batch = worker.batch;
+          const int k = batch.count;
+          uint32_t reject = ~0u, clip = 0;
+          for (int v = 0; v < 3; ++v) {
+            const ProjectedVertex& p = worker.vertex(o, tri[v], m.positions[tri[v]]);
+            reject &= p.reject;
+            clip |= p.clip_planes;
+            batch.fx[v][k] = p.fx;
+            batch.fy[v][k] = p.fy;
+            batch.sx[v][k] = p.sx;
+            batch.sy[v][k] = p.sy;
+            batch.w[v][k] = p.clip.w;
+            batch.inv_w[v][k] = p.inv_w;
+          }
+          if (reject) {  // trivially outside the view frustum
+            ++local_clipped;
+            continue;
+          }
+          if (clip) {  // crosses the near or a guard plane: the scalar clipper, in order
+            worker.flush(kernels, width, height, local);
+            worker.setup.add(
+                worker.setup.project(m.positions[tri.x]), worker.setup.project(m.positions[tri.y]),
+                worker.setup.project(m.positions[tri.z]), o, primitive, local, local_clipped);
+            continue;
+          }
+          batch.object[k] = o;
+          batch.primitive[k] = primitive;
+          if (++batch.count == kSetupBatch) worker.flush(kernels, width, height, local);
         }
+        worker.flush(kernels, width, height, local);
         sub_clipped[s] = local_clipped;
       });
     });

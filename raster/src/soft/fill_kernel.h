@@ -1,11 +1,14 @@
-// The per-pixel loop of softraster, as SIMD kernels compiled once per instruction set
-// (src/soft/kernels/, like the tracer's) and chosen at run time: edge functions and depths of
+// The per-pixel loop of softraster (and its batched triangle setup, setup_kernel.h), as SIMD
+// kernels compiled once per instruction set (src/soft/kernels/, like the tracer's) and chosen
+// at run time: edge functions and depths of
 // 2 (SSE) or 4 (AVX2, AVX-512) pixels at once, in the same double-precision operations as the
 // scalar formulas of SetupTriangle, so every kernel draws the same bytes. Plain data only: a
 // kernel translation unit must not instantiate inline code that baseline code also uses.
 #pragma once
 
 #include <cstdint>
+
+#include "soft/setup_kernel.h"
 
 namespace rvr::soft {
 
@@ -42,6 +45,8 @@ struct FillKernels {
   // Pixels [x0, x1] x [y0, y1]; `full`: every centre is known to be covered (no edge tests).
   void (*fill)(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x1, int y1,
                bool full, FillResult& result);
+  // Sets up batch's triangles into out[0 .. returned count): those emit would keep, in order.
+  int (*setup)(const SetupBatch& batch, int width, int height, SetupTriangle* out);
 };
 
 namespace isa_sse {

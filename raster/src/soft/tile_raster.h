@@ -45,6 +45,8 @@ class DepthTarget {
   int height() const { return height_; }
   int tiles_x() const { return tiles_x_; }
   int tiles_y() const { return tiles_y_; }
+  // The kernels of the instruction set chosen for this render (setup uses them too).
+  const FillKernels& kernels() const { return *kernels_; }
 
   // Draws the triangles bin[0..count) into tile (tx, ty), in that order; an entry is
   // sub-chunk << kLocalBits | index in that sub-chunk's triangles. Tiles are independent: any

@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <utility>
 
+#include "soft/setup_kernel.h"
+
 namespace rvr::soft {
 
 namespace {
-
-// Snapping moves a vertex by at most half a sub-pixel step in x and in y.
-constexpr double kSnapDistance = 0.7072 / double(kSub);
 
 // std::llround (halves away from zero) without the library call, which baseline x86-64 cannot
 // inline: x minus its truncation is exact for |x| < 2^52 (screen positions in sub-pixels inside

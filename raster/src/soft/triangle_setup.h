@@ -4,51 +4,20 @@
 // the same bytes whichever path a triangle takes.
 #pragma once
 
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
 
 #include "rvr/shared/scene.h"
+#include "soft/setup_triangle.h"
 
 namespace rvr::soft {
 
-// Sub-pixel precision of the edge functions: finer than GL's usual 8 bits, so that snapping
-// an edge-on sliver (a sphere's silhouette) rarely makes it cover a centre it does not.
-constexpr int kSubBits = 12;
-constexpr int64_t kSub = int64_t(1) << kSubBits;
 // Guard-band clipping keeps screen coordinates within +-(2^15 + 2^14) pixels, i.e. 28-bit
 // fixed point, so edge functions (products of 29-bit differences) never overflow int64.
 constexpr double kGuardPixels = double(1 << 16);
 constexpr int kMaxImageSide = 1 << 15;
-
-// A screen-space triangle after clipping. One input triangle gives up to a few of these.
-struct SetupTriangle {
-  std::array<int64_t, 3> x, y;   // fixed point, oriented so the edge functions are >= 0 inside
-  std::array<bool, 3> top_left;  // edge i runs from vertex i to vertex i+1
-  // q_j(p) = q0[j] + qa[j]*(px - ox) + qb[j]*(py - oy) = (barycentric j of the ORIGINAL
-  // triangle) / w: linear in screen space, so sum_j q_j = 1/w = 1/view depth, and q_j/sum is
-  // the perspective-correct barycentric. From the unsnapped vertices, in double: P must be
-  // exact where 1/|L - P|^2 is steep (surfaces next to a light).
-  std::array<double, 3> q0, qa, qb;
-  double ox = 0, oy = 0;
-  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // pixel bounding box, inclusive, on screen
-  // No fragment is nearer than this (view depth): the hi-z test's bound (see min_depth_bound).
-  double min_depth = 0;
-  uint32_t object = 0, primitive = 0;
-
-  double inv_w(double px, double py, std::array<double, 3>& q) const {
-    double s = 0;
-    for (int j = 0; j < 3; ++j) {
-      // Clamped: a sliver may cover a centre just outside itself (snapping); it is then seen
-      // at its nearest edge point instead of extrapolating depth.
-      q[j] = std::max(0.0, q0[j] + qa[j] * (px - ox) + qb[j] * (py - oy));
-      s += q[j];
-    }
-    return s;
-  }
-};
 
 // A vertex in clip space, projected when it lies in front of the near plane.
 struct ProjectedVertex {

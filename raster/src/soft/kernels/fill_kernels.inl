@@ -126,8 +126,5 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
 }
 
 }  // namespace
-
-extern const FillKernels kFillKernels = {RVR_KERNEL_NAME, fill};
-
 }  // namespace RVR_KERNEL_NS
 }  // namespace rvr::soft

@@ -1,0 +1,42 @@
+// What softraster's setup hands the tile rasterizer for one screen triangle. Plain data (C
+// arrays), so the per-ISA setup kernels (kernels/setup_kernels.inl) can write it.
+#pragma once
+
+#include <cstdint>
+
+namespace rvr::soft {
+
+// Sub-pixel precision of the edge functions: finer than GL's usual 8 bits, so that snapping
+// an edge-on sliver (a sphere's silhouette) rarely makes it cover a centre it does not.
+constexpr int kSubBits = 12;
+constexpr int64_t kSub = int64_t(1) << kSubBits;
+
+// A screen-space triangle after clipping. One input triangle gives up to a few of these.
+struct SetupTriangle {
+  int64_t x[3], y[3];  // fixed point, oriented so the edge functions are >= 0 inside
+  bool top_left[3];    // edge i runs from vertex i to vertex i+1
+  // q_j(p) = q0[j] + qa[j]*(px - ox) + qb[j]*(py - oy) = (barycentric j of the ORIGINAL
+  // triangle) / w: linear in screen space, so sum_j q_j = 1/w = 1/view depth, and q_j/sum is
+  // the perspective-correct barycentric. From the unsnapped vertices, in double: P must be
+  // exact where 1/|L - P|^2 is steep (surfaces next to a light).
+  double q0[3], qa[3], qb[3];
+  double ox = 0, oy = 0;
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // pixel bounding box, inclusive, on screen
+  // No fragment is nearer than this (view depth): the hi-z test's bound (see min_depth_bound).
+  double min_depth = 0;
+  uint32_t object = 0, primitive = 0;
+
+  double inv_w(double px, double py, double (&q)[3]) const {
+    double s = 0;
+    for (int j = 0; j < 3; ++j) {
+      // Clamped: a sliver may cover a centre just outside itself (snapping); it is then seen
+      // at its nearest edge point instead of extrapolating depth.
+      const double v = q0[j] + qa[j] * (px - ox) + qb[j] * (py - oy);
+      q[j] = v > 0.0 ? v : 0.0;
+      s += q[j];
+    }
+    return s;
+  }
+};
+
+}  // namespace rvr::soft
