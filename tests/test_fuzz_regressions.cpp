@@ -17,9 +17,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// The files of tests/fuzz/SUB. A missing folder is a failure, not nothing to replay: git keeps
+// no empty folder, and a renamed or lost one would otherwise pass silently.
 std::vector<fs::path> files_in(const std::string& sub) {
   std::vector<fs::path> out;
   fs::path dir = fs::path(RVR_SOURCE_DIR) / "tests" / "fuzz" / sub;
+  EXPECT_TRUE(fs::is_directory(dir)) << dir << " is missing";
   if (!fs::is_directory(dir)) return out;
   for (const auto& e : fs::directory_iterator(dir)) {
     if (e.is_regular_file()) out.push_back(e.path());
@@ -38,7 +41,9 @@ const fs::path& dir() {
   return d;
 }
 
-void replay(const std::string& sub, bool mesh, size_t* count) {
+// Replays every file of tests/fuzz/SUB and returns how many there were.
+size_t replay(const std::string& sub, bool mesh) {
+  size_t count = 0;
   for (const fs::path& p : files_in(sub)) {
     SCOPED_TRACE(p.string());
     std::vector<uint8_t> bytes = read_bytes(p);
@@ -49,24 +54,36 @@ void replay(const std::string& sub, bool mesh, size_t* count) {
     if (!s.ok()) {
       EXPECT_EQ(s.error().kind, rvr::ErrorKind::BadInput);
     }
-    ++*count;
+    ++count;
   }
+  return count;
 }
 
 }  // namespace
 
+// Each harness replays at least one regression input and one seed: an empty or missing folder
+// fails here instead of replaying nothing.
 TEST(FuzzRegressions, SceneInputsLoadOrFailCleanly) {
-  size_t n = 0;
-  replay("regressions/scene", false, &n);
-  replay("corpus/scene", false, &n);
-  EXPECT_GT(n, 0u);
+  EXPECT_GE(replay("regressions/scene", false), 1u);
+  EXPECT_GE(replay("corpus/scene", false), 1u);
 }
 
 TEST(FuzzRegressions, MeshInputsLoadOrFailCleanly) {
-  size_t n = 0;
-  replay("regressions/mesh", true, &n);
-  replay("corpus/mesh", true, &n);
-  EXPECT_GT(n, 0u);
+  EXPECT_GE(replay("regressions/mesh", true), 1u);
+  EXPECT_GE(replay("corpus/mesh", true), 1u);
+}
+
+// Every folder of regressions/ and corpus/ is a harness's: one named otherwise (a typo, a
+// harness renamed) would never be replayed.
+TEST(FuzzRegressions, EveryFolderBelongsToAHarness) {
+  for (const char* kind : {"regressions", "corpus"}) {
+    const fs::path dir = fs::path(RVR_SOURCE_DIR) / "tests" / "fuzz" / kind;
+    ASSERT_TRUE(fs::is_directory(dir)) << dir;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      const std::string name = e.path().filename().string();
+      EXPECT_TRUE(e.is_directory() && (name == "scene" || name == "mesh")) << e.path();
+    }
+  }
 }
 
 TEST(FuzzRegressions, ValidSeedsLoad) {

@@ -12,9 +12,11 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 #include <utility>
@@ -47,7 +49,6 @@ TEST(ProgressSink, CountsFromManyThreadsAndBeginResets) {
   EXPECT_EQ(s.done, 8000u);
   EXPECT_EQ(s.rate_unit, "rays");
   EXPECT_EQ(s.rate_done, 20000u);
-  EXPECT_GE(s.seconds, 0.0);
 
   sink.begin("setup", 10, "triangles");  // no rate unit: the speed is in the unit itself
   sink.advance(3);
@@ -55,6 +56,35 @@ TEST(ProgressSink, CountsFromManyThreadsAndBeginResets) {
   EXPECT_EQ(s.done, 3u);
   EXPECT_EQ(s.rate_unit, "triangles");
   EXPECT_EQ(s.rate_done, 3u);
+}
+
+// `seconds` is the time since the phase began: bracketed by the test's own clock read around
+// begin() and snapshot(), so it holds on a machine of any speed. A sink made long before the
+// phase (the sleep) tells a clock started at construction, or not restarted by begin(), from
+// the right one; the sleep inside the phase tells milliseconds or a stuck zero from seconds.
+TEST(ProgressSink, SecondsCountFromTheStartOfThePhase) {
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  ProgressSink sink;
+  sink.begin("build", 10);
+  std::this_thread::sleep_for(std::chrono::milliseconds(60));
+  const Clock::time_point before_begin = Clock::now();
+  sink.begin("trace", 10);
+  const ProgressSnapshot fresh = sink.snapshot();
+  const double fresh_bound = since(before_begin);
+  EXPECT_GE(fresh.seconds, 0.0);
+  EXPECT_LE(fresh.seconds, fresh_bound);  // not the 60 ms of the phase before
+
+  const Clock::time_point before_sleep = Clock::now();
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const ProgressSnapshot later = sink.snapshot();
+  const double later_bound = since(before_begin);
+  // sleep_for waits at least as long as asked; the phase began before the sleep.
+  EXPECT_GE(later.seconds, 0.050);
+  EXPECT_GE(later.seconds, std::chrono::duration<double>(before_sleep - before_begin).count());
+  EXPECT_LE(later.seconds, later_bound);
 }
 
 TEST(ProgressLine, PercentBarRateAndTimeLeft) {
@@ -136,13 +166,16 @@ TEST(ProgressSink, EveryRendererAndRasterOnEglDrawsTheSameWhenWatched) {
 struct PtyRun {
   int status = -1;
   std::string err;  // what the terminal received on stderr (with the tty's \n -> \r\n)
-  double seconds = 0;
+  double seconds_after_interrupt = -1;  // from SIGINT to the exit; -1 when none was sent
 };
 
+bool has_progress_bar(const std::string& text);
+
 // Runs rvr with stderr on a new pseudo-terminal (stdout to /dev/null), TERM set to `term`;
-// sends SIGINT after `interrupt_after` seconds when that is positive.
+// with `interrupt_on_bar`, sends SIGINT as soon as a progress bar has been drawn (whenever that
+// is on this machine, not after a guessed time).
 PtyRun run_on_pty(const std::vector<std::string>& args, const char* term = "xterm",
-                  double interrupt_after = 0) {
+                  bool interrupt_on_bar = false) {
   PtyRun r;
   int master = ::posix_openpt(O_RDWR | O_NOCTTY);
   if (master < 0 || ::grantpt(master) != 0 || ::unlockpt(master) != 0) return r;
@@ -151,7 +184,6 @@ PtyRun run_on_pty(const std::vector<std::string>& args, const char* term = "xter
   ws.ws_row = 40;
   ::ioctl(master, TIOCSWINSZ, &ws);
   std::string slave_name = ::ptsname(master);
-  auto start = std::chrono::steady_clock::now();
   pid_t pid = ::fork();
   if (pid == 0) {
     ::setsid();
@@ -168,20 +200,13 @@ PtyRun run_on_pty(const std::vector<std::string>& args, const char* term = "xter
     ::execv(RVR_BINARY, argv.data());
     ::_exit(127);
   }
-  // Read until every holder of the terminal has gone (EIO), with a generous guard.
+  // Read until every holder of the terminal has gone (EIO), with a guard: nothing on the
+  // terminal for the process time limit kills it.
   char buf[4096];
-  bool interrupted = false;
+  std::chrono::steady_clock::time_point interrupted{};
   while (true) {
-    const double now =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (interrupt_after > 0 && !interrupted && now >= interrupt_after) {
-      ::kill(pid, SIGINT);
-      interrupted = true;
-    }
     pollfd p{master, POLLIN, 0};
-    const int wait_ms = interrupt_after > 0 && !interrupted ? 20 : 60'000;
-    int ready = ::poll(&p, 1, wait_ms);
-    if (ready == 0 && wait_ms == 20) continue;
+    int ready = ::poll(&p, 1, RVR_PROCESS_TIMEOUT * 1000);
     if (ready <= 0) {
       ::kill(pid, SIGKILL);
       break;
@@ -189,11 +214,17 @@ PtyRun run_on_pty(const std::vector<std::string>& args, const char* term = "xter
     ssize_t n = ::read(master, buf, sizeof buf);
     if (n <= 0) break;
     r.err.append(buf, size_t(n));
+    if (interrupt_on_bar && interrupted == decltype(interrupted){} && has_progress_bar(r.err)) {
+      interrupted = std::chrono::steady_clock::now();
+      ::kill(pid, SIGINT);
+    }
   }
   int raw = 0;
   ::waitpid(pid, &raw, 0);
   ::close(master);
-  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (interrupted != decltype(interrupted){})
+    r.seconds_after_interrupt =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - interrupted).count();
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
   return r;
 }
@@ -237,9 +268,11 @@ class ProgressCli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  // About a second of tracing on one thread (20000 triangles, no BVH, 64x48 pixels, 12 tiles):
-  // well over the half second before a bar appears, well under the test's time budget.
-  std::vector<std::string> long_render(const std::string& out) const {
+  // Tracing on one thread (20000 triangles, no BVH, 64x48 pixels, 12 tiles) for about two
+  // seconds on this machine, whatever its speed: the samples per pixel are scaled by a timed
+  // run of one sample (spp_for_seconds). Well over the half second before a bar appears and
+  // several redraws, well under the test's time budget.
+  std::vector<std::string> long_render(const std::string& out, double seconds = 2.0) const {
     return {"render",    "builtin:soup:20000",
             "-r",        "raytrace",
             "--accel",   "none",
@@ -247,7 +280,38 @@ class ProgressCli : public ::testing::Test {
             "--threads", "1",
             "--width",   "64",
             "--height",  "48",
+            "--spp",     std::to_string(spp_for_seconds(seconds)),
             "-o",        out};
+  }
+
+  // Samples per pixel for the render above to last about `seconds`: the render phase of one
+  // sample (its --stats "time.render", so process start-up does not count) is measured once
+  // per test binary, the slower of two runs, so that a lucky run does not shrink the work.
+  static int spp_for_seconds(double seconds) {
+    static const double one_sample = [] {
+      const fs::path stem =
+          fs::temp_directory_path() / ("rvr_progress_calibrate_" + std::to_string(::getpid()));
+      double slowest = 0;
+      for (int run = 0; run < 2; ++run) {
+        const std::string cmd =
+            "timeout -k 10 " + std::to_string(RVR_PROCESS_TIMEOUT) + " " + RVR_BINARY +
+            " render builtin:soup:20000 -r raytrace --accel none --mode local "
+            "--threads 1 --width 64 --height 48 --spp 1 --quiet -o " +
+            stem.string() + ".png --stats " + stem.string() + ".json </dev/null >/dev/null 2>&1";
+        EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+        std::ifstream in(stem.string() + ".json");
+        nlohmann::json stats = nlohmann::json::parse(in, nullptr, false);
+        const double render = stats.is_object() && stats["time"].contains("render")
+                                  ? stats["time"]["render"].get<double>()
+                                  : 0.0;
+        EXPECT_GT(render, 0.0) << cmd;
+        slowest = std::max(slowest, render);
+      }
+      fs::remove(stem.string() + ".png");
+      fs::remove(stem.string() + ".json");
+      return slowest;
+    }();
+    return std::clamp(int(std::ceil(seconds / std::max(one_sample, 1e-3))), 1, 4096);
   }
 
   fs::path dir_;
@@ -293,8 +357,8 @@ TEST_F(ProgressCli, TerminalShowsPercentRateAndTimeLeftThenErases) {
 
 TEST_F(ProgressCli, CompareNamesWhichRendererOfHowMany) {
   PtyRun r = run_on_pty({"compare", "builtin:soup:20000", "-r", "softraster,raytrace", "--accel",
-                         "none", "--threads", "1", "--width", "64", "--height", "48", "-o",
-                         (dir_ / "cmp").string()});
+                         "none", "--threads", "1", "--width", "64", "--height", "48", "--spp",
+                         std::to_string(spp_for_seconds(2.0)), "-o", (dir_ / "cmp").string()});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("2/2 raytrace  trace"), std::string::npos) << r.err;
   EXPECT_TRUE(has_progress_bar(r.err)) << r.err;
@@ -347,11 +411,12 @@ TEST_F(ProgressCli, ErrorAfterTheBarIsOneCleanLine) {
 }
 
 TEST_F(ProgressCli, InterruptedWhileTheBarIsShownIsOneCleanLine) {
-  std::vector<std::string> args = long_render((dir_ / "i.png").string());
-  args.insert(args.end(), {"--spp", "64"});   // far longer than the wait below
-  PtyRun r = run_on_pty(args, "xterm", 1.8);  // start-up, the half second, a few redraws
+  // Far longer than it takes for the bar to appear; interrupted as soon as it has.
+  PtyRun r = run_on_pty(long_render((dir_ / "i.png").string(), 60.0), "xterm", true);
   EXPECT_EQ(r.status, 130) << r.err;
-  EXPECT_LT(r.seconds, 10.0);
+  ASSERT_GE(r.seconds_after_interrupt, 0.0) << "no bar was drawn: " << r.err;
+  // The handler exits at once; the bound is for a loaded machine, far below the render's 60 s.
+  EXPECT_LT(r.seconds_after_interrupt, 5.0);
   EXPECT_NE(r.err.find('%'), std::string::npos) << r.err;
   std::vector<std::string> shown = screen(r.err);
   ASSERT_EQ(shown.size(), 1u) << r.err;
