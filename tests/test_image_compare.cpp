@@ -446,6 +446,71 @@ TEST(Compare, ConstantOffsetGivesKnownRmseAndPsnr) {
   EXPECT_GT(m.color.ssim, 0.99);  // a tiny shift of the mean barely changes the structure
 }
 
+// SSIM (Wang et al. 2004) of two constant images is the luminance term alone, the same in every
+// window: (2 a b + C1) / (a^2 + b^2 + C1) with C1 = 0.01^2 (the variances and covariance are 0,
+// so the contrast-structure term is C2 / C2). Grey colours have luminance equal to the grey.
+TEST(Compare, SsimOfConstantImagesIsTheLuminanceTerm) {
+  const double C1 = 0.01 * 0.01;
+  for (auto [a, b] : {std::pair{0.25, 0.26}, std::pair{0.5, 0.4}, std::pair{0.1, 0.9}}) {
+    double expected = (2 * a * b + C1) / (a * a + b * b + C1);
+    double ssim =
+        compare_buffers(flat(40, 30, glm::vec3(float(a))), flat(40, 30, glm::vec3(float(b))))
+            .color.ssim;
+    EXPECT_NEAR(ssim, expected, 1e-6) << a << " vs " << b;
+  }
+  // Identical images with structure: every window's two terms are exactly 1.
+  FrameBuffers a = flat(64, 48);
+  for (size_t i = 0; i < a.pixel_count(); ++i)
+    a.color[i] = glm::vec3(float((i * 37) % 101) / 100.0f);
+  EXPECT_NEAR(compare_buffers(a, a).color.ssim, 1.0, 1e-12);
+}
+
+// Depth percentiles and outliers on a crafted frame: 100x100 pixels, column 0 another object,
+// depth 4 in A and 4 / (1 - e) in B, so each pixel's relative error is e. Errors: 9880 pixels
+// 0, 100 at 1e-4, 15 at 5e-4, 5 above the outlier threshold 1e-3 (2 next to column 0, that
+// is on an object's outline; 3 in the middle). Nearest rank over 10000 pixels: p99 is the
+// 9900th smallest (1e-4), p99.9 the 9990th (5e-4).
+TEST(Compare, DepthPercentilesAndOutliersByCause) {
+  FrameBuffers a = flat(100, 100), b;
+  for (int y = 0; y < 100; ++y) a.object_id[a.index(0, y)] = 1;
+  for (float& d : a.depth) d = 4.0f;
+  b = a;
+  auto set_error = [&](int x, int y, double e) { b.depth[b.index(x, y)] = float(4.0 / (1.0 - e)); };
+  int placed = 0;
+  for (int y = 10; y < 90 && placed < 100; ++y)
+    for (int x = 20; x < 30 && placed < 100; ++x, ++placed) set_error(x, y, 1e-4);
+  for (int k = 0; k < 15; ++k) set_error(40 + k, 50, 5e-4);
+  set_error(1, 20, 6e-3);  // next to column 0: outline
+  set_error(1, 70, 2e-3);  // outline
+  set_error(60, 60, 5e-3);
+  set_error(70, 70, 4e-3);
+  set_error(80, 80, 3e-3);
+  const DepthMetrics m = compare_buffers(a, b).depth;
+  EXPECT_NEAR(m.max_rel_error, 6e-3, 1e-7);
+  EXPECT_NEAR(m.mean_rel_error, (100 * 1e-4 + 15 * 5e-4 + 20e-3) / 10000, 1e-9);
+  EXPECT_NEAR(m.p99_rel_error, 1e-4, 1e-7);
+  EXPECT_NEAR(m.p999_rel_error, 5e-4, 1e-7);
+  EXPECT_EQ(m.outliers, 5u);
+  EXPECT_EQ(m.outliers_at_silhouettes, 2u);
+  EXPECT_EQ(m.outliers_elsewhere, 3u);
+  ASSERT_EQ(m.worst_outliers.size(), 5u);
+  const int expected_x[] = {1, 60, 70, 80, 1}, expected_y[] = {20, 60, 70, 80, 70};
+  for (size_t k = 0; k < 5; ++k) {
+    const DepthOutlier& o = m.worst_outliers[k];
+    EXPECT_EQ(o.x, expected_x[k]) << k;
+    EXPECT_EQ(o.y, expected_y[k]) << k;
+    EXPECT_EQ(o.object, 0u);
+    EXPECT_EQ(o.depth_a, 4.0f);
+    EXPECT_EQ(o.cause, o.x == 1 ? DepthOutlierCause::Silhouette : DepthOutlierCause::Elsewhere) << k;
+  }
+  // Nothing compared (all background): every statistic is 0.
+  FrameBuffers empty;
+  empty.reset(8, 8, glm::vec3(0.0f));
+  const DepthMetrics none = compare_buffers(empty, empty).depth;
+  EXPECT_EQ(none.p99_rel_error, 0.0);
+  EXPECT_EQ(none.outliers, 0u);
+}
+
 TEST(Compare, SsimDropsForNoise) {
   FrameBuffers a = flat(64, 48), b = a;
   std::mt19937 rng(42);

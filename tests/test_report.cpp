@@ -25,6 +25,14 @@ size_t count_of(const std::string& text, const std::string& what) {
   return n;
 }
 
+// The first SVG of this class, from its opening tag to the next </svg>.
+std::string svg_with_class(const std::string& html, const std::string& cls) {
+  size_t at = html.find("<svg class=\"" + cls + "\"");
+  if (at == std::string::npos) return "";
+  size_t end = html.find("</svg>", at);
+  return end == std::string::npos ? "" : html.substr(at, end + 6 - at);
+}
+
 ReportInput sample_input(const std::string& out_dir) {
   ReportInput in;
   in.scene = "builtin:cornell";
@@ -46,7 +54,16 @@ ReportInput sample_input(const std::string& out_dir) {
                    {{"kernel", "avx2"}}};
   in.renderers = {a, b};
   in.metrics.visibility = {48, 47.0 / 48.0, 1, 0};
-  in.metrics.depth = {0.0004, 0.00001};
+  in.metrics.depth.max_rel_error = 0.0004;
+  in.metrics.depth.mean_rel_error = 0.00001;
+  in.metrics.depth.p99_rel_error = 0.00007;
+  in.metrics.depth.p999_rel_error = 0.0002;
+  in.metrics.depth.outliers = 3;
+  in.metrics.depth.outliers_at_silhouettes = 2;
+  in.metrics.depth.outliers_elsewhere = 1;
+  in.metrics.depth.worst_outliers = {
+      {5, 4, 7, 0.0035, 2.5f, 2.51f, DepthOutlierCause::Elsewhere},
+      {1, 2, 3, 0.0012, 6.0f, 6.0075f, DepthOutlierCause::Silhouette}};
   in.metrics.color = {0.004, 47.9, 0.21, 0.998};
   in.heat_map_scale = 0.1f;
   return in;
@@ -105,16 +122,41 @@ TEST(MetricsJson, HasEveryRequiredField) {
   EXPECT_DOUBLE_EQ(doc["renderers"]["raster"]["seconds"].get<double>(), 0.12);
   EXPECT_EQ(doc["renderers"]["raytrace"]["warnings"][0], "csg objects skipped: <1> & \"more\"");
   EXPECT_EQ(doc["renderers"]["raytrace"]["stats"]["rays.primary"], 48);
-  for (const char* key : {"pixels", "id_agreement", "mismatched_pixels", "mismatched_off_edge"})
-    EXPECT_TRUE(doc["visibility"][key].is_number()) << key;
-  EXPECT_EQ(doc["visibility"]["pixels"], 48);
-  EXPECT_EQ(doc["visibility"]["mismatched_pixels"], 1);
-  EXPECT_EQ(doc["visibility"]["mismatched_off_edge"], 0);
-  for (const char* key : {"max_rel_error", "mean_rel_error"})
-    EXPECT_TRUE(doc["depth"][key].is_number()) << key;
-  for (const char* key : {"rmse", "psnr_db", "max_abs", "ssim"})
-    EXPECT_TRUE(doc["color"][key].is_number()) << key;
-  EXPECT_DOUBLE_EQ(doc["color"]["psnr_db"].get<double>(), 47.9);
+  // Every metric under its own name: sample_input gives each a different value, so two fields
+  // swapped (or one written twice) fail here.
+  auto number = [&](const char* group, const char* key) {
+    const auto& v = doc[group][key];
+    EXPECT_TRUE(v.is_number()) << group << "." << key;
+    return v.is_number() ? v.get<double>() : std::nan("");
+  };
+  EXPECT_EQ(number("visibility", "pixels"), 48.0);
+  EXPECT_DOUBLE_EQ(number("visibility", "id_agreement"), 47.0 / 48.0);
+  EXPECT_EQ(number("visibility", "mismatched_pixels"), 1.0);
+  EXPECT_EQ(number("visibility", "mismatched_off_edge"), 0.0);
+  EXPECT_DOUBLE_EQ(number("depth", "max_rel_error"), 0.0004);
+  EXPECT_DOUBLE_EQ(number("depth", "mean_rel_error"), 0.00001);
+  EXPECT_DOUBLE_EQ(number("depth", "p99_rel_error"), 0.00007);
+  EXPECT_DOUBLE_EQ(number("depth", "p999_rel_error"), 0.0002);
+  EXPECT_DOUBLE_EQ(number("depth", "outlier_threshold"), 1e-3);
+  EXPECT_EQ(number("depth", "outliers"), 3.0);
+  EXPECT_EQ(number("depth", "outliers_at_silhouettes"), 2.0);
+  EXPECT_EQ(number("depth", "outliers_elsewhere"), 1.0);
+  const auto& listed = doc["depth"]["outlier_pixels"];
+  ASSERT_EQ(listed.size(), 2u);
+  EXPECT_EQ(listed[0]["x"], 5);
+  EXPECT_EQ(listed[0]["y"], 4);
+  EXPECT_EQ(listed[0]["object"], 7);
+  EXPECT_DOUBLE_EQ(listed[0]["rel_error"].get<double>(), 0.0035);
+  EXPECT_DOUBLE_EQ(listed[0]["depth_a"].get<double>(), 2.5);
+  EXPECT_DOUBLE_EQ(listed[0]["depth_b"].get<double>(), 2.51);
+  EXPECT_EQ(listed[0]["cause"], "elsewhere");
+  EXPECT_EQ(listed[1]["cause"], "silhouette");
+  EXPECT_DOUBLE_EQ(listed[1]["depth_b"].get<double>(), 6.0075);
+  EXPECT_DOUBLE_EQ(number("color", "rmse"), 0.004);
+  EXPECT_DOUBLE_EQ(number("color", "psnr_db"), 47.9);
+  EXPECT_DOUBLE_EQ(number("color", "max_abs"), 0.21);
+  EXPECT_DOUBLE_EQ(number("color", "ssim"), 0.998);
+  EXPECT_DOUBLE_EQ(doc["renderers"]["raytrace"]["seconds"].get<double>(), 0.4);
   EXPECT_EQ(doc["command"], "rvr compare builtin:cornell -o out --renderers raster,raytrace");
   EXPECT_EQ(doc["heat_map_scale"].get<double>(), 0.1);
   // The work-per-pixel picture, only for a renderer that reports work.
@@ -182,6 +224,30 @@ TEST_F(ReportDir, HtmlIsSelfContained) {
         "time.build", "diff.png", "id_mismatch.png", "depth_diff.png"})
     EXPECT_NE(h.find(word), std::string::npos) << word;
   EXPECT_NE(h.find("</html>"), std::string::npos);
+}
+
+// The depth outliers: ringed on depth_diff.png at their pixel centres (orange at a
+// silhouette, red elsewhere) in the image's own coordinates, and listed in a table.
+TEST_F(ReportDir, DepthOutliersAreRingedAndListed) {
+  auto html = report_html(sample_input(dir_.string()));
+  ASSERT_TRUE(html.ok()) << html.error().message;
+  const std::string& h = html.value();
+  const std::string marks = svg_with_class(h, "marks");
+  ASSERT_FALSE(marks.empty());
+  EXPECT_NE(marks.find("viewBox=\"0 0 8 6\""), std::string::npos) << marks;
+  EXPECT_NE(marks.find("<circle cx=\"5.5\" cy=\"4.5\""), std::string::npos) << marks;
+  EXPECT_NE(marks.find("<circle cx=\"1.5\" cy=\"2.5\""), std::string::npos) << marks;
+  EXPECT_EQ(count_of(marks, "stroke=\"#ff1744\""), 1u);  // the one elsewhere
+  EXPECT_EQ(count_of(marks, "stroke=\"#ff9f1c\""), 1u);  // the silhouette one
+  EXPECT_NE(h.find("3 pixels differ in depth by more than 1e-3 (relative): 2 on an object's "
+                   "outline, 1 elsewhere"),
+            std::string::npos);
+  EXPECT_NE(h.find("<tr><td class=\"num\">5</td><td class=\"num\">4</td><td class=\"num\">7"
+                   "</td><td class=\"num\">2.5</td><td class=\"num\">2.51</td><td class=\"num "
+                   "bad\">0.0035</td><td>elsewhere</td></tr>"),
+            std::string::npos);
+  for (const char* word : {"p99_rel_error", "p999_rel_error", "outliers_elsewhere"})
+    EXPECT_NE(h.find(word), std::string::npos) << word;
 }
 
 TEST_F(ReportDir, EmbeddedImageDecodesToTheFile) {

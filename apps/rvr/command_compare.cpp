@@ -105,8 +105,13 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   std::printf("  id agreement      %.5f  (%zu of %zu pixels differ, %zu off edges)\n",
               m.visibility.id_agreement, m.visibility.mismatched_pixels, m.visibility.pixels,
               m.visibility.mismatched_off_edge);
-  std::printf("  depth rel error   max %.3g  mean %.3g\n", m.depth.max_rel_error,
-              m.depth.mean_rel_error);
+  std::printf("  depth rel error   max %.3g  mean %.3g  p99 %.3g  p99.9 %.3g\n",
+              m.depth.max_rel_error, m.depth.mean_rel_error, m.depth.p99_rel_error,
+              m.depth.p999_rel_error);
+  if (m.depth.outliers)
+    std::printf("  depth outliers    %zu above %g: %zu at silhouettes, %zu elsewhere\n",
+                m.depth.outliers, kDepthOutlierThreshold, m.depth.outliers_at_silhouettes,
+                m.depth.outliers_elsewhere);
   std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
               m.color.psnr_db, m.color.max_abs, m.color.ssim);
   std::printf(

@@ -82,8 +82,24 @@ std::string metrics_json(const ReportInput& input) {
                          {"mismatched_pixels", v.mismatched_pixels},
                          {"mismatched_off_edge", v.mismatched_off_edge}};
     const auto& d = input.metrics.depth;
+    ordered_json outliers = ordered_json::array();
+    for (const DepthOutlier& o : d.worst_outliers)
+      outliers.push_back({{"x", o.x},
+                          {"y", o.y},
+                          {"object", o.object},
+                          {"rel_error", number(o.rel_error)},
+                          {"depth_a", float_number(o.depth_a)},
+                          {"depth_b", float_number(o.depth_b)},
+                          {"cause", to_string(o.cause)}});
     doc["depth"] = {{"max_rel_error", number(d.max_rel_error)},
-                    {"mean_rel_error", number(d.mean_rel_error)}};
+                    {"mean_rel_error", number(d.mean_rel_error)},
+                    {"p99_rel_error", number(d.p99_rel_error)},
+                    {"p999_rel_error", number(d.p999_rel_error)},
+                    {"outlier_threshold", kDepthOutlierThreshold},
+                    {"outliers", d.outliers},
+                    {"outliers_at_silhouettes", d.outliers_at_silhouettes},
+                    {"outliers_elsewhere", d.outliers_elsewhere},
+                    {"outlier_pixels", outliers}};
     const auto& c = input.metrics.color;
     doc["color"] = {{"rmse", number(c.rmse)},
                     {"psnr_db", psnr_number(c.psnr_db)},

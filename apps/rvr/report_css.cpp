@@ -25,6 +25,8 @@ figure{margin:0;background:#fff;padding:8px;border-radius:6px;
   box-shadow:0 1px 3px rgba(0,0,0,.12);min-width:0}
 figure img{display:block;width:100%;height:auto;image-rendering:pixelated}
 figcaption{font-size:13px;color:#4a5366;margin-top:6px}
+.marked{position:relative}
+.marked svg.marks{position:absolute;left:0;top:0;width:100%;height:100%;pointer-events:none}
 .flip{position:relative;display:block;width:100%;user-select:none}
 .flip img{display:block;width:100%;height:auto;image-rendering:pixelated}
 .flip img.top{position:absolute;left:0;top:0}

@@ -46,6 +46,53 @@ struct MetricRow {
   bool flagged = false;
 };
 
+// Rings over depth_diff.png around the listed depth outliers, in its pixel coordinates (the
+// SVG stretches with the image): orange at a silhouette, red elsewhere.
+std::string outlier_marks(const DepthMetrics& depth, int width, int height) {
+  if (depth.worst_outliers.empty() || width <= 0 || height <= 0) return "";
+  std::ostringstream svg;
+  const double r = std::max(4.0, 0.012 * std::max(width, height));
+  svg << "<svg class=\"marks\" viewBox=\"0 0 " << width << " " << height
+      << "\" preserveAspectRatio=\"none\" aria-hidden=\"true\">";
+  for (const DepthOutlier& o : depth.worst_outliers)
+    svg << "<circle cx=\"" << o.x + 0.5 << "\" cy=\"" << o.y + 0.5 << "\" r=\"" << r
+        << "\" fill=\"none\" stroke-width=\"" << r / 4 << "\" stroke=\""
+        << (o.cause == DepthOutlierCause::Silhouette ? "#ff9f1c" : "#ff1744") << "\"/>";
+  svg << "</svg>";
+  return svg.str();
+}
+
+// The listed depth outliers as a table: where, which object, both depths, why.
+std::string outlier_table(const DepthMetrics& depth, const std::string& name_a,
+                          const std::string& name_b) {
+  std::ostringstream h;
+  h << "<h2>Depth outliers</h2>\n<p class=\"why\">" << depth.outliers
+    << " pixels differ in depth by more than " << short_number(kDepthOutlierThreshold)
+    << " (relative): " << depth.outliers_at_silhouettes << " on an object's outline, "
+    << depth.outliers_elsewhere
+    << " elsewhere. On an outline, a facet seen edge-on changes depth faster than the "
+       "z-buffer's sub-pixel vertex snapping (1/256 pixel) can follow, so a pixel centre a hair "
+       "outside one facet may be drawn on it while the tracer hits its neighbour. Anywhere else "
+       "the renderers disagree, unless spheres are analytic: then the z-buffer draws a polygon "
+       "inside the sphere (--spheres mesh compares like with like). They are ringed on depth_diff.png (orange: outline, red: "
+       "elsewhere).</p>\n";
+  if (depth.worst_outliers.empty()) return h.str();
+  h << "<div class=\"scroll\"><table><thead><tr><th>x</th><th>y</th><th>object</th><th>depth "
+    << escape_html(name_a) << "</th><th>depth " << escape_html(name_b)
+    << "</th><th>relative error</th><th>cause</th></tr></thead><tbody>\n";
+  for (const DepthOutlier& o : depth.worst_outliers)
+    h << "<tr><td class=\"num\">" << o.x << "</td><td class=\"num\">" << o.y
+      << "</td><td class=\"num\">" << o.object << "</td><td class=\"num\">"
+      << fmt("%.7g", o.depth_a) << "</td><td class=\"num\">" << fmt("%.7g", o.depth_b)
+      << "</td><td class=\"num" << (o.cause == DepthOutlierCause::Elsewhere ? " bad" : "") << "\">"
+      << fmt("%.3g", o.rel_error) << "</td><td>" << to_string(o.cause) << "</td></tr>\n";
+  h << "</tbody></table></div>\n";
+  if (depth.outliers > depth.worst_outliers.size())
+    h << "<p class=\"why\">The " << depth.worst_outliers.size()
+      << " largest are listed (metrics.json lists the same).</p>\n";
+  return h.str();
+}
+
 }  // namespace
 
 Expected<std::string> report_html(const ReportInput& input) {
@@ -166,8 +213,9 @@ Expected<std::string> report_html(const ReportInput& input) {
       << "\" alt=\"object id mismatches\"><figcaption><b>id_mismatch.png</b>: pixels whose "
          "object id differs, in red, over a grey version of "
       << escape_html(name_a) << ".</figcaption></figure>\n"
-      << "<figure><img src=\"" << depth_uri.value()
-      << "\" alt=\"relative depth difference\"><figcaption><b>depth_diff.png</b>: relative "
+      << "<figure><div class=\"marked\"><img src=\"" << depth_uri.value()
+      << "\" alt=\"relative depth difference\">" << outlier_marks(dep, input.width, input.height)
+      << "</div><figcaption><b>depth_diff.png</b>: relative "
          "view-depth difference |d<sub>A</sub> &minus; d<sub>B</sub>| / max(d<sub>A</sub>, "
          "d<sub>B</sub>) of "
       << escape_html(name_a) << " and " << escape_html(name_b)
@@ -214,6 +262,18 @@ Expected<std::string> report_html(const ReportInput& input) {
          "view-axis depth over pixels where the ids agree (background excluded)."},
         {"depth", "mean_rel_error", fmt("%.3g", dep.mean_rel_error),
          "Mean of the same relative depth error."},
+        {"depth", "p99_rel_error", fmt("%.3g", dep.p99_rel_error),
+         "99th percentile of the same error: 99% of those pixels are at or below it."},
+        {"depth", "p999_rel_error", fmt("%.3g", dep.p999_rel_error), "99.9th percentile."},
+        {"depth", "outliers", std::to_string(dep.outliers),
+         "Pixels whose relative depth error is above " + short_number(kDepthOutlierThreshold) +
+             " (see Depth outliers below)."},
+        {"depth", "outliers_at_silhouettes", std::to_string(dep.outliers_at_silhouettes),
+         "Of those, on an object's outline: an edge-on facet under the z-buffer's vertex "
+         "snapping."},
+        {"depth", "outliers_elsewhere", std::to_string(dep.outliers_elsewhere),
+         "Of those, anywhere else: unexplained, a real disagreement. Should be 0.",
+         dep.outliers_elsewhere != 0},
         {"color", "rmse", fmt("%.4g", col.rmse),
          "Root mean square difference of linear RGB over every pixel and channel."},
         {"color", "psnr_db",
@@ -232,7 +292,7 @@ Expected<std::string> report_html(const ReportInput& input) {
       h << "<tr><td>" << row.group << "</td><td><code>" << row.name << "</code></td><td class=\"num"
         << (row.flagged ? " bad" : "") << "\">" << row.value << "</td><td class=\"why\">" << row.why
         << "</td></tr>\n";
-    h << "</tbody></table>\n";
+    h << "</tbody></table>\n" << outlier_table(dep, name_a, name_b);
 
     // Timings: seconds and every "time.*" stat, one row per renderer.
     std::set<std::string> time_keys;

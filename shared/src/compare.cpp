@@ -139,6 +139,75 @@ double psnr_of(double rmse) {
   return rmse > 0.0 ? 20.0 * std::log10(1.0 / rmse) : kInf;
 }
 
+// The nearest-rank percentile `p` (0 < p <= 1) of `values`, which it reorders.
+double percentile(std::vector<double>& values, double p) {
+  if (values.empty()) return 0.0;
+  const size_t rank = size_t(std::ceil(p * double(values.size())));
+  const size_t at = std::min(values.size(), std::max<size_t>(rank, 1)) - 1;
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(at), values.end());
+  return values[at];
+}
+
+// Whether the 3x3 neighbourhood of pixel (x, y) holds another object, or the background, in
+// either image: the object's outline.
+bool on_outline(const FrameBuffers& a, const FrameBuffers& b, int x, int y) {
+  const uint32_t object = a.object_id[a.index(x, y)];
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int xx = x + dx, yy = y + dy;
+      if (xx < 0 || yy < 0 || xx >= a.width || yy >= a.height) continue;
+      const size_t j = a.index(xx, yy);
+      if (a.object_id[j] != object || b.object_id[j] != object) return true;
+    }
+  return false;
+}
+
+}  // namespace
+
+const char* to_string(DepthOutlierCause cause) {
+  return cause == DepthOutlierCause::Silhouette ? "silhouette" : "elsewhere";
+}
+
+namespace {
+
+// Depth statistics of the pixels whose ids agree and are not background.
+DepthMetrics depth_metrics(const FrameBuffers& a, const FrameBuffers& b) {
+  DepthMetrics m;
+  std::vector<double> errors;
+  errors.reserve(a.pixel_count());
+  double sum = 0.0;
+  std::vector<DepthOutlier>& listed = m.worst_outliers;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      const size_t i = a.index(x, y);
+      if (id_key(a, i) != id_key(b, i) || a.object_id[i] == kNoId) continue;
+      const double rel = relative_depth_error(a.depth[i], b.depth[i]);
+      errors.push_back(rel);
+      sum += rel;
+      m.max_rel_error = std::max(m.max_rel_error, rel);
+      if (!(rel > kDepthOutlierThreshold)) continue;
+      const DepthOutlierCause cause =
+          on_outline(a, b, x, y) ? DepthOutlierCause::Silhouette : DepthOutlierCause::Elsewhere;
+      ++m.outliers;
+      ++(cause == DepthOutlierCause::Silhouette ? m.outliers_at_silhouettes : m.outliers_elsewhere);
+      listed.push_back({x, y, a.object_id[i], rel, a.depth[i], b.depth[i], cause});
+      if (listed.size() > 2 * DepthMetrics::kMaxListed) {  // keep the list bounded
+        std::sort(listed.begin(), listed.end(), [](const DepthOutlier& p, const DepthOutlier& q) {
+          return p.rel_error > q.rel_error;
+        });
+        listed.resize(DepthMetrics::kMaxListed);
+      }
+    }
+  std::stable_sort(listed.begin(), listed.end(), [](const DepthOutlier& p, const DepthOutlier& q) {
+    return p.rel_error > q.rel_error;
+  });
+  if (listed.size() > DepthMetrics::kMaxListed) listed.resize(DepthMetrics::kMaxListed);
+  m.mean_rel_error = errors.empty() ? 0.0 : sum / double(errors.size());
+  m.p99_rel_error = percentile(errors, 0.99);
+  m.p999_rel_error = percentile(errors, 0.999);
+  return m;
+}
+
 }  // namespace
 
 std::vector<bool> id_boundaries(const FrameBuffers& fb) {
@@ -168,6 +237,7 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) 
     m.visibility.mismatched_pixels = n;
     m.visibility.mismatched_off_edge = n;
     m.depth.max_rel_error = m.depth.mean_rel_error = 1.0;
+    m.depth.p99_rel_error = m.depth.p999_rel_error = 1.0;
     m.color = ColorMetrics{1.0, 0.0, 1.0, 0.0};
     return m;
   }
@@ -187,25 +257,17 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) 
   const std::vector<bool> boundary_b = id_boundaries(b);
   for (size_t i = 0; i < boundary.size(); ++i) boundary[i] = boundary[i] || boundary_b[i];
   const std::vector<bool> near_edge = dilate3x3(boundary, w, h);
-  size_t mismatched = 0, off_edge = 0, depth_count = 0;
-  double depth_sum = 0.0, depth_max = 0.0;
+  size_t mismatched = 0, off_edge = 0;
   for (size_t i = 0; i < n; ++i) {
     if (id_key(a, i) != id_key(b, i)) {
       ++mismatched;
       if (!near_edge[i]) ++off_edge;
-      continue;
     }
-    if (a.object_id[i] == kNoId) continue;
-    const double rel = relative_depth_error(a.depth[i], b.depth[i]);
-    depth_sum += rel;
-    depth_max = std::max(depth_max, rel);
-    ++depth_count;
   }
   m.visibility.mismatched_pixels = mismatched;
   m.visibility.mismatched_off_edge = off_edge;
   m.visibility.id_agreement = double(n - mismatched) / double(n);
-  m.depth.max_rel_error = depth_max;
-  m.depth.mean_rel_error = depth_count ? depth_sum / double(depth_count) : 0.0;
+  m.depth = depth_metrics(a, b);
 
   // Colour, linear values, peak 1.
   double sq = 0.0, max_abs = 0.0;

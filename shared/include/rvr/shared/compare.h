@@ -2,7 +2,9 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
@@ -21,9 +23,43 @@ struct VisibilityMetrics {
   size_t mismatched_off_edge = 0;
 };
 
+// Why a pixel's depths differ by more than kDepthOutlierThreshold (docs/cli.md).
+enum class DepthOutlierCause {
+  // On an object's outline (its 3x3 neighbourhood holds another object or the background in
+  // either image): a facet seen edge-on there changes depth by more than the threshold within
+  // the z-buffer's sub-pixel vertex snapping (1/256 px in llvmpipe), so a pixel centre a hair
+  // outside one facet in exact arithmetic is drawn on it, and the tracer hits its neighbour.
+  // Both are the same object (and, for a tessellated sphere, the same primitive).
+  Silhouette,
+  // Anything else: a real disagreement when both draw the same triangles (--spheres mesh).
+  // With analytic spheres the z-buffer's polygon lies inside the tracer's sphere, by more
+  // than the threshold towards the outline.
+  Elsewhere,
+};
+const char* to_string(DepthOutlierCause cause);  // "silhouette", "elsewhere"
+
+inline constexpr double kDepthOutlierThreshold = 1e-3;
+
+struct DepthOutlier {
+  int x = 0, y = 0;
+  uint32_t object = 0;
+  double rel_error = 0.0;
+  float depth_a = 0.0f, depth_b = 0.0f;
+  DepthOutlierCause cause = DepthOutlierCause::Elsewhere;
+};
+
 struct DepthMetrics {  // over pixels whose ids agree and are not background
   double max_rel_error = 0.0;
   double mean_rel_error = 0.0;
+  // Nearest-rank percentiles: the smallest error that 99% (99.9%) of those pixels do not exceed.
+  double p99_rel_error = 0.0;
+  double p999_rel_error = 0.0;
+  // Pixels whose error is above kDepthOutlierThreshold, by cause; the worst are listed.
+  size_t outliers = 0;
+  size_t outliers_at_silhouettes = 0;
+  size_t outliers_elsewhere = 0;
+  std::vector<DepthOutlier> worst_outliers;  // by error, largest first; at most kMaxListed
+  static constexpr size_t kMaxListed = 100;
 };
 
 struct ColorMetrics {  // linear RGB, peak value 1 for PSNR and SSIM
