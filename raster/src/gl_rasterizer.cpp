@@ -150,6 +150,50 @@ Status append_mesh(const TriangleMesh& mesh, const std::string& name, std::vecto
   return ok_status();
 }
 
+// What upload() made of the scene: one draw per object, the CSG objects it could not draw, the
+// light samples it put in the light buffer (none in visibility mode).
+struct SceneUpload {
+  std::vector<DrawItem> draws;
+  std::vector<std::string> skipped_csg;
+  std::vector<LightSample> samples;
+};
+
+// Full mode's shadow maps: their side, how many light samples share one batch of maps, and the
+// projection of every cube face. Disabled: no lights, or not full mode.
+struct ShadowPlan {
+  bool enabled = false;
+  int map_size = 0;
+  size_t batch = 1;
+  glm::mat4 light_projection{1.0f};
+};
+
+// Everything a pass over the scene needs: what was uploaded and the camera it is drawn with.
+struct ScenePass {
+  const Scene& scene;
+  const RenderOptions& options;
+  const SceneUpload& upload;
+  const ShadowPlan& shadows;
+  glm::mat4 view, projection;
+};
+
+// What a z-buffer cannot do, named for this scene only (shadows it does, with shadow maps).
+void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& options,
+                                    const SceneUpload& upload, std::vector<std::string>& warnings) {
+  if (!upload.skipped_csg.empty()) warnings.push_back(skipped_csg_warning(upload.skipped_csg));
+  if (options.mode != RenderMode::Full) return;
+  std::string mirrors =
+      material_names(upload.draws, [](const Material& m) { return m.mirror > 0.0f; });
+  if (!mirrors.empty())
+    warnings.push_back(
+        fmt::format("reflection (mirror materials: {}) not rendered by a z-buffer", mirrors));
+  std::string clear =
+      material_names(upload.draws, [](const Material& m) { return m.transparency > 0.0f; });
+  if (!clear.empty())
+    warnings.push_back(fmt::format("refraction/transparency (materials: {}) not rendered", clear));
+  if (scene.camera.aperture_radius > 0.0f)
+    warnings.push_back("depth of field (aperture_radius > 0) not rendered: pinhole");
+}
+
 }  // namespace
 
 const char* to_string(GlBackend backend) {
@@ -221,7 +265,18 @@ struct GlRasterizer::Impl {
   void release_shadow_maps();
   void release_targets();
   void release();
+
+  // One frame, in the order render() runs them.
   Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options);
+  Expected<SceneUpload> upload(const Scene& scene, const RenderOptions& options);
+  Expected<ShadowPlan> plan_shadows(const RenderOptions& options,
+                                    const std::vector<LightSample>& samples, RenderOutput& out);
+  Status scene_passes(const ScenePass& pass, int msaa, RenderOutput& out);
+  void draw_scene(const ScenePass& pass, bool shade_pass, size_t first, size_t end, bool base);
+  void clear_scene_targets(const Scene& scene);
+  void draw_to_every_target();
+  Status cost_pass(const ScenePass& pass);
+  Status readback(int w, int h, FrameBuffers& fb, uint64_t& samples_passed);
 };
 
 Status GlRasterizer::Impl::init() {
@@ -497,28 +552,11 @@ void GlRasterizer::Impl::release() {
   width = height = 0;
 }
 
-Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
-                                                  const RenderOptions& options) {
-  const int w = scene.image.width, h = scene.image.height;
-  if (w < 1 || h < 1) return bad_input(fmt::format("image size {}x{} is empty", w, h));
-  RenderOutput out;
-  ProgressSink* progress = options.progress;  // null when nobody is watching
-
-  // --- setup: context, programs (first call only), render targets (on size change)
-  if (progress) progress->begin("setup");
-  auto t = Clock::now();
-  RVR_TRY(init());
-  out.warnings = context_warnings;
-  RVR_TRY(resize(w, h));
-  out.stats["time.setup"] = seconds_since(t);
-
-  // --- upload: expand every object to triangles, then one vertex buffer and one light buffer
-  if (progress) progress->begin("upload");  // mostly one glBufferData: time only
-  t = Clock::now();
+// --- upload: every object expanded to triangles in one vertex buffer, the lights in one buffer
+Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const RenderOptions& options) {
+  SceneUpload up;
   vertices.clear();
   vertices.reserve(3 * scene.triangle_count());  // meshes; tessellated shapes add a little
-  std::vector<DrawItem> draws;
-  std::vector<std::string> skipped_csg;
   const Material fallback = default_material();
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
@@ -540,23 +578,21 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
         d.smooth = o.type == ObjectType::Sphere;
         break;
       case ObjectType::Csg:
-        skipped_csg.push_back(object_label(o, i));
+        up.skipped_csg.push_back(object_label(o, i));
         continue;
     }
     d.count = GLsizei(GLint(vertices.size()) - d.first);
-    if (d.count > 0) draws.push_back(d);
+    if (d.count > 0) up.draws.push_back(d);
   }
   gl().BindVertexArray(vao);
   gl().BindBuffer(GL_ARRAY_BUFFER, vertex_buffer);
   gl().BufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)), vertices.data(),
                   GL_STATIC_DRAW);
 
-  const std::vector<LightSample> samples = options.mode == RenderMode::Visibility
-                                               ? std::vector<LightSample>{}
-                                               : light_samples(scene.lights);
+  if (options.mode != RenderMode::Visibility) up.samples = light_samples(scene.lights);
   std::vector<glm::vec4> light_texels;
-  light_texels.reserve(2 * samples.size() + 2);
-  for (const LightSample& s : samples) {
+  light_texels.reserve(2 * up.samples.size() + 2);
+  for (const LightSample& s : up.samples) {
     light_texels.emplace_back(s.position, 1.0f);
     light_texels.emplace_back(s.intensity, 0.0f);
   }
@@ -568,130 +604,133 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   gl().BindTexture(GL_TEXTURE_BUFFER, light_texture);
   gl().TexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, light_buffer);
   RVR_GL_CHECK("uploading geometry and lights");
-  out.stats["time.upload"] = seconds_since(t);
+  return up;
+}
 
-  // --- shadow-map plan (full mode): resolution, batches, light-space projection
-  const bool shade = options.mode != RenderMode::Visibility;
-  const bool shadows = options.mode == RenderMode::Full && !samples.empty();
-  int map_size = 0;
-  size_t batch = std::max<size_t>(samples.size(), 1);
-  glm::mat4 light_projection(1.0f);
-  if (shadows) {
-    if (options.shadow_map_size < 1)
-      return bad_input(fmt::format("shadow map size {} must be positive", options.shadow_map_size));
-    if (!(options.shadow_bias >= 0.0f) || !std::isfinite(options.shadow_bias))
-      return bad_input(fmt::format("shadow bias {} must be >= 0", options.shadow_bias));
-    map_size = std::min(options.shadow_map_size, max_texture_size);
-    const double texels = 6.0 * double(samples.size()) * double(map_size) * double(map_size);
-    if (texels > kShadowTexelBudget) {
-      const int fit = int(std::sqrt(kShadowTexelBudget / (6.0 * double(samples.size()))));
-      map_size = std::max(std::min(map_size, kShadowMinSize), fit);
-    }
-    if (map_size < options.shadow_map_size)
-      out.warnings.push_back(
-          fmt::format("shadow maps of {} texels per side for {} light samples ({} requested)",
-                      map_size, samples.size(), options.shadow_map_size));
-    const size_t per_sample = 6 * size_t(map_size) * size_t(map_size) * sizeof(float);
-    batch = std::clamp<size_t>(kShadowBatchBytes / per_sample, 1, samples.size());
-    batch = std::min(batch, size_t(std::max(max_layers / 6, 1)));
-    // Near and far only clip: distances are stored exactly and nearest-kept by GL_MIN, so a
-    // near plane far below any feature size (1e-6 of the scene) costs no precision.
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    for (const Vertex& v : vertices) {
-      lo = glm::min(lo, v.position);
-      hi = glm::max(hi, v.position);
-    }
-    float reach = 0.0f;
-    for (const LightSample& ls : samples)
-      reach = std::max(
-          reach, glm::length(glm::max(glm::abs(ls.position - lo), glm::abs(ls.position - hi))));
-    if (vertices.empty()) reach = 1.0f;
-    reach = std::max(reach, 1e-3f);
-    light_projection = glm::perspective(glm::radians(90.0f), 1.0f, 1e-6f * reach, 2.0f * reach);
-    RVR_TRY(ensure_shadow_maps(map_size, int(6 * batch)));
+// --- shadow-map plan (full mode): resolution, batches, light-space projection
+Expected<ShadowPlan> GlRasterizer::Impl::plan_shadows(const RenderOptions& options,
+                                                      const std::vector<LightSample>& samples,
+                                                      RenderOutput& out) {
+  ShadowPlan plan;
+  plan.enabled = options.mode == RenderMode::Full && !samples.empty();
+  plan.batch = std::max<size_t>(samples.size(), 1);
+  if (!plan.enabled) return plan;
+  if (options.shadow_map_size < 1)
+    return bad_input(fmt::format("shadow map size {} must be positive", options.shadow_map_size));
+  if (!(options.shadow_bias >= 0.0f) || !std::isfinite(options.shadow_bias))
+    return bad_input(fmt::format("shadow bias {} must be >= 0", options.shadow_bias));
+  int map_size = std::min(options.shadow_map_size, max_texture_size);
+  const double texels = 6.0 * double(samples.size()) * double(map_size) * double(map_size);
+  if (texels > kShadowTexelBudget) {
+    const int fit = int(std::sqrt(kShadowTexelBudget / (6.0 * double(samples.size()))));
+    map_size = std::max(std::min(map_size, kShadowMinSize), fit);
   }
-
-  // --- multisampling: colour into a multisampled FBO, resolved into the colour target
-  int msaa = 1;
-  if (shade && scene.image.samples_per_pixel > 1) {
-    msaa = std::min(scene.image.samples_per_pixel, int(max_samples));
-    if (msaa < scene.image.samples_per_pixel)
-      out.warnings.push_back(
-          fmt::format("{} samples per pixel requested; the GL allows {}, rendered {}",
-                      scene.image.samples_per_pixel, max_samples, msaa));
-    RVR_TRY(ensure_msaa(msaa));
+  if (map_size < options.shadow_map_size)
+    out.warnings.push_back(
+        fmt::format("shadow maps of {} texels per side for {} light samples ({} requested)",
+                    map_size, samples.size(), options.shadow_map_size));
+  const size_t per_sample = 6 * size_t(map_size) * size_t(map_size) * sizeof(float);
+  size_t batch = std::clamp<size_t>(kShadowBatchBytes / per_sample, 1, samples.size());
+  batch = std::min(batch, size_t(std::max(max_layers / 6, 1)));
+  // Near and far only clip: distances are stored exactly and nearest-kept by GL_MIN, so a
+  // near plane far below any feature size (1e-6 of the scene) costs no precision.
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  for (const Vertex& v : vertices) {
+    lo = glm::min(lo, v.position);
+    hi = glm::max(hi, v.position);
   }
+  float reach = 0.0f;
+  for (const LightSample& ls : samples)
+    reach = std::max(reach,
+                     glm::length(glm::max(glm::abs(ls.position - lo), glm::abs(ls.position - hi))));
+  if (vertices.empty()) reach = 1.0f;
+  reach = std::max(reach, 1e-3f);
+  plan.light_projection = glm::perspective(glm::radians(90.0f), 1.0f, 1e-6f * reach, 2.0f * reach);
+  plan.map_size = map_size;
+  plan.batch = batch;
+  RVR_TRY(ensure_shadow_maps(map_size, int(6 * batch)));
+  return plan;
+}
 
-  // --- scene passes: z-buffer visibility, ids, depth, normal, shading
-  double shadow_time = 0.0;
-  t = Clock::now();
-  // One accumulation-buffer pass (the hybrid's): the camera as that sample sees it.
-  const glm::mat4 view = options.image_sample
-                             ? sample_view_matrix(scene.camera, *options.image_sample)
-                             : view_matrix(scene.camera);
-  const glm::mat4 projection =
-      options.image_sample ? sample_projection_matrix(scene.camera, w, h, *options.image_sample)
-                           : projection_matrix(scene.camera, w, h);
+// One draw of every object with the scene program; the caller sets the pass's state.
+void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size_t first,
+                                    size_t end, bool base) {
+  static const std::array<glm::mat3, 6> rotations = face_rotations();
+  const Scene& scene = pass.scene;
+  gl().UseProgram(scene_program);
+  gl().UniformMatrix4fv(su.view, 1, GL_FALSE, glm::value_ptr(pass.view));
+  gl().UniformMatrix4fv(su.projection, 1, GL_FALSE, glm::value_ptr(pass.projection));
+  gl().Uniform3fv(su.eye, 1, glm::value_ptr(scene.camera.eye));
+  gl().Uniform3fv(su.ambient, 1, glm::value_ptr(scene.ambient));
+  gl().Uniform3fv(su.background, 1, glm::value_ptr(scene.image.background));
+  gl().Uniform1i(su.shade, shade_pass ? 1 : 0);
+  gl().Uniform1i(su.lights, kLightUnit);
+  gl().Uniform1i(su.light_first, GLint(first));
+  gl().Uniform1i(su.light_end, GLint(end));
+  gl().Uniform1i(su.base, base ? 1 : 0);
+  gl().Uniform1i(su.shadows, pass.shadows.enabled ? 1 : 0);
+  gl().Uniform1i(su.shadow_maps, kShadowUnit);
+  gl().UniformMatrix3fv(su.face_rotation, 6, GL_FALSE, glm::value_ptr(rotations[0]));
+  gl().Uniform1f(su.shadow_bias, pass.options.shadow_bias);
+  // A texel spans at most 2/size in tan units (at a face centre): normal offset and slope bias
+  // are measured in it (gl_shaders.h, shadow_visibility).
+  gl().Uniform1f(su.shadow_texel,
+                 pass.shadows.map_size > 0 ? 2.0f / float(pass.shadows.map_size) : 0.0f);
+  gl().Uniform1i(su.shadow_pcf, pass.options.shadow_pcf ? 1 : 0);
+  for (const DrawItem& d : pass.upload.draws) {
+    gl().Uniform1ui(su.object_id, d.object);
+    gl().Uniform1i(su.smooth, d.smooth ? 1 : 0);
+    gl().Uniform1i(su.use_primitive_id, d.use_primitive_id ? 1 : 0);
+    gl().Uniform3fv(su.diffuse, 1, glm::value_ptr(d.material->diffuse));
+    gl().Uniform3fv(su.specular, 1, glm::value_ptr(d.material->specular));
+    gl().Uniform3fv(su.emission, 1, glm::value_ptr(d.material->emission));
+    gl().Uniform1f(su.shininess, d.material->shininess);
+    gl().DrawArrays(GL_TRIANGLES, d.first, d.count);
+  }
+}
+
+void GlRasterizer::Impl::clear_scene_targets(const Scene& scene) {
   const float inf = std::numeric_limits<float>::infinity();
   const glm::vec4 background(scene.image.background, 1.0f);
   const glm::vec4 zero(0.0f);
   const GLuint no_id[4] = {kNoId, kNoId, kNoId, kNoId};
   const GLfloat far_view[4] = {inf, 0.0f, 0.0f, 0.0f};
   const GLfloat depth_one = 1.0f;
-  const GLenum colour_only = GL_COLOR_ATTACHMENT0;
+  gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+  draw_to_every_target();
+  gl().ClearBufferfv(GL_COLOR, kColour, glm::value_ptr(background));
+  gl().ClearBufferuiv(GL_COLOR, kObjectId, no_id);
+  gl().ClearBufferuiv(GL_COLOR, kPrimitiveId, no_id);
+  gl().ClearBufferfv(GL_COLOR, kViewDepth, far_view);
+  gl().ClearBufferfv(GL_COLOR, kNormal, glm::value_ptr(zero));
+  gl().ClearBufferfv(GL_DEPTH, 0, &depth_one);
+}
+
+void GlRasterizer::Impl::draw_to_every_target() {
   std::array<GLenum, kCost> all_outputs{};
   for (int i = 0; i < kCost; ++i) all_outputs[size_t(i)] = GLenum(GL_COLOR_ATTACHMENT0 + i);
-  static const std::array<glm::mat3, 6> rotations = face_rotations();
+  gl().DrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
+}
 
-  // One draw of every object with the scene program; the caller sets the pass's state.
-  auto draw_scene = [&](bool shade_pass, size_t first, size_t end, bool base) {
-    gl().UseProgram(scene_program);
-    gl().UniformMatrix4fv(su.view, 1, GL_FALSE, glm::value_ptr(view));
-    gl().UniformMatrix4fv(su.projection, 1, GL_FALSE, glm::value_ptr(projection));
-    gl().Uniform3fv(su.eye, 1, glm::value_ptr(scene.camera.eye));
-    gl().Uniform3fv(su.ambient, 1, glm::value_ptr(scene.ambient));
-    gl().Uniform3fv(su.background, 1, glm::value_ptr(scene.image.background));
-    gl().Uniform1i(su.shade, shade_pass ? 1 : 0);
-    gl().Uniform1i(su.lights, kLightUnit);
-    gl().Uniform1i(su.light_first, GLint(first));
-    gl().Uniform1i(su.light_end, GLint(end));
-    gl().Uniform1i(su.base, base ? 1 : 0);
-    gl().Uniform1i(su.shadows, shadows ? 1 : 0);
-    gl().Uniform1i(su.shadow_maps, kShadowUnit);
-    gl().UniformMatrix3fv(su.face_rotation, 6, GL_FALSE, glm::value_ptr(rotations[0]));
-    gl().Uniform1f(su.shadow_bias, options.shadow_bias);
-    // A texel spans at most 2/size in tan units (at a face centre): normal offset and slope bias
-    // are measured in it (gl_shaders.h, shadow_visibility).
-    gl().Uniform1f(su.shadow_texel, map_size > 0 ? 2.0f / float(map_size) : 0.0f);
-    gl().Uniform1i(su.shadow_pcf, options.shadow_pcf ? 1 : 0);
-    for (const DrawItem& d : draws) {
-      gl().Uniform1ui(su.object_id, d.object);
-      gl().Uniform1i(su.smooth, d.smooth ? 1 : 0);
-      gl().Uniform1i(su.use_primitive_id, d.use_primitive_id ? 1 : 0);
-      gl().Uniform3fv(su.diffuse, 1, glm::value_ptr(d.material->diffuse));
-      gl().Uniform3fv(su.specular, 1, glm::value_ptr(d.material->specular));
-      gl().Uniform3fv(su.emission, 1, glm::value_ptr(d.material->emission));
-      gl().Uniform1f(su.shininess, d.material->shininess);
-      gl().DrawArrays(GL_TRIANGLES, d.first, d.count);
-    }
-  };
-  auto clear_scene_targets = [&] {
-    gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
-    gl().DrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
-    gl().ClearBufferfv(GL_COLOR, kColour, glm::value_ptr(background));
-    gl().ClearBufferuiv(GL_COLOR, kObjectId, no_id);
-    gl().ClearBufferuiv(GL_COLOR, kPrimitiveId, no_id);
-    gl().ClearBufferfv(GL_COLOR, kViewDepth, far_view);
-    gl().ClearBufferfv(GL_COLOR, kNormal, glm::value_ptr(zero));
-    gl().ClearBufferfv(GL_DEPTH, 0, &depth_one);
-  };
+// --- scene passes: z-buffer visibility, ids, depth, normal, shading; shadow maps per batch
+Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderOutput& out) {
+  const int w = pass.scene.image.width, h = pass.scene.image.height;
+  const std::vector<LightSample>& samples = pass.upload.samples;
+  const ShadowPlan& shadows = pass.shadows;
+  const bool shade = pass.options.mode != RenderMode::Visibility;
+  const glm::vec4 background(pass.scene.image.background, 1.0f);
+  const GLfloat depth_one = 1.0f;
+  const GLenum colour_only = GL_COLOR_ATTACHMENT0;
+  ProgressSink* progress = pass.options.progress;
+  double shadow_time = 0.0;
+  auto t = Clock::now();
 
   gl().Disable(GL_CULL_FACE);  // two-sided, like the tracer
   gl().Disable(GL_BLEND);
   gl().ActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
   gl().BindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
   gl().ActiveTexture(GL_TEXTURE0);
-  const size_t batches = shadows ? (samples.size() + batch - 1) / batch : 1;
+  const size_t batches = shadows.enabled ? (samples.size() + shadows.batch - 1) / shadows.batch : 1;
   // With several batches of light samples, progress counts passes (the speed, triangles drawn,
   // shadow maps' six faces per sample included); one pass shows its time only. GL is
   // asynchronous: a pass counts when submitted; the next batch's glFinish waits for it.
@@ -702,10 +741,11 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
       progress->begin("render");
   }
   for (size_t b = 0; b < batches; ++b) {
-    const size_t first = b * batch, end = std::min(samples.size(), first + batch);
-    if (shadows) {
+    const size_t first = b * shadows.batch, end = std::min(samples.size(), first + shadows.batch);
+    if (shadows.enabled) {
       auto ts = Clock::now();
-      RVR_TRY(render_shadow_maps(samples, first, end, light_projection, GLsizei(vertices.size())));
+      RVR_TRY(render_shadow_maps(samples, first, end, shadows.light_projection,
+                                 GLsizei(vertices.size())));
       gl().Finish();
       shadow_time += seconds_since(ts);
     }
@@ -720,10 +760,10 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
         gl().ClearBufferfv(GL_COLOR, 0, glm::value_ptr(background));
         gl().ClearBufferfv(GL_DEPTH, 0, &depth_one);
       } else {
-        clear_scene_targets();
+        clear_scene_targets(pass.scene);
         gl().BeginQuery(GL_SAMPLES_PASSED, query);
       }
-      draw_scene(shade, first, end, true);
+      draw_scene(pass, shade, first, end, true);
       if (msaa == 1) gl().EndQuery(GL_SAMPLES_PASSED);
     } else {
       // Additive pass for this batch's lights, on exactly the surfaces the base pass kept.
@@ -733,68 +773,66 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
       gl().DepthMask(GL_FALSE);
       gl().Enable(GL_BLEND);
       gl().BlendFunc(GL_ONE, GL_ONE);
-      draw_scene(true, first, end, false);
+      draw_scene(pass, true, first, end, false);
       gl().Disable(GL_BLEND);
       gl().DepthMask(GL_TRUE);
       gl().DepthFunc(GL_LESS);
     }
     if (progress && batches > 1) {
       const uint64_t triangles = vertices.size() / 3;
-      progress->advance(1, triangles * (1 + (shadows ? 6 * (end - first) : 0)));
+      progress->advance(1, triangles * (1 + (shadows.enabled ? 6 * (end - first) : 0)));
     }
   }
   if (msaa > 1) {
     // The per-pixel AOVs (ids, depth, normal) come from one sample at the pixel centre; the
     // colour is the multisampled one, resolved (averaged) over each pixel's samples.
-    clear_scene_targets();
+    clear_scene_targets(pass.scene);
     gl().BeginQuery(GL_SAMPLES_PASSED, query);
-    draw_scene(false, 0, 0, true);
+    draw_scene(pass, false, 0, 0, true);
     gl().EndQuery(GL_SAMPLES_PASSED);
     gl().BindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo);
     gl().ReadBuffer(GL_COLOR_ATTACHMENT0);
     gl().BindFramebuffer(GL_DRAW_FRAMEBUFFER, scene_fbo);
     gl().DrawBuffers(1, &colour_only);
     gl().BlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-    gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
-    gl().DrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
-  } else {
-    gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
-    gl().DrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
   }
+  gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+  draw_to_every_target();
   gl().Finish();
   RVR_GL_CHECK("scene pass");
   out.stats["time.render"] = seconds_since(t) - shadow_time;
-  if (shadows) {
+  if (shadows.enabled) {
     out.stats["time.shadow_maps"] = shadow_time;
     out.stats["shadow_map.maps"] = double(samples.size());
     out.stats["shadow_map.faces"] = 6.0 * double(samples.size());
-    out.stats["shadow_map.size"] = double(map_size);
+    out.stats["shadow_map.size"] = double(shadows.map_size);
     out.stats["shadow_map.texels"] =
-        6.0 * double(map_size) * double(map_size) * double(samples.size());
+        6.0 * double(shadows.map_size) * double(shadows.map_size) * double(samples.size());
     out.stats["shadow_map.batches"] = double(batches);
   }
+  return ok_status();
+}
 
-  // --- cost pass: every fragment generated, whatever the depth test would say
-  if (progress) progress->begin("cost");
-  t = Clock::now();
+// --- cost pass: every fragment generated, whatever the depth test would say
+Status GlRasterizer::Impl::cost_pass(const ScenePass& pass) {
+  const glm::vec4 zero(0.0f);
   gl().BindFramebuffer(GL_FRAMEBUFFER, cost_fbo);
   gl().ClearBufferfv(GL_COLOR, 0, glm::value_ptr(zero));
   gl().Disable(GL_DEPTH_TEST);
   gl().Enable(GL_BLEND);
   gl().BlendFunc(GL_ONE, GL_ONE);
   gl().UseProgram(cost_program);
-  gl().UniformMatrix4fv(cost_view, 1, GL_FALSE, glm::value_ptr(view));
-  gl().UniformMatrix4fv(cost_projection, 1, GL_FALSE, glm::value_ptr(projection));
+  gl().UniformMatrix4fv(cost_view, 1, GL_FALSE, glm::value_ptr(pass.view));
+  gl().UniformMatrix4fv(cost_projection, 1, GL_FALSE, glm::value_ptr(pass.projection));
   if (!vertices.empty()) gl().DrawArrays(GL_TRIANGLES, 0, GLsizei(vertices.size()));
   gl().Disable(GL_BLEND);
   gl().Finish();
   RVR_GL_CHECK("cost pass");
-  out.stats["time.cost"] = seconds_since(t);
+  return ok_status();
+}
 
-  // --- readback
-  if (progress) progress->begin("readback");
-  t = Clock::now();
-  FrameBuffers& fb = out.buffers;
+// --- readback: every target into the FrameBuffers, rows flipped (GL rows are bottom-up)
+Status GlRasterizer::Impl::readback(int w, int h, FrameBuffers& fb, uint64_t& samples_passed) {
   fb.width = w;
   fb.height = h;
   const size_t n = fb.pixel_count();
@@ -806,7 +844,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   fb.cost.resize(n);
   gl().PixelStorei(GL_PACK_ALIGNMENT, 1);
   // Each attachment is read in its stored layout into reused scratch memory, then copied once
-  // into the FrameBuffers with rows flipped (GL rows are bottom-up, ours top-down).
+  // into the FrameBuffers with rows flipped.
   auto read_scalar = [&](GLuint fbo, int attachment, GLenum format, GLenum type, auto& dst) {
     using T = typename std::decay_t<decltype(dst)>::value_type;
     static_assert(sizeof(T) == 4);
@@ -838,11 +876,72 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   GLuint64 passed = 0;
   gl().GetQueryObjectui64v(query, GL_QUERY_RESULT, &passed);
   RVR_GL_CHECK("readback");
+  samples_passed = uint64_t(passed);
+  return ok_status();
+}
+
+Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
+                                                  const RenderOptions& options) {
+  const int w = scene.image.width, h = scene.image.height;
+  if (w < 1 || h < 1) return bad_input(fmt::format("image size {}x{} is empty", w, h));
+  RenderOutput out;
+  ProgressSink* progress = options.progress;  // null when nobody is watching
+
+  // --- setup: context, programs (first call only), render targets (on size change)
+  if (progress) progress->begin("setup");
+  auto t = Clock::now();
+  RVR_TRY(init());
+  out.warnings = context_warnings;
+  RVR_TRY(resize(w, h));
+  out.stats["time.setup"] = seconds_since(t);
+
+  if (progress) progress->begin("upload");  // mostly one glBufferData: time only
+  t = Clock::now();
+  Expected<SceneUpload> uploaded = upload(scene, options);
+  if (!uploaded) return uploaded.error();
+  out.stats["time.upload"] = seconds_since(t);
+
+  Expected<ShadowPlan> shadows = plan_shadows(options, uploaded->samples, out);
+  if (!shadows) return shadows.error();
+
+  // --- multisampling: colour into a multisampled FBO, resolved into the colour target
+  int msaa = 1;
+  if (options.mode != RenderMode::Visibility && scene.image.samples_per_pixel > 1) {
+    msaa = std::min(scene.image.samples_per_pixel, int(max_samples));
+    if (msaa < scene.image.samples_per_pixel)
+      out.warnings.push_back(
+          fmt::format("{} samples per pixel requested; the GL allows {}, rendered {}",
+                      scene.image.samples_per_pixel, max_samples, msaa));
+    RVR_TRY(ensure_msaa(msaa));
+  }
+
+  // One accumulation-buffer pass (the hybrid's): the camera as that sample sees it.
+  const ScenePass pass{
+      scene,
+      options,
+      *uploaded,
+      *shadows,
+      options.image_sample ? sample_view_matrix(scene.camera, *options.image_sample)
+                           : view_matrix(scene.camera),
+      options.image_sample ? sample_projection_matrix(scene.camera, w, h, *options.image_sample)
+                           : projection_matrix(scene.camera, w, h)};
+  RVR_TRY(scene_passes(pass, msaa, out));
+
+  if (progress) progress->begin("cost");
+  t = Clock::now();
+  RVR_TRY(cost_pass(pass));
+  out.stats["time.cost"] = seconds_since(t);
+
+  if (progress) progress->begin("readback");
+  t = Clock::now();
+  FrameBuffers& fb = out.buffers;
+  uint64_t passed = 0;
+  RVR_TRY(readback(w, h, fb, passed));
   out.stats["time.readback"] = seconds_since(t);
 
   double generated = 0.0;
   size_t covered = 0;
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i = 0; i < fb.pixel_count(); ++i) {
     generated += double(fb.cost[i]);
     covered += fb.object_id[i] != kNoId ? 1 : 0;
   }
@@ -851,22 +950,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   out.stats["fragments.passed"] = double(passed);
   out.stats["pixels.covered"] = double(covered);
   out.stats["overdraw"] = covered > 0 ? generated / double(covered) : 0.0;
-
-  if (!skipped_csg.empty()) out.warnings.push_back(skipped_csg_warning(skipped_csg));
-  if (options.mode == RenderMode::Full) {
-    // What a z-buffer cannot do, named for this scene only (shadows it does, with shadow maps).
-    std::string mirrors = material_names(draws, [](const Material& m) { return m.mirror > 0.0f; });
-    if (!mirrors.empty())
-      out.warnings.push_back(
-          fmt::format("reflection (mirror materials: {}) not rendered by a z-buffer", mirrors));
-    std::string clear =
-        material_names(draws, [](const Material& m) { return m.transparency > 0.0f; });
-    if (!clear.empty())
-      out.warnings.push_back(
-          fmt::format("refraction/transparency (materials: {}) not rendered", clear));
-    if (scene.camera.aperture_radius > 0.0f)
-      out.warnings.push_back("depth of field (aperture_radius > 0) not rendered: pinhole");
-  }
+  note_what_a_zbuffer_leaves_out(scene, options, *uploaded, out.warnings);
   return out;
 }
 
