@@ -353,3 +353,31 @@ TEST_F(ReportDir, TimingChartHasEveryPhaseOfEveryRenderer) {
   EXPECT_NE(svg.find("<desc id=\"timing-desc\">raster: load 0.002 s, setup 0.01 s"),
             std::string::npos);
 }
+
+// The hybrid's bar splits into its z-buffer passes and its traced rays; the tracer's centre
+// pass (time.render) is part of time.trace and is not stacked twice.
+TEST_F(ReportDir, TimingChartSplitsTheHybridIntoZBufferAndTrace) {
+  ReportInput in = sample_input(dir_.string());
+  in.renderers[1].name = "hybrid";
+  in.renderers[1].stats = {{"time.load", 0.002},  {"time.build", 0.01},
+                           {"time.zbuffer", 0.2}, {"time.trace", 0.3},
+                           {"time.render", 0.25}, {"zbuffer.time.raster", 0.1}};
+  in.renderers[1].seconds = 0.51;  // build + zbuffer + trace: no "other"
+  auto html = report_html(in);
+  ASSERT_TRUE(html.ok()) << html.error().message;
+  const std::string svg = svg_with_id(html.value(), "timing-chart");
+  size_t at = svg.find("<g class=\"bar-row\" data-renderer=\"hybrid\">");
+  ASSERT_NE(at, std::string::npos);
+  const std::string bar = svg.substr(at, svg.find("</g>", at) - at);
+  size_t last = 0;
+  for (const char* phase : {"load", "build", "zbuffer", "trace"}) {
+    size_t found = bar.find(std::string("data-phase=\"") + phase + "\"");
+    ASSERT_NE(found, std::string::npos) << phase;
+    EXPECT_GT(found, last) << phase << " out of pipeline order";
+    last = found;
+  }
+  EXPECT_EQ(bar.find("data-phase=\"render\""), std::string::npos);
+  EXPECT_EQ(bar.find("data-phase=\"other\""), std::string::npos);
+  EXPECT_NE(bar.find("hybrid: trace 0.3 s (of which render 0.25 s)"), std::string::npos);
+  EXPECT_NE(bar.find(">0.512 s</text>"), std::string::npos);  // load + the render call
+}

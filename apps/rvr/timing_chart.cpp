@@ -32,11 +32,15 @@ struct Phase {
   double seconds = 0.0;
 };
 
-const std::map<std::string, std::string> kNestedPhases = {{"time.bvh_build", "time.build"}};
+// The hybrid's time.render (the tracer's pixel-centre pass) is part of its time.trace (every
+// traced and rebuilt ray), which stands beside time.zbuffer (its visibility passes).
+const std::map<std::string, std::string> kNestedPhases = {{"time.bvh_build", "time.build"},
+                                                          {"time.render", "time.trace"}};
 
 int phase_rank(const std::string& name) {
-  static const char* order[] = {"load",   "setup", "build", "upload",   "shadow_maps", "raster",
-                                "render", "shade", "cost",  "readback", "write"};
+  static const char* order[] = {"load",    "setup",    "build",  "upload", "shadow_maps",
+                                "zbuffer", "raster",   "render", "trace",  "shade",
+                                "cost",    "readback", "write"};
   for (int i = 0; i < int(std::size(order)); ++i)
     if (name == order[i]) return i;
   return name == "other" ? 1000 : 100;
@@ -46,7 +50,9 @@ std::vector<Phase> phases_of(const ReportRenderer& r) {
   std::vector<Phase> phases;
   double in_call = 0.0;
   for (const auto& [key, value] : r.stats) {
-    if (key.rfind("time.", 0) != 0 || kNestedPhases.count(key) || !std::isfinite(value) ||
+    const auto nested = kNestedPhases.find(key);
+    if (key.rfind("time.", 0) != 0 ||
+        (nested != kNestedPhases.end() && r.stats.count(nested->second)) || !std::isfinite(value) ||
         value < 0)
       continue;
     phases.push_back({key.substr(5), value});
@@ -148,11 +154,10 @@ std::string timing_chart(const std::vector<ReportRenderer>& renderers) {
       at += p.seconds;
       const char* const* c = colour(p.name);
       std::string tip = renderers[i].name + ": " + p.name + " " + fmt_s(p.seconds);
-      if (p.name == "build")
-        for (const auto& [nested, parent] : kNestedPhases)
-          if (auto it = renderers[i].stats.find(nested);
-              parent == "time.build" && it != renderers[i].stats.end())
-            tip += " (of which " + nested.substr(5) + " " + fmt_s(it->second) + ")";
+      for (const auto& [nested, parent] : kNestedPhases)
+        if (auto it = renderers[i].stats.find(nested);
+            parent == "time." + p.name && it != renderers[i].stats.end())
+          tip += " (of which " + nested.substr(5) + " " + fmt_s(it->second) + ")";
       o << "<rect data-phase=\"" << escape_html(p.name) << "\" x=\"" << x0 << "\" y=\"" << y
         << "\" width=\"" << std::max(0.0, x1 - x0) << "\" height=\"" << kBar << "\" fill=\"" << c[0]
         << "\"><title>" << escape_html(tip) << "</title></rect>";
