@@ -627,11 +627,13 @@ bool starts_like_json(const std::string& path) {
 // which it was.
 Expected<Scene> load_path(const std::string& path, const SceneOverrides& overrides, bool* model) {
   *model = true;
-  if (is_model_file_name(path)) return load_model_scene(path, overrides);
+  // Missing files, folders and devices: the scene reader's messages, as before model files.
   std::error_code ec;
+  bool regular = fs::is_regular_file(path, ec);
+  if (regular && is_model_file_name(path)) return load_model_scene(path, overrides);
   std::string ext = fs::path(path).extension().string();
   bool named_json = ext == ".json" || ext == ".JSON";
-  if (!named_json && fs::is_regular_file(path, ec) && !starts_like_json(path)) {
+  if (!named_json && regular && !starts_like_json(path)) {
     Expected<Scene> scene = load_model_scene(path, overrides);
     if (scene.ok()) return scene;
   }
