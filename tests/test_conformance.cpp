@@ -6,8 +6,10 @@
 // whose hits are the tracer's: both must hold).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <set>
 
 #include "rvr/renderers/registry.h"
@@ -31,12 +33,19 @@ void PrintTo(const RendererCase& r, std::ostream* os) {
   *os << r.choice.name << " vs " << r.reference;
 }
 
+// Each pair once: "raytrace vs raster" would repeat "raster vs raytrace" (the metrics are
+// symmetric but for which image is A), so a choice that is some earlier case's reference, with
+// that case's renderer as its own reference, is left out.
 std::vector<RendererCase> renderer_cases() {
   std::vector<RendererCase> cases;
   for (const RendererChoice& c : renderer_choices()) {
     std::string reference;
     for (const RendererInfo& r : renderers())
       if (reference.empty() && r.order != c.info->order) reference = r.name;
+    const bool repeated = std::any_of(cases.begin(), cases.end(), [&](const RendererCase& k) {
+      return k.choice.name == reference && k.reference == c.name;
+    });
+    if (repeated) continue;
     RendererConfig config;
     RenderOptions options;
     c.apply(config, options);
@@ -72,6 +81,24 @@ TEST(ConformanceScenes, CoverEveryBuiltinSceneButCsg) {
 constexpr double kMinAgreement = 0.999;
 constexpr double kMaxDepthRelError = 1e-3;
 constexpr double kMinPsnr = 40.0;
+// - colour per object, over the pixels away from every edge (colour_error_by_object), the
+//   largest channel difference and its mean over the region:
+//   - one sample per pixel: both shade the same surface point (the pixel centre's) with the
+//     same equation in float; only how the point and normal are found differs (GL interpolates
+//     them per fragment, the tracer from its own barycentrics), about 1e-5 apart. The steepest
+//     term, Blinn-Phong with exponent 64, turns a normal error e into at most 64 e of colour
+//     per unit of light: 1e-3 at a pixel. Rounding averages out over a region: 1e-5 mean, which
+//     a wrong term on one pixel in 400 of a region (a 1/255 step) already crosses. Measured
+//     on this suite: at most 8e-5 and 8e-7.
+//   - several samples per pixel (dof has 16): each renderer averages the shading at its own
+//     sample positions (GL's multisample pattern, the tracer's jittered strata), so a pixel may
+//     differ by the colour's change across a fraction of a pixel, largest at a highlight's
+//     rim: 1e-2 at a pixel, 1e-3 mean. Measured: 3.1e-3 and 3.7e-4 (raster vs raytrace, dof).
+// - SSIM: see the test.
+constexpr double kMaxRegionColourError = 1e-3, kMaxRegionMeanColourError = 1e-5;
+constexpr double kMaxRegionColourErrorMultisampled = 1e-2,
+                 kMaxRegionMeanColourErrorMultisampled = 1e-3;
+constexpr double kSsimSlack = 1e-3;
 constexpr int kSegments = 48;
 
 // Renders with a table entry or variant, by name: its changes go over these settings.
@@ -107,6 +134,92 @@ std::string worst_depth(const FrameBuffers& a, const FrameBuffers& b) {
   return "worst at (" + std::to_string(at % a.width) + ", " + std::to_string(at / a.width) +
          "), object " + std::to_string(a.object_id[at]) + ": " + std::to_string(a.depth[at]) +
          " vs " + std::to_string(b.depth[at]);
+}
+
+// Primitives the scene holds as a renderer draws it with spheres as meshes, counted from the
+// scene alone: a mesh's own triangles; a UV sphere of `segments` longitudes and segments / 2
+// rings has two pole fans of `segments` triangles and segments / 2 - 2 bands of 2 * segments,
+// segments * (segments - 2) in all; a square is two triangles for a z-buffer and one analytic
+// primitive for a tracer (`square_primitives`).
+size_t scene_primitives(const Scene& scene, int segments, size_t square_primitives) {
+  size_t n = 0;
+  for (const Object& o : scene.objects) {
+    switch (o.type) {
+      case ObjectType::Triangles:
+        n += o.mesh.triangles.size();
+        break;
+      case ObjectType::Sphere:
+        n += size_t(segments) * size_t(segments - 2);
+        break;
+      case ObjectType::Plane:
+        n += square_primitives;
+        break;
+      case ObjectType::Csg:  // no z-buffer form (kScenes has none)
+        break;
+    }
+  }
+  return n;
+}
+
+// What a renderer says it drew or traced, from its stats (docs/cli.md), and what the scene
+// holds in that form: the z-buffers' triangles.submitted and the hybrids' z-buffer pass count
+// triangles; the tracers' primitives are triangles plus analytic squares. -1 when none.
+struct Drawn {
+  double reported = -1;
+  double expected = -1;
+};
+Drawn primitives_drawn(const RenderOutput& out, const Scene& scene) {
+  auto stat = [&](const char* key) {
+    auto it = out.stats.find(key);
+    return it == out.stats.end() ? -1.0 : it->second;
+  };
+  const double zbuffer = stat("zbuffer.triangles.submitted") >= 0
+                             ? stat("zbuffer.triangles.submitted")
+                             : stat("triangles.submitted");
+  if (zbuffer >= 0) return {zbuffer, double(scene_primitives(scene, kSegments, 2))};
+  return {stat("primitives"), double(scene_primitives(scene, kSegments, 1))};
+}
+
+// Colour error of the pixels away from every edge, per object: pixels whose (object,
+// primitive) id agrees and none of whose 3x3 neighbourhood lies on an id boundary in either
+// image. There both renderers shade the same surface point with the same equation, so any
+// difference is shading, not coverage.
+struct RegionError {
+  size_t pixels = 0;
+  double sum = 0, max = 0;
+  int max_x = 0, max_y = 0;
+  double mean() const { return pixels ? sum / double(pixels) : 0.0; }
+};
+
+std::map<uint32_t, RegionError> colour_error_by_object(const FrameBuffers& a,
+                                                       const FrameBuffers& b) {
+  std::vector<bool> edge = id_boundaries(a);
+  const std::vector<bool> edge_b = id_boundaries(b);
+  for (size_t i = 0; i < edge.size(); ++i) edge[i] = edge[i] || edge_b[i];
+  std::map<uint32_t, RegionError> regions;
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      const size_t i = a.index(x, y);
+      if (a.object_id[i] == kNoId || a.object_id[i] != b.object_id[i] ||
+          a.primitive_id[i] != b.primitive_id[i])
+        continue;
+      bool near_edge = false;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          if (xx >= 0 && yy >= 0 && xx < a.width && yy < a.height && edge[a.index(xx, yy)])
+            near_edge = true;
+        }
+      if (near_edge) continue;
+      double d = 0;
+      for (int c = 0; c < 3; ++c) d = std::max(d, double(std::abs(a.color[i][c] - b.color[i][c])));
+      if (std::isnan(d)) d = 1.0;
+      RegionError& r = regions[a.object_id[i]];
+      ++r.pixels;
+      r.sum += d;
+      if (d > r.max) r.max = d, r.max_x = x, r.max_y = y;
+    }
+  return regions;
 }
 
 class Conformance : public ::testing::TestWithParam<std::tuple<RendererCase, const char*>> {};
@@ -149,9 +262,42 @@ TEST_P(Conformance, AgreesWithTheOtherLoopOrder) {
       << m.visibility.mismatched_pixels << " mismatched pixels";
   EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
   EXPECT_LE(m.depth.max_rel_error, kMaxDepthRelError) << worst_depth(a.buffers, b.buffers);
+  EXPECT_EQ(m.depth.outliers_elsewhere, 0u) << worst_depth(a.buffers, b.buffers);
   EXPECT_GE(m.color.psnr_db, kMinPsnr);
+
+  // SSIM: a window without a mismatched pixel sees the same structure in both images, and
+  // its luminance term differs from 1 by about (colour error)^2 / (2 mean^2): below 1e-3
+  // (kSsimSlack) for the region errors allowed below (mean 1e-3 at most) on surfaces brighter
+  // than 0.05. A window holding a mismatch may drop to anything: 11x11 windows, so at most
+  // 121 windows per mismatched pixel.
+  const double windows_with_a_mismatch =
+      std::min(1.0, 121.0 * double(m.visibility.mismatched_pixels) / double(m.visibility.pixels));
+  EXPECT_GE(m.color.ssim, 1.0 - windows_with_a_mismatch - kSsimSlack)
+      << m.visibility.mismatched_pixels << " mismatched pixels";
+
+  // Colour per object, away from edges: the whole-image PSNR lets a wrong region of 1% of the
+  // image pass; these do not.
+  for (const auto& [object, region] : colour_error_by_object(a.buffers, b.buffers)) {
+    const std::string where = "object " + std::to_string(object) + " (" +
+                              scene->objects[object].name + "), worst at (" +
+                              std::to_string(region.max_x) + ", " + std::to_string(region.max_y) +
+                              ") of " + std::to_string(region.pixels) + " pixels";
+    const bool multisampled = scene->image.samples_per_pixel > 1;
+    EXPECT_LE(region.max, multisampled ? kMaxRegionColourErrorMultisampled : kMaxRegionColourError)
+        << where;
+    EXPECT_LE(region.mean(),
+              multisampled ? kMaxRegionMeanColourErrorMultisampled : kMaxRegionMeanColourError)
+        << where;
+  }
+
+  // Every triangle of the scene drawn (or traced): a dropped one hides among edge ties in a
+  // dense mesh, where every pixel is near an edge.
+  const Drawn drawn_a = primitives_drawn(a, *scene), drawn_b = primitives_drawn(b, *scene);
+  EXPECT_EQ(drawn_a.reported, drawn_a.expected) << r.choice.name;
+  EXPECT_EQ(drawn_b.reported, drawn_b.expected) << r.reference;
   RecordProperty("id_agreement", std::to_string(m.visibility.id_agreement));
   RecordProperty("psnr_db", std::to_string(m.color.psnr_db));
+  RecordProperty("ssim", std::to_string(m.color.ssim));
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryRendererEveryScene, Conformance,
