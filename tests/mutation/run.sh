@@ -74,8 +74,8 @@ build_and_test() {  # $1: name for the log; prints the failed cases, one per lin
   }
   ctest --test-dir "$build" -L "$label" -j "$jobs" --output-on-failure >"$work/$1.test.log" 2>&1 ||
     true
-  sed -n 's/^ *[0-9]* - \(.*\) (\(Failed\|Timeout\|SEGFAULT\|Subprocess aborted\|Exception\|Not Run\)).*/\1/p' \
-    "$work/$1.test.log"
+  sed -n 's/^[[:space:]]*[0-9]* - \(.*\) (\(Failed\|Timeout\|SEGFAULT\|Subprocess aborted\|Exception\|Not Run\)).*/\1/p' \
+    "$work/$1.test.log" | sed 's/  # GetParam() = .*//'
 }
 
 # Each mutation: file, then a sed program; the sed must change the file.
@@ -118,6 +118,12 @@ if [[ -n $baseline ]]; then
   sed 's/^/  /' <<<"$baseline"
 fi
 
+# Failed cases grouped: "Suite.Case (n)" for the parameterised ones (Prefix/Suite.Case/param).
+summarise() {
+  sed -E 's#^[^/]+/([^/]+)/.*#\1#' | sort | uniq -c |
+    awk '{printf "%s%s%s", (NR > 1 ? ", " : ""), $2, ($1 > 1 ? " (" $1 ")" : "")}'
+}
+
 status=0
 table=""
 for m in "${selected[@]}"; do
@@ -134,13 +140,13 @@ for m in "${selected[@]}"; do
     table+="| $m | NOT CAUGHT |"$'\n'
   else
     sed 's/^/   caught by: /' <<<"$failed"
-    table+="| $m | $(grep -c . <<<"$failed") cases: $(paste -sd, <<<"$failed" | sed 's/,/, /g') |"$'\n'
+    table+="| $m | $(grep -c . <<<"$failed"): $(summarise <<<"$failed") |"$'\n'
   fi
 done
 sync_tree  # leave the kept tree as committed
 
 echo
-echo "| mutation | ctest cases that failed (label $label) |"
+echo "| mutation | ctest cases that failed (label $label): how many, then by case (renderers) |"
 echo "|---|---|"
 printf '%s' "$table"
 exit $status
