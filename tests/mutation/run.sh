@@ -113,6 +113,10 @@ fi
 
 echo "== baseline (no mutation): fast programs: ${targets[*]}"
 baseline=$(build_and_test baseline)
+if [[ $baseline == "BUILD FAILED"* ]]; then
+  echo "baseline: $baseline"
+  exit 2
+fi
 if [[ -n $baseline ]]; then
   echo "baseline failures (left out of every mutation's list):"
   sed 's/^/  /' <<<"$baseline"
@@ -134,7 +138,11 @@ for m in "${selected[@]}"; do
   if [[ -n $baseline ]]; then
     failed=$(grep -vxF -f <(printf '%s\n' "$baseline") <<<"$failed" || true)
   fi
-  if [[ -z $failed ]]; then
+  if [[ $failed == "BUILD FAILED"* ]]; then  # a mutation that does not compile proves nothing
+    echo "   $failed"
+    status=1
+    table+="| $m | build failed |"$'\n'
+  elif [[ -z $failed ]]; then
     echo "   NOT CAUGHT"
     status=1
     table+="| $m | NOT CAUGHT |"$'\n'
