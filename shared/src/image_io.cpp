@@ -1,10 +1,9 @@
 // Image files through OpenImageIO, written atomically (temporary name in the same folder, then
-// rename). No codec is written by hand: OpenImageIO picks the format from the extension.
+// rename). No codec is written by hand: OpenImageIO picks the format from the extension. It is
+// reached through the image codec module, loaded on the first read or write
+// (image_codec_loader.h), so runs without images never load it.
 #include "rvr/shared/image_io.h"
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
-#include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,6 +20,8 @@
 #include <string>
 #include <system_error>
 #include <vector>
+
+#include "image_codec_loader.h"
 
 namespace fs = std::filesystem;
 
@@ -127,72 +128,58 @@ std::string first_line(std::string s) {
 
 bool write_pixels(const fs::path& temp, const Image& image, bool linear_to_srgb,
                   std::string& reason) {
-  std::string ext = lower(fs::path(temp).extension().string());
-  auto out = OIIO::ImageOutput::create(temp.string());
-  if (!out) {
-    reason = first_line(OIIO::geterror());
-    if (reason == "unknown error") reason = "no image format for extension '" + ext + "'";
+  Expected<const rvr_image_codec*> codec = image_codec();
+  if (!codec) {
+    reason = codec.error().message;
     return false;
   }
+  const std::string ext = lower(fs::path(temp).extension().string());
   const bool as_float = is_float_format(ext);
-  OIIO::ImageSpec spec(image.width, image.height, image.channels,
-                       as_float ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-  if (image.channel_names.size() == size_t(image.channels)) {
-    spec.channelnames = image.channel_names;
-    // A lone "Z" channel is depth to OpenImageIO; do not let it take it for alpha.
-    spec.alpha_channel = -1;
-    for (int c = 0; c < image.channels; ++c) {
-      if (image.channel_names[c] == "A") spec.alpha_channel = c;
-      if (image.channel_names[c] == "Z") spec.z_channel = c;
-    }
-  }
+  std::vector<const char*> names;
+  if (image.channel_names.size() == size_t(image.channels))
+    for (const std::string& n : image.channel_names) names.push_back(n.c_str());
   // 8-bit files hold display (sRGB-encoded) values either way: encoded here from linear, or
   // already display referred (heat maps).
-  spec.attribute("oiio:ColorSpace", as_float ? "Linear" : "sRGB");
-
-  bool ok = false;
-  if (!out->open(temp.string(), spec)) {
-    reason = first_line(out->geterror());
-    return false;
-  }
-  if (as_float) {
-    ok = out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
-  } else {
-    std::vector<uint8_t> bytes(image.pixels.size());
+  std::vector<uint8_t> bytes;
+  if (!as_float) {
+    bytes.resize(image.pixels.size());
     for (size_t i = 0; i < bytes.size(); ++i) {
       float v = image.pixels[i];
       v = linear_to_srgb ? srgb_encode(v) : (v > 0.0f ? std::min(v, 1.0f) : 0.0f);
       bytes[i] = uint8_t(std::lround(v * 255.0f));
     }
-    ok = out->write_image(OIIO::TypeDesc::UINT8, bytes.data());
   }
-  if (!ok) reason = first_line(out->geterror());
-  if (!out->close() && ok) {
-    ok = false;
-    reason = first_line(out->geterror());
+  char err[512] = {};
+  const int ok = (*codec)->write(temp.c_str(), image.width, image.height, image.channels,
+                                 names.empty() ? nullptr : names.data(), as_float ? 1 : 0,
+                                 as_float ? static_cast<const void*>(image.pixels.data())
+                                          : static_cast<const void*>(bytes.data()),
+                                 err, sizeof(err));
+  if (!ok) {
+    reason = first_line(err);
+    if (reason == "no image format for this extension")
+      reason = "no image format for extension '" + ext + "'";
   }
-  return ok;
+  return ok != 0;
 }
 
-// Linear inferno colours of `values` / `scale` (clamped to [0, 1]), through OpenImageIO.
+// Linear inferno colours of `values` / `scale` (clamped to [0, 1]), through OpenImageIO; black
+// where the library cannot be loaded (the write that follows reports why).
 Image inferno_linear(std::span<const float> values, int width, int height, float scale) {
-  OIIO::ImageBuf src(OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::FLOAT));
   std::vector<float> scaled(values.size());
   const float inv = scale > 0.0f ? 1.0f / scale : 0.0f;
   for (size_t i = 0; i < values.size(); ++i) {
     float v = values[i] * inv;
     scaled[i] = v > 0.0f ? std::min(v, 1.0f) : 0.0f;  // NaN -> 0
   }
-  src.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, scaled.data());
-  OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, "inferno");
   Image img;
   img.width = width;
   img.height = height;
   img.channels = 3;
   img.channel_names = {"R", "G", "B"};
   img.pixels.assign(size_t(width) * height * 3, 0.0f);
-  if (mapped.initialized())
-    mapped.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, img.pixels.data());
+  if (Expected<const rvr_image_codec*> codec = image_codec(); codec && width > 0 && height > 0)
+    (*codec)->inferno(scaled.data(), width, height, img.pixels.data());
   return img;
 }
 
@@ -229,19 +216,22 @@ Expected<Image> read_image(const std::string& path) {
     std::error_code ec;
     if (!fs::exists(path, ec)) return fail("no such file");
     if (fs::is_directory(path, ec)) return fail("is a folder");
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) return fail(first_line(OIIO::geterror()));
-    const OIIO::ImageSpec& spec = in->spec();
+    Expected<const rvr_image_codec*> codec = image_codec();
+    if (!codec) return codec.error();
+    char err[512] = {};
     Image img;
-    img.width = spec.width;
-    img.height = spec.height;
-    img.channels = spec.nchannels;
-    img.channel_names = spec.channelnames;
+    rvr_image_reader* in =
+        (*codec)->open(path.c_str(), &img.width, &img.height, &img.channels, err, sizeof(err));
+    if (!in) return fail(first_line(err));
+    std::unique_ptr<rvr_image_reader, void (*)(rvr_image_reader*)> closer(in, (*codec)->close);
     if (img.width <= 0 || img.height <= 0 || img.channels <= 0) return fail("empty image");
+    for (int c = 0; c < img.channels; ++c) {
+      char name[256];
+      (*codec)->channel_name(in, c, name, sizeof(name));
+      img.channel_names.emplace_back(name);
+    }
     img.pixels.resize(size_t(img.width) * img.height * img.channels);
-    if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data()))
-      return fail(first_line(in->geterror()));
-    in->close();
+    if (!(*codec)->read(in, img.pixels.data(), err, sizeof(err))) return fail(first_line(err));
     return img;
   } catch (const std::exception& e) {
     return bad_input("cannot read '" + path + "': " + e.what());
@@ -349,7 +339,8 @@ Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
 }
 
 std::string openimageio_version() {
-  return OIIO_VERSION_STRING;
+  Expected<const rvr_image_codec*> codec = image_codec();
+  return codec ? std::string((*codec)->library_version()) : "not loaded: " + codec.error().message;
 }
 
 void remove_unfinished_output() noexcept {
