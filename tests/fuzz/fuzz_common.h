@@ -46,11 +46,7 @@ inline void write_file(const std::filesystem::path& p, const uint8_t* data, size
 // The loader must return a scene or an error, never crash, hang or throw. An error must be
 // bad input (exit status 2 in the CLI), one line, starting with the file's name. Returns
 // what the loader returned; a broken promise aborts (so the fuzzer reports it).
-inline Expected<Scene> load_scene_text(const std::filesystem::path& dir, const uint8_t* data,
-                                       size_t size) {
-  std::filesystem::path p = dir / "scene.json";
-  write_file(p, data, size);
-  Expected<Scene> s = load_scene(p.string());
+inline Expected<Scene> check_loaded(const std::filesystem::path& p, Expected<Scene> s) {
   if (!s.ok()) {
     const Error& e = s.error();
     bool well_formed = e.kind == ErrorKind::BadInput && e.message.rfind(p.string(), 0) == 0 &&
@@ -64,8 +60,17 @@ inline Expected<Scene> load_scene_text(const std::filesystem::path& dir, const u
   return s;
 }
 
+inline Expected<Scene> load_scene_text(const std::filesystem::path& dir, const uint8_t* data,
+                                       size_t size) {
+  std::filesystem::path p = dir / "scene.json";
+  write_file(p, data, size);
+  return check_loaded(p, load_scene(p.string()));
+}
+
 // Mesh mode: the first byte picks the file's extension (the importer chooses its reader by
-// it) and whether `smooth` is set; the rest is the mesh file, referenced by a small scene.
+// it) and whether `smooth` is set; the rest is the mesh file, loaded as the scene itself (a
+// model file: its materials, camera and lights read too) and referenced by a small scene,
+// whose result is returned.
 inline constexpr const char* kMeshExtensions[] = {"obj", "ply", "gltf", "3ds",
                                                   "stl", "off", "glb",  "dae"};
 
@@ -77,6 +82,7 @@ inline Expected<Scene> load_mesh_bytes(const std::filesystem::path& dir, const u
   bool smooth = (data[0] / n) % 2 == 1;
   std::string name = "mesh." + ext;
   write_file(dir / name, data + 1, size - 1);
+  check_loaded(dir / name, load_scene((dir / name).string()));
   std::string scene = std::string(R"({"camera": {"eye": [0, 0, 5], "target": [0, 0, 0],)") +
                       R"( "up": [0, 1, 0]}, "objects": [{"type": "mesh", "file": ")" + name +
                       R"(", "smooth": )" + (smooth ? "true" : "false") + "}]}";
