@@ -2,10 +2,14 @@
 // lit, partly lit or shadowed by the area light must agree almost everywhere.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <vector>
 
+#include "closed_form_oracle.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
@@ -168,6 +172,154 @@ TEST(ShadowAgreement, SoftrasterPcfAgreesWithGlPcf) {
   Agreement a = agreement(ours.full, ours.classes, gl.full, gl.classes);
   std::printf("softraster PCF vs GL PCF: %.3f%% of %zu pixels\n", a.percent(), a.compared);
   EXPECT_GE(a.percent(), 99.5);
+}
+
+// Where each renderer puts the edges of hard shadows, against the closed form. builtin:spheres
+// with its first point light only: 25 spheres resting on a floor, their shadows on the floor.
+// Each floor pixel's point P is where the pixel centre's camera ray meets the floor (y = 0),
+// and P is in shadow exactly when the segment from the light to P passes within the radius of a
+// sphere (closed_form_oracle.h; nothing of the renderers' own geometry is used). A renderer may
+// classify a pixel otherwise than that only
+//  - within the tessellation's band: spheres are drawn (and, in mesh mode, traced) as a UV
+//    sphere of `segments` longitudes and segments/2 rings, whose triangles lie between r and
+//    r cos(delta), delta the angular diagonal of one quad of the grid (any point of a triangle
+//    is within delta of one of its vertices, seen from the centre);
+//  - plus, for shadow maps, the map's resolution: the lookup takes the texel the direction
+//    falls in (its centre up to half a diagonal, 0.71 texel, away), the map holds a silhouette
+//    rasterised at texel centres (again up to 0.71 texel off), and the normal offset moves the
+//    lookup by one texel's footprint (1 texel): 2.42, rounded up to 2.5 texels. A texel is at most
+//    2 / size radians wide seen from the light (90-degree faces, widest at their centre);
+//  - or where the depth bias lets light leak through a sphere that meets the floor: a map
+//    pixel lit whose occluder lies within the bias (constant + slope term as in the lookup, its
+//    tangent capped at 8, plus the normal offset) in front of P.
+//  - for shadow rays, the tracer's own offset of their origin off the surface (1e-4 of the
+//    point's largest coordinate, at least 1e-4: ray_tracer.cpp) and float rounding (1e-5 at this
+//    scene's scale), in world units at the occluder.
+// The statistic is each disagreeing pixel's displacement: how far its light ray passes outside
+// the band of the sphere it grazes, in texels of angle seen from the light for shadow maps.
+struct ShadowEdgeStats {
+  size_t floor_pixels = 0, analytic_shadowed = 0, disagree = 0, bias_leak = 0, beyond = 0;
+  double max_displacement_texels = 0.0, max_over_allowed = 0.0;
+  std::vector<size_t> histogram = std::vector<size_t>(4, 0);  // texels: <0.5, <1.5, <2.5, more
+};
+
+constexpr double kMapTexelsAllowed = 2.5;
+
+// map_size 0: shadow rays.
+ShadowEdgeStats shadow_edge_stats(const Scene& s, const Classification& c, int segments,
+                                  int map_size) {
+  using glm::dvec3;
+  const dvec3 light(s.lights[0].position);
+  const double pi = 3.14159265358979323846;
+  const double delta = std::hypot(2.0 * pi / segments, pi / (segments / 2));
+  const double inner = std::cos(delta);  // tessellated spheres lie in [r * inner, r]
+  const double texel_angle = map_size ? 2.0 / map_size : 0.0;
+  uint32_t floor = kNoId;
+  for (size_t o = 0; o < s.objects.size(); ++o)
+    if (s.objects[o].type == ObjectType::Plane) floor = uint32_t(o);
+  ShadowEdgeStats st;
+  const FrameBuffers& fb = c.full;
+  for (int y = 0; y < fb.height; ++y)
+    for (int x = 0; x < fb.width; ++x) {
+      const size_t i = size_t(y) * size_t(fb.width) + size_t(x);
+      if (!c.classes.valid[i] || fb.object_id[i] != floor) continue;
+      const oracle::Ray eye = oracle::camera_ray(s.camera, fb.width, fb.height, x + 0.5, y + 0.5);
+      if (!(eye.direction.y < 0.0)) continue;
+      const dvec3 P = eye.origin + (-eye.origin.y / eye.direction.y) * eye.direction;
+      const dvec3 to_p = P - light;
+      const double length = glm::length(to_p);
+      const dvec3 d = to_p / length;
+      const double ray_slack =
+          1e-4 * std::max({std::abs(P.x), std::abs(P.y), std::abs(P.z), 1.0}) + 1e-5;
+      bool shadowed = false;
+      double texels = INFINITY, over_allowed = INFINITY;  // to the nearest sphere's band
+      double occluder_gap = INFINITY;  // from P back to the nearest sphere surface on the ray
+      for (const Object& o : s.objects) {
+        if (o.type != ObjectType::Sphere) continue;
+        const dvec3 C(o.sphere.center);
+        const double r = o.sphere.radius;
+        const double along = glm::dot(C - light, d);
+        if (along <= 0.0 || along - r >= length) continue;       // behind the light or beyond P
+        const double miss = glm::length(C - light - along * d);  // closest approach
+        if (miss < r) {
+          shadowed = true;
+          const auto t = oracle::hit_sphere({light, d}, o.sphere);
+          if (t && *t < length) occluder_gap = std::min(occluder_gap, length - *t);
+        }
+        const double outside = miss > r ? miss - r : miss < r * inner ? r * inner - miss : 0.0;
+        const double at = std::min(along, length);  // from the light
+        const double allowed = map_size ? kMapTexelsAllowed * texel_angle * at : ray_slack;
+        over_allowed = std::min(over_allowed, outside / allowed);
+        if (map_size) texels = std::min(texels, outside / (texel_angle * at));
+      }
+      ++st.floor_pixels;
+      st.analytic_shadowed += shadowed ? 1 : 0;
+      const LightState want = shadowed ? LightState::Shadowed : LightState::Lit;
+      if (c.classes.state[i] == want) continue;
+      ++st.disagree;
+      if (map_size && shadowed && c.classes.state[i] == LightState::Lit) {
+        const double cos_theta = std::abs(d.y);
+        const double tan_theta = std::min(std::sqrt(1.0 - cos_theta * cos_theta) / cos_theta, 8.0);
+        const double leak =
+            double(RenderOptions{}.shadow_bias) + (0.75 * tan_theta + 1.0) * texel_angle * length;
+        if (occluder_gap <= leak) {
+          ++st.bias_leak;
+          continue;
+        }
+      }
+      st.max_over_allowed = std::max(st.max_over_allowed, over_allowed);
+      st.beyond += over_allowed > 1.0 ? 1 : 0;
+      if (map_size) {
+        st.max_displacement_texels = std::max(st.max_displacement_texels, texels);
+        st.histogram[texels < 0.5 ? 0 : texels < 1.5 ? 1 : texels < 2.5 ? 2 : 3]++;
+      }
+    }
+  return st;
+}
+
+TEST(ShadowAgreement, HardShadowEdgesLieWithinTheMapResolutionOfTheClosedForm) {
+  Scene s = make_builtin_scene("spheres").value();
+  s.lights.resize(1);
+  s.image.samples_per_pixel = 1;
+  const RenderOptions defaults;
+  RayTracer tracer;
+  GlRasterizer raster;
+  SoftRasterizer soft;
+  struct Case {
+    Renderer* renderer;
+    int map_size;  // 0: shadow rays
+  };
+  for (const Case& k : {Case{&tracer, 0}, Case{&raster, 1024}, Case{&soft, 1024},
+                        Case{&raster, 256}, Case{&soft, 256}}) {
+    RenderOptions options;
+    options.spheres = SphereMode::Mesh;
+    options.shadow_map_size = k.map_size ? k.map_size : defaults.shadow_map_size;
+    options.mode = RenderMode::Full;
+    auto full = k.renderer->render(s, options);
+    options.mode = RenderMode::Local;
+    auto local = k.renderer->render(s, options);
+    ASSERT_TRUE(full.ok() && local.ok()) << k.renderer->name();
+    Classification c;
+    c.classes = classify_renders(s, full->buffers, local->buffers);
+    c.full = std::move(full->buffers);
+    const ShadowEdgeStats st = shadow_edge_stats(s, c, defaults.sphere_segments, k.map_size);
+    std::printf(
+        "%s %s: %zu floor pixels, %zu in shadow by the closed form; %zu classified otherwise "
+        "(%zu the bias's leak at contacts), at most %.2f of the allowed displacement",
+        k.renderer->name().c_str(),
+        k.map_size ? ("map " + std::to_string(k.map_size)).c_str() : "rays", st.floor_pixels,
+        st.analytic_shadowed, st.disagree, st.bias_leak, st.max_over_allowed);
+    if (k.map_size)
+      std::printf(
+          "; off the silhouette band by <0.5 texel: %zu, <1.5: %zu, <2.5: %zu, more: %zu "
+          "(max %.2f texels)",
+          st.histogram[0], st.histogram[1], st.histogram[2], st.histogram[3],
+          st.max_displacement_texels);
+    std::printf("\n");
+    EXPECT_GT(st.floor_pixels, c.full.pixel_count() / 4) << k.renderer->name();
+    EXPECT_GT(st.analytic_shadowed, st.floor_pixels / 50) << k.renderer->name();
+    EXPECT_EQ(st.beyond, 0u) << k.renderer->name() << " map " << k.map_size;
+  }
 }
 
 }  // namespace
