@@ -4,6 +4,9 @@
 // oracle) and test_model_compare (rvr compare on bare model files).
 #pragma once
 
+#include <gtest/gtest.h>
+#include <unistd.h>
+
 #include <array>
 #include <cstdint>
 #include <cstring>
@@ -45,6 +48,29 @@ inline std::string num(float x) {
 inline void write_file(const std::filesystem::path& p, const std::string& bytes) {
   std::ofstream(p, std::ios::binary) << bytes;
 }
+
+// A fixture with a fresh folder of its own per test (named after the test and the process, so
+// parallel ctest runs never share one) where the test writes its model files.
+class ModelDirTest : public ::testing::Test {
+ protected:
+  virtual const char* folder_prefix() const = 0;
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() /
+           (folder_prefix() +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+
+  std::string write(const std::string& name, const std::string& bytes) {
+    write_file(dir_ / name, bytes);
+    return (dir_ / name).string();
+  }
+
+  std::filesystem::path dir_;
+};
 
 template <class T>
 void put(std::string& s, T v) {

@@ -27,22 +27,9 @@ std::string slurp(const fs::path& p) {
   return ss.str();
 }
 
-class ModelCompare : public ::testing::Test {
+class ModelCompare : public corpus::ModelDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("rvr_model_compare_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string write(const std::string& name, const std::string& bytes) {
-    corpus::write_file(dir_ / name, bytes);
-    return (dir_ / name).string();
-  }
+  const char* folder_prefix() const override { return "rvr_model_compare_"; }
 
   // rvr compare MODEL -o DIR, as a process; returns its exit status (stderr kept for messages).
   int compare(const std::string& model, const fs::path& out, std::string* err) {
@@ -101,8 +88,6 @@ class ModelCompare : public ::testing::Test {
       }
     }
   }
-
-  fs::path dir_;
 };
 
 TEST_F(ModelCompare, BareObjWithMtl) {

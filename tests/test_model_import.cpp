@@ -23,24 +23,9 @@ namespace corpus = rvr::test::corpus;
 
 namespace {
 
-class ModelFiles : public ::testing::Test {
+class ModelFiles : public corpus::ModelDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("rvr_models_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  std::string write(const std::string& name, const std::string& bytes) {
-    corpus::write_file(dir_ / name, bytes);
-    return (dir_ / name).string();
-  }
-
-  fs::path dir_;
+  const char* folder_prefix() const override { return "rvr_models_"; }
 };
 
 // The oracle: Assimp on its own, triangulating, nothing of rvr's. -1 when it refuses the file.
