@@ -419,6 +419,31 @@ std::optional<Error> check_visibility_size(const Scene& scene, const PrimaryVisi
   return std::nullopt;
 }
 
+// Runs tile(x0, y0, x1, y1, counters) over the image's kTileSize tiles in parallel on `threads`
+// (0: all), and returns the counters of every thread added up.
+template <class Tile>
+RayCounters for_each_tile(int w, int h, int threads, const Tile& tile) {
+  tbb::combinable<RayCounters> counters;
+  const int tiles_x = (w + kTileSize - 1) / kTileSize;
+  const int tiles_y = (h + kTileSize - 1) / kTileSize;
+  tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+  arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
+        [&](const tbb::blocked_range<int>& range) {
+          RayCounters& local = counters.local();
+          for (int t = range.begin(); t != range.end(); ++t) {
+            const int x0 = (t % tiles_x) * kTileSize, y0 = (t / tiles_x) * kTileSize;
+            tile(x0, y0, std::min(x0 + kTileSize, w), std::min(y0 + kTileSize, h), local);
+          }
+        },
+        tbb::simple_partitioner());
+  });
+  RayCounters total;
+  counters.combine_each([&](const RayCounters& c) { total.add(c); });
+  return total;
+}
+
 }  // namespace
 
 Expected<RenderOutput> RayTracer::render_visible(const Scene& scene, const RenderOptions& options,
@@ -444,26 +469,10 @@ Expected<std::map<std::string, double>> RayTracer::add_visible_sample(
   FrameTracer tracer(scene, resolved, geometry);
   const ImageSample sample =
       image_sample(scene.camera, options.seed, k, spp, options.mode == RenderMode::Full);
-  tbb::combinable<RayCounters> counters;
-  const int tiles_x = (w + kTileSize - 1) / kTileSize;
-  const int tiles_y = (h + kTileSize - 1) / kTileSize;
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
-        [&](const tbb::blocked_range<int>& range) {
-          RayCounters& local = counters.local();
-          for (int tile = range.begin(); tile != range.end(); ++tile) {
-            const int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
-            tracer.sample_block_visible(x0, y0, std::min(x0 + kTileSize, w),
-                                        std::min(y0 + kTileSize, h), visible, k, sample, sum.data(),
-                                        local);
-          }
-        },
-        tbb::simple_partitioner());
-  });
-  RayCounters total;
-  counters.combine_each([&](const RayCounters& c) { total.add(c); });
+  const RayCounters total =
+      for_each_tile(w, h, options.threads, [&](int x0, int y0, int x1, int y1, RayCounters& c) {
+        tracer.sample_block_visible(x0, y0, x1, y1, visible, k, sample, sum.data(), c);
+      });
   return std::map<std::string, double>{
       {"rays.primary", double(total.primary)},
       {"rays.shadow", double(total.shadow)},
@@ -490,40 +499,25 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   out.buffers.allocate(w, h);  // every pixel is written below, in parallel
   FrameTracer tracer(scene, options, geometry);
   if (centre_only) tracer.keep_centre_colour();
-  tbb::combinable<RayCounters> counters;
-  const int tiles_x = (w + kTileSize - 1) / kTileSize;
-  const int tiles_y = (h + kTileSize - 1) / kTileSize;
   // The fraction in pixels (known up front), the speed in rays of every kind (known as they go).
   ProgressSink* const progress = options.progress;
   if (progress) progress->begin("trace", uint64_t(w) * uint64_t(h), "pixels", "rays");
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  arena.execute([&] {
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
-        [&](const tbb::blocked_range<int>& range) {
-          RayCounters& local = counters.local();
-          for (int tile = range.begin(); tile != range.end(); ++tile) {
-            int x0 = (tile % tiles_x) * kTileSize, y0 = (tile / tiles_x) * kTileSize;
-            int x1 = std::min(x0 + kTileSize, w), y1 = std::min(y0 + kTileSize, h);
-            const uint64_t rays_before = local.rays();
-            for (int by = y0; by < y1; by += kPacketSide)
-              for (int bx = x0; bx < x1; bx += kPacketSide) {
-                int bx1 = std::min(bx + kPacketSide, x1), by1 = std::min(by + kPacketSide, y1);
-                if (visible)
-                  tracer.render_block_visible(bx, by, bx1, by1, *visible, out.buffers, local);
-                else
-                  tracer.render_block(bx, by, bx1, by1, out.buffers, local);
-              }
-            if (progress)
-              progress->advance(uint64_t(x1 - x0) * uint64_t(y1 - y0), local.rays() - rays_before);
+  const RayCounters total =
+      for_each_tile(w, h, options.threads, [&](int x0, int y0, int x1, int y1, RayCounters& local) {
+        const uint64_t rays_before = local.rays();
+        for (int by = y0; by < y1; by += kPacketSide)
+          for (int bx = x0; bx < x1; bx += kPacketSide) {
+            int bx1 = std::min(bx + kPacketSide, x1), by1 = std::min(by + kPacketSide, y1);
+            if (visible)
+              tracer.render_block_visible(bx, by, bx1, by1, *visible, out.buffers, local);
+            else
+              tracer.render_block(bx, by, bx1, by1, out.buffers, local);
           }
-        },
-        tbb::simple_partitioner());
-  });
+        if (progress)
+          progress->advance(uint64_t(x1 - x0) * uint64_t(y1 - y0), local.rays() - rays_before);
+      });
   out.stats["time.render"] = seconds_since(t_render);
 
-  RayCounters total;
-  counters.combine_each([&](const RayCounters& c) { total.add(c); });
   out.stats["rays.primary"] = double(total.primary);
   out.stats["rays.shadow"] = double(total.shadow);
   out.stats["rays.reflection"] = double(total.reflection);
