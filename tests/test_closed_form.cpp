@@ -345,6 +345,27 @@ Scene shadow_scene(float plane_mirror) {
   return s;
 }
 
+// The pixels of a shadow_scene frame away from label's edges: the emissive sphere (its
+// emission exactly) and the background are checked here, plane pixels handed to
+// on_plane(x, y, point, the renderer's colour).
+template <class Label, class OnPlane>
+void check_shadow_scene(const Scene& s, const RenderedFrame& f, const Label& label, Check& check,
+                        const OnPlane& on_plane) {
+  for (int y = 0; y < s.image.height; ++y) {
+    for (int x = 0; x < s.image.width; ++x) {
+      if (!away_from_edges(x, y, label)) continue;
+      SurfacePoint sp = trace(s, x + 0.5, y + 0.5);
+      const glm::vec3& got = f.buffers.color[size_t(y) * s.image.width + x];
+      if (sp.object != 0) {
+        dvec3 want = sp.object < 0 ? dvec3(s.image.background) : dvec3(0.9, 0.3, 0.1);
+        check.pixel(x, y, sp.object == 1, got, want, kTolerance);
+        continue;
+      }
+      on_plane(x, y, sp, got);
+    }
+  }
+}
+
 // Full mode, plane pixels well inside or outside the analytic shadow: ambient alone, or the
 // whole local term. The sphere is pure emission, so its pixels are its emission exactly.
 TEST_P(ClosedForm, PointLightShadowOfASphereOnAPlane) {
@@ -362,23 +383,14 @@ TEST_P(ClosedForm, PointLightShadowOfASphereOnAPlane) {
   };
   Check check;
   size_t shadowed = 0;
-  for (int y = 0; y < s.image.height; ++y) {
-    for (int x = 0; x < s.image.width; ++x) {
-      if (!away_from_edges(x, y, label)) continue;
-      SurfacePoint sp = trace(s, x + 0.5, y + 0.5);
-      size_t i = size_t(y) * s.image.width + x;
-      if (sp.object != 0) {
-        dvec3 want = sp.object < 0 ? dvec3(s.image.background) : dvec3(0.9, 0.3, 0.1);
-        check.pixel(x, y, sp.object == 1, f.buffers.color[i], want, kTolerance);
-        continue;
-      }
-      double lit = lit_by(sp.P, lights[0].position, occluder);
-      shadowed += lit == 0;
-      dvec3 want = oracle::local_colour(s.materials[s.objects[0].material], dvec3(s.ambient), sp.P,
-                                        sp.N, sp.ray.origin, lights, {lit});
-      check.pixel(x, y, false, f.buffers.color[i], want, kTolerance);
-    }
-  }
+  check_shadow_scene(
+      s, f, label, check, [&](int x, int y, const SurfacePoint& sp, const glm::vec3& got) {
+        double lit = lit_by(sp.P, lights[0].position, occluder);
+        shadowed += lit == 0;
+        dvec3 want = oracle::local_colour(s.materials[s.objects[0].material], dvec3(s.ambient),
+                                          sp.P, sp.N, sp.ray.origin, lights, {lit});
+        check.pixel(x, y, false, got, want, kTolerance);
+      });
   EXPECT_GT(shadowed, 100u) << "the shadow must be in view";
   EXPECT_GT(check.checked_plane, 2000u);
   EXPECT_EQ(check.failed, 0u) << check.summary();
@@ -411,26 +423,17 @@ TEST_P(ClosedForm, MirrorPlaneReflectsAnEmissiveSphere) {
   };
   Check check;
   size_t reflecting = 0;
-  for (int y = 0; y < s.image.height; ++y) {
-    for (int x = 0; x < s.image.width; ++x) {
-      if (!away_from_edges(x, y, label)) continue;
-      SurfacePoint sp = trace(s, x + 0.5, y + 0.5);
-      size_t i = size_t(y) * s.image.width + x;
-      if (sp.object != 0) {
-        dvec3 want = sp.object < 0 ? dvec3(s.image.background) : dvec3(0.9, 0.3, 0.1);
-        check.pixel(x, y, sp.object == 1, f.buffers.color[i], want, kTolerance);
-        continue;
-      }
-      double lit = lit_by(sp.P, lights[0].position, sphere);
-      dvec3 local = oracle::local_colour(s.materials[s.objects[0].material], dvec3(s.ambient), sp.P,
-                                         sp.N, sp.ray.origin, lights, {lit});
-      bool hit = reflects_sphere(sp);
-      reflecting += hit;
-      dvec3 reflected = hit ? dvec3(0.9, 0.3, 0.1) : dvec3(s.image.background);
-      dvec3 want = traces_mirrors ? 0.25 * local + 0.75 * reflected : local;
-      check.pixel(x, y, false, f.buffers.color[i], want, kTolerance);
-    }
-  }
+  check_shadow_scene(
+      s, f, label, check, [&](int x, int y, const SurfacePoint& sp, const glm::vec3& got) {
+        double lit = lit_by(sp.P, lights[0].position, sphere);
+        dvec3 local = oracle::local_colour(s.materials[s.objects[0].material], dvec3(s.ambient),
+                                           sp.P, sp.N, sp.ray.origin, lights, {lit});
+        bool hit = reflects_sphere(sp);
+        reflecting += hit;
+        dvec3 reflected = hit ? dvec3(0.9, 0.3, 0.1) : dvec3(s.image.background);
+        dvec3 want = traces_mirrors ? 0.25 * local + 0.75 * reflected : local;
+        check.pixel(x, y, false, got, want, kTolerance);
+      });
   EXPECT_GT(reflecting, 50u) << "the sphere's reflection must be in view";
   EXPECT_GT(check.checked_plane, 2000u);
   EXPECT_EQ(check.failed, 0u) << check.summary();
