@@ -2,6 +2,7 @@
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
+	libpng-dev libopenexr-dev \
 	openimageio-tools libbenchmark-dev libgtest-dev libembree-dev libtbb-dev \
 	nlohmann-json3-dev libcli11-dev libfmt-dev libassimp-dev python3-matplotlib \
 	clang-14 libclang-rt-14-dev python3-glad libegl-dev libegl-mesa0 chromium python3-websocket \

@@ -10,8 +10,6 @@
 namespace rvr {
 namespace {
 
-constexpr const char* kModule = "librvr_image_codec.so";
-
 // The folder of the running executable, where the build puts the module beside it.
 std::string executable_folder() {
   char path[PATH_MAX];
@@ -22,39 +20,43 @@ std::string executable_folder() {
   return slash == std::string::npos ? std::string() : exe.substr(0, slash);
 }
 
+template <class Table>
 struct Loaded {
-  const rvr_image_codec* codec = nullptr;
+  const Table* table = nullptr;
   std::string error;
 };
 
-Loaded load() {
-  Loaded result;
+// dlopens `module` (beside the executable first) and takes its table from `symbol`, which must
+// carry `abi_version`.
+template <class Table>
+Loaded<Table> load(const char* module, const char* symbol, int abi_version) {
+  Loaded<Table> result;
   std::string tried;
   void* handle = nullptr;
   const std::string folder = executable_folder();
   if (!folder.empty()) {
-    const std::string beside = folder + "/" + kModule;
+    const std::string beside = folder + "/" + module;
     handle = ::dlopen(beside.c_str(), RTLD_NOW | RTLD_LOCAL);
     if (!handle) tried = ::dlerror();
   }
   if (!handle) {
-    handle = ::dlopen(kModule, RTLD_NOW | RTLD_LOCAL);
+    handle = ::dlopen(module, RTLD_NOW | RTLD_LOCAL);
     if (!handle) tried += (tried.empty() ? "" : "; ") + std::string(::dlerror());
   }
   if (!handle) {
-    result.error = "cannot load the image library " + std::string(kModule) + ": " + tried;
+    result.error = "cannot load the image library " + std::string(module) + ": " + tried;
     return result;
   }
-  using Get = const rvr_image_codec* (*)();
-  auto get = reinterpret_cast<Get>(::dlsym(handle, "rvr_image_codec_get"));
-  const rvr_image_codec* codec = get ? get() : nullptr;
-  if (!codec || codec->abi_version != RVR_IMAGE_CODEC_ABI_VERSION) {
-    result.error = std::string(kModule) + " is not this build's image library (interface " +
-                   (codec ? std::to_string(codec->abi_version) : std::string("missing")) +
-                   ", expected " + std::to_string(RVR_IMAGE_CODEC_ABI_VERSION) + ")";
+  using Get = const Table* (*)();
+  auto get = reinterpret_cast<Get>(::dlsym(handle, symbol));
+  const Table* table = get ? get() : nullptr;
+  if (!table || table->abi_version != abi_version) {
+    result.error = std::string(module) + " is not this build's image library (interface " +
+                   (table ? std::to_string(table->abi_version) : std::string("missing")) +
+                   ", expected " + std::to_string(abi_version) + ")";
     return result;
   }
-  result.codec = codec;  // kept loaded for the life of the process
+  result.table = table;  // kept loaded for the life of the process
   return result;
 }
 
@@ -62,10 +64,24 @@ Loaded load() {
 
 Expected<const rvr_image_codec*> image_codec() {
   static std::once_flag once;
-  static Loaded loaded;
-  std::call_once(once, [] { loaded = load(); });
-  if (!loaded.codec) return internal_error(loaded.error);
-  return loaded.codec;
+  static Loaded<rvr_image_codec> loaded;
+  std::call_once(once, [] {
+    loaded = load<rvr_image_codec>("librvr_image_codec.so", "rvr_image_codec_get",
+                                   RVR_IMAGE_CODEC_ABI_VERSION);
+  });
+  if (!loaded.table) return internal_error(loaded.error);
+  return loaded.table;
+}
+
+Expected<const rvr_image_writer*> image_writer() {
+  static std::once_flag once;
+  static Loaded<rvr_image_writer> loaded;
+  std::call_once(once, [] {
+    loaded = load<rvr_image_writer>("librvr_image_writer.so", "rvr_image_writer_get",
+                                    RVR_IMAGE_WRITER_ABI_VERSION);
+  });
+  if (!loaded.table) return internal_error(loaded.error);
+  return loaded.table;
 }
 
 }  // namespace rvr

@@ -1,14 +1,19 @@
-// The image codec module (image_codec/: OpenImageIO behind a C table), loaded on first use.
+// The image modules (image_codec/), loaded on first use: the full codec (OpenImageIO behind a
+// C table) and the light PNG/EXR writer.
 #pragma once
 
 #include "rvr/image_codec/image_codec_abi.h"
+#include "rvr/image_codec/image_writer_abi.h"
 #include "rvr/shared/expected.h"
 
 namespace rvr {
 
-// The module's table, loaded once per process (thread-safe): from the folder of the running
+// The full codec's table, loaded once per process (thread-safe): from the folder of the running
 // executable, else wherever the dynamic loader finds librvr_image_codec.so. The error names
 // what was tried.
 Expected<const rvr_image_codec*> image_codec();
+
+// The light writer's table (librvr_image_writer.so), found and loaded the same way.
+Expected<const rvr_image_writer*> image_writer();
 
 }  // namespace rvr

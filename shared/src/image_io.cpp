@@ -1,7 +1,9 @@
 // Image files through OpenImageIO, written atomically (temporary name in the same folder, then
 // rename). No codec is written by hand: OpenImageIO picks the format from the extension. It is
 // reached through the image codec module, loaded on the first read or write
-// (image_codec_loader.h), so runs without images never load it.
+// (image_codec_loader.h), so runs without images never load it. PNG and EXR, which every render
+// writes, go through the light writer module (libpng, OpenEXR) when it takes the image, so such
+// runs do not pay for loading OpenImageIO either.
 #include "rvr/shared/image_io.h"
 
 #include <unistd.h>
@@ -10,6 +12,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -126,13 +129,22 @@ std::string first_line(std::string s) {
   return s.empty() ? std::string("unknown error") : s;
 }
 
+// The light writer (PNG, EXR) when it takes this image, so that the run need not load
+// OpenImageIO; null otherwise, or when RVR_IMAGE_WRITER=openimageio asks for the full library
+// (to compare the two, and as a way out should the light writer misbehave).
+const rvr_image_writer* light_writer_for(const std::string& ext, int channels,
+                                         const std::vector<const char*>& names, bool as_float) {
+  const char* choice = std::getenv("RVR_IMAGE_WRITER");
+  if (choice && std::strcmp(choice, "openimageio") == 0) return nullptr;
+  Expected<const rvr_image_writer*> writer = image_writer();
+  if (!writer) return nullptr;  // the full codec writes it instead
+  const bool takes = (*writer)->handles(ext.c_str(), channels,
+                                        names.empty() ? nullptr : names.data(), as_float ? 1 : 0);
+  return takes ? *writer : nullptr;
+}
+
 bool write_pixels(const fs::path& temp, const Image& image, bool linear_to_srgb,
                   std::string& reason) {
-  Expected<const rvr_image_codec*> codec = image_codec();
-  if (!codec) {
-    reason = codec.error().message;
-    return false;
-  }
   const std::string ext = lower(fs::path(temp).extension().string());
   const bool as_float = is_float_format(ext);
   std::vector<const char*> names;
@@ -149,12 +161,22 @@ bool write_pixels(const fs::path& temp, const Image& image, bool linear_to_srgb,
       bytes[i] = uint8_t(std::lround(v * 255.0f));
     }
   }
+  const rvr_image_writer* light = light_writer_for(ext, image.channels, names, as_float);
+  auto write = light ? light->write : nullptr;
+  if (!write) {
+    Expected<const rvr_image_codec*> codec = image_codec();
+    if (!codec) {
+      reason = codec.error().message;
+      return false;
+    }
+    write = (*codec)->write;
+  }
   char err[512] = {};
-  const int ok = (*codec)->write(temp.c_str(), image.width, image.height, image.channels,
-                                 names.empty() ? nullptr : names.data(), as_float ? 1 : 0,
-                                 as_float ? static_cast<const void*>(image.pixels.data())
-                                          : static_cast<const void*>(bytes.data()),
-                                 err, sizeof(err));
+  const int ok = write(temp.c_str(), image.width, image.height, image.channels,
+                       names.empty() ? nullptr : names.data(), as_float ? 1 : 0,
+                       as_float ? static_cast<const void*>(image.pixels.data())
+                                : static_cast<const void*>(bytes.data()),
+                       err, sizeof(err));
   if (!ok) {
     reason = first_line(err);
     if (reason == "no image format for this extension")
