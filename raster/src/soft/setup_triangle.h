@@ -12,18 +12,26 @@ constexpr int kSubBits = 12;
 constexpr int64_t kSub = int64_t(1) << kSubBits;
 
 // A screen-space triangle after clipping. One input triangle gives up to a few of these.
-struct SetupTriangle {
-  int64_t x[3], y[3];  // fixed point, oriented so the edge functions are >= 0 inside
-  bool top_left[3];    // edge i runs from vertex i to vertex i+1
+// Hot and cold halves: draw_tile reads the first cache line of every binned triangle (pixel
+// box, hi-z bound, edge functions) and the other two only for triangles with a block to fill;
+// at 10^6 scattered triangles a chunk is far beyond L2, so lines not touched are misses saved.
+struct alignas(64) SetupTriangle {
+  // --- hot: one cache line
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // pixel bounding box, inclusive, on screen
+  // No fragment is nearer than this (view depth): the hi-z test's bound (see min_depth_bound).
+  double min_depth = 0;
+  // Fixed point, oriented so the edge functions are >= 0 inside. Guard-band coordinates are
+  // below 2^28 in magnitude (triangle_setup.h), so 32 bits hold them exactly.
+  int32_t x[3], y[3];
+  bool top_left[3];  // edge i runs from vertex i to vertex i+1
+  // --- cold: read only to fill pixels
   // q_j(p) = q0[j] + qa[j]*(px - ox) + qb[j]*(py - oy) = (barycentric j of the ORIGINAL
   // triangle) / w: linear in screen space, so sum_j q_j = 1/w = 1/view depth, and q_j/sum is
   // the perspective-correct barycentric. From the unsnapped vertices, in double: P must be
   // exact where 1/|L - P|^2 is steep (surfaces next to a light).
-  double q0[3], qa[3], qb[3];
+  alignas(64) double q0[3];
+  double qa[3], qb[3];
   double ox = 0, oy = 0;
-  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // pixel bounding box, inclusive, on screen
-  // No fragment is nearer than this (view depth): the hi-z test's bound (see min_depth_bound).
-  double min_depth = 0;
   uint32_t object = 0, primitive = 0;
 
   double inv_w(double px, double py, double (&q)[3]) const {
@@ -38,5 +46,6 @@ struct SetupTriangle {
     return s;
   }
 };
+static_assert(sizeof(SetupTriangle) == 192, "a hot cache line and two cold ones");
 
 }  // namespace rvr::soft

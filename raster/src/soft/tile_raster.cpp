@@ -93,8 +93,33 @@ void DepthTarget::draw_tile(int tx, int ty, const std::vector<SetupTriangle>* su
                             const uint32_t* bin, size_t count, TileCounters& counters) {
   const int ox = tx * kTile, oy = ty * kTile;
   const int ex = std::min(ox + kTile, width_) - 1, ey = std::min(oy + kTile, height_) - 1;
+  auto triangle = [&](size_t k) -> const SetupTriangle& {
+    return sub_chunks[bin[k] >> kLocalBits][bin[k] & ((1u << kLocalBits) - 1)];
+  };
+  // A bin's triangles lie scattered over the chunk (megabytes, beyond L2), and so do the pixels
+  // they touch in the frame's buffers: both are fetched ahead, so that the misses overlap
+  // instead of stalling one by one. Triangle k + kHotAhead: its hot line. Triangle
+  // k + kColdAhead (whose hot line has arrived by then): its cold lines and the depth and
+  // fragment-count lines of the first two rows of its box in this tile.
+  constexpr size_t kHotAhead = 8, kColdAhead = 4;
+  auto fetch_rest = [&](const SetupTriangle& t) {
+    const char* cold = reinterpret_cast<const char*>(&t) + 64;
+    __builtin_prefetch(cold);
+    __builtin_prefetch(cold + 64);
+    const int px = std::max(t.x0, ox), py = std::max(t.y0, oy);
+    const int py1 = std::min({t.y1, ey, py + 1});
+    for (int y = py; y <= py1; ++y) {
+      const size_t i = size_t(y) * size_t(width_) + size_t(px);
+      __builtin_prefetch(&depth_[i], 1);
+      if (!depth_only_) __builtin_prefetch(&fragments_[i], 1);
+    }
+  };
+  for (size_t k = 0; k < std::min(count, kHotAhead); ++k) __builtin_prefetch(&triangle(k));
+  for (size_t k = 0; k < std::min(count, kColdAhead); ++k) fetch_rest(triangle(k));
   for (size_t k = 0; k < count; ++k) {
-    const SetupTriangle& t = sub_chunks[bin[k] >> kLocalBits][bin[k] & ((1u << kLocalBits) - 1)];
+    if (k + kHotAhead < count) __builtin_prefetch(&triangle(k + kHotAhead));
+    if (k + kColdAhead < count) fetch_rest(triangle(k + kColdAhead));
+    const SetupTriangle& t = triangle(k);
     const int x0 = std::max(t.x0, ox), x1 = std::min(t.x1, ex);
     const int y0 = std::max(t.y0, oy), y1 = std::min(t.y1, ey);
     if (x0 > x1 || y0 > y1) continue;
@@ -125,8 +150,8 @@ void DepthTarget::draw(const SetupTriangle& t, int x0, int y0, int x1, int y1,
   int64_t dx[3], dy[3], bias[3];
   for (int i = 0; i < 3; ++i) {
     const int n = (i + 1) % 3;
-    dx[i] = t.x[n] - t.x[i];
-    dy[i] = t.y[n] - t.y[i];
+    dx[i] = int64_t(t.x[n]) - t.x[i];
+    dy[i] = int64_t(t.y[n]) - t.y[i];
     bias[i] = t.top_left[i] ? 0 : 1;
   }
   auto edge = [&](int i, int x, int y) {

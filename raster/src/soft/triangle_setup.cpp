@@ -151,13 +151,15 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
   SetupTriangle t;
   double sx[3], sy[3];
   for (int i = 0; i < 3; ++i) {
-    t.x[i] = fx[order[i]];
-    t.y[i] = fy[order[i]];
+    t.x[i] = int32_t(fx[order[i]]);
+    t.y[i] = int32_t(fy[order[i]]);
     sx[i] = sx_in[order[i]];
     sy[i] = sy_in[order[i]];
   }
-  int64_t min_x = std::min({t.x[0], t.x[1], t.x[2]}), max_x = std::max({t.x[0], t.x[1], t.x[2]});
-  int64_t min_y = std::min({t.y[0], t.y[1], t.y[2]}), max_y = std::max({t.y[0], t.y[1], t.y[2]});
+  const int64_t min_x = std::min({t.x[0], t.x[1], t.x[2]});
+  const int64_t max_x = std::max({t.x[0], t.x[1], t.x[2]});
+  const int64_t min_y = std::min({t.y[0], t.y[1], t.y[2]});
+  const int64_t max_y = std::max({t.y[0], t.y[1], t.y[2]});
   // The pixels whose centres ((x + 1/2) kSub) lie in the bounding box: only they can be
   // covered. Most triangles of a dense mesh hold none, and stop here.
   auto first_centre = [](int64_t lo) { return int((lo - kSub / 2 + kSub - 1) >> kSubBits); };
@@ -169,7 +171,7 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
   if (t.x0 > t.x1 || t.y0 > t.y1) return;
   int64_t edge_dx[3], edge_dy[3];
   for (int i = 0; i < 3; ++i) {
-    int64_t dx = t.x[(i + 1) % 3] - t.x[i], dy = t.y[(i + 1) % 3] - t.y[i];
+    const int64_t dx = int64_t(t.x[(i + 1) % 3]) - t.x[i], dy = int64_t(t.y[(i + 1) % 3]) - t.y[i];
     edge_dx[i] = dx;
     edge_dy[i] = dy;
     // y points down: with positive area, top edges run right and left edges run up.

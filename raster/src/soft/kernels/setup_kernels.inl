@@ -150,8 +150,8 @@ int setup_batch(const SetupBatch& in, int width, int height, SetupTriangle* out)
     const int k = index[r];
     SetupTriangle& t = out[written++];
     for (int i = 0; i < 3; ++i) {
-      t.x[i] = x[i][k];
-      t.y[i] = y[i][k];
+      t.x[i] = int32_t(x[i][k]);
+      t.y[i] = int32_t(y[i][k]);
       t.top_left[i] = top_left[i][k] != 0;
       t.q0[i] = f[0][i][r];
       t.qa[i] = qa[i][r];
