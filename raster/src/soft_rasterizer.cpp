@@ -24,8 +24,10 @@
 #include "rvr/shared/image_sample.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/timer.h"
+#include "soft/deferred_shading.h"
 #include "soft/draw_triangles.h"
 #include "soft/fill_dispatch.h"
+#include "soft/shade_dispatch.h"
 #include "soft/shadow_cube.h"
 #include "soft/tile_raster.h"
 
@@ -139,13 +141,13 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   // --- shade: deferred, each visible pixel once
   t = Clock::now();
   FrameBuffers& fb = out.buffers;
-  fb.allocate(w, h);  // every pixel is written below
   const std::vector<LightSample> samples = options.mode == RenderMode::Visibility
                                                ? std::vector<LightSample>{}
                                                : light_samples(scene.lights);
   const bool shadows = options.mode == RenderMode::Full && !samples.empty();
   const glm::vec3 eye = scene.camera.eye;
-  // The visible surface at pixel o (covered): position, normals, direction to the eye.
+  // The visible surface at pixel o (covered): position, normals, direction to the eye. The
+  // shadow pass adds the lights with it; the shading kernels do the same float operations.
   struct Surface {
     const DrawObject* object;
     uint32_t primitive;
@@ -171,29 +173,15 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     return s;
   };
   if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
-      for (int y = r.begin(); y != r.end(); ++y) {
-        for (int x = 0; x < w; ++x) {
-          const size_t o = fb.index(x, y);
-          fb.set_background(o, scene.image.background);
-          fb.cost[o] = target.cost(x, y);
-          if (!target.covered(o)) continue;
-          const Surface s = surface_at(o);
-          fb.depth[o] = float(target.depth(o));
-          fb.object_id[o] = target.object(o);
-          fb.primitive_id[o] = s.object->use_primitive_id ? s.primitive : 0u;
-          fb.normal[o] = s.N;
-          if (options.mode == RenderMode::Visibility) continue;
-          // With shadows the lights are added below, batch by batch of shadow cubes.
-          fb.color[o] =
-              shadows ? shade_base(*s.object->material, scene.ambient)
-                      : shade_local(*s.object->material, s.P, s.N, s.V, scene.ambient, samples);
-        }
-      }
-      if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));
-    });
-  });
+  soft::DeferredShading shading;
+  shading.eye = eye;
+  shading.ambient = scene.ambient;
+  shading.background = scene.image.background;
+  shading.colour = options.mode == RenderMode::Visibility ? soft::ShadedColour::Background
+                   : shadows                              ? soft::ShadedColour::Base
+                                                          : soft::ShadedColour::Local;
+  shading.samples = &samples;
+  soft::shade_pixels(list, target, shading, soft::shade_kernels(isa), arena, progress, fb);
   out.stats["time.shade"] = seconds_since(t);
 
   // --- shadows (full mode): a cube of distance maps per light sample, drawn by this z-buffer,

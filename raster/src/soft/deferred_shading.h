@@ -1,0 +1,40 @@
+// softraster's deferred shading pass: after the z-buffer pass, every pixel of the frame buffers
+// is written once: the background where nothing was drawn, else depth, ids, the shading normal
+// and the colour, the visible pixels shaded a batch at a time by a SIMD shading kernel
+// (shade_kernel.h).
+#pragma once
+
+#include <tbb/task_arena.h>
+
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/progress.h"
+#include "rvr/shared/scene.h"
+#include "soft/draw_triangles.h"
+#include "soft/shade_kernel.h"
+#include "soft/tile_raster.h"
+
+namespace rvr::soft {
+
+enum class ShadedColour {
+  Background,  // visibility mode: colour stays the background
+  Base,        // emission + ambient * diffuse (the lights are added later, with shadows)
+  Local,       // base plus every light sample, unshadowed
+};
+
+struct DeferredShading {
+  glm::vec3 eye;
+  glm::vec3 ambient;
+  glm::vec3 background;
+  ShadedColour colour = ShadedColour::Local;
+  const std::vector<LightSample>* samples = nullptr;  // Local: the light samples, in order
+};
+
+// Sizes fb to the target and writes every pixel of every buffer.
+void shade_pixels(const DrawList& list, const DepthTarget& target, const DeferredShading& settings,
+                  const ShadeKernels& kernels, tbb::task_arena& arena, ProgressSink* progress,
+                  FrameBuffers& fb);
+
+}  // namespace rvr::soft

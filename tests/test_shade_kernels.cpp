@@ -1,0 +1,162 @@
+// softraster's shading kernels (soft/shade_kernel.h), each this CPU can run, against the scalar
+// shading code they replace: surface_at's glm formulas and rvr::shade_local, the function the
+// tracer calls. Bit for bit, on random pixels and on the equation's special cases, so an image
+// cannot depend on the kernel, and softraster and the tracer compute the same colour for the
+// same surface point.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <glm/glm.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "rvr/shared/isa.h"
+#include "rvr/shared/shading.h"
+#include "soft/shade_dispatch.h"
+
+using namespace rvr;
+
+namespace {
+
+// One pixel as the deferred pass sees it.
+struct Pixel {
+  glm::vec3 bary;
+  glm::vec3 vertex[3], normal[3];
+  bool smooth;
+  Material material;
+};
+
+struct Shaded {
+  glm::vec3 normal, colour;
+};
+
+// The scalar code: surface_at (soft_rasterizer.cpp, before the kernels) and shade_local.
+Shaded scalar_shade(const Pixel& p, const glm::vec3& eye, const glm::vec3& ambient,
+                    const std::vector<LightSample>& lights) {
+  const glm::vec3 P = p.bary.x * p.vertex[0] + p.bary.y * p.vertex[1] + p.bary.z * p.vertex[2];
+  const glm::vec3 geometric =
+      glm::normalize(glm::cross(p.vertex[1] - p.vertex[0], p.vertex[2] - p.vertex[0]));
+  const glm::vec3 shading =
+      p.smooth
+          ? glm::normalize(p.bary.x * p.normal[0] + p.bary.y * p.normal[1] + p.bary.z * p.normal[2])
+          : geometric;
+  const glm::vec3 V = glm::normalize(eye - P);
+  const glm::vec3 N = face_viewer(shading, geometric, V);
+  return {N, shade_local(p.material, P, N, V, ambient, lights)};
+}
+
+void put(float (&to)[3][soft::kShadeBatch], int i, const glm::vec3& v) {
+  for (int a = 0; a < 3; ++a) to[a][i] = v[a];
+}
+
+// Shades pixels [0, n) with one kernel, the batch padded as the deferred pass pads it.
+std::vector<Shaded> kernel_shade(const soft::ShadeKernels& kernels, const std::vector<Pixel>& px,
+                                 const glm::vec3& eye, const glm::vec3& ambient,
+                                 const std::vector<LightSample>& lights) {
+  std::vector<float> data[6];
+  for (const LightSample& l : lights)
+    for (int a = 0; a < 3; ++a) {
+      data[a].push_back(l.position[a]);
+      data[3 + a].push_back(l.intensity[a]);
+    }
+  const soft::ShadeLights soa = {{data[0].data(), data[1].data(), data[2].data()},
+                                 {data[3].data(), data[4].data(), data[5].data()},
+                                 int(lights.size())};
+  const float eye_xyz[3] = {eye.x, eye.y, eye.z};
+  auto batch = std::make_unique<soft::ShadeBatch>();
+  std::vector<Shaded> out;
+  for (size_t first = 0; first < px.size(); first += soft::kShadeBatch) {
+    const int n = int(std::min<size_t>(soft::kShadeBatch, px.size() - first));
+    const int padded = (n + soft::kShadeMaxLanes - 1) / soft::kShadeMaxLanes * soft::kShadeMaxLanes;
+    for (int i = 0; i < padded; ++i) {
+      const Pixel& p = px[first + size_t(std::min(i, n - 1))];
+      put(batch->bary, i, p.bary);
+      for (int c = 0; c < 3; ++c) {
+        put(batch->vertex[c], i, p.vertex[c]);
+        put(batch->normal[c], i, p.smooth ? p.normal[c] : glm::vec3(0.0f));
+      }
+      batch->smooth[i] = p.smooth ? ~0u : 0u;
+      put(batch->diffuse, i, p.material.diffuse);
+      put(batch->specular, i, p.material.specular);
+      put(batch->base, i, shade_base(p.material, ambient));
+      batch->shininess[i] = p.material.shininess;
+    }
+    batch->count = n;
+    kernels.shade(*batch, eye_xyz, soa);
+    for (int i = 0; i < n; ++i)
+      out.push_back(
+          {{batch->shading_normal[0][i], batch->shading_normal[1][i], batch->shading_normal[2][i]},
+           {batch->colour[0][i], batch->colour[1][i], batch->colour[2][i]}});
+  }
+  return out;
+}
+
+bool same_bits(const glm::vec3& a, const glm::vec3& b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
+
+std::string show(const glm::vec3& v) {
+  char s[128];
+  std::snprintf(s, sizeof s, "(%.9g, %.9g, %.9g)", double(v.x), double(v.y), double(v.z));
+  return s;
+}
+
+}  // namespace
+
+TEST(ShadeKernels, EveryKernelShadesAsTheScalarShadeLocalBitForBit) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f), positive(0.0f, 1.0f);
+  auto random_vec = [&](float scale) { return scale * glm::vec3(unit(rng), unit(rng), unit(rng)); };
+  const glm::vec3 eye(0.3f, 0.6f, 3.2f), ambient(0.05f, 0.07f, 0.02f);
+  // Three samples: in front of most surfaces, behind some, one exactly at a vertex.
+  const glm::vec3 at_vertex(0.25f, -0.5f, 0.125f);
+  const std::vector<LightSample> lights = {{{2.0f, 3.0f, 3.0f}, {20.0f, 18.0f, 15.0f}},
+                                           {{-1.5f, 0.5f, -2.0f}, {3.0f, 4.0f, 5.0f}},
+                                           {at_vertex, {1.0f, 1.0f, 1.0f}}};
+  std::vector<Pixel> pixels;
+  const float shininess[] = {48.0f, 1.0f, 0.0f, 7.5f, 200.0f};
+  for (int k = 0; k < 3001; ++k) {  // not a multiple of any lane count or of the batch
+    Pixel p;
+    const float u = positive(rng), v = positive(rng) * (1.0f - u);
+    p.bary = {1.0f - u - v, u, v};
+    const glm::vec3 centre = random_vec(1.0f);
+    for (int c = 0; c < 3; ++c) {
+      p.vertex[c] = centre + random_vec(k % 7 == 0 ? 0.001f : 0.2f);  // some sub-pixel-sized
+      p.normal[c] = random_vec(1.0f);
+    }
+    p.smooth = k % 3 != 0;
+    p.material.diffuse = {positive(rng), positive(rng), positive(rng)};
+    p.material.specular = {positive(rng), positive(rng), positive(rng)};
+    p.material.emission = k % 5 == 0 ? glm::vec3(0.5f, 0.0f, 0.25f) : glm::vec3(0.0f);
+    p.material.shininess = shininess[k % 5];
+    if (k % 11 == 0) {  // no specular and no diffuse: brdf 0 skips every sample
+      p.material.diffuse = glm::vec3(0.0f);
+      p.material.specular = glm::vec3(0.0f);
+    }
+    if (k % 13 == 0) {  // P exactly at the third sample: |L - P| = 0 adds nothing
+      p.bary = {1.0f, 0.0f, 0.0f};
+      p.vertex[0] = at_vertex;
+    }
+    pixels.push_back(p);
+  }
+  int tested = 0;
+  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
+    if (!cpu_supports(isa)) continue;
+    ++tested;
+    const soft::ShadeKernels& kernels = soft::shade_kernels(isa);
+    EXPECT_EQ(std::string(kernels.isa), to_string(isa));
+    const std::vector<Shaded> got = kernel_shade(kernels, pixels, eye, ambient, lights);
+    ASSERT_EQ(got.size(), pixels.size());
+    int failures = 0;
+    for (size_t i = 0; i < pixels.size() && failures < 5; ++i) {
+      const Shaded want = scalar_shade(pixels[i], eye, ambient, lights);
+      if (same_bits(got[i].normal, want.normal) && same_bits(got[i].colour, want.colour)) continue;
+      ++failures;
+      ADD_FAILURE() << to_string(isa) << " pixel " << i << ": normal " << show(got[i].normal)
+                    << " colour " << show(got[i].colour) << ", scalar " << show(want.normal) << " "
+                    << show(want.colour);
+    }
+  }
+  EXPECT_GE(tested, 1);
+}
