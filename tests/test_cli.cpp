@@ -110,6 +110,18 @@ TEST_F(Cli, RenderWritesImageAovsAndStats) {
   EXPECT_GT(stats["peak_memory_bytes"].get<double>(), 0.0);
 }
 
+// "-" is standard output, as tools read it: the JSON on stdout, no file named "-" anywhere.
+TEST_F(Cli, StatsDashPrintsTheJsonOnStandardOutput) {
+  RunResult r = run("render builtin:spheres -r raytrace --mode local " + std::string(kSmall) +
+                    " -o " + (dir_ / "s.png").string() + " --stats - --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  nlohmann::json stats = nlohmann::json::parse(r.out);
+  EXPECT_EQ(stats["renderer"], "raytrace");
+  EXPECT_EQ(stats["width"], 80);
+  EXPECT_FALSE(fs::exists("-"));
+  EXPECT_FALSE(fs::exists(dir_ / "-"));
+}
+
 TEST_F(Cli, RasterRenders) {
   RunResult r = run("render builtin:spheres -r raster --mode local " + std::string(kSmall) +
                     " -o " + (dir_ / "r.exr").string());

@@ -46,7 +46,9 @@ nlohmann::json finite_or_null(double v) {
 }  // namespace
 
 int run_render(const RenderArgs& a) {
-  std::vector<std::string> outputs{a.out, a.stats};
+  const bool stats_to_stdout = a.stats == "-";  // as tools read "-": standard output
+  std::vector<std::string> outputs{a.out};
+  if (!stats_to_stdout && !a.stats.empty()) outputs.push_back(a.stats);
   const std::string base = std::filesystem::path(a.out).replace_extension().string();
   for (const std::string& aov : a.aovs)
     outputs.push_back(base + "." + aov + (aov == "cost" ? ".png" : ".exr"));
@@ -95,7 +97,10 @@ int run_render(const RenderArgs& a) {
                             o.mesh.normals.size() * sizeof(glm::vec3) +
                             o.mesh.triangles.size() * sizeof(glm::uvec3));
     j["scene_mesh_bytes"] = scene_bytes;
-    check(write_text_file(a.stats, j.dump(2) + "\n"));
+    if (stats_to_stdout)
+      std::fputs((j.dump(2) + "\n").c_str(), stdout);
+    else
+      check(write_text_file(a.stats, j.dump(2) + "\n"));
   }
   if (!a.common.quiet) {
     std::fprintf(stderr, "%s: %s %dx%d %s in %.3f s -> %s\n", a.renderer.c_str(),
