@@ -5,6 +5,7 @@
 // also set up every triangle exactly as its scalar setup does.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <glm/gtc/matrix_transform.hpp>
 #include <random>
@@ -219,6 +220,75 @@ TEST(SoftrasterSetup, EveryKernelSetsUpTrianglesAsTheScalarSetupDoes) {
     for (size_t i = 0; i < n; ++i)
       ASSERT_EQ(setup_difference(got[i], expected[i]), "")
           << kernels.isa << ": set-up triangle " << i << " (input " << expected[i].primitive << ")";
+  }
+}
+
+// SetupTriangle keeps fixed-point vertices in 32 bits: enough for anything inside the guard band
+// (clipping keeps screen positions within kGuardPixels / 2 + width / 2 pixels). A triangle
+// reaching far left is clipped at the guard plane (scalar path); one reaching just inside it is
+// not (the setup kernels). Their stored x must be the fixed-point value the screen position
+// gives, computed here from the guard band's definition (the clip and the division may move a
+// clipped vertex by rounding: one sub-pixel of slack, far below any truncation's error).
+TEST(SoftrasterSetup, FixedPointVerticesAtTheGuardBandAreStoredExactly) {
+  const int width = 1024, height = 768;
+  // clip = (x / 3, y, z, 1): a third is no binary fraction, so positions are not round numbers
+  // that a narrower type (a float's 24 bits) would happen to hold exactly.
+  glm::dmat4 view_projection(1.0);
+  view_projection[0][0] = 1.0 / 3.0;
+  const soft::TriangleSetup setup(width, height, view_projection);
+  const double guard_ndc = soft::kGuardPixels / width;
+  // The sub-pixel that world x snaps to (the projection's operations, in its order).
+  auto fixed_x = [&](float x) {
+    const double ndc = (1.0 / 3.0) * double(x);
+    return std::llround((ndc * 0.5 + 0.5) * width * double(soft::kSub));
+  };
+  const int64_t at_guard = std::llround((-guard_ndc * 0.5 + 0.5) * width * double(soft::kSub));
+  ASSERT_LT(at_guard, -(int64_t(1) << 26));  // far beyond 16 bits: the test can see truncation
+
+  // Clipped: vertex A at NDC x = -40 guard widths (x = -120 guard widths); the clipped vertices lie on x = -guard.
+  {
+    soft::TriangleSetup clipper = setup;
+    std::vector<soft::SetupTriangle> out;
+    size_t clipped = 0;
+    clipper.add(setup.project({-120.0f * float(guard_ndc), -0.5f, 0.0f}),
+                setup.project({2.7f, 0.9f, 0.0f}), setup.project({2.7f, -0.9f, 0.0f}), 1, 0, out,
+                clipped);
+    ASSERT_EQ(clipped, 1u);
+    ASSERT_FALSE(out.empty());
+    const int64_t right = fixed_x(2.7f);
+    int at_the_guard = 0;
+    for (const soft::SetupTriangle& t : out)
+      for (int64_t x : t.x) {
+        const bool on_guard = std::abs(x - at_guard) <= 1, on_right = x == right;
+        EXPECT_TRUE(on_guard || on_right) << x << " is neither " << at_guard << " nor " << right;
+        at_the_guard += on_guard;
+      }
+    EXPECT_GT(at_the_guard, 0);
+  }
+  // Unclipped, through every setup kernel: vertex A just inside the guard plane.
+  const float inside = -2.997f * float(guard_ndc);
+  const glm::vec3 p[3] = {{inside, 0.0f, 0.0f}, {2.7f, 0.9f, 0.0f}, {2.7f, -0.9f, 0.0f}};
+  soft::SetupBatch batch;
+  batch.count = 1;
+  for (int v = 0; v < 3; ++v) {
+    const soft::ProjectedVertex pv = setup.project(p[v]);
+    ASSERT_EQ(pv.clip_planes, 0u);
+    batch.fx[v][0] = pv.fx;
+    batch.fy[v][0] = pv.fy;
+    batch.sx[v][0] = pv.sx;
+    batch.sy[v][0] = pv.sy;
+    batch.w[v][0] = pv.clip.w;
+    batch.inv_w[v][0] = pv.inv_w;
+  }
+  batch.object[0] = 1;
+  batch.primitive[0] = 0;
+  for (Isa isa : runnable_isas()) {
+    const soft::FillKernels& kernels = soft::fill_kernels(isa);
+    soft::SetupTriangle t;
+    ASSERT_EQ(kernels.setup(batch, width, height, &t), 1) << kernels.isa;
+    EXPECT_EQ(t.x[0], fixed_x(inside)) << kernels.isa;
+    EXPECT_EQ(t.x[1], fixed_x(2.7f)) << kernels.isa;
+    EXPECT_EQ(t.x[2], fixed_x(2.7f)) << kernels.isa;
   }
 }
 
