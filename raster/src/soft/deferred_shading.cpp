@@ -1,5 +1,6 @@
 #include "soft/deferred_shading.h"
 
+#include <sys/mman.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -27,6 +28,20 @@ void put(float (&to)[3][kShadeBatch], int i, const glm::vec3& v) {
   to[2][i] = v.z;
 }
 
+// Asks for transparent huge pages over a buffer not yet touched. The frame's buffers are fresh
+// memory every frame (the caller takes them away): 31 MB at 1024x768, first touched here, one
+// page fault per 4 KiB (page faults were a fifth of the samples of a tessphere:100000 frame).
+// Where the system grants huge pages on request, that is one fault per 2 MiB (measured: 4,600
+// faults a frame before, 2,000 after). Advice only: no byte written changes, and a refusal (an
+// error return) leaves the small pages.
+template <class T>
+void ask_for_huge_pages(PixelVector<T>& v) {
+  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = reinterpret_cast<uintptr_t>(v.data() + v.size()) & ~(kHuge - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+
 // Repeats slot `from` in slot `to` (every input of the kernel).
 void copy_slot(ShadeBatch& b, int from, int to) {
   for (int a = 0; a < 3; ++a) {
@@ -50,6 +65,12 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
                   FrameBuffers& fb) {
   const int w = target.width(), h = target.height();
   fb.allocate(w, h);  // every pixel is written below
+  ask_for_huge_pages(fb.color);
+  ask_for_huge_pages(fb.normal);
+  ask_for_huge_pages(fb.depth);
+  ask_for_huge_pages(fb.object_id);
+  ask_for_huge_pages(fb.primitive_id);
+  ask_for_huge_pages(fb.cost);
   std::vector<ObjectShading> objects(list.objects.size());
   for (size_t i = 0; i < objects.size(); ++i) {
     const DrawObject& d = list.objects[i];
