@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "rvr/shared/srgb.h"
+
 namespace rvr {
 
 namespace detail {
@@ -64,12 +66,6 @@ double relative_depth_error(double da, double db) {
 float luminance(const glm::vec3& c) {
   auto cl = [](float v) { return v > 0.0f ? std::min(v, 1.0f) : 0.0f; };  // NaN -> 0
   return 0.2126f * cl(c.r) + 0.7152f * cl(c.g) + 0.0722f * cl(c.b);
-}
-
-float srgb_encode(float v) {
-  if (!(v > 0.0f)) return 0.0f;
-  if (v >= 1.0f) return 1.0f;
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
 // Mean SSIM of two luminance images: 11x11 Gaussian window (sigma 1.5), C1 = 0.01^2,

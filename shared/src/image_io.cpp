@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "image_codec_loader.h"
+#include "rvr/shared/srgb.h"
 
 namespace fs = std::filesystem;
 
@@ -41,12 +42,6 @@ std::string lower(std::string s) {
 // 8 bits per channel, clamped, and the sRGB transfer when asked for.
 bool is_float_format(const std::string& ext) {
   return ext == ".exr" || ext == ".hdr" || ext == ".pfm";
-}
-
-float srgb_encode(float v) {
-  if (!(v > 0.0f)) return 0.0f;  // also NaN
-  if (v >= 1.0f) return 1.0f;
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
 // A name for the temporary file beside `path` that keeps its extension, because OpenImageIO
@@ -156,9 +151,10 @@ bool write_pixels(const fs::path& temp, const Image& image, bool linear_to_srgb,
   if (!as_float) {
     bytes.resize(image.pixels.size());
     for (size_t i = 0; i < bytes.size(); ++i) {
-      float v = image.pixels[i];
-      v = linear_to_srgb ? srgb_encode(v) : (v > 0.0f ? std::min(v, 1.0f) : 0.0f);
-      bytes[i] = uint8_t(std::lround(v * 255.0f));
+      const float v = image.pixels[i];
+      bytes[i] = linear_to_srgb
+                     ? srgb8(v)
+                     : uint8_t(std::lround((v > 0.0f ? std::min(v, 1.0f) : 0.0f) * 255.0f));
     }
   }
   const rvr_image_writer* light = light_writer_for(ext, image.channels, names, as_float);

@@ -1,0 +1,16 @@
+// The sRGB transfer function, from linear values to display-referred ones: for 8-bit images
+// and the display-referred greys of the report.
+#pragma once
+
+#include <cstdint>
+
+namespace rvr {
+
+// Linear [0, 1] to sRGB-encoded [0, 1]; below 0 and NaN give 0, above 1 gives 1.
+float srgb_encode(float linear);
+
+// The 8-bit value of a linear one, exactly lround(255 * srgb_encode(linear)) for every float,
+// found in a table of the 255 places where that value steps (no pow per pixel).
+uint8_t srgb8(float linear);
+
+}  // namespace rvr
