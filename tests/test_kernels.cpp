@@ -184,7 +184,7 @@ TEST(SoftrasterSetup, EveryKernelSetsUpTrianglesAsTheScalarSetupDoes) {
   }
   const size_t count = vertices.size() / 3;
   soft::TriangleSetup reference_setup = scalar;
-  std::vector<soft::SetupTriangle> expected;
+  soft::SetupTriangles expected;
   size_t clipped = 0;
   for (size_t i = 0; i < count; ++i)
     reference_setup.add(vertices[3 * i], vertices[3 * i + 1], vertices[3 * i + 2], 7, uint32_t(i),
@@ -245,10 +245,11 @@ TEST(SoftrasterSetup, FixedPointVerticesAtTheGuardBandAreStoredExactly) {
   const int64_t at_guard = std::llround((-guard_ndc * 0.5 + 0.5) * width * double(soft::kSub));
   ASSERT_LT(at_guard, -(int64_t(1) << 26));  // far beyond 16 bits: the test can see truncation
 
-  // Clipped: vertex A at NDC x = -40 guard widths (x = -120 guard widths); the clipped vertices lie on x = -guard.
+  // Clipped: vertex A at NDC x = -40 guard widths (x = -120 guard widths); the clipped vertices lie
+  // on x = -guard.
   {
     soft::TriangleSetup clipper = setup;
-    std::vector<soft::SetupTriangle> out;
+    soft::SetupTriangles out;
     size_t clipped = 0;
     clipper.add(setup.project({-120.0f * float(guard_ndc), -0.5f, 0.0f}),
                 setup.project({2.7f, 0.9f, 0.0f}), setup.project({2.7f, -0.9f, 0.0f}), 1, 0, out,

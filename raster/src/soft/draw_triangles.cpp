@@ -20,7 +20,8 @@ using Clock = std::chrono::steady_clock;
 // a time in parallel, binned, and drawn into every tile before the next: memory holds one chunk,
 // whatever the triangle count.
 constexpr size_t kChunk = size_t(1) << 16;
-constexpr size_t kSubChunk = 4096;
+// 8192 set-up triangles are 1.5 MiB: one huge page each (HugePageAllocator).
+constexpr size_t kSubChunk = 8192;
 
 // A thread's setup state: its own clipping scratch, a cache of projected vertices (a mesh's
 // neighbouring triangles share them, so most are projected once, not once per triangle) and
@@ -39,7 +40,7 @@ struct SetupWorker {
     return cache[slot];
   }
   // Sets up the waiting batch into `out` (after what is there: submission order).
-  void flush(const FillKernels& kernels, int width, int height, std::vector<SetupTriangle>& out) {
+  void flush(const FillKernels& kernels, int width, int height, SetupTriangles& out) {
     if (batch.count == 0) return;
     const size_t at = out.size();
     out.resize(at + size_t(batch.count));
@@ -76,7 +77,7 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
   const FillKernels& kernels = target.kernels();
   const TriangleSetup prototype(target.width(), target.height(), view_projection);
   tbb::enumerable_thread_specific<SetupWorker> workers(prototype);
-  std::vector<std::vector<SetupTriangle>> sub_out((kChunk + kSubChunk - 1) / kSubChunk);
+  std::vector<SetupTriangles> sub_out((kChunk + kSubChunk - 1) / kSubChunk);
   std::vector<size_t> sub_clipped(sub_out.size());
   std::vector<uint32_t> counts, bin_start(tile_count + 1), bin;
   std::vector<TileCounters> counters(tile_count);
@@ -93,11 +94,11 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
     arena.execute([&] {
       tbb::parallel_for(size_t(0), subs, [&](size_t s) {
         SetupWorker& worker = workers.local();
-        std::vector<SetupTriangle>& local = sub_out[s];
+        SetupTriangles& local = sub_out[s];
         local.clear();
-        local.reserve(kSubChunk);
         size_t local_clipped = 0;
         const size_t begin = chunk + s * kSubChunk, end = std::min(chunk_end, begin + kSubChunk);
+        local.reserve(end - begin);
         size_t object = size_t(std::upper_bound(list.first.begin(), list.first.end(), begin) -
                                list.first.begin()) -
                         1;
@@ -178,7 +179,9 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
     });
     result.bin_seconds += seconds_since(t);
     size_t chunk_bytes = (bin.capacity() + counts.capacity()) * sizeof(uint32_t);
-    for (const auto& v : sub_out) chunk_bytes += v.capacity() * sizeof(SetupTriangle);
+    for (const auto& v : sub_out)
+      if (v.capacity() > 0)
+        chunk_bytes += HugePageAllocator<SetupTriangle>::bytes_for(v.capacity());
     result.peak_chunk_bytes = std::max(result.peak_chunk_bytes, chunk_bytes);
 
     // --- raster: tiles in parallel, each independent of the others

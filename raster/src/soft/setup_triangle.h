@@ -3,6 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
+
+#include "soft/huge_page_allocator.h"
 
 namespace rvr::soft {
 
@@ -47,5 +50,8 @@ struct alignas(64) SetupTriangle {
   }
 };
 static_assert(sizeof(SetupTriangle) == 192, "a hot cache line and two cold ones");
+
+// A run of set-up triangles (a sub-chunk's, in submission order).
+using SetupTriangles = std::vector<SetupTriangle, HugePageAllocator<SetupTriangle>>;
 
 }  // namespace rvr::soft

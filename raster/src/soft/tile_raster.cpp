@@ -89,8 +89,8 @@ void DepthTarget::update_block_max(int bx, int by) {
   block_max_[size_t(by) * size_t(blocks_x_) + size_t(bx)] = m;
 }
 
-void DepthTarget::draw_tile(int tx, int ty, const std::vector<SetupTriangle>* sub_chunks,
-                            const uint32_t* bin, size_t count, TileCounters& counters) {
+void DepthTarget::draw_tile(int tx, int ty, const SetupTriangles* sub_chunks, const uint32_t* bin,
+                            size_t count, TileCounters& counters) {
   const int ox = tx * kTile, oy = ty * kTile;
   const int ex = std::min(ox + kTile, width_) - 1, ey = std::min(oy + kTile, height_) - 1;
   auto triangle = [&](size_t k) -> const SetupTriangle& {

@@ -52,7 +52,7 @@ class DepthTarget {
   // sub-chunk << kLocalBits | index in that sub-chunk's triangles. Tiles are independent: any
   // thread may draw any tile, and the bytes do not change.
   static constexpr uint32_t kLocalBits = 20;
-  void draw_tile(int tx, int ty, const std::vector<SetupTriangle>* sub_chunks, const uint32_t* bin,
+  void draw_tile(int tx, int ty, const SetupTriangles* sub_chunks, const uint32_t* bin,
                  size_t count, TileCounters& counters);
 
   // What the frame ended with, per pixel.

@@ -63,7 +63,7 @@ ProjectedVertex TriangleSetup::project(const glm::vec3& p) const {
 
 void TriangleSetup::add(const ProjectedVertex& a, const ProjectedVertex& b,
                         const ProjectedVertex& c, uint32_t object, uint32_t primitive,
-                        std::vector<SetupTriangle>& out, size_t& clipped) {
+                        SetupTriangles& out, size_t& clipped) {
   // Trivial reject against the view frustum; then clip only where a plane is crossed.
   if (a.reject & b.reject & c.reject) {
     ++clipped;
@@ -106,7 +106,7 @@ void TriangleSetup::clip_polygon(const Polygon& in, const glm::dvec4& plane, Pol
 }
 
 void TriangleSetup::clip_and_emit(const ProjectedVertex* pv[3], uint32_t object, uint32_t primitive,
-                                  std::vector<SetupTriangle>& out) {
+                                  SetupTriangles& out) {
   Polygon& v = poly_;
   v.resize(3);
   for (int i = 0; i < 3; ++i) {
@@ -142,8 +142,7 @@ void TriangleSetup::clip_and_emit(const ProjectedVertex* pv[3], uint32_t object,
 
 void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int64_t fx[3],
                          const int64_t fy[3], const double f_in[3][3], const double w[3],
-                         uint32_t object, uint32_t primitive,
-                         std::vector<SetupTriangle>& out) const {
+                         uint32_t object, uint32_t primitive, SetupTriangles& out) const {
   int order[3] = {0, 1, 2};
   int64_t area = (fx[1] - fx[0]) * (fy[2] - fy[0]) - (fy[1] - fy[0]) * (fx[2] - fx[0]);
   if (area == 0) return;                        // covers no pixel centre

@@ -38,7 +38,7 @@ class TriangleSetup {
   // Culls, clips and sets up one input triangle; appends what covers a pixel centre's bounding
   // box to `out`. Counts clipped or culled input triangles in `clipped`.
   void add(const ProjectedVertex& a, const ProjectedVertex& b, const ProjectedVertex& c,
-           uint32_t object, uint32_t primitive, std::vector<SetupTriangle>& out, size_t& clipped);
+           uint32_t object, uint32_t primitive, SetupTriangles& out, size_t& clipped);
 
  private:
   struct ClipVertex {
@@ -48,11 +48,11 @@ class TriangleSetup {
   using Polygon = std::vector<ClipVertex>;
   static void clip_polygon(const Polygon& in, const glm::dvec4& plane, Polygon& out);
   void clip_and_emit(const ProjectedVertex* v[3], uint32_t object, uint32_t primitive,
-                     std::vector<SetupTriangle>& out);
+                     SetupTriangles& out);
   // One screen triangle: vertices' screen and fixed-point positions and f_j = b_j / w.
   void emit(const double sx[3], const double sy[3], const int64_t fx[3], const int64_t fy[3],
             const double f[3][3], const double w[3], uint32_t object, uint32_t primitive,
-            std::vector<SetupTriangle>& out) const;
+            SetupTriangles& out) const;
 
   int width_, height_;
   glm::dmat4 view_projection_;

@@ -1,0 +1,57 @@
+// An allocator for softraster's large per-chunk arrays of set-up triangles: whole 2 MiB pages,
+// marked for transparent huge pages (Linux's madvise mode grants them only when asked). The
+// tile pass reads a chunk's triangles (megabytes) in scattered order; with 4 KiB pages nearly
+// every one is a TLB miss, which also makes the prefetches of them late.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+namespace rvr::soft {
+
+template <class T>
+struct HugePageAllocator {
+  using value_type = T;
+  static constexpr size_t kPage = size_t(2) << 20;
+  HugePageAllocator() = default;
+  template <class U>
+  HugePageAllocator(const HugePageAllocator<U>&) {}
+  // Below half a page, plain memory: a huge page for a small scene's few triangles would only
+  // cost its clearing (2 MiB at the first touch).
+  static bool huge(size_t n) { return n * sizeof(T) >= kPage / 2; }
+  // What allocate(n) takes.
+  static size_t bytes_for(size_t n) {
+    return huge(n) ? (n * sizeof(T) + kPage - 1) / kPage * kPage : n * sizeof(T);
+  }
+  T* allocate(size_t n) {
+    const size_t bytes = bytes_for(n);
+    // sizeof(T) is a multiple of alignof(T), so bytes is one of the alignment as it must be.
+    const size_t align = huge(n) ? kPage : std::max(alignof(T), alignof(std::max_align_t));
+    void* p = std::aligned_alloc(align, bytes);
+    if (!p) throw std::bad_alloc();
+#if defined(MADV_HUGEPAGE)
+    if (huge(n)) madvise(p, bytes, MADV_HUGEPAGE);  // a hint: without huge pages it works as before
+#endif
+    return static_cast<T*>(p);
+  }
+  void deallocate(T* p, size_t) {
+    std::free(p);
+  }
+  template <class U>
+  bool operator==(const HugePageAllocator<U>&) const {
+    return true;
+  }
+  template <class U>
+  bool operator!=(const HugePageAllocator<U>&) const {
+    return false;
+  }
+};
+
+}  // namespace rvr::soft
