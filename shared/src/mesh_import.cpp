@@ -21,7 +21,6 @@
 #include <map>
 #include <set>
 #include <stdexcept>
-#include <unordered_map>
 #include <vector>
 
 #include "mesh_repair.h"
@@ -335,32 +334,35 @@ void append_mesh(TriangleMesh& mesh, const aiScene* ai, unsigned m, bool normals
 // takes about a tenth of it. Geometry is the file's, bit for bit.
 void weld_identical_vertices(TriangleMesh& mesh) {
   const bool normals = mesh.normals.size() == mesh.positions.size();
-  struct Key {
-    std::array<uint32_t, 6> bits{};
-    bool operator==(const Key& o) const { return bits == o.bits; }
+  const size_t n = mesh.positions.size();
+  auto bits_of = [&](size_t v) {
+    std::array<uint32_t, 6> b{};
+    std::memcpy(b.data(), &mesh.positions[v], sizeof(glm::vec3));
+    if (normals) std::memcpy(b.data() + 3, &mesh.normals[v], sizeof(glm::vec3));
+    return b;
   };
-  struct KeyHash {
-    size_t operator()(const Key& k) const {
-      uint64_t h = 1469598103934665603ull;  // FNV-1a over the six words
-      for (uint32_t b : k.bits) h = (h ^ b) * 1099511628211ull;
-      return size_t(h ^ (h >> 29));
-    }
-  };
-  std::unordered_map<Key, uint32_t, KeyHash> index;
-  index.reserve(mesh.positions.size());
-  std::vector<uint32_t> remap(mesh.positions.size());
+  // Open addressing, no allocation per vertex: slots hold 1 + the input index of the first
+  // vertex with those bits (0: empty), at most half full.
+  size_t size = 16;
+  while (size < 2 * n) size *= 2;
+  std::vector<uint32_t> slot(size, 0);
+  std::vector<uint32_t> remap(n);
   std::vector<glm::vec3> positions, new_normals;
-  positions.reserve(mesh.positions.size());
-  for (size_t v = 0; v < mesh.positions.size(); ++v) {
-    Key key;
-    std::memcpy(key.bits.data(), &mesh.positions[v], sizeof(glm::vec3));
-    if (normals) std::memcpy(key.bits.data() + 3, &mesh.normals[v], sizeof(glm::vec3));
-    auto [it, added] = index.emplace(key, uint32_t(positions.size()));
-    if (added) {
+  positions.reserve(n);
+  for (size_t v = 0; v < n; ++v) {
+    const std::array<uint32_t, 6> key = bits_of(v);
+    uint64_t h = 1469598103934665603ull;  // FNV-1a over the six words
+    for (uint32_t b : key) h = (h ^ b) * 1099511628211ull;
+    size_t i = size_t(h ^ (h >> 29)) & (size - 1);
+    while (slot[i] != 0 && bits_of(slot[i] - 1) != key) i = (i + 1) & (size - 1);
+    if (slot[i] == 0) {
+      slot[i] = uint32_t(v + 1);
+      remap[v] = uint32_t(positions.size());
       positions.push_back(mesh.positions[v]);
       if (normals) new_normals.push_back(mesh.normals[v]);
+    } else {
+      remap[v] = remap[slot[i] - 1];
     }
-    remap[v] = it->second;
   }
   for (glm::uvec3& t : mesh.triangles) t = {remap[t.x], remap[t.y], remap[t.z]};
   mesh.positions = std::move(positions);
