@@ -8,7 +8,10 @@
 #include <cstddef>
 #include <cstdlib>
 #include <new>
+#include <utility>
 #include <vector>
+
+#include "rvr/shared/pixel_memory.h"
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -30,19 +33,30 @@ struct HugePageAllocator {
   static size_t bytes_for(size_t n) {
     return huge(n) ? (n * sizeof(T) + kPage - 1) / kPage * kPage : n * sizeof(T);
   }
+  // From the frame memory that is recycled between frames (pixel_memory.h): the next frame's
+  // chunks reuse these pages instead of faulting and clearing fresh huge pages.
   T* allocate(size_t n) {
-    const size_t bytes = bytes_for(n);
     // sizeof(T) is a multiple of alignof(T), so bytes is one of the alignment as it must be.
-    const size_t align = huge(n) ? kPage : std::max(alignof(T), alignof(std::max_align_t));
-    void* p = std::aligned_alloc(align, bytes);
-    if (!p) throw std::bad_alloc();
+    const size_t align = huge(n) ? kPage : std::max<size_t>(alignof(T), 64);
+    void* p = acquire_pixel_memory(bytes_for(n), align);
 #if defined(MADV_HUGEPAGE)
-    if (huge(n)) madvise(p, bytes, MADV_HUGEPAGE);  // a hint: without huge pages it works as before
+    if (huge(n))
+      madvise(p, bytes_for(n), MADV_HUGEPAGE);  // a hint: without huge pages it works as before
 #endif
     return static_cast<T*>(p);
   }
-  void deallocate(T* p, size_t) {
-    std::free(p);
+  // resize() default-initialises: the caller writes what it appends (SetupTriangle has no
+  // member defaults), so no value-initialising pass over memory about to be overwritten.
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+  void deallocate(T* p, size_t n) noexcept {
+    release_pixel_memory(p, bytes_for(n), huge(n) ? kPage : std::max<size_t>(alignof(T), 64));
   }
   template <class U>
   bool operator==(const HugePageAllocator<U>&) const {

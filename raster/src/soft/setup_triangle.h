@@ -15,14 +15,17 @@ constexpr int kSubBits = 12;
 constexpr int64_t kSub = int64_t(1) << kSubBits;
 
 // A screen-space triangle after clipping. One input triangle gives up to a few of these.
+// No default member values: setup writes every field, and a vector of them is resized a batch at
+// a time (HugePageAllocator default-initialises), so a value-initialising memset per batch
+// (192 bytes a triangle, 10^6 times a frame) would be work thrown away.
 // Hot and cold halves: draw_tile reads the first cache line of every binned triangle (pixel
 // box, hi-z bound, edge functions) and the other two only for triangles with a block to fill;
 // at 10^6 scattered triangles a chunk is far beyond L2, so lines not touched are misses saved.
 struct alignas(64) SetupTriangle {
   // --- hot: one cache line
-  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;  // pixel bounding box, inclusive, on screen
+  int x0, y0, x1, y1;  // pixel bounding box, inclusive, on screen
   // No fragment is nearer than this (view depth): the hi-z test's bound (see min_depth_bound).
-  double min_depth = 0;
+  double min_depth;
   // Fixed point, oriented so the edge functions are >= 0 inside. Guard-band coordinates are
   // below 2^28 in magnitude (triangle_setup.h), so 32 bits hold them exactly.
   int32_t x[3], y[3];
@@ -34,8 +37,8 @@ struct alignas(64) SetupTriangle {
   // exact where 1/|L - P|^2 is steep (surfaces next to a light).
   alignas(64) double q0[3];
   double qa[3], qb[3];
-  double ox = 0, oy = 0;
-  uint32_t object = 0, primitive = 0;
+  double ox, oy;
+  uint32_t object, primitive;
 
   double inv_w(double px, double py, double (&q)[3]) const {
     double s = 0;

@@ -11,22 +11,36 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/shared/pixel_memory.h"
+
 namespace rvr {
 
 constexpr uint32_t kNoId = 0xFFFFFFFFu;  // object/primitive id of the background
 
-// std::allocator whose resize() leaves new elements uninitialised (default-initialised), so a
+// An allocator whose resize() leaves new elements uninitialised (default-initialised), so a
 // renderer that writes every pixel can size its buffers without a serial pass over them: the
-// pages are then first touched by the threads that render them.
+// pages are then first touched by the threads that render them. Its memory is recycled
+// between frames (pixel_memory.h).
 template <class T>
-struct PixelAllocator : std::allocator<T> {
-  template <class U>
-  struct rebind {
-    using other = PixelAllocator<U>;
-  };
+struct PixelAllocator {
+  using value_type = T;
   PixelAllocator() = default;
   template <class U>
   PixelAllocator(const PixelAllocator<U>&) {}
+  T* allocate(size_t n) {
+    static_assert(alignof(T) <= 64, "pixel memory is 64-byte aligned");
+    if (n > size_t(-1) / sizeof(T)) throw std::bad_array_new_length();
+    return static_cast<T*>(acquire_pixel_memory(n * sizeof(T)));
+  }
+  void deallocate(T* p, size_t n) noexcept { release_pixel_memory(p, n * sizeof(T)); }
+  template <class U>
+  bool operator==(const PixelAllocator<U>&) const {
+    return true;
+  }
+  template <class U>
+  bool operator!=(const PixelAllocator<U>&) const {
+    return false;
+  }
   template <class U>
   void construct(U* p) noexcept {
     ::new (static_cast<void*>(p)) U;
