@@ -7,6 +7,8 @@
 
 #include <cstring>
 #include <glm/glm.hpp>
+#include <limits>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -50,10 +52,20 @@ void put(float (&to)[3][soft::kShadeBatch], int i, const glm::vec3& v) {
   for (int a = 0; a < 3; ++a) to[a][i] = v[a];
 }
 
-// Shades pixels [0, n) with one kernel, the batch padded as the deferred pass pads it.
+bool same_material(const Material& a, const Material& b) {
+  return a.diffuse == b.diffuse && a.specular == b.specular && a.emission == b.emission &&
+         a.shininess == b.shininess;
+}
+
+// Shades pixels [0, n) with one kernel, the batch padded as the deferred pass pads it. With
+// `as_the_pass`, what the deferred pass leaves out is filled with NaN, so that reading it shows:
+// a batch of one material passes it once (batch.material), not per slot, and flat pixels'
+// vertex normals are not gathered.
 std::vector<Shaded> kernel_shade(const soft::ShadeKernels& kernels, const std::vector<Pixel>& px,
                                  const glm::vec3& eye, const glm::vec3& ambient,
-                                 const std::vector<LightSample>& lights) {
+                                 const std::vector<LightSample>& lights, bool as_the_pass) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const glm::vec3 nan3(nan);
   std::vector<float> data[6];
   for (const LightSample& l : lights)
     for (int a = 0; a < 3; ++a) {
@@ -69,18 +81,31 @@ std::vector<Shaded> kernel_shade(const soft::ShadeKernels& kernels, const std::v
   for (size_t first = 0; first < px.size(); first += soft::kShadeBatch) {
     const int n = int(std::min<size_t>(soft::kShadeBatch, px.size() - first));
     const int padded = (n + soft::kShadeMaxLanes - 1) / soft::kShadeMaxLanes * soft::kShadeMaxLanes;
+    bool one_material = as_the_pass;
+    for (int i = 1; i < n; ++i)
+      one_material =
+          one_material && same_material(px[first + size_t(i)].material, px[first].material);
+    soft::ShadeMaterial material;
+    for (int a = 0; a < 3; ++a) {
+      material.diffuse[a] = px[first].material.diffuse[a];
+      material.specular[a] = px[first].material.specular[a];
+      material.base[a] = shade_base(px[first].material, ambient)[a];
+    }
+    material.shininess = px[first].material.shininess;
+    batch->material = one_material ? &material : nullptr;
     for (int i = 0; i < padded; ++i) {
       const Pixel& p = px[first + size_t(std::min(i, n - 1))];
       put(batch->bary, i, p.bary);
+      const glm::vec3 flat_normal = as_the_pass ? nan3 : glm::vec3(0.0f);
       for (int c = 0; c < 3; ++c) {
         put(batch->vertex[c], i, p.vertex[c]);
-        put(batch->normal[c], i, p.smooth ? p.normal[c] : glm::vec3(0.0f));
+        put(batch->normal[c], i, p.smooth ? p.normal[c] : flat_normal);
       }
       batch->smooth[i] = p.smooth ? ~0u : 0u;
-      put(batch->diffuse, i, p.material.diffuse);
-      put(batch->specular, i, p.material.specular);
-      put(batch->base, i, shade_base(p.material, ambient));
-      batch->shininess[i] = p.material.shininess;
+      put(batch->diffuse, i, one_material ? nan3 : p.material.diffuse);
+      put(batch->specular, i, one_material ? nan3 : p.material.specular);
+      put(batch->base, i, one_material ? nan3 : shade_base(p.material, ambient));
+      batch->shininess[i] = one_material ? nan : p.material.shininess;
     }
     batch->count = n;
     kernels.shade(*batch, eye_xyz, soa);
@@ -102,18 +127,18 @@ std::string show(const glm::vec3& v) {
   return s;
 }
 
-}  // namespace
+const glm::vec3 kEye(0.3f, 0.6f, 3.2f), kAmbient(0.05f, 0.07f, 0.02f);
+// Three samples: in front of most surfaces, behind some, one exactly at a vertex.
+const glm::vec3 kAtVertex(0.25f, -0.5f, 0.125f);
+const std::vector<LightSample> kLights = {{{2.0f, 3.0f, 3.0f}, {20.0f, 18.0f, 15.0f}},
+                                          {{-1.5f, 0.5f, -2.0f}, {3.0f, 4.0f, 5.0f}},
+                                          {kAtVertex, {1.0f, 1.0f, 1.0f}}};
 
-TEST(ShadeKernels, EveryKernelShadesAsTheScalarShadeLocalBitForBit) {
+// Random pixels and the equation's special cases, each with its own material.
+std::vector<Pixel> random_pixels() {
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f), positive(0.0f, 1.0f);
   auto random_vec = [&](float scale) { return scale * glm::vec3(unit(rng), unit(rng), unit(rng)); };
-  const glm::vec3 eye(0.3f, 0.6f, 3.2f), ambient(0.05f, 0.07f, 0.02f);
-  // Three samples: in front of most surfaces, behind some, one exactly at a vertex.
-  const glm::vec3 at_vertex(0.25f, -0.5f, 0.125f);
-  const std::vector<LightSample> lights = {{{2.0f, 3.0f, 3.0f}, {20.0f, 18.0f, 15.0f}},
-                                           {{-1.5f, 0.5f, -2.0f}, {3.0f, 4.0f, 5.0f}},
-                                           {at_vertex, {1.0f, 1.0f, 1.0f}}};
   std::vector<Pixel> pixels;
   const float shininess[] = {48.0f, 1.0f, 0.0f, 7.5f, 200.0f};
   for (int k = 0; k < 3001; ++k) {  // not a multiple of any lane count or of the batch
@@ -136,21 +161,27 @@ TEST(ShadeKernels, EveryKernelShadesAsTheScalarShadeLocalBitForBit) {
     }
     if (k % 13 == 0) {  // P exactly at the third sample: |L - P| = 0 adds nothing
       p.bary = {1.0f, 0.0f, 0.0f};
-      p.vertex[0] = at_vertex;
+      p.vertex[0] = kAtVertex;
     }
     pixels.push_back(p);
   }
+  return pixels;
+}
+
+// Every kernel this CPU runs against scalar_shade, bit for bit.
+void expect_kernels_shade_as_scalar(const std::vector<Pixel>& pixels, bool as_the_pass) {
   int tested = 0;
   for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
     if (!cpu_supports(isa)) continue;
     ++tested;
     const soft::ShadeKernels& kernels = soft::shade_kernels(isa);
     EXPECT_EQ(std::string(kernels.isa), to_string(isa));
-    const std::vector<Shaded> got = kernel_shade(kernels, pixels, eye, ambient, lights);
+    const std::vector<Shaded> got =
+        kernel_shade(kernels, pixels, kEye, kAmbient, kLights, as_the_pass);
     ASSERT_EQ(got.size(), pixels.size());
     int failures = 0;
     for (size_t i = 0; i < pixels.size() && failures < 5; ++i) {
-      const Shaded want = scalar_shade(pixels[i], eye, ambient, lights);
+      const Shaded want = scalar_shade(pixels[i], kEye, kAmbient, kLights);
       if (same_bits(got[i].normal, want.normal) && same_bits(got[i].colour, want.colour)) continue;
       ++failures;
       ADD_FAILURE() << to_string(isa) << " pixel " << i << ": normal " << show(got[i].normal)
@@ -159,4 +190,23 @@ TEST(ShadeKernels, EveryKernelShadesAsTheScalarShadeLocalBitForBit) {
     }
   }
   EXPECT_GE(tested, 1);
+}
+
+}  // namespace
+
+TEST(ShadeKernels, EveryKernelShadesAsTheScalarShadeLocalBitForBit) {
+  expect_kernels_shade_as_scalar(random_pixels(), false);
+}
+
+// The deferred pass's batches: objects in runs (one material per batch, or two when a run ends
+// inside one), groups of lanes all flat, all smooth or mixed; what it does not gather is NaN.
+TEST(ShadeKernels, BatchesOfOneMaterialAndFlatGroupsShadeAsTheScalarCode) {
+  std::vector<Pixel> pixels = random_pixels();
+  for (size_t k = 0; k < pixels.size(); ++k) {
+    const size_t run = k < 1000 ? 128 : 200;  // then runs that end inside batches
+    pixels[k].material = pixels[k / run * run].material;
+    const size_t group = k / 16 % 3;  // 0: flat, 1: smooth, 2: alternating
+    pixels[k].smooth = group == 1 || (group == 2 && k % 2 == 0);
+  }
+  expect_kernels_shade_as_scalar(pixels, true);
 }

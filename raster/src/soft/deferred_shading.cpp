@@ -4,6 +4,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 
@@ -18,14 +19,18 @@ struct ObjectShading {
   const TriangleMesh* mesh = nullptr;
   bool smooth = false;
   bool use_primitive_id = false;
-  glm::vec3 diffuse{0.0f}, specular{0.0f}, base{0.0f};
-  float shininess = 0.0f;
+  ShadeMaterial material{};
 };
 
 void put(float (&to)[3][kShadeBatch], int i, const glm::vec3& v) {
   to[0][i] = v.x;
   to[1][i] = v.y;
   to[2][i] = v.z;
+}
+void put(float (&to)[3][kShadeBatch], int i, const float (&v)[3]) {
+  to[0][i] = v[0];
+  to[1][i] = v[1];
+  to[2][i] = v[2];
 }
 
 // Asks for transparent huge pages over a buffer not yet touched. The frame's buffers are fresh
@@ -42,20 +47,46 @@ void ask_for_huge_pages(PixelVector<T>& v) {
   if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
 }
 
-// Repeats slot `from` in slot `to` (every input of the kernel).
-void copy_slot(ShadeBatch& b, int from, int to) {
+void put_material(ShadeBatch& b, int i, const ShadeMaterial& m) {
+  put(b.diffuse, i, m.diffuse);
+  put(b.specular, i, m.specular);
+  put(b.base, i, m.base);
+  b.shininess[i] = m.shininess;
+}
+
+// Repeats slot `from` in slot `to` (every input of the kernel; the material too if each slot
+// carries its own).
+void copy_slot(ShadeBatch& b, int from, int to, bool materials) {
   for (int a = 0; a < 3; ++a) {
     b.bary[a][to] = b.bary[a][from];
     for (int c = 0; c < 3; ++c) {
       b.vertex[c][a][to] = b.vertex[c][a][from];
       b.normal[c][a][to] = b.normal[c][a][from];
     }
+  }
+  b.smooth[to] = b.smooth[from];
+  if (!materials) return;
+  for (int a = 0; a < 3; ++a) {
     b.diffuse[a][to] = b.diffuse[a][from];
     b.specular[a][to] = b.specular[a][from];
     b.base[a][to] = b.base[a][from];
   }
-  b.smooth[to] = b.smooth[from];
   b.shininess[to] = b.shininess[from];
+}
+
+// The pixels [begin, end) of a row nothing covers: FrameBuffers::set_background's values, one
+// buffer at a time (the cost is written with the row's).
+void fill_background(FrameBuffers& fb, size_t begin, size_t end, const glm::vec3& background) {
+  std::fill(fb.color.begin() + std::ptrdiff_t(begin), fb.color.begin() + std::ptrdiff_t(end),
+            background);
+  std::fill(fb.depth.begin() + std::ptrdiff_t(begin), fb.depth.begin() + std::ptrdiff_t(end),
+            std::numeric_limits<float>::infinity());
+  std::fill(fb.object_id.begin() + std::ptrdiff_t(begin),
+            fb.object_id.begin() + std::ptrdiff_t(end), kNoId);
+  std::fill(fb.primitive_id.begin() + std::ptrdiff_t(begin),
+            fb.primitive_id.begin() + std::ptrdiff_t(end), kNoId);
+  std::fill(fb.normal.begin() + std::ptrdiff_t(begin), fb.normal.begin() + std::ptrdiff_t(end),
+            glm::vec3(0.0f));
 }
 
 }  // namespace
@@ -79,10 +110,13 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
     s.smooth = d.smooth;
     s.use_primitive_id = d.use_primitive_id;
     if (!d.material) continue;
-    s.diffuse = d.material->diffuse;
-    s.specular = d.material->specular;
-    s.shininess = d.material->shininess;
-    s.base = shade_base(*d.material, settings.ambient);
+    const glm::vec3 base = shade_base(*d.material, settings.ambient);
+    for (int a = 0; a < 3; ++a) {
+      s.material.diffuse[a] = d.material->diffuse[a];
+      s.material.specular[a] = d.material->specular[a];
+      s.material.base[a] = base[a];
+    }
+    s.material.shininess = d.material->shininess;
   }
   // The light samples as the kernel reads them (none: the colour is the base).
   std::vector<float> light_data[6];
@@ -97,16 +131,29 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
                               int(light_data[0].size())};
   const float eye[3] = {settings.eye.x, settings.eye.y, settings.eye.z};
   const bool write_colour = settings.colour != ShadedColour::Background;
+  // The target marks a pixel nothing covers with the id the frame buffers give the background.
+  static_assert(kNoId == 0xFFFFFFFFu);
+  const double* depths = target.depths();
+  const uint32_t* object_of = target.objects();
+  const uint32_t* primitive_of = target.primitives();
+  const float* barycentrics = target.barycentrics();
 
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
       ShadeBatch batch;
+      // Flat pixels leave their slots' vertex normals as they were: defined values, not read.
+      std::fill(&batch.normal[0][0][0], &batch.normal[0][0][0] + 9 * kShadeBatch, 0.0f);
       size_t pixel[kShadeBatch];  // frame-buffer index of each slot
+      // The object of every slot so far, while the batch holds one (then batch.material is
+      // set at the flush and the per-slot material arrays are not filled).
+      uint32_t batch_object = 0;
+      bool mixed = false;
       auto flush = [&] {
         if (batch.count == 0) return;
         const int n = batch.count;
         const int padded = (n + kShadeMaxLanes - 1) / kShadeMaxLanes * kShadeMaxLanes;
-        for (int i = n; i < padded; ++i) copy_slot(batch, n - 1, i);
+        for (int i = n; i < padded; ++i) copy_slot(batch, n - 1, i, mixed);
+        batch.material = mixed ? nullptr : &objects[batch_object].material;
         kernels.shade(batch, eye, lights);
         for (int i = 0; i < n; ++i) {
           const size_t o = pixel[i];
@@ -116,37 +163,57 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
             fb.color[o] = {batch.colour[0][i], batch.colour[1][i], batch.colour[2][i]};
         }
         batch.count = 0;
+        mixed = false;
       };
+      // The last triangle gathered: consecutive pixels mostly show the same one.
+      uint32_t last_object = kNoId, last_primitive = kNoId;
+      glm::vec3 last_vertex[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
+      glm::vec3 last_normal[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
       for (int y = r.begin(); y != r.end(); ++y) {
-        for (int x = 0; x < w; ++x) {
-          const size_t o = fb.index(x, y);
-          if (!target.covered(o)) {
-            fb.set_background(o, settings.background);
-            fb.cost[o] = target.cost(x, y);
+        const size_t row = fb.index(0, y);
+        target.cost_row(y, fb.cost.data() + row);
+        int x = 0;
+        while (x < w) {
+          if (object_of[row + size_t(x)] == kNoId) {
+            int end = x + 1;
+            while (end < w && object_of[row + size_t(end)] == kNoId) ++end;
+            fill_background(fb, row + size_t(x), row + size_t(end), settings.background);
+            x = end;
             continue;
           }
-          const uint32_t id = target.object(o);
+          const size_t o = row + size_t(x);
+          ++x;
+          const uint32_t id = object_of[o];
           const ObjectShading& s = objects[id];
-          const uint32_t primitive = target.primitive(o);
-          fb.cost[o] = target.cost(x, y);
-          fb.depth[o] = float(target.depth(o));
+          const uint32_t primitive = primitive_of[o];
+          fb.depth[o] = float(depths[o]);
           fb.object_id[o] = id;
           fb.primitive_id[o] = s.use_primitive_id ? primitive : 0u;
           if (!write_colour) fb.color[o] = settings.background;
 
           const int i = batch.count++;
           pixel[i] = o;
-          put(batch.bary, i, target.barycentric(o));
-          const TriangleMesh& mesh = *s.mesh;
-          const glm::uvec3& tri = mesh.triangles[primitive];
-          for (int c = 0; c < 3; ++c) put(batch.vertex[c], i, mesh.positions[tri[c]]);
+          if (i == 0)
+            batch_object = id;
+          else if (!mixed && id != batch_object) {
+            mixed = true;  // from now on each slot carries its material
+            for (int k = 0; k < i; ++k) put_material(batch, k, objects[batch_object].material);
+          }
+          if (mixed) put_material(batch, i, s.material);
+          for (int a = 0; a < 3; ++a) batch.bary[a][i] = barycentrics[3 * o + size_t(a)];
+          if (id != last_object || primitive != last_primitive) {
+            last_object = id;
+            last_primitive = primitive;
+            const TriangleMesh& mesh = *s.mesh;
+            const glm::uvec3& tri = mesh.triangles[primitive];
+            for (int c = 0; c < 3; ++c) last_vertex[c] = mesh.positions[tri[c]];
+            if (s.smooth)
+              for (int c = 0; c < 3; ++c) last_normal[c] = mesh.normals[tri[c]];
+          }
+          for (int c = 0; c < 3; ++c) put(batch.vertex[c], i, last_vertex[c]);
           batch.smooth[i] = s.smooth ? ~0u : 0u;
-          for (int c = 0; c < 3; ++c)
-            put(batch.normal[c], i, s.smooth ? mesh.normals[tri[c]] : glm::vec3(0.0f));
-          put(batch.diffuse, i, s.diffuse);
-          put(batch.specular, i, s.specular);
-          put(batch.base, i, s.base);
-          batch.shininess[i] = s.shininess;
+          if (s.smooth)
+            for (int c = 0; c < 3; ++c) put(batch.normal[c], i, last_normal[c]);
           if (batch.count == kShadeBatch) flush();
         }
       }

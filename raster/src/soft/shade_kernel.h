@@ -14,14 +14,25 @@ namespace rvr::soft {
 // Lanes of the widest kernel: batches are padded to a multiple of it.
 constexpr int kShadeMaxLanes = 16;
 
+// The material terms the kernel reads, of one object.
+struct ShadeMaterial {
+  float diffuse[3], specular[3], base[3];  // base: shade_base, emission + ambient * diffuse
+  float shininess;
+};
+
 // Up to kShadeBatch visible pixels in structure-of-arrays form: [i] is the i-th pixel.
 constexpr int kShadeBatch = 128;
 struct ShadeBatch {
   int count = 0;  // pixels filled; lanes [count, padded count) repeat the last pixel
+  // Not null: every pixel has this material (a batch of one object, the common case), and the
+  // per-pixel material arrays below are not read. The same floats, so the same bits.
+  const ShadeMaterial* material = nullptr;
   alignas(64) float bary[3][kShadeBatch];
   alignas(64) float vertex[3][3][kShadeBatch];  // [corner][axis]: the triangle's positions
-  alignas(64) float normal[3][3][kShadeBatch];  // [corner][axis]: its vertex normals if smooth
-  alignas(64) uint32_t smooth[kShadeBatch];     // ~0u: interpolate normals, 0: flat
+  // [corner][axis]: its vertex normals if smooth; not read (may be anything) where flat.
+  alignas(64) float normal[3][3][kShadeBatch];
+  alignas(64) uint32_t smooth[kShadeBatch];  // ~0u: interpolate normals, 0: flat
+  // Per pixel, when material is null:
   alignas(64) float diffuse[3][kShadeBatch];
   alignas(64) float specular[3][kShadeBatch];
   alignas(64) float shininess[kShadeBatch];

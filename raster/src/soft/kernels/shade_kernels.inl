@@ -207,6 +207,9 @@ struct V3 {
 inline V3 load3(const float (&p)[3][kShadeBatch], int i) {
   return {load(p[0] + i), load(p[1] + i), load(p[2] + i)};
 }
+inline V3 splat3(const float (&p)[3]) {
+  return {splat(p[0]), splat(p[1]), splat(p[2])};
+}
 inline void store3(float (&p)[3][kShadeBatch], int i, const V3& v) {
   store(p[0] + i, v.x);
   store(p[1] + i, v.y);
@@ -267,8 +270,12 @@ void shade(ShadeBatch& batch, const float eye_position[3], const ShadeLights& li
     const V3 p0 = load3(batch.vertex[0], i);
     const V3 geometric =
         normalize(cross(sub3(load3(batch.vertex[1], i), p0), sub3(load3(batch.vertex[2], i), p0)));
-    const V3 shading =
-        select3(load_mask(batch.smooth + i), normalize(interpolate(b, batch.normal, i)), geometric);
+    // Flat lanes take the geometric normal whatever their vertex normals hold: a group with no
+    // smooth lane skips the interpolation (the selection would discard it).
+    const M smooth = load_mask(batch.smooth + i);
+    const V3 shading = bits(smooth) == 0
+                           ? geometric
+                           : select3(smooth, normalize(interpolate(b, batch.normal, i)), geometric);
     const V3 V = normalize(sub3(eye, P));
     // face_viewer: dot(geometric, V) < 0 turns the normal.
     const M back = less(dot(geometric, V), zero);
@@ -276,9 +283,11 @@ void shade(ShadeBatch& batch, const float eye_position[3], const ShadeLights& li
     store3(batch.shading_normal, i, N);
 
     // shade_local: base, then each light sample in order.
-    const V3 diffuse = load3(batch.diffuse, i), specular = load3(batch.specular, i);
-    const VF shininess = load(batch.shininess + i);
-    V3 colour = load3(batch.base, i);
+    const ShadeMaterial* m = batch.material;
+    const V3 diffuse = m ? splat3(m->diffuse) : load3(batch.diffuse, i);
+    const V3 specular = m ? splat3(m->specular) : load3(batch.specular, i);
+    const VF shininess = m ? splat(m->shininess) : load(batch.shininess + i);
+    V3 colour = m ? splat3(m->base) : load3(batch.base, i);
     for (int l = 0; l < lights.count; ++l) {
       const V3 position = {splat(lights.position[0][l]), splat(lights.position[1][l]),
                            splat(lights.position[2][l])};
