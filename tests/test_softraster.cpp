@@ -266,17 +266,19 @@ TEST(SoftRasterizer, ReusedRendererDrawsWhatAFreshOneDraws) {
     const char* scene;
     bool hiz;
     int width;
+    bool no_objects = false;  // every tile left empty: cleared without a triangle in it
   };
-  const Case cases[] = {{"soup:20000", true, 160},    {"spheres", true, 160},
-                        {"occluders:8", true, 160},   {"spheres", false, 160},
-                        {"tessphere:5000", true, 96}, {"soup:20000", true, 160},
-                        {"cornell", true, 160}};
+  const Case cases[] = {
+      {"soup:20000", true, 160}, {"spheres", true, 160},       {"occluders:8", true, 160},
+      {"spheres", false, 160},   {"tessphere:5000", true, 96}, {"soup:20000", true, 160},
+      {"cornell", true, 160},    {"spheres", true, 160, true}, {"soup:20000", false, 160}};
   SoftRasterizer reused;
   for (const Case& c : cases) {
     Expected<Scene> scene = make_builtin_scene(c.scene);
     ASSERT_TRUE(scene.ok());
     scene->image.width = c.width;
     scene->image.height = c.width * 3 / 4;
+    if (c.no_objects) scene->objects.clear();
     RenderOptions options;
     options.mode = RenderMode::Local;
     options.hiz = c.hiz;
