@@ -34,12 +34,6 @@ class DepthTarget {
               const FillKernels& kernels, bool depth_only = false);
   // Back to nothing drawn, for the next pass through the same target.
   void clear();
-  // The same, lazily: a tile's pixels are cleared when the pass first draws into it (so their
-  // lines are in cache when its triangles touch them, instead of cleared for the whole frame
-  // first and fetched again), and end_frame() clears the tiles nothing was drawn in. Call
-  // end_frame() (inside the arena) before reading the target.
-  void begin_frame();
-  void end_frame();
   // Whether this target was made with these arguments (and can be cleared instead of rebuilt).
   bool same_setup(int width, int height, double near_plane, double far_plane, bool hiz,
                   const FillKernels& kernels) const {
@@ -102,8 +96,6 @@ class DepthTarget {
     return size_t(y / kBlock) * size_t(blocks_x_) + size_t(x / kBlock);
   }
   void update_block_max(int bx, int by);
-  void clear_blocks();
-  void clear_tile(int tx, int ty);
 
   int width_, height_, tiles_x_, tiles_y_, blocks_x_, blocks_y_;
   double near_, far_;
@@ -116,7 +108,6 @@ class DepthTarget {
   std::vector<double> block_max_;        // farthest depth in each block (+inf: not all drawn)
   std::vector<uint32_t> block_rejects_;  // hi-z rejections per block
   std::vector<uint16_t> block_empty_;    // pixels of each block nothing has been drawn in
-  std::vector<uint8_t> tile_stale_;      // 1: the tile's pixels still hold the last pass's
 };
 
 }  // namespace rvr::soft
