@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <glm/gtc/matrix_transform.hpp>
+#include <limits>
 #include <random>
 
 #include "rvr/raster/soft_rasterizer.h"
@@ -149,6 +150,24 @@ std::string setup_difference(const soft::SetupTriangle& a, const soft::SetupTria
   return "";
 }
 
+// A setup batch's vertices in SoA, filled from TriangleSetup::project's results.
+struct BatchVertices {
+  std::vector<int32_t> fx, fy;
+  std::vector<double> sx, sy, w, inv_w;
+  explicit BatchVertices(size_t n) : fx(n), fy(n), sx(n), sy(n), w(n), inv_w(n) {}
+  void set(size_t i, const soft::ProjectedVertex& p) {
+    fx[i] = int32_t(p.fx);
+    fy[i] = int32_t(p.fy);
+    sx[i] = p.sx;
+    sy[i] = p.sy;
+    w[i] = p.clip.w;
+    inv_w[i] = p.inv_w;
+  }
+  soft::VertexArrays arrays() {
+    return {fx.data(), fy.data(), sx.data(), sy.data(), w.data(), inv_w.data()};
+  }
+};
+
 }  // namespace
 
 // The batched setup kernels against TriangleSetup::add, the scalar setup (the oracle: the code
@@ -196,21 +215,18 @@ TEST(SoftrasterSetup, EveryKernelSetsUpTrianglesAsTheScalarSetupDoes) {
   for (Isa isa : runnable_isas()) {
     const soft::FillKernels& kernels = soft::fill_kernels(isa);
     std::vector<soft::SetupTriangle> got(count);
+    BatchVertices all(vertices.size());
+    const size_t last = vertices.size() - 1;
+    for (size_t i = 0; i < vertices.size(); ++i) all.set(last - i, vertices[i]);
     size_t n = 0;
-    // Batches of every fill from 1 to kSetupBatch, so partial vectors are exercised.
+    // Batches of every fill from 1 to kSetupBatch, so partial vectors are exercised; corners
+    // listed in reverse order, so a kernel must follow the indices.
     for (size_t i = 0, fill = 1; i < count; fill = fill % soft::kSetupBatch + 1) {
       soft::SetupBatch batch;
+      batch.vertices = all.arrays();
       for (; batch.count < int(fill) && i < count; ++i, ++batch.count) {
         const int k = batch.count;
-        for (int v = 0; v < 3; ++v) {
-          const soft::ProjectedVertex& p = vertices[3 * i + size_t(v)];
-          batch.fx[v][k] = p.fx;
-          batch.fy[v][k] = p.fy;
-          batch.sx[v][k] = p.sx;
-          batch.sy[v][k] = p.sy;
-          batch.w[v][k] = p.clip.w;
-          batch.inv_w[v][k] = p.inv_w;
-        }
+        for (int v = 0; v < 3; ++v) batch.vertex[v][k] = uint32_t(last - (3 * i + size_t(v)));
         batch.object[k] = 7;
         batch.primitive[k] = uint32_t(i);
       }
@@ -221,6 +237,70 @@ TEST(SoftrasterSetup, EveryKernelSetsUpTrianglesAsTheScalarSetupDoes) {
       ASSERT_EQ(setup_difference(got[i], expected[i]), "")
           << kernels.isa << ": set-up triangle " << i << " (input " << expected[i].primitive << ")";
   }
+}
+
+// The projection kernels against TriangleSetup::project, bit for bit, on points everywhere:
+// inside the view, outside each frustum plane, behind the eye, across the guard band and just
+// inside it, on the eye plane (w = 0), and non-finite ones (which must be left to the scalar
+// path: kScalarOnly).
+TEST(SoftrasterSetup, EveryProjectionKernelProjectsAsTriangleSetupDoes) {
+  const int width = 1024, height = 768;
+  const glm::dmat4 view_projection =
+      glm::dmat4(glm::perspective(0.9f, float(width) / float(height), 0.1f, 500.0f)) *
+      glm::dmat4(glm::lookAt(glm::vec3(0.3f, 0.2f, 4.0f), glm::vec3(0.0f), glm::vec3(0, 1, 0)));
+  const soft::TriangleSetup scalar(width, height, view_projection);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::uniform_real_distribution<float> log_scale(std::log(1e-3f), std::log(1e5f));
+  std::vector<glm::vec3> points;
+  for (int i = 0; i < 50000; ++i) {
+    const float s = std::exp(log_scale(rng));
+    points.push_back(s * glm::vec3(unit(rng), unit(rng), unit(rng)));
+  }
+  const float inf = std::numeric_limits<float>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  points.push_back({0.3f, 0.2f, 4.0f});  // the eye
+  points.push_back({nan, 0.0f, 0.0f});
+  points.push_back({0.0f, inf, 0.0f});
+  points.push_back({-inf, 0.0f, -inf});
+  const size_t n = points.size();
+  size_t unclipped = 0, scalar_only = 0;
+  for (Isa isa : runnable_isas()) {
+    const soft::FillKernels& kernels = soft::fill_kernels(isa);
+    BatchVertices got(n);
+    std::vector<uint8_t> reject(n), clip(n);
+    soft::ProjectionParams params{};
+    for (int c = 0; c < 4; ++c)
+      for (int r = 0; r < 4; ++r) params.m[c][r] = view_projection[c][r];
+    params.width = width;
+    params.height = height;
+    params.gx = soft::kGuardPixels / width;
+    params.gy = soft::kGuardPixels / height;
+    kernels.project(params, &points[0].x, n, {got.arrays(), reject.data(), clip.data()});
+    unclipped = scalar_only = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const soft::ProjectedVertex e = scalar.project(points[i]);
+      ASSERT_EQ(reject[i], e.reject) << kernels.isa << ": point " << i;
+      ASSERT_EQ(clip[i] & ~soft::kScalarOnly, e.clip_planes) << kernels.isa << ": point " << i;
+      if (e.clip_planes != 0) continue;
+      const bool finite = std::isfinite(e.sx) && std::isfinite(e.sy);
+      ASSERT_EQ((clip[i] & soft::kScalarOnly) != 0, !finite) << kernels.isa << ": point " << i;
+      if (!finite) {
+        ++scalar_only;
+        continue;
+      }
+      ++unclipped;
+      auto same = [](double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+      ASSERT_EQ(got.fx[i], e.fx) << kernels.isa << ": point " << i;
+      ASSERT_EQ(got.fy[i], e.fy) << kernels.isa << ": point " << i;
+      ASSERT_TRUE(same(got.sx[i], e.sx) && same(got.sy[i], e.sy)) << kernels.isa << ": " << i;
+      ASSERT_TRUE(same(got.w[i], e.clip.w) && same(got.inv_w[i], e.inv_w)) << kernels.isa;
+    }
+  }
+  // The sample reaches both sides of the clip test and the non-finite case.
+  EXPECT_GT(unclipped, n / 10);
+  EXPECT_LT(unclipped, n * 9 / 10);
+  EXPECT_GT(scalar_only, 0u);
 }
 
 // SetupTriangle keeps fixed-point vertices in 32 bits: enough for anything inside the guard band
@@ -271,15 +351,13 @@ TEST(SoftrasterSetup, FixedPointVerticesAtTheGuardBandAreStoredExactly) {
   const glm::vec3 p[3] = {{inside, 0.0f, 0.0f}, {2.7f, 0.9f, 0.0f}, {2.7f, -0.9f, 0.0f}};
   soft::SetupBatch batch;
   batch.count = 1;
+  BatchVertices corners(3);
+  batch.vertices = corners.arrays();
   for (int v = 0; v < 3; ++v) {
     const soft::ProjectedVertex pv = setup.project(p[v]);
     ASSERT_EQ(pv.clip_planes, 0u);
-    batch.fx[v][0] = pv.fx;
-    batch.fy[v][0] = pv.fy;
-    batch.sx[v][0] = pv.sx;
-    batch.sy[v][0] = pv.sy;
-    batch.w[v][0] = pv.clip.w;
-    batch.inv_w[v][0] = pv.inv_w;
+    corners.set(size_t(v), pv);
+    batch.vertex[v][0] = uint32_t(v);
   }
   batch.object[0] = 1;
   batch.primitive[0] = 0;

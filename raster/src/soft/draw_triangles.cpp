@@ -23,13 +23,35 @@ constexpr size_t kChunk = size_t(1) << 16;
 // 8192 set-up triangles are 1.5 MiB: one huge page each (HugePageAllocator).
 constexpr size_t kSubChunk = 8192;
 
-// A thread's setup state: its own clipping scratch, a cache of projected vertices (a mesh's
-// neighbouring triangles share them, so most are projected once, not once per triangle) and
-// the batch of unclipped triangles waiting for the setup kernel.
+// A sub-chunk whose vertex indices span at most this many vertices per triangle is projected as
+// one index range (a mesh like a tessellated sphere: about half a vertex per triangle, or a soup:
+// three); wider spans (scattered indices) go through the vertex cache instead.
+constexpr size_t kRangePerTriangle = 4;
+
+// Growable SoA storage for VertexArrays.
+struct VertexStore {
+  std::vector<int32_t> fx, fy;
+  std::vector<double> sx, sy, w, inv_w;
+  void resize(size_t n) {
+    if (fx.size() >= n) return;
+    for (auto* v : {&fx, &fy}) v->resize(n);
+    for (auto* v : {&sx, &sy, &w, &inv_w}) v->resize(n);
+  }
+  VertexArrays arrays() {
+    return {fx.data(), fy.data(), sx.data(), sy.data(), w.data(), inv_w.data()};
+  }
+};
+
+// A thread's setup state: its own clipping scratch, the projected vertices of the sub-chunk's
+// index range (or a cache of projected vertices for scattered indices: a mesh's neighbouring
+// triangles share them, so most are projected once, not once per triangle) and the batch of
+// unclipped triangles waiting for the setup kernel.
 struct SetupWorker {
   static constexpr size_t kCacheSize = 4096;
   explicit SetupWorker(const TriangleSetup& prototype)
-      : setup(prototype), keys(kCacheSize, ~0ull), cache(kCacheSize) {}
+      : setup(prototype), keys(kCacheSize, ~0ull), cache(kCacheSize) {
+    batch_vertices.resize(3 * kSetupBatch);
+  }
   const ProjectedVertex& vertex(uint32_t object, uint32_t index, const glm::vec3& p) {
     const uint64_t key = uint64_t(object) << 32 | index;
     const size_t slot = (index ^ object * 0x9E3779B1u) & (kCacheSize - 1);
@@ -38,6 +60,18 @@ struct SetupWorker {
       cache[slot] = setup.project(p);
     }
     return cache[slot];
+  }
+  // Projects vertices [first, first + count) of `positions` into the range arrays.
+  void project_range(const FillKernels& kernels, const ProjectionParams& params,
+                     const glm::vec3* positions, size_t count) {
+    range.resize(count);
+    if (range_reject.size() < count) {
+      range_reject.resize(count);
+      range_clip.resize(count);
+    }
+    static_assert(sizeof(glm::vec3) == 3 * sizeof(float), "packed float triples");
+    kernels.project(params, &positions->x, count,
+                    {range.arrays(), range_reject.data(), range_clip.data()});
   }
   // Sets up the waiting batch into `out` (after what is there: submission order).
   void flush(const FillKernels& kernels, int width, int height, SetupTriangles& out) {
@@ -51,8 +85,28 @@ struct SetupWorker {
   TriangleSetup setup;
   std::vector<uint64_t> keys;
   std::vector<ProjectedVertex> cache;
+  VertexStore range, batch_vertices;  // a sub-chunk's index range; the cached path's batch copy
+  std::vector<uint8_t> range_reject, range_clip;
   SetupBatch batch;
 };
+
+// The batch kernel's 32-bit fixed point holds the vertex exactly (see kScalarOnly).
+bool fits_32_bits(const ProjectedVertex& p) {
+  constexpr int64_t kLimit = int64_t(1) << 29;
+  return p.fx > -kLimit && p.fx < kLimit && p.fy > -kLimit && p.fy < kLimit;
+}
+
+ProjectionParams projection_params(int width, int height, const glm::dmat4& view_projection) {
+  ProjectionParams p{};
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) p.m[c][r] = view_projection[c][r];
+  p.width = width;
+  p.height = height;
+  // TriangleSetup's guard planes' w terms.
+  p.gx = kGuardPixels / width;
+  p.gy = kGuardPixels / height;
+  return p;
+}
 
 }  // namespace
 
@@ -86,6 +140,43 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
       for (int tx = st.x0 / kTile; tx <= st.x1 / kTile; ++tx)
         fn(size_t(ty) * size_t(tiles_x) + size_t(tx));
   };
+  const ProjectionParams params = projection_params(width, height, view_projection);
+  // Triangles tris[0 .. n) of mesh m (primitives from `primitive0`), whose vertices lie in
+  // [lo, lo + span): the range projected at once, then each triangle culled, clipped (scalar
+  // path) or batched by vertex index, in order.
+  auto set_up_range = [&](SetupWorker& worker, const TriangleMesh& m, uint32_t object,
+                          const glm::uvec3* tris, size_t n, uint32_t primitive0, uint32_t lo,
+                          uint32_t span, SetupTriangles& local, size_t& local_clipped) {
+    worker.project_range(kernels, params, m.positions.data() + lo, span);
+    SetupBatch& batch = worker.batch;
+    batch.vertices = worker.range.arrays();
+    const uint8_t* reject = worker.range_reject.data();
+    const uint8_t* clip = worker.range_clip.data();
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t a = tris[i].x - lo, b = tris[i].y - lo, c = tris[i].z - lo;
+      const int k = batch.count;
+      batch.vertex[0][k] = a;
+      batch.vertex[1][k] = b;
+      batch.vertex[2][k] = c;
+      if (reject[a] & reject[b] & reject[c]) {  // trivially outside the view frustum
+        ++local_clipped;
+        continue;
+      }
+      const uint32_t primitive = primitive0 + uint32_t(i);
+      if (clip[a] | clip[b] | clip[c]) {  // the scalar clipper, in order
+        worker.flush(kernels, width, height, local);
+        worker.setup.add(worker.setup.project(m.positions[tris[i].x]),
+                         worker.setup.project(m.positions[tris[i].y]),
+                         worker.setup.project(m.positions[tris[i].z]), object, primitive, local,
+                         local_clipped);
+        continue;
+      }
+      batch.object[k] = object;
+      batch.primitive[k] = primitive;
+      if (++batch.count == kSetupBatch) worker.flush(kernels, width, height, local);
+    }
+    worker.flush(kernels, width, height, local);
+  };
   for (size_t chunk = 0; chunk < submitted; chunk += kChunk) {
     const size_t chunk_end = std::min(submitted, chunk + kChunk);
     const size_t subs = (chunk_end - chunk + kSubChunk - 1) / kSubChunk;
@@ -102,26 +193,50 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
         size_t object = size_t(std::upper_bound(list.first.begin(), list.first.end(), begin) -
                                list.first.begin()) -
                         1;
+        SetupBatch& batch = worker.batch;
+        // One object and a compact index range: project the range in one kernel pass.
+        const TriangleMesh& first_mesh = *list.objects[object].mesh;
+        if (end <= list.first[object + 1]) {
+          const glm::uvec3* tris = first_mesh.triangles.data() + (begin - list.first[object]);
+          const size_t n = end - begin;
+          uint32_t lo = ~0u, hi = 0;
+          for (size_t i = 0; i < n; ++i)
+            for (int v = 0; v < 3; ++v) {
+              lo = std::min(lo, tris[i][v]);
+              hi = std::max(hi, tris[i][v]);
+            }
+          if (size_t(hi - lo) < kRangePerTriangle * n) {
+            set_up_range(worker, first_mesh, uint32_t(object), tris, n,
+                         uint32_t(begin - list.first[object]), lo, hi - lo + 1, local,
+                         local_clipped);
+            sub_clipped[s] = local_clipped;
+            return;
+          }
+        }
+        batch.vertices = worker.batch_vertices.arrays();
+        VertexStore& store = worker.batch_vertices;
         for (size_t g = begin; g < end; ++g) {
           while (g >= list.first[object + 1]) ++object;
           const TriangleMesh& m = *list.objects[object].mesh;
           const uint32_t primitive = uint32_t(g - list.first[object]);
           const glm::uvec3& tri = m.triangles[primitive];
           const uint32_t o = uint32_t(object);
-          // The vertices straight into the batch's next slot (a later lookup may evict them).
-          SetupBatch& batch = worker.batch;
+          // The vertices straight into the batch's own copy (a later lookup may evict them).
           const int k = batch.count;
           uint32_t reject = ~0u, clip = 0;
           for (int v = 0; v < 3; ++v) {
             const ProjectedVertex& p = worker.vertex(o, tri[v], m.positions[tri[v]]);
             reject &= p.reject;
             clip |= p.clip_planes;
-            batch.fx[v][k] = p.fx;
-            batch.fy[v][k] = p.fy;
-            batch.sx[v][k] = p.sx;
-            batch.sy[v][k] = p.sy;
-            batch.w[v][k] = p.clip.w;
-            batch.inv_w[v][k] = p.inv_w;
+            const uint32_t at = uint32_t(v * kSetupBatch + k);
+            clip |= fits_32_bits(p) ? 0u : kScalarOnly;
+            store.fx[at] = int32_t(p.fx);
+            store.fy[at] = int32_t(p.fy);
+            store.sx[at] = p.sx;
+            store.sy[at] = p.sy;
+            store.w[at] = p.clip.w;
+            store.inv_w[at] = p.inv_w;
+            batch.vertex[v][k] = at;
           }
           if (reject) {  // trivially outside the view frustum
             ++local_clipped;

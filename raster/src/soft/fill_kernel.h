@@ -47,6 +47,9 @@ struct FillKernels {
                bool full, FillResult& result);
   // Sets up batch's triangles into out[0 .. returned count): those emit would keep, in order.
   int (*setup)(const SetupBatch& batch, int width, int height, SetupTriangle* out);
+  // TriangleSetup::project for `count` vertices (float x, y, z each), into `out`'s arrays.
+  void (*project)(const ProjectionParams& params, const float* xyz, size_t count,
+                  const ProjectedRun& out);
 };
 
 namespace isa_sse {

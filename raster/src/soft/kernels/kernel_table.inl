@@ -3,7 +3,7 @@
 namespace rvr::soft {
 namespace RVR_KERNEL_NS {
 
-extern const FillKernels kFillKernels = {RVR_KERNEL_NAME, fill, setup_batch};
+extern const FillKernels kFillKernels = {RVR_KERNEL_NAME, fill, setup_batch, project_vertices};
 
 }  // namespace RVR_KERNEL_NS
 }  // namespace rvr::soft

@@ -21,40 +21,102 @@ namespace rvr::soft {
 namespace RVR_KERNEL_NS {
 namespace {
 
-// Products of edge function terms: both factors are differences of guard-band fixed-point
-// coordinates (|.| < 2^30), so their 32-bit truncations are exact and a 32x32->64 multiply
-// (one vpmuldq) gives emit's int64 product.
-inline int64_t wide_mul(int64_t a, int64_t b) {
-  return int64_t(int32_t(a)) * int64_t(int32_t(b));
+// project_vertices' tests and viewport for n clip-space positions (restrict parameters: the
+// outputs alias nothing, so the loop vectorizes).
+void project_block(const double* __restrict clip_x, const double* __restrict clip_y,
+                   const double* __restrict clip_z, const double* __restrict clip_w, size_t n,
+                   double width, double height, double gx, double gy, uint8_t* __restrict reject,
+                   uint8_t* __restrict clip, int32_t* __restrict fx, int32_t* __restrict fy,
+                   double* __restrict sx_out, double* __restrict sy_out, double* __restrict w_out,
+                   double* __restrict inv_w_out) {
+  for (size_t i = 0; i < n; ++i) {
+    const double cx = clip_x[i], cy = clip_y[i], cz = clip_z[i], cw = clip_w[i];
+    reject[i] = uint8_t(int(cx + cw < 0) | int(-cx + cw < 0) << 1 | int(cy + cw < 0) << 2 |
+                        int(-cy + cw < 0) << 3 | int(cz + cw < 0) << 4 | int(-cz + cw < 0) << 5);
+    const int planes = int(cz + cw < 0) | int(cx + gx * cw < 0) << 1 | int(-cx + gx * cw < 0) << 2 |
+                       int(cy + gy * cw < 0) << 3 | int(-cy + gy * cw < 0) << 4;
+    const double sx = (cx / cw * 0.5 + 0.5) * width;
+    const double sy = (0.5 - cy / cw * 0.5) * height;
+    const double ux = sx * double(kSub), uy = sy * double(kSub);
+    // round_half_away in 32 bits where it is exact: |u| < 2^29 (guard-band coordinates are);
+    // anything else (NaN, infinities) is flagged for the scalar path, and not converted.
+    constexpr double kLimit = double(1 << 29);
+    const bool fits = (std::fabs(ux) < kLimit) & (std::fabs(uy) < kLimit);
+    const double vx = fits ? ux : 0.0, vy = fits ? uy : 0.0;
+    int32_t ix = int32_t(vx), iy = int32_t(vy);
+    const double rx = vx - double(ix), ry = vy - double(iy);
+    ix += int32_t(rx >= 0.5) - int32_t(rx <= -0.5);
+    iy += int32_t(ry >= 0.5) - int32_t(ry <= -0.5);
+    clip[i] = uint8_t(planes | (planes == 0 && !fits ? kScalarOnly : 0));
+    fx[i] = ix;
+    fy[i] = iy;
+    sx_out[i] = sx;
+    sy_out[i] = sy;
+    w_out[i] = cw;
+    inv_w_out[i] = 1.0 / cw;
+  }
+}
+
+// TriangleSetup::project for xyz[0 .. count) (float triples), its operations in its order:
+// glm's dmat4 * dvec4 is (m0 x + m1 y) + (m2 z + m3 w), and m3 * 1.0 is m3 exactly.
+void project_vertices(const ProjectionParams& p, const float* xyz, size_t count,
+                      const ProjectedRun& out) {
+  // A local copy: stores through the outputs cannot change it, so the loop vectorizes.
+  double m[4][4];
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r) m[c][r] = p.m[c][r];
+  const double width = p.width, height = p.height, gx = p.gx, gy = p.gy;
+  const VertexArrays& o = out.vertices;
+  // Blocks of clip-space positions first (a loop of its own: the vectorizer takes the float
+  // triples' strided loads there), then the tests and the viewport over them in SoA.
+  constexpr size_t kBlock = 256;
+  alignas(64) double clip_x[kBlock], clip_y[kBlock], clip_z[kBlock], clip_w[kBlock];
+  for (size_t first = 0; first < count; first += kBlock) {
+    const size_t n = count - first < kBlock ? count - first : kBlock;
+    const float* block = xyz + 3 * first;
+    for (size_t i = 0; i < n; ++i) {
+      const double px = block[3 * i], py = block[3 * i + 1], pz = block[3 * i + 2];
+      clip_x[i] = (m[0][0] * px + m[1][0] * py) + (m[2][0] * pz + m[3][0]);
+      clip_y[i] = (m[0][1] * px + m[1][1] * py) + (m[2][1] * pz + m[3][1]);
+      clip_z[i] = (m[0][2] * px + m[1][2] * py) + (m[2][2] * pz + m[3][2]);
+      clip_w[i] = (m[0][3] * px + m[1][3] * py) + (m[2][3] * pz + m[3][3]);
+    }
+    project_block(clip_x, clip_y, clip_z, clip_w, n, width, height, gx, gy, out.reject + first,
+                  out.clip + first, o.fx + first, o.fy + first, o.sx + first, o.sy + first,
+                  o.w + first, o.inv_w + first);
+  }
 }
 
 int setup_batch(const SetupBatch& in, int width, int height, SetupTriangle* out) {
   const int n = in.count;
   constexpr int B = kSetupBatch;
+  const VertexArrays& vs = in.vertices;
   // Vertices in emit's order (1 and 2 swapped for negative area), pixel boxes, top-left edges.
-  alignas(64) int64_t x[3][B], y[3][B];
-  alignas(64) int64_t swapped[B], live[B];
+  // Fixed point in 32 bits: guard-band coordinates and their differences fit (setup_triangle.h).
+  alignas(64) int32_t x[3][B], y[3][B];
+  alignas(64) int32_t swapped[B], live[B];
   alignas(64) int32_t bx0[B], by0[B], bx1[B], by1[B];
-  alignas(64) int64_t top_left[3][B];
+  alignas(64) int32_t top_left[3][B];
   for (int k = 0; k < n; ++k) {
-    const int64_t ax = in.fx[0][k], bx = in.fx[1][k], cx = in.fx[2][k];
-    const int64_t ay = in.fy[0][k], by = in.fy[1][k], cy = in.fy[2][k];
-    const int64_t area = wide_mul(bx - ax, cy - ay) - wide_mul(by - ay, cx - ax);
+    const uint32_t a = in.vertex[0][k], b = in.vertex[1][k], c = in.vertex[2][k];
+    const int32_t ax = vs.fx[a], bx = vs.fx[b], cx = vs.fx[c];
+    const int32_t ay = vs.fy[a], by = vs.fy[b], cy = vs.fy[c];
+    const int64_t area = int64_t(bx - ax) * int64_t(cy - ay) - int64_t(by - ay) * int64_t(cx - ax);
     const bool swap = area < 0;  // two-sided: either winding, oriented here
-    const int64_t x1 = swap ? cx : bx, x2 = swap ? bx : cx;
-    const int64_t y1 = swap ? cy : by, y2 = swap ? by : cy;
+    const int32_t x1 = swap ? cx : bx, x2 = swap ? bx : cx;
+    const int32_t y1 = swap ? cy : by, y2 = swap ? by : cy;
     x[0][k] = ax, x[1][k] = x1, x[2][k] = x2;
     y[0][k] = ay, y[1][k] = y1, y[2][k] = y2;
     swapped[k] = swap;
-    const int64_t min_x = ax < x1 ? (ax < x2 ? ax : x2) : (x1 < x2 ? x1 : x2);
-    const int64_t max_x = ax > x1 ? (ax > x2 ? ax : x2) : (x1 > x2 ? x1 : x2);
-    const int64_t min_y = ay < y1 ? (ay < y2 ? ay : y2) : (y1 < y2 ? y1 : y2);
-    const int64_t max_y = ay > y1 ? (ay > y2 ? ay : y2) : (y1 > y2 ? y1 : y2);
-    // emit's first_centre / last_centre in 32 bits (guard-band coordinates fit).
-    const int32_t fx0 = (int32_t(min_x) + int32_t(kSub / 2 - 1)) >> kSubBits;
-    const int32_t fy0 = (int32_t(min_y) + int32_t(kSub / 2 - 1)) >> kSubBits;
-    const int32_t lx1 = (int32_t(max_x) - int32_t(kSub / 2)) >> kSubBits;
-    const int32_t ly1 = (int32_t(max_y) - int32_t(kSub / 2)) >> kSubBits;
+    const int32_t min_x = ax < x1 ? (ax < x2 ? ax : x2) : (x1 < x2 ? x1 : x2);
+    const int32_t max_x = ax > x1 ? (ax > x2 ? ax : x2) : (x1 > x2 ? x1 : x2);
+    const int32_t min_y = ay < y1 ? (ay < y2 ? ay : y2) : (y1 < y2 ? y1 : y2);
+    const int32_t max_y = ay > y1 ? (ay > y2 ? ay : y2) : (y1 > y2 ? y1 : y2);
+    // emit's first_centre / last_centre.
+    const int32_t fx0 = (min_x + int32_t(kSub / 2 - 1)) >> kSubBits;
+    const int32_t fy0 = (min_y + int32_t(kSub / 2 - 1)) >> kSubBits;
+    const int32_t lx1 = (max_x - int32_t(kSub / 2)) >> kSubBits;
+    const int32_t ly1 = (max_y - int32_t(kSub / 2)) >> kSubBits;
     bx0[k] = fx0 > 0 ? fx0 : 0;
     by0[k] = fy0 > 0 ? fy0 : 0;
     bx1[k] = lx1 < width - 1 ? lx1 : width - 1;
@@ -64,7 +126,8 @@ int setup_batch(const SetupBatch& in, int width, int height, SetupTriangle* out)
   // Top-left edges, and a box of at most four centres tested with the rasterizer's own edge
   // functions (candidate c at column a, row b of the box: 1xN, 2x1, 2x2, Nx1 boxes).
   for (int k = 0; k < n; ++k) {
-    int64_t edx[3], edy[3], bias[3];
+    int32_t edx[3], edy[3];
+    int64_t bias[3];
     for (int i = 0; i < 3; ++i) {
       const int nx = i == 2 ? 0 : i + 1;
       edx[i] = x[nx][k] - x[i][k];
@@ -79,11 +142,13 @@ int setup_batch(const SetupBatch& in, int width, int height, SetupTriangle* out)
     for (int32_t c = 0; c < 4; ++c) {
       const int32_t a = wx == 1 ? 0 : (wx == 2 ? (c & 1) : c);
       const int32_t b = wx == 1 ? c : (wx == 2 ? (c >> 1) : 0);
-      const int64_t px = int64_t(bx0[k] + a) * kSub + kSub / 2;
-      const int64_t py = int64_t(by0[k] + b) * kSub + kSub / 2;
+      const int32_t px = (bx0[k] + a) * int32_t(kSub) + int32_t(kSub / 2);
+      const int32_t py = (by0[k] + b) * int32_t(kSub) + int32_t(kSub / 2);
       bool inside = c < box;
       for (int i = 0; i < 3; ++i)
-        inside &= wide_mul(edx[i], py - y[i][k]) - wide_mul(edy[i], px - x[i][k]) - bias[i] >= 0;
+        inside &= int64_t(edx[i]) * int64_t(py - y[i][k]) -
+                      int64_t(edy[i]) * int64_t(px - x[i][k]) - bias[i] >=
+                  0;
       covers |= inside;
     }
     live[k] &= box > 4 || covers;
@@ -99,16 +164,18 @@ int setup_batch(const SetupBatch& in, int width, int height, SetupTriangle* out)
   alignas(64) double sx[3][B], sy[3][B], f[3][3][B], w_min[B];
   for (int r = 0; r < m; ++r) {
     const int k = index[r];
+    const uint32_t vertex[3] = {in.vertex[0][k], in.vertex[1][k], in.vertex[2][k]};
     const int order[3] = {0, swapped[k] ? 2 : 1, swapped[k] ? 1 : 2};
     for (int v = 0; v < 3; ++v) {
-      sx[v][r] = in.sx[order[v]][k];
-      sy[v][r] = in.sy[order[v]][k];
-      for (int j = 0; j < 3; ++j) f[v][j][r] = order[v] == j ? in.inv_w[j][k] : 0.0;
+      sx[v][r] = vs.sx[vertex[order[v]]];
+      sy[v][r] = vs.sy[vertex[order[v]]];
+      for (int j = 0; j < 3; ++j) f[v][j][r] = order[v] == j ? vs.inv_w[vertex[j]] : 0.0;
     }
     // std::min({w0, w1, w2}) in emit's (input) order.
-    double wm = in.w[0][k];
-    if (in.w[1][k] < wm) wm = in.w[1][k];
-    if (in.w[2][k] < wm) wm = in.w[2][k];
+    const double w0 = vs.w[vertex[0]], w1 = vs.w[vertex[1]], w2 = vs.w[vertex[2]];
+    double wm = w0;
+    if (w1 < wm) wm = w1;
+    if (w2 < wm) wm = w2;
     w_min[r] = wm;
   }
   alignas(64) double qa[3][B], qb[3][B], min_depth[B];
@@ -150,8 +217,8 @@ int setup_batch(const SetupBatch& in, int width, int height, SetupTriangle* out)
     const int k = index[r];
     SetupTriangle& t = out[written++];
     for (int i = 0; i < 3; ++i) {
-      t.x[i] = int32_t(x[i][k]);
-      t.y[i] = int32_t(y[i][k]);
+      t.x[i] = x[i][k];
+      t.y[i] = y[i][k];
       t.top_left[i] = top_left[i][k] != 0;
       t.q0[i] = f[0][i][r];
       t.qa[i] = qa[i][r];
