@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include "rvr/shared/shading.h"
@@ -74,19 +75,14 @@ void copy_slot(ShadeBatch& b, int from, int to, bool materials) {
   b.shininess[to] = b.shininess[from];
 }
 
-// The pixels [begin, end) of a row nothing covers: FrameBuffers::set_background's values, one
-// buffer at a time (the cost is written with the row's).
-void fill_background(FrameBuffers& fb, size_t begin, size_t end, const glm::vec3& background) {
-  std::fill(fb.color.begin() + std::ptrdiff_t(begin), fb.color.begin() + std::ptrdiff_t(end),
-            background);
-  std::fill(fb.depth.begin() + std::ptrdiff_t(begin), fb.depth.begin() + std::ptrdiff_t(end),
-            std::numeric_limits<float>::infinity());
-  std::fill(fb.object_id.begin() + std::ptrdiff_t(begin),
-            fb.object_id.begin() + std::ptrdiff_t(end), kNoId);
-  std::fill(fb.primitive_id.begin() + std::ptrdiff_t(begin),
-            fb.primitive_id.begin() + std::ptrdiff_t(end), kNoId);
-  std::fill(fb.normal.begin() + std::ptrdiff_t(begin), fb.normal.begin() + std::ptrdiff_t(end),
-            glm::vec3(0.0f));
+// v in p[0, n). std::fill stores a glm::vec3 a float at a time; four of them are 48 bytes,
+// three 16-byte stores of one repeating pattern.
+void fill_vec3(glm::vec3* p, size_t n, const glm::vec3& v) {
+  float pattern[12];
+  for (int k = 0; k < 12; ++k) pattern[k] = v[k % 3];
+  size_t i = 0;
+  for (; i + 4 <= n; i += 4) std::memcpy(static_cast<void*>(p + i), pattern, sizeof pattern);
+  for (; i < n; ++i) p[i] = v;
 }
 
 }  // namespace
@@ -133,6 +129,9 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
   const bool write_colour = settings.colour != ShadedColour::Background;
   // The target marks a pixel nothing covers with the id the frame buffers give the background.
   static_assert(kNoId == 0xFFFFFFFFu);
+  bool every_primitive_id = true;
+  for (const ObjectShading& s : objects)
+    every_primitive_id = every_primitive_id && s.use_primitive_id;
   const double* depths = target.depths();
   const uint32_t* object_of = target.objects();
   const uint32_t* primitive_of = target.primitives();
@@ -169,15 +168,41 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
       uint32_t last_object = kNoId, last_primitive = kNoId;
       glm::vec3 last_vertex[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
       glm::vec3 last_normal[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
+      const int width = w;  // a local: stores through uint32_t* could alias a captured int
       for (int y = r.begin(); y != r.end(); ++y) {
         const size_t row = fb.index(0, y);
         target.cost_row(y, fb.cost.data() + row);
+        // Depth and ids of the whole row, one buffer at a time (the target's "nothing
+        // covers it" id is the frame buffers' background id).
+        const uint32_t* __restrict row_object = object_of + row;
+        const uint32_t* __restrict row_primitive = primitive_of + row;
+        const double* __restrict row_depth = depths + row;
+        float* __restrict depth_out = fb.depth.data() + row;
+        uint32_t* __restrict primitive_out = fb.primitive_id.data() + row;
+        std::memcpy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
+        // Loads before the selection, so that these loops vectorize (branch-free).
+        for (int k = 0; k < width; ++k) {
+          const float depth = float(row_depth[k]);
+          depth_out[k] = row_object[k] == kNoId ? std::numeric_limits<float>::infinity() : depth;
+        }
+        if (every_primitive_id)
+          for (int k = 0; k < width; ++k) {
+            const uint32_t primitive = row_primitive[k];
+            primitive_out[k] = row_object[k] == kNoId ? kNoId : primitive;
+          }
+        else
+          for (int k = 0; k < width; ++k)
+            primitive_out[k] = row_object[k] == kNoId                    ? kNoId
+                               : objects[row_object[k]].use_primitive_id ? row_primitive[k]
+                                                                         : 0u;
         int x = 0;
         while (x < w) {
           if (object_of[row + size_t(x)] == kNoId) {
             int end = x + 1;
             while (end < w && object_of[row + size_t(end)] == kNoId) ++end;
-            fill_background(fb, row + size_t(x), row + size_t(end), settings.background);
+            fill_vec3(fb.color.data() + row + size_t(x), size_t(end - x), settings.background);
+            std::memset(static_cast<void*>(fb.normal.data() + row + size_t(x)), 0,
+                        size_t(end - x) * sizeof(glm::vec3));  // +0.0f is all zero bits
             x = end;
             continue;
           }
@@ -186,9 +211,6 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
           const uint32_t id = object_of[o];
           const ObjectShading& s = objects[id];
           const uint32_t primitive = primitive_of[o];
-          fb.depth[o] = float(depths[o]);
-          fb.object_id[o] = id;
-          fb.primitive_id[o] = s.use_primitive_id ? primitive : 0u;
           if (!write_colour) fb.color[o] = settings.background;
 
           const int i = batch.count++;
