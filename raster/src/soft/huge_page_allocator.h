@@ -20,7 +20,7 @@
 namespace rvr::soft {
 
 template <class T>
-struct HugePageAllocator {
+struct HugePageAllocator : DefaultInitConstruct {  // SetupTriangle has no member defaults
   using value_type = T;
   static constexpr size_t kPage = size_t(2) << 20;
   HugePageAllocator() = default;
@@ -44,16 +44,6 @@ struct HugePageAllocator {
       madvise(p, bytes_for(n), MADV_HUGEPAGE);  // a hint: without huge pages it works as before
 #endif
     return static_cast<T*>(p);
-  }
-  // resize() default-initialises: the caller writes what it appends (SetupTriangle has no
-  // member defaults), so no value-initialising pass over memory about to be overwritten.
-  template <class U>
-  void construct(U* p) noexcept {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
   void deallocate(T* p, size_t n) noexcept {
     release_pixel_memory(p, bytes_for(n), huge(n) ? kPage : std::max<size_t>(alignof(T), 64));

@@ -22,7 +22,7 @@ constexpr uint32_t kNoId = 0xFFFFFFFFu;  // object/primitive id of the backgroun
 // pages are then first touched by the threads that render them. Its memory is recycled
 // between frames (pixel_memory.h).
 template <class T>
-struct PixelAllocator {
+struct PixelAllocator : DefaultInitConstruct {
   using value_type = T;
   PixelAllocator() = default;
   template <class U>
@@ -40,14 +40,6 @@ struct PixelAllocator {
   template <class U>
   bool operator!=(const PixelAllocator<U>&) const {
     return false;
-  }
-  template <class U>
-  void construct(U* p) noexcept {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
 };
 

@@ -9,6 +9,8 @@
 #pragma once
 
 #include <cstddef>
+#include <new>
+#include <utility>
 
 namespace rvr {
 
@@ -22,5 +24,18 @@ void* acquire_pixel_memory(size_t bytes, size_t align = 64);
 void release_pixel_memory(void* p, size_t bytes, size_t align = 64) noexcept;
 // Bytes held for recycling now (at most kRecycleLimitBytes).
 size_t recycled_pixel_bytes();
+
+// For allocators of frame memory: resize() default-initialises (no value-initialising pass
+// over elements their writer is about to overwrite).
+struct DefaultInitConstruct {
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
 
 }  // namespace rvr
