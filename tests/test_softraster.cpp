@@ -226,6 +226,48 @@ TEST(SoftRasterizer, HierarchicalZChangesNothingSeen) {
   }
 }
 
+// A triangle whose box spans two blocks is tested against each block's farthest depth: the
+// block hidden behind a nearer occluder is rejected (counted once per triangle, 1/64 of a cost
+// unit on each of its pixels) and its pixels get no fragment, while the other block's pixels
+// are drawn. A rectangle 6x4 pixels wide (two triangles, each a box narrower than a block) lies
+// across block columns 0 and 1 behind a quad covering column 0 (pixels x < 8) entirely.
+TEST(SoftRasterizer, HierarchicalZRejectsTheHiddenBlockOfASmallTriangle) {
+  Scene s = test::empty_scene(64, 64, {0, 0, 0}, {0, 0, -1}, 90.0f);
+  uint32_t m = test::emissive(s, {1, 1, 1});
+  // 90 degree field of view, 64 pixels: at depth d, screen (x, y) = (32 + 32 wx / d,
+  // 32 - 32 wy / d). Corners on pixel boundaries, so no centre lies on an edge (the
+  // rectangle's diagonal, 6y - 4x = 75 at centres, has no integer solution).
+  auto at = [](float sx, float sy, float d) {
+    return glm::vec3((sx - 32.0f) * d / 32.0f, (32.0f - sy) * d / 32.0f, -d);
+  };
+  auto add_rectangle = [&](float x0, float y0, float x1, float y1, float d) {
+    Object o;
+    o.type = ObjectType::Triangles;
+    o.material = m;
+    o.mesh.positions = {at(x0, y0, d), at(x1, y0, d), at(x1, y1, d), at(x0, y1, d)};
+    o.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+    s.objects.push_back(o);
+  };
+  add_rectangle(0, 0, 8, 64, 1.0f);    // the occluder, drawn first: block column 0
+  add_rectangle(5, 16, 11, 20, 2.0f);  // behind it in column 0, alone in column 1
+  for (bool hiz : {true, false}) {
+    const FrameBuffers& fb = render_soft(s, RenderMode::Visibility, 0, hiz).buffers;
+    for (int y = 0; y < 64; ++y)
+      for (int x = 0; x < 64; ++x) {
+        const bool occluder = x < 8, behind = x >= 5 && x < 11 && y >= 16 && y < 20;
+        float expected = float(occluder) + float(behind);
+        // Both triangles of the rectangle reject block (0, 2): rows 16-23 of column 0.
+        if (hiz && x < 8 && y >= 16 && y < 24) expected = 1.0f + 2.0f / 64.0f;
+        if (hiz && x < 8 && behind) expected = 1.0f + 2.0f / 64.0f;
+        EXPECT_EQ(fb.cost[fb.index(x, y)], expected) << x << "," << y << (hiz ? "" : " no hi-z");
+        EXPECT_EQ(fb.object_id[fb.index(x, y)], occluder ? 0u
+                                                : behind ? 1u
+                                                         : kNoId)
+            << x << "," << y;
+      }
+  }
+}
+
 // Triangles stream through in chunks of 65,536: a scene of several chunks gives the same bytes
 // on one thread as on two, with and without hi-z, and the rasterizer's memory (the frame's
 // z-buffer state plus one chunk) does not grow with the number of triangles.

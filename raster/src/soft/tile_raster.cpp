@@ -187,6 +187,23 @@ void DepthTarget::draw(const SetupTriangle& t, int x0, int y0, int x1, int y1,
         for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx) update_block_max(bx, by);
     return;
   }
+  // A box of at most a block's size (2x2 blocks at most) whose blocks hi-z keeps: the whole
+  // box in one kernel pass, every edge tested. The block loop would give the same pixels and
+  // counts (its outside blocks yield no fragment, its full ones the same fragments without the
+  // tests), but in a kernel call per block after classifying each one's corners.
+  if (x1 - x0 < kBlock && y1 - y0 < kBlock) {
+    bool block_rejected = false;
+    if (hiz_)
+      for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+        for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx)
+          block_rejected |= t.min_depth >= block_max_[size_t(by) * size_t(blocks_x_) + size_t(bx)];
+    if (!block_rejected) {
+      if (fill(x0, y0, x1, y1, false) && hiz_)
+        for (int by = y0 / kBlock; by <= y1 / kBlock; ++by)
+          for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx) update_block_max(bx, by);
+      return;
+    }
+  }
   for (int by = y0 / kBlock; by <= y1 / kBlock; ++by) {
     for (int bx = x0 / kBlock; bx <= x1 / kBlock; ++bx) {
       const int cx0 = std::max(x0, bx * kBlock), cx1 = std::min(x1, bx * kBlock + kBlock - 1);
