@@ -268,13 +268,13 @@ TEST(SoftRasterizer, HierarchicalZRejectsTheHiddenBlockOfASmallTriangle) {
   }
 }
 
-// Triangles stream through in chunks of 65,536: a scene of several chunks gives the same bytes
+// Triangles stream through in chunks of 262,144: a scene of several chunks gives the same bytes
 // on one thread as on two, with and without hi-z, and the rasterizer's memory (the frame's
 // z-buffer state plus one chunk) does not grow with the number of triangles.
 TEST(SoftRasterizer, ManyChunksSameBytesBoundedMemory) {
   double memory[2] = {0, 0};
   int k = 0;
-  for (const char* name : {"soup:150000", "soup:600000"}) {
+  for (const char* name : {"soup:600000", "soup:2400000"}) {
     Expected<Scene> scene = make_builtin_scene(name);
     ASSERT_TRUE(scene.ok());
     for (bool hiz : {true, false}) {
