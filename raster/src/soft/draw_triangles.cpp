@@ -185,8 +185,9 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
     const size_t subs = (chunk_end - chunk + kSubChunk - 1) / kSubChunk;
     // --- setup: transform, cull, clip; sub-chunks in parallel, kept in order
     auto t = Clock::now();
+    counts.assign(subs * tile_count, 0);
     arena.execute([&] {
-      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
+      auto set_up_sub_chunk = [&](size_t s) {
         SetupWorker& worker = workers.local();
         SetupTriangles& local = sub_out[s];
         local.clear();
@@ -258,6 +259,13 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
         }
         worker.flush(kernels, width, height, local);
         sub_clipped[s] = local_clipped;
+      };
+      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
+        set_up_sub_chunk(s);
+        // The binning's counts, while the sub-chunk's triangles are still in this core's cache
+        // (a pass of its own read them all back from memory).
+        uint32_t* c = &counts[s * tile_count];
+        for (const SetupTriangle& st : sub_out[s]) for_tiles(st, [&](size_t b) { ++c[b]; });
       });
     });
     for (size_t s = 0; s < subs; ++s) {
@@ -266,15 +274,9 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
     }
     result.setup_seconds += seconds_since(t);
 
-    // --- bin: a counting sort of the chunk's triangles into tiles, in submission order
+    // --- bin: a counting sort of the chunk's triangles into tiles, in submission order (the
+    // counts were taken in the setup pass)
     t = Clock::now();
-    counts.assign(subs * tile_count, 0);
-    arena.execute([&] {
-      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
-        uint32_t* c = &counts[s * tile_count];
-        for (const SetupTriangle& st : sub_out[s]) for_tiles(st, [&](size_t b) { ++c[b]; });
-      });
-    });
     // Offsets: tile by tile, and within a tile sub-chunk by sub-chunk (submission order).
     uint32_t running = 0;
     for (size_t b = 0; b < tile_count; ++b) {
