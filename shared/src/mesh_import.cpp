@@ -18,12 +18,16 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <set>
 #include <stdexcept>
 #include <vector>
 
+#include "allocation_budget.h"
+#include "isolated_call.h"
 #include "mesh_repair.h"
+#include "model_wire.h"
 #include "scene_json_errors.h"
 
 namespace rvr::scene_load {
@@ -32,6 +36,22 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr size_t kMaxMeshTriangles = 50'000'000;
+
+// What Assimp's readers may hold while reading a file: kMemoryBase plus kMemoryPerByte times
+// the bytes of every file they open (the model and its .mtl, .bin, ...; a file sniffed and then
+// read counts twice). Measured (Assimp 5.2.5, a 180,000-triangle grid in each format): peaks of
+// 0.9 (glb) to 4.4 (OBJ) bytes per byte opened, plus up to 17 MB whatever the size (OBJ's line
+// buffers), so 64 leaves a margin of more than 10x. A file whose header declares more data
+// than it holds asks for more, and is refused (see allocation_budget.h).
+constexpr uint64_t kMemoryBase = uint64_t(256) << 20;
+constexpr uint64_t kMemoryPerByte = 64;
+
+// The CPU time of the isolated import (isolated_call.h): kCpuSeconds plus kCpuSecondsPerByte
+// times the bytes of every file opened. Assimp reads OBJ, the slowest here, at about 50 MB/s
+// and post-processing takes as long again, so 1 s per MiB is a margin of 25x; a small file
+// that takes 5 s of CPU is a reader spinning.
+constexpr double kCpuSeconds = 5.0;
+constexpr double kCpuSecondsPerByte = 1.0 / double(1 << 20);
 
 std::string file_status(const fs::path& p) {
   std::error_code ec;
@@ -76,6 +96,11 @@ class BudgetIOSystem : public Assimp::IOSystem {
     }
   };
 
+  // Each file opened raises `memory` (if any) by kMemoryPerByte times its size.
+  explicit BudgetIOSystem(AllocationBudget* memory = nullptr) : memory_(memory) {}
+
+  void forget_memory() { memory_ = nullptr; }
+
   bool Exists(const char* file) const override { return base_.Exists(file); }
   char getOsSeparator() const override { return base_.getOsSeparator(); }
   Assimp::IOStream* Open(const char* file, const char* mode) override {
@@ -83,6 +108,8 @@ class BudgetIOSystem : public Assimp::IOSystem {
     Assimp::IOStream* inner = base_.Open(file, mode);
     if (!inner) return nullptr;
     budget_.bytes_opened += inner->FileSize();
+    if (memory_) memory_->raise(kMemoryPerByte * inner->FileSize());
+    extend_cpu_time(kCpuSecondsPerByte * double(inner->FileSize()));
     return new Stream(inner, &budget_);
   }
   void Close(Assimp::IOStream* stream) override { delete stream; }
@@ -118,6 +145,7 @@ class BudgetIOSystem : public Assimp::IOSystem {
 
   Assimp::DefaultIOSystem base_;
   mutable Budget budget_;
+  AllocationBudget* memory_;
 };
 
 // Assimp's PLY reader loops forever or reads out of bounds on some malformed headers (found by
@@ -264,8 +292,19 @@ const aiScene* read_checked(Assimp::Importer& importer, const fs::path& full,
   if (std::string problem = ply_header_problem(full, ext == ".ply"); !problem.empty()) {
     fail(path, prefix + problem);
   }
-  importer.SetIOHandler(new BudgetIOSystem);  // the importer owns it
-  const aiScene* ai = importer.ReadFile(full.string(), aiProcess_ValidateDataStructure);
+  const aiScene* ai = nullptr;
+  {
+    AllocationBudget memory(kMemoryBase);
+    auto* io = new BudgetIOSystem(&memory);
+    importer.SetIOHandler(io);  // the importer owns it
+    ai = importer.ReadFile(full.string(), aiProcess_ValidateDataStructure);
+    io->forget_memory();  // `memory` ends here; post-processing opens no files
+    if (!ai && memory.exceeded()) {
+      fail(path, prefix + fmt::format("the file declares more data than it holds (reading it "
+                                      "would take more than {} MiB)",
+                                      memory.limit() >> 20));
+    }
+  }
   if (!ai) import_failed(importer, file, path);
   if (std::string problem = raw_mesh_problem(ai); !problem.empty()) {
     fail(path, quote_json(file) + ": " + problem);
@@ -512,11 +551,8 @@ void read_lights(const aiScene* ai, ImportedModel& model) {
   }
 }
 
-}  // namespace
-
-TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
-                         const std::string& path, bool smooth, size_t* skipped_primitives) {
-  fs::path full = resolve(file, base_dir, path);
+TriangleMesh import_mesh_here(const fs::path& full, const std::string& file,
+                              const std::string& path, bool smooth, size_t* skipped_primitives) {
   Assimp::Importer importer;
   read_checked(importer, full, file, path);
   unsigned flags =
@@ -531,9 +567,8 @@ TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
   return mesh;
 }
 
-ImportedModel import_model(const std::string& file, const std::string& base_dir,
-                           const std::string& path) {
-  fs::path full = resolve(file, base_dir, path);
+ImportedModel import_model_here(const fs::path& full, const std::string& file,
+                                const std::string& path) {
   Assimp::Importer importer;
   ImportedModel model;
   const aiScene* raw = read_checked(importer, full, file, path);
@@ -573,6 +608,80 @@ ImportedModel import_model(const std::string& file, const std::string& base_dir,
         textured, textured == 1 ? " has" : "es have"));
   }
   return model;
+}
+
+// The child's side of an isolated import: `body`'s result then 'O' (a tag at the end, so a
+// large result is not copied to make room), or its error: the JSON path, a NUL, the message,
+// 'E'; 'M' out of memory; what any other exception said, 'X'.
+std::string child_side(const std::function<std::string()>& body) {
+  std::string out;
+  char tag = 'O';
+  try {
+    out = body();
+  } catch (const LoadError& e) {
+    out = e.path;
+    out.push_back('\0');
+    out += e.what;
+    tag = 'E';
+  } catch (const std::bad_alloc&) {
+    out.clear();
+    tag = 'M';
+  } catch (const std::exception& e) {
+    out = e.what();
+    tag = 'X';
+  } catch (...) {
+    out = "unknown exception";
+    tag = 'X';
+  }
+  out.push_back(tag);
+  return out;
+}
+
+// Runs `body` (an import of `file`) in a child process and returns what it produced, or
+// throws its error here.
+std::string import_isolated(const std::function<std::string()>& body, const std::string& file,
+                            const std::string& path) {
+  IsolatedResult r = run_isolated([&] { return child_side(body); }, kCpuSeconds);
+  if (r.status != IsolatedResult::Status::Ok || r.bytes.empty()) {
+    fail(path, "cannot read " + quote_json(file) + ": the importer " +
+                   (r.problem.empty() ? "returned nothing" : r.problem) + " on this file");
+  }
+  char tag = r.bytes.back();
+  r.bytes.pop_back();
+  switch (tag) {
+    case 'O':
+      return std::move(r.bytes);
+    case 'E': {
+      size_t nul = r.bytes.find('\0');
+      fail(r.bytes.substr(0, nul), nul == std::string::npos ? "" : r.bytes.substr(nul + 1));
+    }
+    case 'M':
+      throw std::bad_alloc();
+    default:
+      throw std::runtime_error(r.bytes);
+  }
+}
+
+}  // namespace
+
+TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
+                         const std::string& path, bool smooth, size_t* skipped_primitives) {
+  fs::path full = resolve(file, base_dir, path);
+  std::string bytes = import_isolated(
+      [&] {
+        size_t skipped = 0;
+        TriangleMesh mesh = import_mesh_here(full, file, path, smooth, &skipped);
+        return encode(mesh, skipped);
+      },
+      file, path);
+  return decode_mesh(bytes, skipped_primitives);
+}
+
+ImportedModel import_model(const std::string& file, const std::string& base_dir,
+                           const std::string& path) {
+  fs::path full = resolve(file, base_dir, path);
+  return decode_model(
+      import_isolated([&] { return encode(import_model_here(full, file, path)); }, file, path));
 }
 
 }  // namespace rvr::scene_load
