@@ -1,7 +1,7 @@
 // The per-pixel loop of softraster (and its batched triangle setup, setup_kernel.h), as SIMD
 // kernels compiled once per instruction set (src/soft/kernels/, like the tracer's) and chosen
 // at run time: edge functions and depths of
-// 2 (SSE) or 4 (AVX2, AVX-512) pixels at once, in the same double-precision operations as the
+// 2 (SSE), 4 (AVX2) or 8 (AVX-512) pixels at once, in the same double-precision operations as the
 // scalar formulas of SetupTriangle, so every kernel draws the same bytes. Plain data only: a
 // kernel translation unit must not instantiate inline code that baseline code also uses.
 #pragma once

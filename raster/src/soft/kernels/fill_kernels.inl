@@ -2,22 +2,26 @@
 // unit, which defines RVR_KERNEL_NS. Lane k of a group handles pixel x + k of a row: its edge
 // functions are the row's plus k steps (integer adds, exact), its depth the scalar formula of
 // SetupTriangle::inv_w in the same order of double operations (no FMA: these units build with
-// -ffp-contract=off), so the bytes do not depend on the kernel.
+// -ffp-contract=off), so the bytes do not depend on the kernel. AVX-512 has its own loop, 8
+// pixels wide with masked loads and stores (fill_kernel_avx512.inl).
+#ifndef RVR_KERNEL_NS
+#error "define RVR_KERNEL_NS before including this file"
+#endif
+
+#if defined(__AVX512F__)
+#include "fill_kernel_avx512.inl"
+#else
 #include <immintrin.h>
 
 #include <cstdint>
 
 #include "soft/fill_kernel.h"
 
-#ifndef RVR_KERNEL_NS
-#error "define RVR_KERNEL_NS before including this file"
-#endif
-
 namespace rvr::soft {
 namespace RVR_KERNEL_NS {
 namespace {
 
-#if defined(__AVX2__)
+#if defined(__AVX2__)  // 4 pixels a group
 constexpr int kLanes = 4;
 using VD = __m256d;
 using VI = __m256i;
@@ -128,3 +132,4 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
 }  // namespace
 }  // namespace RVR_KERNEL_NS
 }  // namespace rvr::soft
+#endif  // !__AVX512F__
