@@ -1,8 +1,8 @@
-// softraster's shading kernels (soft/shade_kernel.h), each this CPU can run, against the scalar
-// shading code they replace: surface_at's glm formulas and rvr::shade_local, the function the
-// tracer calls. Bit for bit, on random pixels and on the equation's special cases, so an image
-// cannot depend on the kernel, and softraster and the tracer compute the same colour for the
-// same surface point.
+// The shading kernels (rvr/shared/shade_kernel.h), each this CPU can run, against the scalar
+// shading code they replace: softraster's surface_at glm formulas, the tracer's viewer and
+// face_viewer, and rvr::shade_local. Bit for bit, on random pixels and on the equation's special
+// cases, so an image cannot depend on the kernel, and softraster and the tracer compute the same
+// colour for the same surface point.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -14,8 +14,9 @@
 #include <vector>
 
 #include "rvr/shared/isa.h"
+#include "rvr/shared/shade_batch.h"
+#include "rvr/shared/shade_kernel.h"
 #include "rvr/shared/shading.h"
-#include "soft/shade_dispatch.h"
 
 using namespace rvr;
 
@@ -48,7 +49,7 @@ Shaded scalar_shade(const Pixel& p, const glm::vec3& eye, const glm::vec3& ambie
   return {N, shade_local(p.material, P, N, V, ambient, lights)};
 }
 
-void put(float (&to)[3][soft::kShadeBatch], int i, const glm::vec3& v) {
+void put(float (&to)[3][kShadeBatch], int i, const glm::vec3& v) {
   for (int a = 0; a < 3; ++a) to[a][i] = v[a];
 }
 
@@ -61,7 +62,7 @@ bool same_material(const Material& a, const Material& b) {
 // `as_the_pass`, what the deferred pass leaves out is filled with NaN, so that reading it shows:
 // a batch of one material passes it once (batch.material), not per slot, and flat pixels'
 // vertex normals are not gathered.
-std::vector<Shaded> kernel_shade(const soft::ShadeKernels& kernels, const std::vector<Pixel>& px,
+std::vector<Shaded> kernel_shade(const ShadeKernels& kernels, const std::vector<Pixel>& px,
                                  const glm::vec3& eye, const glm::vec3& ambient,
                                  const std::vector<LightSample>& lights, bool as_the_pass) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -72,20 +73,20 @@ std::vector<Shaded> kernel_shade(const soft::ShadeKernels& kernels, const std::v
       data[a].push_back(l.position[a]);
       data[3 + a].push_back(l.intensity[a]);
     }
-  const soft::ShadeLights soa = {{data[0].data(), data[1].data(), data[2].data()},
-                                 {data[3].data(), data[4].data(), data[5].data()},
-                                 int(lights.size())};
+  const ShadeLights soa = {{data[0].data(), data[1].data(), data[2].data()},
+                           {data[3].data(), data[4].data(), data[5].data()},
+                           int(lights.size())};
   const float eye_xyz[3] = {eye.x, eye.y, eye.z};
-  auto batch = std::make_unique<soft::ShadeBatch>();
+  auto batch = std::make_unique<ShadeBatch>();
   std::vector<Shaded> out;
-  for (size_t first = 0; first < px.size(); first += soft::kShadeBatch) {
-    const int n = int(std::min<size_t>(soft::kShadeBatch, px.size() - first));
-    const int padded = (n + soft::kShadeMaxLanes - 1) / soft::kShadeMaxLanes * soft::kShadeMaxLanes;
+  for (size_t first = 0; first < px.size(); first += kShadeBatch) {
+    const int n = int(std::min<size_t>(kShadeBatch, px.size() - first));
+    const int padded = (n + kShadeMaxLanes - 1) / kShadeMaxLanes * kShadeMaxLanes;
     bool one_material = as_the_pass;
     for (int i = 1; i < n; ++i)
       one_material =
           one_material && same_material(px[first + size_t(i)].material, px[first].material);
-    soft::ShadeMaterial material;
+    ShadeMaterial material;
     for (int a = 0; a < 3; ++a) {
       material.diffuse[a] = px[first].material.diffuse[a];
       material.specular[a] = px[first].material.specular[a];
@@ -174,7 +175,7 @@ void expect_kernels_shade_as_scalar(const std::vector<Pixel>& pixels, bool as_th
   for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
     if (!cpu_supports(isa)) continue;
     ++tested;
-    const soft::ShadeKernels& kernels = soft::shade_kernels(isa);
+    const ShadeKernels& kernels = shade_kernels(isa);
     EXPECT_EQ(std::string(kernels.isa), to_string(isa));
     const std::vector<Shaded> got =
         kernel_shade(kernels, pixels, kEye, kAmbient, kLights, as_the_pass);
@@ -209,4 +210,111 @@ TEST(ShadeKernels, BatchesOfOneMaterialAndFlatGroupsShadeAsTheScalarCode) {
     pixels[k].smooth = group == 1 || (group == 2 && k % 2 == 0);
   }
   expect_kernels_shade_as_scalar(pixels, true);
+}
+
+namespace {
+
+// A tracer's hit: the surface as given, the ray's direction.
+struct SurfacePixel {
+  glm::vec3 position, direction, geometric, shading;
+  Material material;
+};
+
+// The tracer's scalar code (ray_tracer.cpp before the kernels): V = -normalize(d), then
+// face_viewer and shade_local.
+Shaded scalar_shade_surface(const SurfacePixel& p, const glm::vec3& ambient,
+                            const std::vector<LightSample>& lights) {
+  const glm::vec3 V = -glm::normalize(p.direction);
+  const glm::vec3 N = face_viewer(p.shading, p.geometric, V);
+  return {N, shade_local(p.material, p.position, N, V, ambient, lights)};
+}
+
+// The deferred pass's pixels as hits: the same surfaces seen along rays from random eyes.
+std::vector<SurfacePixel> random_surface_pixels() {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  std::vector<SurfacePixel> out;
+  for (const Pixel& p : random_pixels()) {
+    SurfacePixel s;
+    s.position = p.bary.x * p.vertex[0] + p.bary.y * p.vertex[1] + p.bary.z * p.vertex[2];
+    const glm::vec3 eye = kEye + 0.5f * glm::vec3(unit(rng), unit(rng), unit(rng));
+    s.direction = (s.position - eye) * (1.0f + unit(rng) * 0.5f);  // not unit length
+    s.geometric = glm::normalize(glm::cross(p.vertex[1] - p.vertex[0], p.vertex[2] - p.vertex[0]));
+    s.shading = p.smooth ? glm::normalize(p.normal[0]) : s.geometric;
+    s.material = p.material;
+    out.push_back(s);
+  }
+  return out;
+}
+
+// Shades the pixels with one kernel as the tracer fills its batches: runs of one material pass
+// it once (the per-slot arrays then NaN), other batches carry it per slot.
+std::vector<Shaded> kernel_shade_surfaces(const ShadeKernels& kernels,
+                                          const std::vector<SurfacePixel>& px,
+                                          const glm::vec3& ambient,
+                                          const std::vector<LightSample>& lights) {
+  const ShadeLightArrays soa(lights);
+  auto batch = std::make_unique<SurfaceBatch>();
+  std::vector<Shaded> out;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (size_t first = 0; first < px.size(); first += kShadeBatch) {
+    const int n = int(std::min<size_t>(kShadeBatch, px.size() - first));
+    bool one_material = true;
+    for (int i = 1; i < n; ++i)
+      one_material =
+          one_material && same_material(px[first + size_t(i)].material, px[first].material);
+    const ShadeMaterial material = shade_material(px[first].material, ambient);
+    batch->count = n;
+    for (int i = 0; i < n; ++i) {
+      const SurfacePixel& p = px[first + size_t(i)];
+      put_vec3(batch->position, i, p.position);
+      put_vec3(batch->direction, i, p.direction);
+      put_vec3(batch->geometric, i, p.geometric);
+      put_vec3(batch->shading, i, p.shading);
+      put_material(*batch, i,
+                   one_material
+                       ? ShadeMaterial{{nan, nan, nan}, {nan, nan, nan}, {nan, nan, nan}, nan}
+                       : shade_material(p.material, ambient));
+    }
+    pad_batch(*batch, !one_material);
+    batch->material = one_material ? &material : nullptr;
+    kernels.shade_surfaces(*batch, soa.lights());
+    for (int i = 0; i < n; ++i)
+      out.push_back(
+          {{batch->shading_normal[0][i], batch->shading_normal[1][i], batch->shading_normal[2][i]},
+           {batch->colour[0][i], batch->colour[1][i], batch->colour[2][i]}});
+  }
+  return out;
+}
+
+void expect_surface_kernels_shade_as_scalar(const std::vector<SurfacePixel>& pixels) {
+  int tested = 0;
+  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
+    if (!cpu_supports(isa)) continue;
+    ++tested;
+    const std::vector<Shaded> got =
+        kernel_shade_surfaces(shade_kernels(isa), pixels, kAmbient, kLights);
+    ASSERT_EQ(got.size(), pixels.size());
+    int failures = 0;
+    for (size_t i = 0; i < pixels.size() && failures < 5; ++i) {
+      const Shaded want = scalar_shade_surface(pixels[i], kAmbient, kLights);
+      if (same_bits(got[i].normal, want.normal) && same_bits(got[i].colour, want.colour)) continue;
+      ++failures;
+      ADD_FAILURE() << to_string(isa) << " hit " << i << ": normal " << show(got[i].normal)
+                    << " colour " << show(got[i].colour) << ", scalar " << show(want.normal) << " "
+                    << show(want.colour);
+    }
+  }
+  EXPECT_GE(tested, 1);
+}
+
+}  // namespace
+
+// The tracer's primary hits: every kernel gives the bits of its scalar shading, with a material
+// per pixel (mixed batches) and with runs of one material.
+TEST(ShadeKernels, EveryKernelShadesTheTracersHitsAsTheScalarCodeBitForBit) {
+  std::vector<SurfacePixel> pixels = random_surface_pixels();
+  expect_surface_kernels_shade_as_scalar(pixels);
+  for (size_t k = 0; k < pixels.size(); ++k) pixels[k].material = pixels[k / 150 * 150].material;
+  expect_surface_kernels_shade_as_scalar(pixels);
 }

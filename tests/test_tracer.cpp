@@ -5,9 +5,12 @@
 #include <cstring>
 
 #include "rvr/raytrace/intersect.h"
+#include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/raytrace/trace_geometry.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/shading.h"
 #include "scene_builders.h"
 
 using namespace rvr;
@@ -269,5 +272,106 @@ TEST(Tracer, NoShadowAcneOnConvexSurfaces) {
     }
     EXPECT_GT(lit, 1500u);
     EXPECT_EQ(differ, 0u) << (mode == SphereMode::Mesh ? "tessellated" : "analytic") << " sphere";
+  }
+}
+
+// The tracer's batched shading of primary hits against the scalar code it replaced, computed
+// here one pixel at a time from the tracer's own queries: the ray through the pixel centre
+// (camera_ray_direction), its closest hit, the surface there, V = -normalize(d), face_viewer and
+// shade_local. Every kernel and both sphere modes give those bits, colour and normal, in local
+// mode; visibility mode writes the same depth and ids, the background colour and no normal.
+TEST(Tracer, BatchedShadingGivesTheScalarShadingBitForBit) {
+  for (const char* name : {"cornell", "spheres", "tessphere:500"}) {
+    Expected<Scene> loaded = make_builtin_scene(name);
+    ASSERT_TRUE(loaded.ok());
+    Scene s = *loaded;
+    s.image.width = 83;  // blocks and tiles cut at odd places
+    s.image.height = 61;
+    const CameraFrame frame = make_camera_frame(s.camera, s.image.width, s.image.height);
+    const std::vector<LightSample> lights = light_samples(s.lights);
+    for (SphereMode spheres : {SphereMode::Analytic, SphereMode::Mesh}) {
+      TraceGeometry geometry(s, spheres, 24, AccelKind::Bvh);
+      ASSERT_TRUE(geometry.error().empty());
+      for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
+        if (!cpu_supports(isa)) continue;
+        RenderOptions o;
+        o.mode = RenderMode::Local;
+        o.isa = isa;
+        o.spheres = spheres;
+        RayTracer tracer;
+        Expected<RenderOutput> local = tracer.render(s, o, geometry);
+        o.mode = RenderMode::Visibility;
+        Expected<RenderOutput> visibility = tracer.render(s, o, geometry);
+        ASSERT_TRUE(local.ok() && visibility.ok());
+        const FrameBuffers& fb = local->buffers;
+        const FrameBuffers& vis = visibility->buffers;
+        EXPECT_EQ(local->info.at("shade_kernel"), to_string(isa));
+        int covered = 0, wrong = 0;
+        for (int y = 0; y < s.image.height; ++y)
+          for (int x = 0; x < s.image.width; ++x) {
+            const size_t i = fb.index(x, y);
+            Ray ray;
+            ray.origin = frame.eye;
+            ray.dir = camera_ray_direction(frame, float(x) + 0.5f, float(y) + 0.5f);
+            ray.tmin = s.camera.near;
+            ray.tmax = s.camera.far;
+            HitRecord hit;
+            glm::vec3 colour = s.image.background, normal(0.0f);
+            uint32_t object = kNoId;
+            if (geometry.closest(ray, hit)) {
+              const SurfaceHit sh = geometry.surface(ray, hit);
+              const glm::vec3 V = -glm::normalize(ray.dir);
+              normal = face_viewer(sh.shading_normal, sh.geometric_normal, V);
+              colour =
+                  shade_local(s.materials[sh.material], sh.position, normal, V, s.ambient, lights);
+              object = sh.object;
+              ++covered;
+            }
+            const bool same = std::memcmp(&fb.color[i], &colour, sizeof colour) == 0 &&
+                              std::memcmp(&fb.normal[i], &normal, sizeof normal) == 0 &&
+                              fb.object_id[i] == object && vis.object_id[i] == object &&
+                              vis.primitive_id[i] == fb.primitive_id[i] &&
+                              std::memcmp(&vis.depth[i], &fb.depth[i], sizeof(float)) == 0 &&
+                              vis.color[i] == s.image.background &&
+                              vis.normal[i] == glm::vec3(0.0f);
+            if (!same && ++wrong <= 3)
+              ADD_FAILURE() << name << " " << to_string(isa) << " pixel (" << x << ", " << y
+                            << ") differs from the scalar shading";
+          }
+        EXPECT_GT(covered, s.image.width * s.image.height / 10) << name;
+      }
+    }
+  }
+}
+
+// Primary rays from the per-frame column and row tables are camera_ray_direction's rays to the
+// bit, as packets of any shape and one at a time, for sizes whose ndc steps are not exact.
+TEST(Tracer, PrimaryRaysAreTheCameraRaysBitForBit) {
+  Camera camera;
+  camera.eye = {0.3f, -1.7f, 4.1f};
+  camera.target = {-0.2f, 0.4f, -0.9f};
+  camera.up = {0.1f, 1.0f, 0.05f};
+  camera.fov_y_deg = 53.0f;
+  for (auto [w, h] : {std::pair{1024, 768}, {97, 61}, {3, 700}}) {
+    const CameraFrame frame = make_camera_frame(camera, w, h);
+    const PrimaryRays rays(frame, 0.25f, 80.0f);
+    int wrong = 0;
+    for (int y0 = 0; y0 < h; y0 += 8)
+      for (int x0 = 0; x0 < w; x0 += 8) {
+        const int pw = std::min(8, w - x0), ph = std::min(8, h - y0);
+        const RayPacket packet = rays.packet(x0, y0, pw, ph);
+        ASSERT_EQ(packet.count, pw * ph);
+        for (int k = 0; k < packet.count; ++k) {
+          const int x = x0 + k % pw, y = y0 + k / pw;
+          const glm::vec3 want = camera_ray_direction(frame, float(x) + 0.5f, float(y) + 0.5f);
+          const Ray one = rays.ray(x, y), of_packet = PrimaryRays::ray_of(packet, k);
+          const bool same = std::memcmp(&one.dir, &want, sizeof want) == 0 &&
+                            std::memcmp(&of_packet.dir, &want, sizeof want) == 0 &&
+                            one.origin == frame.eye && of_packet.origin == frame.eye &&
+                            of_packet.tmin == 0.25f && of_packet.tmax == 80.0f;
+          if (!same && ++wrong <= 3)
+            ADD_FAILURE() << w << "x" << h << " pixel (" << x << ", " << y << ")";
+        }
+      }
   }
 }

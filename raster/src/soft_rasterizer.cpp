@@ -22,12 +22,12 @@
 #include "draw_list_prep.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/image_sample.h"
+#include "rvr/shared/shade_kernel.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/timer.h"
 #include "soft/deferred_shading.h"
 #include "soft/draw_triangles.h"
 #include "soft/fill_dispatch.h"
-#include "soft/shade_dispatch.h"
 #include "soft/shadow_cube.h"
 #include "soft/tile_raster.h"
 
@@ -181,7 +181,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
                    : shadows                              ? soft::ShadedColour::Base
                                                           : soft::ShadedColour::Local;
   shading.samples = &samples;
-  soft::shade_pixels(list, target, shading, soft::shade_kernels(isa), arena, progress, fb);
+  soft::shade_pixels(list, target, shading, shade_kernels(isa), arena, progress, fb);
   out.stats["time.shade"] = seconds_since(t);
 
   // --- shadows (full mode): a cube of distance maps per light sample, drawn by this z-buffer,

@@ -11,13 +11,18 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <optional>
 
+#include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/image_sample.h"
+#include "rvr/shared/shade_batch.h"
+#include "rvr/shared/shade_kernel.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/timer.h"
+#include "screen_bounds.h"
 
 namespace rvr {
 namespace {
@@ -63,7 +68,12 @@ struct RayCounters {
   // empty), and won by a CSG object.
   // Of those traced, the ones whose named primitive the ray missed (silhouettes, edges).
   uint64_t rebuilt = 0, fallback_traced = 0, fallback_missed = 0, csg_pixels = 0;
+  // render_visible: empty pixels left as background without a ray (may_hide_a_surface).
+  uint64_t background = 0;
   TraversalCounters traversal;
+  // Thread time spent on tiles, and of it after the primary hits were known (surfaces, AOVs,
+  // shading): how a frame's time divides between visibility and shading.
+  double busy_seconds = 0, shade_seconds = 0;
 
   uint64_t rays() const { return primary + shadow + reflection + refraction; }
   void add(const RayCounters& o) {
@@ -75,8 +85,11 @@ struct RayCounters {
     fallback_traced += o.fallback_traced;
     fallback_missed += o.fallback_missed;
     csg_pixels += o.csg_pixels;
+    background += o.background;
     traversal.nodes_visited += o.traversal.nodes_visited;
     traversal.primitive_tests += o.traversal.primitive_tests;
+    busy_seconds += o.busy_seconds;
+    shade_seconds += o.shade_seconds;
   }
 };
 
@@ -89,17 +102,29 @@ float ray_epsilon(const glm::vec3& p) {
 
 class FrameTracer {
  public:
-  FrameTracer(const Scene& scene, const RenderOptions& options, const TraceGeometry& geometry)
+  FrameTracer(const Scene& scene, const RenderOptions& options, const TraceGeometry& geometry,
+              const ShadeKernels& kernels)
       : scene_(scene),
         options_(options),
         geometry_(geometry),
         lights_(light_samples(scene.lights)),
         frame_(make_camera_frame(scene.camera, scene.image.width, scene.image.height)),
-        thin_lens_(options.mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f) {}
+        rays_(frame_, scene.camera.near, scene.camera.far),
+        thin_lens_(options.mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f),
+        kernels_(kernels),
+        light_arrays_(lights_) {
+    materials_.reserve(scene.materials.size());
+    for (const Material& m : scene.materials)
+      materials_.push_back(shade_material(m, scene.ambient));
+  }
 
   // render_visible for the hybrid's accumulation-buffer passes: the pixel-centre pass keeps the
   // centre's colour; the passes add the samples (add_visible_sample).
   void keep_centre_colour() { centre_only_ = true; }
+
+  // render_block_visible: pixels a z-buffer may leave empty where the scene is not (1 inside the
+  // screen bounds of the shapes it draws approximately or not at all), row-major; null: none.
+  void set_approximated_mask(const uint8_t* mask) { approximated_mask_ = mask; }
 
   // Sample k of each pixel of [x0, x1) x [y0, y1): its ray intersected with the primitive that
   // `visible` (a z-buffer drawn through image_sample k) names there, else traced; the CSG
@@ -136,36 +161,42 @@ class FrameTracer {
   }
 
   // The pixels [x0, x1) x [y0, y1) of one tile (at most kPacketSide on a side): their centre
-  // rays traced together as one packet, then each pixel shaded on its own.
+  // rays traced together as one packet, then finished (finish_block).
   void render_block(int x0, int y0, int x1, int y1, FrameBuffers& fb, RayCounters& counters) const {
-    const int w = x1 - x0;
-    // t along a direction with forward component 1 is view depth: clip exactly as GL does.
-    const RayPacket packet =
-        primary_ray_packet(frame_, x0, y0, w, y1 - y0, scene_.camera.near, scene_.camera.far);
+    const RayPacket packet = rays_.packet(x0, y0, x1 - x0, y1 - y0);
     HitRecord hits[kPacketRays];
     TraversalCounters work[kPacketRays];
     geometry_.closest_packet(packet, hits, work);
-    for (int k = 0; k < packet.count; ++k) {
-      counters.traversal.nodes_visited += work[k].nodes_visited;
-      counters.traversal.primitive_tests += work[k].primitive_tests;
-      render_pixel(x0 + k % w, y0 + k / w, hits[k], work[k], fb, counters);
-    }
+    counters.primary += uint64_t(packet.count);
+    finish_block(x0, y0, x1 - x0, packet, hits, work, fb, counters);
   }
 
   // The same pixels with their primary hits rebuilt from `visible`'s ids (render_visible).
   void render_block_visible(int x0, int y0, int x1, int y1, const PrimaryVisibility& visible,
                             FrameBuffers& fb, RayCounters& counters) const {
-    const int w = x1 - x0, n = w * (y1 - y0);
+    const int w = x1 - x0;
+    // The very rays render_block traces.
+    const RayPacket packet = rays_.packet(x0, y0, w, y1 - y0);
+    const int n = packet.count;
     HitRecord hits[kPacketRays];
     TraversalCounters work[kPacketRays];
     bool traced[kPacketRays];
     int n_traced = 0;
+    const uint64_t background_before = counters.background;
     for (int k = 0; k < n; ++k) {
       const int x = x0 + k % w, y = y0 + k / w;
       const size_t i = size_t(y) * size_t(visible.width) + size_t(x);
-      // The very ray the packet would carry: same origin, direction and clip range.
-      const Ray ray = primary_ray(float(x) + 0.5f, float(y) + 0.5f);
       HitRecord& hit = hits[k];
+      if (visible.object_id[i] == kNoId && !may_hide_a_surface(x, y, visible)) {
+        // Background to the z-buffer, away from every edge it drew and from every shape it
+        // could not draw exactly: background to the tracer too, without a ray.
+        hit = HitRecord{};
+        work[k] = TraversalCounters{};
+        traced[k] = false;
+        counters.background++;
+        continue;
+      }
+      const Ray ray = PrimaryRays::ray_of(packet, k);
       traced[k] = visible.object_id[i] == kNoId ||
                   !geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i],
                                                hit, work[k]);
@@ -192,8 +223,6 @@ class FrameTracer {
     if (n_traced >= kPacketFallbacks) {
       // Many to trace (an empty background): the whole block as one packet, as render_block
       // traces it; its hits are closest()'s, so which way is taken changes no pixel.
-      const RayPacket packet =
-          primary_ray_packet(frame_, x0, y0, w, y1 - y0, scene_.camera.near, scene_.camera.far);
       HitRecord packet_hits[kPacketRays];
       TraversalCounters packet_work[kPacketRays];
       geometry_.closest_packet(packet, packet_hits, packet_work);
@@ -210,71 +239,116 @@ class FrameTracer {
       for (int k = 0; k < n; ++k) {
         if (!traced[k]) continue;
         hits[k] = HitRecord{};
-        geometry_.closest(primary_ray(float(x0 + k % w) + 0.5f, float(y0 + k / w) + 0.5f), hits[k],
-                          work[k]);
+        geometry_.closest(PrimaryRays::ray_of(packet, k), hits[k], work[k]);
       }
     }
-    for (int k = 0; k < n; ++k) {
-      const int x = x0 + k % w, y = y0 + k / w;
-      if (traced[k] && hits[k].primitive != kNoPrimitive && geometry_.has_csg()) {
-        SurfaceHit s = geometry_.surface(primary_ray(float(x) + 0.5f, float(y) + 0.5f), hits[k]);
-        if (scene_.objects[s.object].type == ObjectType::Csg) counters.csg_pixels++;
-      }
-      counters.traversal.nodes_visited += work[k].nodes_visited;
-      counters.traversal.primitive_tests += work[k].primitive_tests;
-      render_pixel(x, y, hits[k], work[k], fb, counters);
-    }
+    if (geometry_.has_csg())
+      for (int k = 0; k < n; ++k)
+        if (traced[k] && hits[k].primitive != kNoPrimitive &&
+            scene_.objects[geometry_.hit_ids(hits[k]).first].type == ObjectType::Csg)
+          counters.csg_pixels++;
+    counters.primary += uint64_t(n) - (counters.background - background_before);
+    finish_block(x0, y0, w, packet, hits, work, fb, counters);
   }
 
  private:
-  // `hit` is the closest hit of the ray through the pixel centre (primitive kNoPrimitive when it
-  // missed), found with `primary_work`.
-  void render_pixel(int x, int y, const HitRecord& hit, const TraversalCounters& primary_work,
-                    FrameBuffers& fb, RayCounters& counters) const {
-    uint64_t work_before = counters.traversal.nodes_visited + counters.traversal.primitive_tests;
-    size_t i = fb.index(x, y);
-    fb.set_background(i, scene_.image.background);
-    // The AOVs come from the ray through the pixel centre, where OpenGL samples too.
-    Ray ray = primary_ray(float(x) + 0.5f, float(y) + 0.5f);
-    counters.primary++;
-    glm::vec3 centre_colour = scene_.image.background;
-    if (hit.primitive != kNoPrimitive) {
-      SurfaceHit s = geometry_.surface(ray, hit);
-      glm::vec3 V = -glm::normalize(ray.dir);
-      glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
-      fb.depth[i] = s.t;  // the direction's forward component is 1: t is view depth
-      fb.object_id[i] = s.object;
-      fb.primitive_id[i] = s.primitive;
-      fb.normal[i] = N;
-      if (options_.mode != RenderMode::Visibility)
-        centre_colour = shade(ray, s, N, V, 0, counters, nullptr);
-    }
-    int spp = scene_.image.samples_per_pixel;
-    if (options_.mode == RenderMode::Visibility) {
-      fb.color[i] = scene_.image.background;
-    } else if (spp <= 1 || centre_only_) {
-      fb.color[i] = centre_colour;
-    } else {
-      fb.color[i] = supersample(x, y, spp, counters);
-    }
-    fb.cost[i] =
-        float(primary_work.nodes_visited + primary_work.primitive_tests +
-              counters.traversal.nodes_visited + counters.traversal.primitive_tests - work_before);
+  // Whether the tracer may see a surface at empty pixel (x, y) of a z-buffer's ids: next to a
+  // pixel it covered (a silhouette or shared edge may fall either way at a centre), or where a
+  // shape it draws approximately or not at all may appear.
+  bool may_hide_a_surface(int x, int y, const PrimaryVisibility& visible) const {
+    const size_t width = size_t(visible.width);
+    if (approximated_mask_ && approximated_mask_[size_t(y) * width + size_t(x)]) return true;
+    for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, visible.height - 1); ++ny)
+      for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, visible.width - 1); ++nx)
+        if (visible.object_id[size_t(ny) * width + size_t(nx)] != kNoId) return true;
+    return false;
   }
 
-  Ray primary_ray(float px, float py) const {
-    Ray r;
-    r.origin = frame_.eye;
-    r.dir = camera_ray_direction(frame_, px, py);
-    // t along a direction with forward component 1 is view depth: clip exactly as GL does.
-    r.tmin = scene_.camera.near;
-    r.tmax = scene_.camera.far;
-    return r;
+  // The pixels of one block once the closest hits of their centre rays are known: hits[k] (for
+  // ray k of `packet`, row by row, w wide; primitive kNoPrimitive where it missed), found with
+  // work[k]. Every buffer of every pixel is written: the AOVs from the centre hit, the colour
+  // shaded in local mode by the shading kernels, a batch of the block's hits at a time, in full
+  // mode (shadow, reflection and refraction rays) one pixel at a time.
+  void finish_block(int x0, int y0, int w, const RayPacket& packet, const HitRecord* hits,
+                    const TraversalCounters* work, FrameBuffers& fb, RayCounters& counters) const {
+    static_assert(kPacketRays <= kShadeBatch, "a block's hits fit one batch");
+    const auto start = Clock::now();
+    const RenderMode mode = options_.mode;
+    const bool supersampled =
+        mode != RenderMode::Visibility && scene_.image.samples_per_pixel > 1 && !centre_only_;
+    SurfaceBatch batch;
+    size_t batch_pixel[kPacketRays];
+    bool mixed = false;  // the batch's pixels have more than one material
+    uint32_t batch_material = 0;
+    for (int k = 0; k < packet.count; ++k) {
+      const size_t i = fb.index(x0 + k % w, y0 + k / w);
+      const HitRecord& hit = hits[k];
+      counters.traversal.nodes_visited += work[k].nodes_visited;
+      counters.traversal.primitive_tests += work[k].primitive_tests;
+      const uint64_t work_before =
+          counters.traversal.nodes_visited + counters.traversal.primitive_tests;
+      if (hit.primitive == kNoPrimitive) {
+        fb.set_background(i, scene_.image.background);
+      } else if (mode == RenderMode::Visibility) {
+        // Visibility is the hit's distance and ids: no surface, no shading.
+        const auto [object, primitive] = geometry_.hit_ids(hit);
+        fb.color[i] = scene_.image.background;
+        fb.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
+        fb.object_id[i] = object;
+        fb.primitive_id[i] = primitive;
+        fb.normal[i] = glm::vec3(0.0f);
+      } else {
+        const Ray ray = PrimaryRays::ray_of(packet, k);
+        const SurfaceHit s = geometry_.surface(ray, hit);
+        fb.depth[i] = s.t;
+        fb.object_id[i] = s.object;
+        fb.primitive_id[i] = s.primitive;
+        if (mode == RenderMode::Local) {
+          const int slot = batch.count++;
+          batch_pixel[slot] = i;
+          put_vec3(batch.position, slot, s.position);
+          put_vec3(batch.direction, slot, ray.dir);
+          put_vec3(batch.geometric, slot, s.geometric_normal);
+          put_vec3(batch.shading, slot, s.shading_normal);
+          if (slot == 0) {
+            batch_material = s.material;
+          } else if (!mixed && s.material != batch_material) {
+            mixed = true;  // from now on each slot carries its material
+            for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
+          }
+          if (mixed) put_material(batch, slot, materials_[s.material]);
+        } else {
+          const glm::vec3 V = -glm::normalize(ray.dir);
+          const glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
+          fb.normal[i] = N;
+          fb.color[i] = shade(ray, s, N, V, 0, counters, nullptr);
+        }
+      }
+      if (supersampled) fb.color[i] = supersample(x0 + k % w, y0 + k / w, counters);
+      // Work for this pixel: its centre ray and every ray its shading traced.
+      fb.cost[i] =
+          float(work[k].nodes_visited + work[k].primitive_tests + counters.traversal.nodes_visited +
+                counters.traversal.primitive_tests - work_before);
+    }
+    if (batch.count > 0) {
+      pad_batch(batch, mixed);
+      batch.material = mixed ? nullptr : &materials_[batch_material];
+      kernels_.shade_surfaces(batch, light_arrays_.lights());
+      for (int slot = 0; slot < batch.count; ++slot) {
+        const size_t i = batch_pixel[slot];
+        fb.normal[i] = {batch.shading_normal[0][slot], batch.shading_normal[1][slot],
+                        batch.shading_normal[2][slot]};
+        if (!supersampled)
+          fb.color[i] = {batch.colour[0][slot], batch.colour[1][slot], batch.colour[2][slot]};
+      }
+    }
+    counters.shade_seconds += seconds_since(start);
   }
 
   // The samples of image_sample (the same place in every pixel, and with an aperture the same
   // lens point: the accumulation buffer's passes), each with its own random stream.
-  glm::vec3 supersample(int x, int y, int spp, RayCounters& counters) const {
+  glm::vec3 supersample(int x, int y, RayCounters& counters) const {
+    const int spp = scene_.image.samples_per_pixel;
     glm::vec3 sum(0.0f);
     for (int k = 0; k < spp; ++k) {
       const Ray ray =
@@ -291,7 +365,12 @@ class FrameTracer {
   // every ray through one image point meets there). The direction keeps forward component 1, so
   // t stays view depth and near/far clip as before.
   Ray sample_ray(int x, int y, const ImageSample& sample) const {
-    Ray r = primary_ray(float(x) + sample.jx, float(y) + sample.jy);
+    Ray r;
+    r.origin = frame_.eye;
+    r.dir = camera_ray_direction(frame_, float(x) + sample.jx, float(y) + sample.jy);
+    // t along a direction with forward component 1 is view depth: clip exactly as GL does.
+    r.tmin = scene_.camera.near;
+    r.tmax = scene_.camera.far;
     if (!thin_lens_) return r;
     const glm::vec3 lens = frame_.eye + sample.lens_x * frame_.right + sample.lens_y * frame_.up;
     const glm::vec3 focus = frame_.eye + scene_.camera.focus_distance * r.dir;
@@ -367,8 +446,13 @@ class FrameTracer {
   const TraceGeometry& geometry_;
   std::vector<LightSample> lights_;
   CameraFrame frame_;
+  PrimaryRays rays_;
   const bool thin_lens_;  // full mode with an aperture: samples look through the lens
   bool centre_only_ = false;
+  const ShadeKernels& kernels_;
+  const uint8_t* approximated_mask_ = nullptr;
+  std::vector<ShadeMaterial> materials_;  // scene_.materials as the kernels read them
+  ShadeLightArrays light_arrays_;         // lights_ likewise
 };
 
 }  // namespace
@@ -419,6 +503,37 @@ std::optional<Error> check_visibility_size(const Scene& scene, const PrimaryVisi
   return std::nullopt;
 }
 
+// The shading kernels of the options' instruction set (else RVR_ISA's, else the best this CPU
+// runs), as the wide BVH's kernels are chosen.
+Expected<const ShadeKernels*> choose_shade_kernels(const RenderOptions& options) {
+  Isa isa = Isa::Sse;
+  if (options.isa) {
+    isa = *options.isa;
+  } else {
+    Expected<Isa> selected = selected_isa();
+    if (!selected) return selected.error();
+    isa = *selected;
+  }
+  if (!cpu_supports(isa))
+    return bad_input(std::string("this CPU cannot run the ") + to_string(isa) + " kernels");
+  return &shade_kernels(isa);
+}
+
+// 1 at the pixels inside the screen bounds of a shape that a z-buffer draws approximately or not
+// at all (TraceGeometry::approximated_bounds), row-major.
+std::vector<uint8_t> approximated_mask(const Scene& scene, const TraceGeometry& geometry) {
+  const int w = scene.image.width, h = scene.image.height;
+  const CameraFrame frame = make_camera_frame(scene.camera, w, h);
+  std::vector<uint8_t> mask(size_t(w) * size_t(h), 0);
+  for (const Aabb& box : geometry.approximated_bounds()) {
+    const PixelRect r = screen_bounds(frame, scene.camera.near, box);
+    for (int y = r.y0; y < r.y1; ++y)
+      if (r.x1 > r.x0)
+        std::memset(mask.data() + size_t(y) * size_t(w) + size_t(r.x0), 1, size_t(r.x1 - r.x0));
+  }
+  return mask;
+}
+
 // Runs tile(x0, y0, x1, y1, counters) over the image's kTileSize tiles in parallel on `threads`
 // (0: all), and returns the counters of every thread added up.
 template <class Tile>
@@ -466,7 +581,9 @@ Expected<std::map<std::string, double>> RayTracer::add_visible_sample(
                  ErrorKind::Internal};
   RenderOptions resolved = options;
   resolved.accel = geometry.accel();
-  FrameTracer tracer(scene, resolved, geometry);
+  Expected<const ShadeKernels*> kernels = choose_shade_kernels(options);
+  if (!kernels) return kernels.error();
+  FrameTracer tracer(scene, resolved, geometry, **kernels);
   const ImageSample sample =
       image_sample(scene.camera, options.seed, k, spp, options.mode == RenderMode::Full);
   const RayCounters total =
@@ -495,15 +612,23 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   const int w = scene.image.width, h = scene.image.height;
   if (w <= 0 || h <= 0) return bad_input("image size must be positive");
 
+  Expected<const ShadeKernels*> kernels = choose_shade_kernels(options);
+  if (!kernels) return kernels.error();
   auto t_render = Clock::now();
   out.buffers.allocate(w, h);  // every pixel is written below, in parallel
-  FrameTracer tracer(scene, options, geometry);
+  FrameTracer tracer(scene, options, geometry, **kernels);
   if (centre_only) tracer.keep_centre_colour();
+  std::vector<uint8_t> approximated;
+  if (visible) {
+    approximated = approximated_mask(scene, geometry);
+    tracer.set_approximated_mask(approximated.data());
+  }
   // The fraction in pixels (known up front), the speed in rays of every kind (known as they go).
   ProgressSink* const progress = options.progress;
   if (progress) progress->begin("trace", uint64_t(w) * uint64_t(h), "pixels", "rays");
   const RayCounters total =
       for_each_tile(w, h, options.threads, [&](int x0, int y0, int x1, int y1, RayCounters& local) {
+        const auto t_tile = Clock::now();
         const uint64_t rays_before = local.rays();
         for (int by = y0; by < y1; by += kPacketSide)
           for (int bx = x0; bx < x1; bx += kPacketSide) {
@@ -515,8 +640,17 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
           }
         if (progress)
           progress->advance(uint64_t(x1 - x0) * uint64_t(y1 - y0), local.rays() - rays_before);
+        local.busy_seconds += seconds_since(t_tile);
       });
-  out.stats["time.render"] = seconds_since(t_render);
+  const double render_seconds = seconds_since(t_render);
+  out.stats["time.render"] = render_seconds;
+  // The frame's time divided as the threads' time divides: until the primary hits are known
+  // (rays generated and traced, or rebuilt from the z-buffer's ids) and after (surfaces, AOVs,
+  // shading and every ray after the primary hit).
+  const double shade_share = total.busy_seconds > 0 ? total.shade_seconds / total.busy_seconds : 0;
+  out.stats["time.shade"] = render_seconds * shade_share;
+  out.stats["time.visibility"] = render_seconds - out.stats["time.shade"];
+  out.info["shade_kernel"] = (*kernels)->isa;
 
   out.stats["rays.primary"] = double(total.primary);
   out.stats["rays.shadow"] = double(total.shadow);
@@ -527,6 +661,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
     out.stats["hybrid.fallback_traced"] = double(total.fallback_traced);
     out.stats["hybrid.fallback_missed"] = double(total.fallback_missed);
     out.stats["hybrid.csg_pixels"] = double(total.csg_pixels);
+    out.stats["hybrid.background"] = double(total.background);
   }
   if (options.accel != AccelKind::Embree) {  // Embree does not count its traversal steps
     out.stats["bvh.nodes_visited"] = double(total.traversal.nodes_visited);

@@ -232,6 +232,13 @@ Aabb TraceGeometry::analytic_bounds(const Analytic& a) {
   return b;
 }
 
+std::vector<Aabb> TraceGeometry::approximated_bounds() const {
+  std::vector<Aabb> bounds;
+  for (const Analytic& a : analytic_)
+    if (a.kind != Kind::Square) bounds.push_back(analytic_bounds(a));
+  return bounds;
+}
+
 int TraceGeometry::embree_packet_width() const {
   return embree_ ? rvr::embree_packet_width(*embree_) : 0;
 }
@@ -545,6 +552,13 @@ SurfaceHit TraceGeometry::surface(const Ray& ray, const HitRecord& hit) const {
   }
   s.material = object_material_[s.object];
   return s;
+}
+
+std::pair<uint32_t, uint32_t> TraceGeometry::hit_ids(const HitRecord& hit) const {
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  if (hit.primitive < n_triangles)
+    return {triangle_object_[hit.primitive], triangle_id_[hit.primitive]};
+  return {analytic_[hit.primitive - n_triangles].object, 0u};
 }
 
 bool TraceGeometry::intersect_visible(const Ray& ray, uint32_t object, uint32_t primitive,

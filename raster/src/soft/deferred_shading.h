@@ -1,7 +1,7 @@
 // softraster's deferred shading pass: after the z-buffer pass, every pixel of the frame buffers
 // is written once: the background where nothing was drawn, else depth, ids, the shading normal
 // and the colour, the visible pixels shaded a batch at a time by a SIMD shading kernel
-// (shade_kernel.h).
+// (rvr/shared/shade_kernel.h).
 #pragma once
 
 #include <tbb/task_arena.h>
@@ -13,7 +13,7 @@
 #include "rvr/shared/progress.h"
 #include "rvr/shared/scene.h"
 #include "soft/draw_triangles.h"
-#include "soft/shade_kernel.h"
+#include "rvr/shared/shade_kernel.h"
 #include "soft/tile_raster.h"
 
 namespace rvr::soft {

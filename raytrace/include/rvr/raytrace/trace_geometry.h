@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rvr/raytrace/bvh.h"
@@ -90,6 +91,9 @@ class TraceGeometry {
   bool occluded(const Ray& ray, TraversalCounters& counters) const;
   bool occluded(const Ray& ray) const;
   SurfaceHit surface(const Ray& ray, const HitRecord& hit) const;
+  // The object and the primitive id reported (SurfaceHit's object and primitive) of a hit,
+  // without the surface: what visibility needs.
+  std::pair<uint32_t, uint32_t> hit_ids(const HitRecord& hit) const;
 
   // The hit of `ray` with one thing a visibility buffer named, by the same intersection code as
   // closest(): for a mesh object triangle `primitive` of it; for a sphere or square the object
@@ -98,6 +102,9 @@ class TraceGeometry {
   // counters.primitive_tests counts the tests made.
   bool intersect_visible(const Ray& ray, uint32_t object, uint32_t primitive, HitRecord& hit,
                          TraversalCounters& counters) const;
+  // Bounds of the shapes a z-buffer draws only approximately or not at all: analytic spheres
+  // (their tessellation lies inside the exact silhouette) and CSG solids.
+  std::vector<Aabb> approximated_bounds() const;
   // True when the scene holds CSG objects (which no z-buffer draws).
   bool has_csg() const { return !csg_primitives_.empty(); }
   // Closest hit among the CSG objects only, with closest()'s tie rule.

@@ -1,5 +1,5 @@
-// softraster's shading kernel for one instruction set; included once per kernel translation
-// unit, which defines RVR_KERNEL_NS. Lane k shades pixel k of a group with the float operations
+// The shading kernels for one instruction set; included once per kernel translation unit,
+// which defines RVR_KERNEL_NS. Lane k shades pixel k of a group with the float operations
 // of shade_local (shared/include/rvr/shared/shading.h) and of the glm functions it calls
 // (dot = (x*x' + y*y') + z*z', normalize = v * (1 / sqrt(dot(v, v))), cross), in their order;
 // sqrt and division round as their scalar forms do and these units build with
@@ -9,13 +9,13 @@
 
 #include <cstdint>
 
-#include "soft/shade_kernel.h"
+#include "rvr/shared/shade_kernel.h"
 
 #ifndef RVR_KERNEL_NS
 #error "define RVR_KERNEL_NS before including this file"
 #endif
 
-namespace rvr::soft {
+namespace rvr {
 namespace RVR_KERNEL_NS {
 namespace {
 
@@ -260,9 +260,48 @@ inline VF specular_power(VF x, VF s) {
   return load(r);
 }
 
+// shade_local from the base colour on: each light sample in order.
+V3 add_lights(const ShadeLanes& batch, int i, const V3& P, const V3& N, const V3& V,
+              const ShadeLights& lights) {
+  const VF zero = splat(0.0f);
+  const ShadeMaterial* m = batch.material;
+  const V3 diffuse = m ? splat3(m->diffuse) : load3(batch.diffuse, i);
+  const V3 specular = m ? splat3(m->specular) : load3(batch.specular, i);
+  const VF shininess = m ? splat(m->shininess) : load(batch.shininess + i);
+  V3 colour = m ? splat3(m->base) : load3(batch.base, i);
+  for (int l = 0; l < lights.count; ++l) {
+    const V3 position = {splat(lights.position[0][l]), splat(lights.position[1][l]),
+                         splat(lights.position[2][l])};
+    const V3 intensity = {splat(lights.intensity[0][l]), splat(lights.intensity[1][l]),
+                          splat(lights.intensity[2][l])};
+    const V3 to_light = sub3(position, P);
+    const VF dist2 = dot(to_light, to_light);
+    M lit = greater(dist2, zero);  // !(dist2 > 0): the sample adds nothing
+    if (bits(lit) == 0) continue;
+    const V3 Ld = divide3(to_light, square_root(dist2));
+    const VF n_dot_l = clamp0(dot(N, Ld));
+    const V3 H = normalize(add3(Ld, V));
+    const VF n_dot_h = clamp0(dot(N, H));
+    const VF power = specular_power(n_dot_h, shininess);
+    const V3 brdf = add3(scale(diffuse, n_dot_l), scale(specular, power));
+    // brdf == vec3(0) skips the sample (its term could be NaN: 0 * inf).
+    lit = both(lit, either(either(not_equal(brdf.x, zero), not_equal(brdf.y, zero)),
+                           not_equal(brdf.z, zero)));
+    // vis * brdf * I / dist2 with vis = 1: 1 * brdf is brdf, bit for bit.
+    const V3 term = divide3(mul3(brdf, intensity), dist2);
+    colour = select3(lit, add3(colour, term), colour);
+  }
+  return colour;
+}
+
+// face_viewer: dot(geometric, V) < 0 turns the shading normal.
+inline V3 face_viewer(const V3& shading, const V3& geometric, const V3& V) {
+  const M back = less(dot(geometric, V), splat(0.0f));
+  return select3(back, {negate(shading.x), negate(shading.y), negate(shading.z)}, shading);
+}
+
 void shade(ShadeBatch& batch, const float eye_position[3], const ShadeLights& lights) {
   const V3 eye = {splat(eye_position[0]), splat(eye_position[1]), splat(eye_position[2])};
-  const VF zero = splat(0.0f);
   for (int i = 0; i < batch.count; i += kLanes) {
     // surface_at (soft_rasterizer.cpp): position, geometric and shading normals, viewer.
     const VF b[3] = {load(batch.bary[0] + i), load(batch.bary[1] + i), load(batch.bary[2] + i)};
@@ -277,43 +316,25 @@ void shade(ShadeBatch& batch, const float eye_position[3], const ShadeLights& li
                            ? geometric
                            : select3(smooth, normalize(interpolate(b, batch.normal, i)), geometric);
     const V3 V = normalize(sub3(eye, P));
-    // face_viewer: dot(geometric, V) < 0 turns the normal.
-    const M back = less(dot(geometric, V), zero);
-    const V3 N = select3(back, {negate(shading.x), negate(shading.y), negate(shading.z)}, shading);
+    const V3 N = face_viewer(shading, geometric, V);
     store3(batch.shading_normal, i, N);
+    store3(batch.colour, i, add_lights(batch, i, P, N, V, lights));
+  }
+}
 
-    // shade_local: base, then each light sample in order.
-    const ShadeMaterial* m = batch.material;
-    const V3 diffuse = m ? splat3(m->diffuse) : load3(batch.diffuse, i);
-    const V3 specular = m ? splat3(m->specular) : load3(batch.specular, i);
-    const VF shininess = m ? splat(m->shininess) : load(batch.shininess + i);
-    V3 colour = m ? splat3(m->base) : load3(batch.base, i);
-    for (int l = 0; l < lights.count; ++l) {
-      const V3 position = {splat(lights.position[0][l]), splat(lights.position[1][l]),
-                           splat(lights.position[2][l])};
-      const V3 intensity = {splat(lights.intensity[0][l]), splat(lights.intensity[1][l]),
-                            splat(lights.intensity[2][l])};
-      const V3 to_light = sub3(position, P);
-      const VF dist2 = dot(to_light, to_light);
-      M lit = greater(dist2, zero);  // !(dist2 > 0): the sample adds nothing
-      if (bits(lit) == 0) continue;
-      const V3 Ld = divide3(to_light, square_root(dist2));
-      const VF n_dot_l = clamp0(dot(N, Ld));
-      const V3 H = normalize(add3(Ld, V));
-      const VF n_dot_h = clamp0(dot(N, H));
-      const VF power = specular_power(n_dot_h, shininess);
-      const V3 brdf = add3(scale(diffuse, n_dot_l), scale(specular, power));
-      // brdf == vec3(0) skips the sample (its term could be NaN: 0 * inf).
-      lit = both(lit, either(either(not_equal(brdf.x, zero), not_equal(brdf.y, zero)),
-                             not_equal(brdf.z, zero)));
-      // vis * brdf * I / dist2 with vis = 1: 1 * brdf is brdf, bit for bit.
-      const V3 term = divide3(mul3(brdf, intensity), dist2);
-      colour = select3(lit, add3(colour, term), colour);
-    }
-    store3(batch.colour, i, colour);
+void shade_surfaces(SurfaceBatch& batch, const ShadeLights& lights) {
+  for (int i = 0; i < batch.count; i += kLanes) {
+    const V3 P = load3(batch.position, i);
+    const V3 direction = load3(batch.direction, i);
+    // -normalize(direction): the negation is exact.
+    const V3 unit = normalize(direction);
+    const V3 V = {negate(unit.x), negate(unit.y), negate(unit.z)};
+    const V3 N = face_viewer(load3(batch.shading, i), load3(batch.geometric, i), V);
+    store3(batch.shading_normal, i, N);
+    store3(batch.colour, i, add_lights(batch, i, P, N, V, lights));
   }
 }
 
 }  // namespace
 }  // namespace RVR_KERNEL_NS
-}  // namespace rvr::soft
+}  // namespace rvr

@@ -1,6 +1,6 @@
-#include "soft/shade_dispatch.h"
+#include "rvr/shared/shade_kernel.h"
 
-namespace rvr::soft {
+namespace rvr {
 
 const ShadeKernels& shade_kernels(Isa isa) {
   switch (isa) {
@@ -14,4 +14,4 @@ const ShadeKernels& shade_kernels(Isa isa) {
   return isa_sse::kShadeKernels;
 }
 
-}  // namespace rvr::soft
+}  // namespace rvr
