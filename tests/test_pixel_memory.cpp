@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include "rvr/renderers/registry.h"
@@ -56,7 +57,7 @@ TEST(PixelMemory, ThePoolNeverHoldsMoreThanItsLimit) {
     release_pixel_memory(p, bytes);
     EXPECT_LE(recycled_pixel_bytes(), kRecycleLimitBytes);
   }
-  EXPECT_GE(recycled_pixel_bytes(), 4 * bytes);             // the newest four are kept
+  EXPECT_GE(recycled_pixel_bytes(), 4 * bytes);  // the newest four are kept
 }
 
 namespace {
@@ -92,10 +93,15 @@ TEST(PixelMemory, EveryRendererWritesEveryPixelOfRecycledBuffers) {
   ASSERT_GE(pixels * 4, kRecycledBytes);
   for (const RendererChoice& c : renderer_choices()) {
     if (c.variant && c.variant->of == VariantOf::GlContext) continue;  // EGL: its own label
-    for (RenderMode mode : {RenderMode::Local, RenderMode::Full}) {
+    // Visibility mode with and without the cost AOV: z-buffers fill colour, normal (and cost)
+    // without shading.
+    for (auto [mode, cost_aov] :
+         {std::pair{RenderMode::Visibility, true}, std::pair{RenderMode::Visibility, false},
+          std::pair{RenderMode::Local, true}, std::pair{RenderMode::Full, true}}) {
       RendererConfig config{GlBackend::OsMesa};
       RenderOptions options;
       options.mode = mode;
+      options.cost_aov = cost_aov;
       options.shadow_map_size = 128;
       c.apply(config, options);
       std::unique_ptr<Renderer> renderer = c.info->create(config).value();
@@ -104,7 +110,8 @@ TEST(PixelMemory, EveryRendererWritesEveryPixelOfRecycledBuffers) {
       poison_frame_memory(pixels, 0xFF);
       const RenderOutput ones = renderer->render(scene, options).value();
       const FrameBuffers &a = zeros.buffers, &b = ones.buffers;
-      const std::string label = c.name + (mode == RenderMode::Local ? " local" : " full");
+      const std::string label =
+          c.name + " " + to_string(mode) + (cost_aov ? "" : " without the cost AOV");
       EXPECT_TRUE(same_bytes(a.color, b.color)) << label;
       EXPECT_TRUE(same_bytes(a.depth, b.depth)) << label;
       EXPECT_TRUE(same_bytes(a.object_id, b.object_id)) << label;

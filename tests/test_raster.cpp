@@ -12,8 +12,10 @@
 
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/shared/camera.h"
+#include "rvr/shared/scene_loader.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/tessellate.h"
+#include "visibility_frame.h"
 
 namespace rvr {
 namespace {
@@ -405,6 +407,64 @@ TEST(GlRaster, VisibilityModeKeepsBackgroundColour) {
   EXPECT_NEAR(fb.depth[i], 5.0f, 5e-5f);
   EXPECT_EQ(fb.color[i], s.image.background);
   EXPECT_TRUE(out.warnings.empty());
+}
+
+// Visibility mode reads back ids and depth only: depth, ids and cost as local mode's
+// (visibility_frame.h), colour the background, normal 0. Without the cost AOV no cost pass
+// runs (no time.cost, no fragments.generated) and the cost is 0.
+TEST(GlRaster, VisibilityModeWritesIdsDepthAndCostOnly) {
+  for (const char* name : {"cornell", "spheres", "tessphere:1000"}) {
+    Expected<Scene> loaded = make_builtin_scene(name);
+    ASSERT_TRUE(loaded.ok()) << name;
+    Scene scene = *loaded;
+    scene.image.width = 203;
+    scene.image.height = 151;
+    GlRasterizer r;
+    RenderOptions options;
+    options.mode = RenderMode::Local;
+    Expected<RenderOutput> local = r.render(scene, options);
+    ASSERT_TRUE(local.ok()) << local.error().message;
+    options.mode = RenderMode::Visibility;
+    Expected<RenderOutput> visibility = r.render(scene, options);
+    ASSERT_TRUE(visibility.ok()) << visibility.error().message;
+    options.cost_aov = false;
+    Expected<RenderOutput> no_cost = r.render(scene, options);
+    ASSERT_TRUE(no_cost.ok()) << no_cost.error().message;
+    test::expect_visibility_frame(scene, local->buffers, visibility->buffers, no_cost->buffers,
+                                  name);
+    EXPECT_EQ(visibility->stats.count("time.cost"), 1u) << name;
+    EXPECT_EQ(no_cost->stats.count("time.cost"), 0u) << name;
+    EXPECT_EQ(no_cost->stats.count("fragments.generated"), 0u) << name;
+    EXPECT_EQ(no_cost->stats.at("fragments.passed"), visibility->stats.at("fragments.passed"))
+        << name;
+  }
+}
+
+// Without the cost AOV, local and full mode change only the cost, to 0.
+TEST(GlRaster, NoCostAovLeavesEveryOtherBufferAsItWas) {
+  Scene s = base_scene();
+  s.objects.push_back(quad(1.0f, 0.0f));
+  s.objects.push_back(triangle({-2, -1, -1}, {1, -1, 0.5f}, {0, 2, -0.5f}));
+  for (RenderMode mode : {RenderMode::Local, RenderMode::Full}) {
+    GlRasterizer r;
+    RenderOptions options;
+    options.mode = mode;
+    Expected<RenderOutput> with = r.render(s, options);
+    ASSERT_TRUE(with.ok()) << with.error().message;
+    options.cost_aov = false;
+    Expected<RenderOutput> without = r.render(s, options);
+    ASSERT_TRUE(without.ok()) << without.error().message;
+    const FrameBuffers &a = with->buffers, &b = without->buffers;
+    EXPECT_TRUE(test::same_bytes(a.color, b.color)) << to_string(mode);
+    EXPECT_TRUE(test::same_bytes(a.normal, b.normal)) << to_string(mode);
+    EXPECT_TRUE(test::same_bytes(a.depth, b.depth)) << to_string(mode);
+    EXPECT_TRUE(test::same_bytes(a.object_id, b.object_id)) << to_string(mode);
+    EXPECT_TRUE(test::same_bytes(a.primitive_id, b.primitive_id)) << to_string(mode);
+    EXPECT_TRUE(std::all_of(b.cost.begin(), b.cost.end(), [](float c) {
+      return std::signbit(c) == 0 && c == 0.0f;
+    })) << to_string(mode);
+    EXPECT_TRUE(std::any_of(a.cost.begin(), a.cost.end(), [](float c) { return c > 1.0f; }));
+  }
 }
 
 TEST(GlRaster, FullModeWithoutMirrorGlassOrApertureDoesNotWarn) {

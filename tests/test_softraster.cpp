@@ -2,6 +2,7 @@
 // thread counts, agreement with the GL rasterizer and the ray tracer, and the cost AOV.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <glm/glm.hpp>
@@ -13,6 +14,7 @@
 #include "rvr/shared/compare.h"
 #include "rvr/shared/scene_loader.h"
 #include "scene_builders.h"
+#include "visibility_frame.h"
 
 namespace rvr {
 namespace {
@@ -330,6 +332,65 @@ TEST(SoftRasterizer, ReusedRendererDrawsWhatAFreshOneDraws) {
     ASSERT_TRUE(again.ok() && fresh.ok());
     EXPECT_TRUE(same(*again, *fresh)) << c.scene << (c.hiz ? "" : " no hi-z") << " " << c.width;
     EXPECT_EQ(again->stats.at("fragments.generated"), fresh->stats.at("fragments.generated"));
+  }
+}
+
+// Visibility mode writes what visibility is and nothing more: depth, ids and cost as local mode
+// writes them (visibility_frame.h), colour the background, normal 0, no shading time; without
+// the cost AOV the cost is 0. Odd sizes: rows end inside a SIMD group and an 8x8 block.
+TEST(SoftRasterizer, VisibilityModeWritesIdsDepthAndCostOnly) {
+  for (const char* name : {"cornell", "spheres", "tessphere:1000"}) {
+    Expected<Scene> loaded = make_builtin_scene(name);
+    ASSERT_TRUE(loaded.ok()) << name;
+    Scene scene = *loaded;
+    scene.image.width = 203;
+    scene.image.height = 151;
+    for (bool hiz : {true, false}) {
+      const std::string label = std::string(name) + (hiz ? "" : " no hi-z");
+      SoftRasterizer r;  // one renderer, reused across modes, as the hybrid does
+      RenderOptions options;
+      options.hiz = hiz;
+      options.mode = RenderMode::Local;
+      RenderOutput local = r.render(scene, options).value();
+      options.mode = RenderMode::Visibility;
+      RenderOutput visibility = r.render(scene, options).value();
+      options.cost_aov = false;
+      RenderOutput no_cost = r.render(scene, options).value();
+      test::expect_visibility_frame(scene, local.buffers, visibility.buffers, no_cost.buffers,
+                                    label);
+      EXPECT_EQ(visibility.stats.count("time.shade"), 0u) << label;
+      EXPECT_EQ(visibility.stats.count("time.readback"), 1u) << label;
+      EXPECT_EQ(local.stats.count("time.readback"), 0u) << label;
+      for (const RenderOutput* out : {&local, &visibility})
+        EXPECT_GE(out->stats.at("time.visibility"), out->stats.at("time.raster")) << label;
+      EXPECT_EQ(visibility.stats.at("fragments.generated"), local.stats.at("fragments.generated"))
+          << label;
+      EXPECT_EQ(no_cost.stats.at("fragments.generated"), local.stats.at("fragments.generated"))
+          << label;
+    }
+  }
+}
+
+// Without the cost AOV, local and full mode change only the cost, to 0.
+TEST(SoftRasterizer, NoCostAovLeavesEveryOtherBufferAsItWas) {
+  Expected<Scene> scene = make_builtin_scene("cornell");
+  ASSERT_TRUE(scene.ok());
+  for (RenderMode mode : {RenderMode::Local, RenderMode::Full}) {
+    SoftRasterizer r;
+    RenderOptions options;
+    options.mode = mode;
+    const FrameBuffers with = r.render(*scene, options).value().buffers;
+    options.cost_aov = false;
+    const FrameBuffers without = r.render(*scene, options).value().buffers;
+    EXPECT_TRUE(test::same_bytes(with.color, without.color)) << to_string(mode);
+    EXPECT_TRUE(test::same_bytes(with.normal, without.normal)) << to_string(mode);
+    EXPECT_TRUE(test::same_bytes(with.depth, without.depth)) << to_string(mode);
+    EXPECT_TRUE(test::same_bytes(with.object_id, without.object_id)) << to_string(mode);
+    EXPECT_TRUE(test::same_bytes(with.primitive_id, without.primitive_id)) << to_string(mode);
+    EXPECT_TRUE(std::all_of(without.cost.begin(), without.cost.end(), [](float c) {
+      return std::signbit(c) == 0 && c == 0.0f;
+    })) << to_string(mode);
+    EXPECT_TRUE(std::any_of(with.cost.begin(), with.cost.end(), [](float c) { return c > 0; }));
   }
 }
 

@@ -37,6 +37,10 @@ struct Phase {
 const std::map<std::string, std::string> kNestedPhases = {{"time.bvh_build", "time.build"},
                                                           {"time.render", "time.trace"}};
 
+// Totals of other phases (softraster's time.visibility is time.setup + its clear +
+// time.bin + time.raster): never stacked.
+const std::set<std::string> kTotalPhases = {"time.visibility"};
+
 int phase_rank(const std::string& name) {
   static const char* order[] = {"load",    "setup",    "build",  "upload", "shadow_maps",
                                 "zbuffer", "raster",   "render", "trace",  "shade",
@@ -52,8 +56,8 @@ std::vector<Phase> phases_of(const ReportRenderer& r) {
   for (const auto& [key, value] : r.stats) {
     const auto nested = kNestedPhases.find(key);
     if (key.rfind("time.", 0) != 0 ||
-        (nested != kNestedPhases.end() && r.stats.count(nested->second)) || !std::isfinite(value) ||
-        value < 0)
+        (nested != kNestedPhases.end() && r.stats.count(nested->second)) ||
+        kTotalPhases.count(key) || !std::isfinite(value) || value < 0)
       continue;
     phases.push_back({key.substr(5), value});
     if (key != "time.load") in_call += value;

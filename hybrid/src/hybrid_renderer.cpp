@@ -54,6 +54,7 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   // The z-buffer pass writes ids and depth only: the visibility buffer.
   RenderOptions visibility_options = options;
   visibility_options.mode = RenderMode::Visibility;
+  visibility_options.cost_aov = false;  // the cost AOV is the tracer's
   auto t_zbuffer = Clock::now();
   Expected<RenderOutput> zbuffer = rasterizer_->render(scene, visibility_options);
   const double zbuffer_seconds = seconds_since(t_zbuffer);

@@ -276,7 +276,7 @@ struct GlRasterizer::Impl {
   void clear_scene_targets(const Scene& scene);
   void draw_to_every_target();
   Status cost_pass(const ScenePass& pass);
-  Status readback(int w, int h, FrameBuffers& fb, uint64_t& samples_passed);
+  Status readback(int w, int h, const ScenePass& pass, FrameBuffers& fb, uint64_t& samples_passed);
 };
 
 Status GlRasterizer::Impl::init() {
@@ -831,8 +831,11 @@ Status GlRasterizer::Impl::cost_pass(const ScenePass& pass) {
   return ok_status();
 }
 
-// --- readback: every target into the FrameBuffers, rows flipped (GL rows are bottom-up)
-Status GlRasterizer::Impl::readback(int w, int h, FrameBuffers& fb, uint64_t& samples_passed) {
+// --- readback: the targets into the FrameBuffers, rows flipped (GL rows are bottom-up). Every
+// target in local and full mode; in visibility mode ids and depth only, the colour filled with
+// the background and the normal with 0 here. The cost target only after a cost pass, else 0.
+Status GlRasterizer::Impl::readback(int w, int h, const ScenePass& pass, FrameBuffers& fb,
+                                    uint64_t& samples_passed) {
   fb.width = w;
   fb.height = h;
   const size_t n = fb.pixel_count();
@@ -867,12 +870,20 @@ Status GlRasterizer::Impl::readback(int w, int h, FrameBuffers& fb, uint64_t& sa
       for (int x = 0; x < w; ++x) row[x] = glm::vec3(src[x]);
     }
   };
-  read_rgb(kColour, fb.color);
-  read_rgb(kNormal, fb.normal);
+  if (pass.options.mode == RenderMode::Visibility) {
+    std::fill(fb.color.begin(), fb.color.end(), pass.scene.image.background);
+    std::fill(fb.normal.begin(), fb.normal.end(), glm::vec3(0.0f));
+  } else {
+    read_rgb(kColour, fb.color);
+    read_rgb(kNormal, fb.normal);
+  }
   read_scalar(scene_fbo, kObjectId, GL_RED_INTEGER, GL_UNSIGNED_INT, fb.object_id);
   read_scalar(scene_fbo, kPrimitiveId, GL_RED_INTEGER, GL_UNSIGNED_INT, fb.primitive_id);
   read_scalar(scene_fbo, kViewDepth, GL_RED, GL_FLOAT, fb.depth);
-  read_scalar(cost_fbo, 0, GL_RED, GL_FLOAT, fb.cost);
+  if (pass.options.cost_aov)
+    read_scalar(cost_fbo, 0, GL_RED, GL_FLOAT, fb.cost);
+  else
+    std::fill(fb.cost.begin(), fb.cost.end(), 0.0f);
   GLuint64 passed = 0;
   gl().GetQueryObjectui64v(query, GL_QUERY_RESULT, &passed);
   RVR_GL_CHECK("readback");
@@ -927,16 +938,18 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
                            : projection_matrix(scene.camera, w, h)};
   RVR_TRY(scene_passes(pass, msaa, out));
 
-  if (progress) progress->begin("cost");
-  t = Clock::now();
-  RVR_TRY(cost_pass(pass));
-  out.stats["time.cost"] = seconds_since(t);
+  if (options.cost_aov) {
+    if (progress) progress->begin("cost");
+    t = Clock::now();
+    RVR_TRY(cost_pass(pass));
+    out.stats["time.cost"] = seconds_since(t);
+  }
 
   if (progress) progress->begin("readback");
   t = Clock::now();
   FrameBuffers& fb = out.buffers;
   uint64_t passed = 0;
-  RVR_TRY(readback(w, h, fb, passed));
+  RVR_TRY(readback(w, h, pass, fb, passed));
   out.stats["time.readback"] = seconds_since(t);
 
   double generated = 0.0;
@@ -946,10 +959,12 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
     covered += fb.object_id[i] != kNoId ? 1 : 0;
   }
   out.stats["triangles.submitted"] = double(vertices.size() / 3);
-  out.stats["fragments.generated"] = generated;
+  if (options.cost_aov) {  // counted by the cost pass only
+    out.stats["fragments.generated"] = generated;
+    out.stats["overdraw"] = covered > 0 ? generated / double(covered) : 0.0;
+  }
   out.stats["fragments.passed"] = double(passed);
   out.stats["pixels.covered"] = double(covered);
-  out.stats["overdraw"] = covered > 0 ? generated / double(covered) : 0.0;
   note_what_a_zbuffer_leaves_out(scene, options, *uploaded, out.warnings);
   return out;
 }

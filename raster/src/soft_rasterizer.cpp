@@ -73,6 +73,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
 
   // --- setup: objects to triangles, transform, clip, bin (in submission order)
   auto t = Clock::now();
+  const auto t_visibility = t;
   std::vector<TriangleMesh> tessellated;  // sphere and plane meshes, alive until shading ends
   tessellated.reserve(scene.objects.size());
   std::vector<DrawObject> objects(scene.objects.size());
@@ -137,13 +138,24 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   out.stats["time.setup"] += drawn.setup_seconds;
   out.stats["time.bin"] = drawn.bin_seconds;
   out.stats["time.raster"] = drawn.raster_seconds;
-
-  // --- shade: deferred, each visible pixel once
-  t = Clock::now();
+  // Everything before shading: setup, clearing the target, binning, raster.
+  out.stats["time.visibility"] = seconds_since(t_visibility);
   FrameBuffers& fb = out.buffers;
-  const std::vector<LightSample> samples = options.mode == RenderMode::Visibility
-                                               ? std::vector<LightSample>{}
-                                               : light_samples(scene.lights);
+
+  // --- visibility mode: the target's depth, ids and cost into the frame buffers, no shading
+  if (options.mode == RenderMode::Visibility) {
+    t = Clock::now();
+    if (progress) progress->begin("readback", uint64_t(w) * uint64_t(h), "pixels");
+    soft::write_visibility(list, target, scene.image.background, options.cost_aov, arena, progress,
+                           fb);
+    out.stats["time.readback"] = seconds_since(t);
+  }
+
+  // --- shade (local and full mode): deferred, each visible pixel once
+  t = Clock::now();
+  const bool shade = options.mode != RenderMode::Visibility;
+  const std::vector<LightSample> samples =
+      shade ? light_samples(scene.lights) : std::vector<LightSample>{};
   const bool shadows = options.mode == RenderMode::Full && !samples.empty();
   const glm::vec3 eye = scene.camera.eye;
   // The visible surface at pixel o (covered): position, normals, direction to the eye. The
@@ -172,17 +184,18 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     s.N = face_viewer(shading, s.geometric, s.V);
     return s;
   };
-  if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
-  soft::DeferredShading shading;
-  shading.eye = eye;
-  shading.ambient = scene.ambient;
-  shading.background = scene.image.background;
-  shading.colour = options.mode == RenderMode::Visibility ? soft::ShadedColour::Background
-                   : shadows                              ? soft::ShadedColour::Base
-                                                          : soft::ShadedColour::Local;
-  shading.samples = &samples;
-  soft::shade_pixels(list, target, shading, shade_kernels(isa), arena, progress, fb);
-  out.stats["time.shade"] = seconds_since(t);
+  if (shade) {
+    if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
+    soft::DeferredShading shading;
+    shading.eye = eye;
+    shading.ambient = scene.ambient;
+    shading.background = scene.image.background;
+    shading.colour = shadows ? soft::ShadedColour::Base : soft::ShadedColour::Local;
+    shading.samples = &samples;
+    shading.cost = options.cost_aov;
+    soft::shade_pixels(list, target, shading, shade_kernels(isa), arena, progress, fb);
+    out.stats["time.shade"] = seconds_since(t);
+  }
 
   // --- shadows (full mode): a cube of distance maps per light sample, drawn by this z-buffer,
   // in batches that fit kShadowBatchBytes; each batch then adds its samples' light.
@@ -279,7 +292,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   out.stats["triangles.clipped"] = double(drawn.clipped);
   out.stats["triangles.setup"] = double(drawn.set_up);
   out.stats["fragments.generated"] = double(sum.generated);
-  out.stats["fragments.shaded"] = double(covered);
+  out.stats["fragments.shaded"] = shade ? double(covered) : 0.0;
   out.stats["pixels.covered"] = double(covered);
   out.stats["overdraw"] = covered > 0 ? double(sum.generated) / double(covered) : 0.0;
   out.stats["blocks.full"] = double(sum.blocks_full);

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 
+#include "rvr/shared/shade_batch.h"
 #include "rvr/shared/shading.h"
 
 namespace rvr::soft {
@@ -19,20 +20,8 @@ namespace {
 struct ObjectShading {
   const TriangleMesh* mesh = nullptr;
   bool smooth = false;
-  bool use_primitive_id = false;
   ShadeMaterial material{};
 };
-
-void put(float (&to)[3][kShadeBatch], int i, const glm::vec3& v) {
-  to[0][i] = v.x;
-  to[1][i] = v.y;
-  to[2][i] = v.z;
-}
-void put(float (&to)[3][kShadeBatch], int i, const float (&v)[3]) {
-  to[0][i] = v[0];
-  to[1][i] = v[1];
-  to[2][i] = v[2];
-}
 
 // Asks for transparent huge pages over a buffer not yet touched. The frame's buffers are fresh
 // memory every frame (the caller takes them away): 31 MB at 1024x768, first touched here, one
@@ -48,33 +37,6 @@ void ask_for_huge_pages(PixelVector<T>& v) {
   if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
 }
 
-void put_material(ShadeBatch& b, int i, const ShadeMaterial& m) {
-  put(b.diffuse, i, m.diffuse);
-  put(b.specular, i, m.specular);
-  put(b.base, i, m.base);
-  b.shininess[i] = m.shininess;
-}
-
-// Repeats slot `from` in slot `to` (every input of the kernel; the material too if each slot
-// carries its own).
-void copy_slot(ShadeBatch& b, int from, int to, bool materials) {
-  for (int a = 0; a < 3; ++a) {
-    b.bary[a][to] = b.bary[a][from];
-    for (int c = 0; c < 3; ++c) {
-      b.vertex[c][a][to] = b.vertex[c][a][from];
-      b.normal[c][a][to] = b.normal[c][a][from];
-    }
-  }
-  b.smooth[to] = b.smooth[from];
-  if (!materials) return;
-  for (int a = 0; a < 3; ++a) {
-    b.diffuse[a][to] = b.diffuse[a][from];
-    b.specular[a][to] = b.specular[a][from];
-    b.base[a][to] = b.base[a][from];
-  }
-  b.shininess[to] = b.shininess[from];
-}
-
 // v in p[0, n). std::fill stores a glm::vec3 a float at a time; four of them are 48 bytes,
 // three 16-byte stores of one repeating pattern.
 void fill_vec3(glm::vec3* p, size_t n, const glm::vec3& v) {
@@ -85,54 +47,95 @@ void fill_vec3(glm::vec3* p, size_t n, const glm::vec3& v) {
   for (; i < n; ++i) p[i] = v;
 }
 
-}  // namespace
-
-void shade_pixels(const DrawList& list, const DepthTarget& target, const DeferredShading& settings,
-                  const ShadeKernels& kernels, tbb::task_arena& arena, ProgressSink* progress,
-                  FrameBuffers& fb) {
-  const int w = target.width(), h = target.height();
-  fb.allocate(w, h);  // every pixel is written below
+// Sizes fb to w x h; its pixels are left for the caller to write, every one of them.
+void allocate_frame(int w, int h, FrameBuffers& fb) {
+  fb.allocate(w, h);
   ask_for_huge_pages(fb.color);
   ask_for_huge_pages(fb.normal);
   ask_for_huge_pages(fb.depth);
   ask_for_huge_pages(fb.object_id);
   ask_for_huge_pages(fb.primitive_id);
   ask_for_huge_pages(fb.cost);
+}
+
+// What visibility leaves per pixel, a row at a time: depth, object and primitive id, cost.
+// The one writer of those buffers for both passes (shading and visibility only).
+class VisibilityRows {
+ public:
+  VisibilityRows(const DrawList& list, const DepthTarget& target, bool cost)
+      : target_(target), cost_(cost), use_primitive_id_(list.objects.size()) {
+    for (size_t i = 0; i < list.objects.size(); ++i) {
+      use_primitive_id_[i] = list.objects[i].use_primitive_id;
+      every_primitive_id_ = every_primitive_id_ && list.objects[i].use_primitive_id;
+    }
+  }
+
+  // Row y of fb's depth, object id, primitive id and cost (0 without the cost AOV). The
+  // target's "nothing covers it" id is the frame buffers' background id.
+  void write(int y, FrameBuffers& fb) const {
+    static_assert(kNoId == 0xFFFFFFFFu);
+    const int width = target_.width();  // a local: stores through uint32_t* could alias a member
+    const size_t row = fb.index(0, y);
+    if (cost_)
+      target_.cost_row(y, fb.cost.data() + row);
+    else
+      std::fill_n(fb.cost.data() + row, size_t(width), 0.0f);
+    // One buffer at a time.
+    const uint32_t* __restrict row_object = target_.objects() + row;
+    const uint32_t* __restrict row_primitive = target_.primitives() + row;
+    const double* __restrict row_depth = target_.depths() + row;
+    float* __restrict depth_out = fb.depth.data() + row;
+    uint32_t* __restrict primitive_out = fb.primitive_id.data() + row;
+    std::memcpy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
+    // Loads before the selection, so that these loops vectorize (branch-free).
+    for (int k = 0; k < width; ++k) {
+      const float depth = float(row_depth[k]);
+      depth_out[k] = row_object[k] == kNoId ? std::numeric_limits<float>::infinity() : depth;
+    }
+    if (every_primitive_id_) {
+      for (int k = 0; k < width; ++k) {
+        const uint32_t primitive = row_primitive[k];
+        primitive_out[k] = row_object[k] == kNoId ? kNoId : primitive;
+      }
+    } else {
+      const uint8_t* use = use_primitive_id_.data();
+      for (int k = 0; k < width; ++k)
+        primitive_out[k] = row_object[k] == kNoId    ? kNoId
+                           : use[row_object[k]] != 0 ? row_primitive[k]
+                                                     : 0u;
+    }
+  }
+
+ private:
+  const DepthTarget& target_;
+  bool cost_;
+  bool every_primitive_id_ = true;
+  std::vector<uint8_t> use_primitive_id_;  // per object: its triangle index is the primitive id
+};
+
+}  // namespace
+
+void shade_pixels(const DrawList& list, const DepthTarget& target, const DeferredShading& settings,
+                  const ShadeKernels& kernels, tbb::task_arena& arena, ProgressSink* progress,
+                  FrameBuffers& fb) {
+  const int w = target.width(), h = target.height();
+  allocate_frame(w, h, fb);  // every pixel is written below
+  const VisibilityRows visibility(list, target, settings.cost);
   std::vector<ObjectShading> objects(list.objects.size());
   for (size_t i = 0; i < objects.size(); ++i) {
     const DrawObject& d = list.objects[i];
     ObjectShading& s = objects[i];
     s.mesh = d.mesh;
     s.smooth = d.smooth;
-    s.use_primitive_id = d.use_primitive_id;
-    if (!d.material) continue;
-    const glm::vec3 base = shade_base(*d.material, settings.ambient);
-    for (int a = 0; a < 3; ++a) {
-      s.material.diffuse[a] = d.material->diffuse[a];
-      s.material.specular[a] = d.material->specular[a];
-      s.material.base[a] = base[a];
-    }
-    s.material.shininess = d.material->shininess;
+    if (d.material) s.material = shade_material(*d.material, settings.ambient);
   }
   // The light samples as the kernel reads them (none: the colour is the base).
-  std::vector<float> light_data[6];
-  if (settings.colour == ShadedColour::Local && settings.samples)
-    for (const LightSample& l : *settings.samples)
-      for (int a = 0; a < 3; ++a) {
-        light_data[a].push_back(l.position[a]);
-        light_data[3 + a].push_back(l.intensity[a]);
-      }
-  const ShadeLights lights = {{light_data[0].data(), light_data[1].data(), light_data[2].data()},
-                              {light_data[3].data(), light_data[4].data(), light_data[5].data()},
-                              int(light_data[0].size())};
+  const bool lit = settings.colour == ShadedColour::Local && settings.samples;
+  const ShadeLightArrays light_arrays(lit ? *settings.samples : std::vector<LightSample>{});
+  const ShadeLights& lights = light_arrays.lights();
   const float eye[3] = {settings.eye.x, settings.eye.y, settings.eye.z};
-  const bool write_colour = settings.colour != ShadedColour::Background;
   // The target marks a pixel nothing covers with the id the frame buffers give the background.
   static_assert(kNoId == 0xFFFFFFFFu);
-  bool every_primitive_id = true;
-  for (const ObjectShading& s : objects)
-    every_primitive_id = every_primitive_id && s.use_primitive_id;
-  const double* depths = target.depths();
   const uint32_t* object_of = target.objects();
   const uint32_t* primitive_of = target.primitives();
   const float* barycentrics = target.barycentrics();
@@ -150,16 +153,14 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
       auto flush = [&] {
         if (batch.count == 0) return;
         const int n = batch.count;
-        const int padded = (n + kShadeMaxLanes - 1) / kShadeMaxLanes * kShadeMaxLanes;
-        for (int i = n; i < padded; ++i) copy_slot(batch, n - 1, i, mixed);
+        pad_batch(batch, mixed);
         batch.material = mixed ? nullptr : &objects[batch_object].material;
         kernels.shade(batch, eye, lights);
         for (int i = 0; i < n; ++i) {
           const size_t o = pixel[i];
           fb.normal[o] = {batch.shading_normal[0][i], batch.shading_normal[1][i],
                           batch.shading_normal[2][i]};
-          if (write_colour)
-            fb.color[o] = {batch.colour[0][i], batch.colour[1][i], batch.colour[2][i]};
+          fb.color[o] = {batch.colour[0][i], batch.colour[1][i], batch.colour[2][i]};
         }
         batch.count = 0;
         mixed = false;
@@ -168,33 +169,9 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
       uint32_t last_object = kNoId, last_primitive = kNoId;
       glm::vec3 last_vertex[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
       glm::vec3 last_normal[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
-      const int width = w;  // a local: stores through uint32_t* could alias a captured int
       for (int y = r.begin(); y != r.end(); ++y) {
         const size_t row = fb.index(0, y);
-        target.cost_row(y, fb.cost.data() + row);
-        // Depth and ids of the whole row, one buffer at a time (the target's "nothing
-        // covers it" id is the frame buffers' background id).
-        const uint32_t* __restrict row_object = object_of + row;
-        const uint32_t* __restrict row_primitive = primitive_of + row;
-        const double* __restrict row_depth = depths + row;
-        float* __restrict depth_out = fb.depth.data() + row;
-        uint32_t* __restrict primitive_out = fb.primitive_id.data() + row;
-        std::memcpy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
-        // Loads before the selection, so that these loops vectorize (branch-free).
-        for (int k = 0; k < width; ++k) {
-          const float depth = float(row_depth[k]);
-          depth_out[k] = row_object[k] == kNoId ? std::numeric_limits<float>::infinity() : depth;
-        }
-        if (every_primitive_id)
-          for (int k = 0; k < width; ++k) {
-            const uint32_t primitive = row_primitive[k];
-            primitive_out[k] = row_object[k] == kNoId ? kNoId : primitive;
-          }
-        else
-          for (int k = 0; k < width; ++k)
-            primitive_out[k] = row_object[k] == kNoId                    ? kNoId
-                               : objects[row_object[k]].use_primitive_id ? row_primitive[k]
-                                                                         : 0u;
+        visibility.write(y, fb);  // depth, ids and cost of the whole row
         int x = 0;
         while (x < w) {
           if (object_of[row + size_t(x)] == kNoId) {
@@ -211,7 +188,6 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
           const uint32_t id = object_of[o];
           const ObjectShading& s = objects[id];
           const uint32_t primitive = primitive_of[o];
-          if (!write_colour) fb.color[o] = settings.background;
 
           const int i = batch.count++;
           pixel[i] = o;
@@ -232,14 +208,33 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
             if (s.smooth)
               for (int c = 0; c < 3; ++c) last_normal[c] = mesh.normals[tri[c]];
           }
-          for (int c = 0; c < 3; ++c) put(batch.vertex[c], i, last_vertex[c]);
+          for (int c = 0; c < 3; ++c) put_vec3(batch.vertex[c], i, last_vertex[c]);
           batch.smooth[i] = s.smooth ? ~0u : 0u;
           if (s.smooth)
-            for (int c = 0; c < 3; ++c) put(batch.normal[c], i, last_normal[c]);
+            for (int c = 0; c < 3; ++c) put_vec3(batch.normal[c], i, last_normal[c]);
           if (batch.count == kShadeBatch) flush();
         }
       }
       flush();
+      if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));
+    });
+  });
+}
+
+void write_visibility(const DrawList& list, const DepthTarget& target, const glm::vec3& background,
+                      bool cost, tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb) {
+  const int w = target.width(), h = target.height();
+  allocate_frame(w, h, fb);  // every pixel is written below
+  const VisibilityRows visibility(list, target, cost);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
+      for (int y = r.begin(); y != r.end(); ++y) {
+        const size_t row = fb.index(0, y);
+        visibility.write(y, fb);
+        fill_vec3(fb.color.data() + row, size_t(w), background);
+        std::memset(static_cast<void*>(fb.normal.data() + row), 0,
+                    size_t(w) * sizeof(glm::vec3));  // +0.0f is all zero bits
+      }
       if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));
     });
   });

@@ -1,7 +1,8 @@
 // softraster's deferred shading pass: after the z-buffer pass, every pixel of the frame buffers
 // is written once: the background where nothing was drawn, else depth, ids, the shading normal
 // and the colour, the visible pixels shaded a batch at a time by a SIMD shading kernel
-// (rvr/shared/shade_kernel.h).
+// (rvr/shared/shade_kernel.h). Visibility mode writes depth, ids and cost only
+// (write_visibility), with the same code for those buffers.
 #pragma once
 
 #include <tbb/task_arena.h>
@@ -12,16 +13,15 @@
 #include "rvr/shared/framebuffers.h"
 #include "rvr/shared/progress.h"
 #include "rvr/shared/scene.h"
-#include "soft/draw_triangles.h"
 #include "rvr/shared/shade_kernel.h"
+#include "soft/draw_triangles.h"
 #include "soft/tile_raster.h"
 
 namespace rvr::soft {
 
 enum class ShadedColour {
-  Background,  // visibility mode: colour stays the background
-  Base,        // emission + ambient * diffuse (the lights are added later, with shadows)
-  Local,       // base plus every light sample, unshadowed
+  Base,   // emission + ambient * diffuse (the lights are added later, with shadows)
+  Local,  // base plus every light sample, unshadowed
 };
 
 struct DeferredShading {
@@ -30,11 +30,18 @@ struct DeferredShading {
   glm::vec3 background;
   ShadedColour colour = ShadedColour::Local;
   const std::vector<LightSample>* samples = nullptr;  // Local: the light samples, in order
+  bool cost = true;  // false: the cost buffer is 0 everywhere (RenderOptions::cost_aov)
 };
 
 // Sizes fb to the target and writes every pixel of every buffer.
 void shade_pixels(const DrawList& list, const DepthTarget& target, const DeferredShading& settings,
                   const ShadeKernels& kernels, tbb::task_arena& arena, ProgressSink* progress,
                   FrameBuffers& fb);
+
+// Visibility mode: sizes fb to the target and writes every pixel of every buffer without
+// shading: depth, object and primitive id and cost (0 everywhere when !cost) as shade_pixels
+// writes them, colour the background, normal 0.
+void write_visibility(const DrawList& list, const DepthTarget& target, const glm::vec3& background,
+                      bool cost, tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb);
 
 }  // namespace rvr::soft
