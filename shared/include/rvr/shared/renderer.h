@@ -47,6 +47,9 @@ struct RenderOptions {
   bool shadow_pcf = false;
   // softraster: hierarchical z (each 8x8 block's farthest depth rejects triangles behind it).
   bool hiz = true;
+  // false: the caller does not read the cost AOV, which is then 0 everywhere (the z-buffers skip
+  // their fragment-count pass).
+  bool cost_aov = true;
   // Rasterizers: draw what this one sample of every pixel sees (its place in the pixel, its lens
   // point) instead of the pixel centres through a pinhole: one pass of an accumulation buffer.
   // The hybrid sets it for its visibility passes; unset, nothing changes.
