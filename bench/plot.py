@@ -73,7 +73,9 @@ def frame_vs_triangles(rows, context, out):
         axes[row][0].set_ylabel(ylabel)
     for ax in axes[-1]:
         ax.set_xlabel("triangles")
-    axes[0][0].legend()
+    legend_axes = [ax for ax in axes.flat if ax.get_legend_handles_labels()[1]]
+    if legend_axes:
+        legend_axes[0].legend()
     fig.suptitle("Frame time vs triangles: z-buffer vs ray tracing (" + subtitle(context) + ")")
     fig.tight_layout()
     fig.savefig(out / "frame_vs_triangles.png", dpi=100)
