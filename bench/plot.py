@@ -39,24 +39,43 @@ def subtitle(context):
     return f'{context.get("date", "")}, {context.get("num_cpus", "?")} CPUs at {context.get("mhz_per_cpu", "?")} MHz'
 
 
+def sweep_series(rows, family, scene):
+    """A frame sweep's rows at 1024x768 (BM_Frame, BM_Visibility): {renderer: [(n, ms)]}, sorted."""
+    series = defaultdict(list)
+    for b in rows:
+        p = parts(b)
+        if p[0] == family and len(p) == 5 and p[2] == scene and p[4] == "1024":
+            series[p[1]].append((int(p[3]), ms(b)))
+    return {name: sorted(pts) for name, pts in sorted(series.items())}
+
+
 def frame_vs_triangles(rows, context, out):
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), sharey=True)
-    for ax, scene in zip(axes, ["tessphere", "soup"]):
-        series = defaultdict(list)
-        for b in rows:
-            p = parts(b)
-            if p[0] == "BM_Frame" and p[2] == scene and p[4] == "1024":
-                series[p[1]].append((int(p[3]), ms(b)))
-        for name, pts in sorted(series.items()):
-            pts.sort()
-            ax.plot([x for x, _ in pts], [y for _, y in pts], marker="o", label=name)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_title(f"{scene}, 1024x768")
+    """Whole frames (BM_Frame) per scene and, below them when the run has BM_Visibility, the
+    same frames with ids and depth only: the loop without the shading, on the same axes."""
+    families = [("BM_Frame", "frame time (ms)", "")]
+    if any(parts(b)[0] == "BM_Visibility" for b in rows):
+        families.append(("BM_Visibility", "visibility-only frame time (ms)", ", ids + depth only"))
+    scenes = ["tessphere", "soup"]
+    series = {(f, s): sweep_series(rows, f, s) for f, _, _ in families for s in scenes}
+    names = sorted({name for by_name in series.values() for name in by_name})
+    colours = {name: f"C{i % 10}" for i, name in enumerate(names)}  # one colour per renderer
+    fig, axes = plt.subplots(len(families), 2, figsize=(12, 4.5 * len(families)), sharex=True,
+                             sharey=True, squeeze=False)
+    for row, (family, ylabel, what) in enumerate(families):
+        for ax, scene in zip(axes[row], scenes):
+            for name, pts in series[(family, scene)].items():
+                ax.plot([x for x, _ in pts], [y for _, y in pts], marker="o", color=colours[name],
+                        label=name)
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_title(f"{scene}, 1024x768{what}")
+            ax.grid(True, which="both", alpha=0.3)
+        axes[row][0].set_ylabel(ylabel)
+    for ax in axes[-1]:
         ax.set_xlabel("triangles")
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].set_ylabel("frame time (ms)")
-    axes[0].legend()
+    legend_axes = [ax for ax in axes.flat if ax.get_legend_handles_labels()[1]]
+    if legend_axes:
+        legend_axes[0].legend()
     fig.suptitle("Frame time vs triangles: z-buffer vs ray tracing (" + subtitle(context) + ")")
     fig.tight_layout()
     fig.savefig(out / "frame_vs_triangles.png", dpi=100)
@@ -137,31 +156,41 @@ def effects(rows, context, out):
     fig.savefig(out / "effects.png", dpi=100)
 
 
-def hybrid_wins(rows, context, out):
-    """Where the third loop order wins: each hybrid's frame time over the tracer's on the same
-    frame, per effect (cornell 640x480) and against triangle count (1024x768, local mode).
-    Below 1 the hybrid is faster, and the bar or point says by how much."""
-    table = effect_rows(rows)
-    frames = defaultdict(dict)  # (renderer, scene) -> {n: ms}
+def hybrid_split(rows):
+    """The hybrids' time split from their counters, where the run has them (zbuffer_ms: the
+    z-buffer passes, trace_ms: the tracer's part): per effect {hybrid: {effect: zbuffer_ms}} and
+    per frame {(hybrid, scene): [(n, zbuffer_ms / (zbuffer_ms + trace_ms))]} at 1024x768."""
+    effects, frames = defaultdict(dict), defaultdict(list)
     for b in rows:
         p = parts(b)
-        if p[0] == "BM_Frame" and len(p) == 5 and p[4] == "1024":
-            frames[(p[1], p[2])][int(p[3])] = ms(b)
-    hybrids = [h for h in HYBRIDS if table.get(h[0]) or any(k[0] == h[0] for k in frames)]
-    if not hybrids or not (table.get("raytrace") or any(k[0] == "raytrace" for k in frames)):
-        return
-    fig, axes = plt.subplots(1, 2, figsize=(13, 4.8))
-    ax = axes[0]
+        if "zbuffer_ms" not in b or "trace_ms" not in b:
+            continue
+        if p[0] == "BM_Effects" and len(p) == 3:
+            effects[p[1]][p[2]] = b["zbuffer_ms"]
+        elif p[0] == "BM_Frame" and len(p) == 5 and p[4] == "1024":
+            total = b["zbuffer_ms"] + b["trace_ms"]
+            if total > 0:
+                frames[(p[1], p[2])].append((int(p[3]), b["zbuffer_ms"] / total))
+    return effects, {k: sorted(v) for k, v in frames.items()}
+
+
+def hybrid_effects_panel(ax, table, hybrids, zbuffer_ms):
+    """Per effect: each hybrid's time over the tracer's; hatched, the z-buffer's part of it."""
     tracer = table.get("raytrace", {})
     names = [n for n in tracer if any(n in table.get(h[0], {}) for h in hybrids)]
     width = 0.8 / len(hybrids)
+    hatch_label = "z-buffer passes (hatched)"
     for i, (key, colour, label) in enumerate(hybrids):
-        offset = (i - (len(hybrids) - 1) / 2) * width
+        xs = [x + (i - (len(hybrids) - 1) / 2) * width for x in range(len(names))]
         ratios = [table.get(key, {}).get(n, float("nan")) / tracer[n] for n in names]
-        bars = ax.bar([x + offset for x in range(len(names))], ratios, width, color=colour,
-                      label=label)
+        bars = ax.bar(xs, ratios, width, color=colour, label=label)
         ax.bar_label(bars, labels=[f"{r:.2f}" for r in ratios], fontsize=7, rotation=90,
                      padding=2)
+        if zbuffer_ms.get(key):
+            parts_ = [zbuffer_ms[key].get(n, float("nan")) / tracer[n] for n in names]
+            ax.bar(xs, parts_, width, fill=False, hatch="///", edgecolor=(0, 0, 0, 0.45), linewidth=0,
+                   label=hatch_label)
+            hatch_label = None
     ax.axhline(1.0, color="black", linewidth=1)
     ax.set_xticks(list(range(len(names))))
     ax.set_xticklabels(names)
@@ -170,7 +199,10 @@ def hybrid_wins(rows, context, out):
     ax.set_title("per effect, cornell 640x480 (full mode)")
     ax.grid(True, axis="y", alpha=0.3)
     ax.legend(fontsize=8)
-    ax = axes[1]
+
+
+def hybrid_frames_panel(ax, frames, hybrids):
+    """Per frame against triangles: each hybrid's time over the tracer's, per scene."""
     for key, colour, label in hybrids:
         for scene, style in (("tessphere", "-"), ("soup", "--")):
             ours, base = frames.get((key, scene), {}), frames.get(("raytrace", scene), {})
@@ -186,6 +218,46 @@ def hybrid_wins(rows, context, out):
     ax.grid(True, which="both", alpha=0.3)
     if ax.get_legend_handles_labels()[1]:
         ax.legend(fontsize=8)
+
+
+def hybrid_split_panel(ax, shares, hybrids):
+    """Per frame against triangles: the z-buffer's share of each hybrid's z-buffer + trace time."""
+    for key, colour, label in hybrids:
+        for scene, style in (("tessphere", "-"), ("soup", "--")):
+            pts = shares.get((key, scene), [])
+            if pts:
+                ax.plot([n for n, _ in pts], [f for _, f in pts], style, marker="o", color=colour,
+                        label=f"{key} {scene}")
+    ax.set_xscale("log")
+    ax.set_ylim(0, 1)
+    ax.set_xlabel("triangles")
+    ax.set_ylabel("zbuffer_ms / (zbuffer_ms + trace_ms)")
+    ax.set_title("z-buffer's share of the hybrid's frame, 1024x768 (local mode)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+
+
+def hybrid_wins(rows, context, out):
+    """Where the third loop order wins: each hybrid's frame time over the tracer's on the same
+    frame, per effect (cornell 640x480) and against triangle count (1024x768, local mode).
+    Below 1 the hybrid is faster, and the bar or point says by how much. Where the run has the
+    hybrids' zbuffer_ms and trace_ms counters, the split of their time: hatched in the effect
+    bars, and a third panel with the z-buffer's share of each frame."""
+    table = effect_rows(rows)
+    frames = defaultdict(dict)  # (renderer, scene) -> {n: ms}
+    for b in rows:
+        p = parts(b)
+        if p[0] == "BM_Frame" and len(p) == 5 and p[4] == "1024":
+            frames[(p[1], p[2])][int(p[3])] = ms(b)
+    hybrids = [h for h in HYBRIDS if table.get(h[0]) or any(k[0] == h[0] for k in frames)]
+    if not hybrids or not (table.get("raytrace") or any(k[0] == "raytrace" for k in frames)):
+        return
+    zbuffer_ms, shares = hybrid_split(rows)
+    fig, axes = plt.subplots(1, 3 if shares else 2, figsize=(19 if shares else 13, 4.8))
+    hybrid_effects_panel(axes[0], table, hybrids, zbuffer_ms)
+    hybrid_frames_panel(axes[1], frames, hybrids)
+    if shares:
+        hybrid_split_panel(axes[2], shares, hybrids)
     fig.suptitle("Where the hybrid (z-buffer for primary visibility, rays for the rest) wins (" +
                  subtitle(context) + ")")
     fig.tight_layout()

@@ -1,5 +1,6 @@
 // rvr_bench: what each loop order costs. Names are stable (bench/README.md documents them):
 //   BM_Frame/<renderer>/<scene>/<n>/<width>   a whole frame, height = width * 3/4
+//   BM_Visibility/<renderer>/<scene>/<n>/<width>  the same frames, ids and depth only
 //   BM_DepthComplexity/<renderer>/<N>          occluders:N at 512x384, front to back
 //   BM_DepthComplexityBackToFront/<renderer>/<N>  the same quads rearmost first
 //   BM_Effects/<effect>                        the tracer on cornell, one effect at a time
@@ -8,11 +9,19 @@
 //   BM_Build/<accel>/<n>                       acceleration structure build
 //   BM_Threads/<renderer>/<threads>            tessphere:100000 at 1024x768 on 1 or 2 threads
 // Scenes and acceleration structures are built outside the timed loops (FrameRenderer).
+// Counters of every frame benchmark: rays/s, triangles/s, pixels/s; from the renderer's phase
+// stats, each the mean over the timed frames in ms and only when the renderer reports it:
+//   visibility_ms (time.visibility), shade_ms (time.shade): the z-buffer or primary-ray pass
+//     and the shading after it (softraster, raytrace);
+//   zbuffer_ms (time.zbuffer), trace_ms (time.trace): the hybrids' z-buffer passes and the
+//     tracer's part (hits rebuilt, shading, rays).
+// softraster also: raster_MiB, hiz_blocks_rejected, fragments (of the last frame).
 // Renderers and their variants (raytrace_bvh2, softraster_nohiz) come from the renderer table,
 // rvr/renderers/registry.h.
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <array>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -56,6 +65,36 @@ void add_counters(benchmark::State& state, const RenderOutput& out, double pixel
   state.counters["pixels/s"] = C(pixels, C::kIsIterationInvariantRate);
 }
 
+// The renderer's phase stats (seconds) summed over the timed frames, reported as counters: the
+// mean over the frames that reported each, in ms. A stat no frame reported gives no counter.
+class PhaseTimes {
+ public:
+  void add(const RenderOutput& out) {
+    for (size_t i = 0; i < kPhases.size(); ++i) {
+      auto it = out.stats.find(kPhases[i].stat);
+      if (it == out.stats.end()) continue;
+      seconds_[i] += it->second;
+      frames_[i] += 1;
+    }
+  }
+  void report(benchmark::State& state) const {
+    for (size_t i = 0; i < kPhases.size(); ++i)
+      if (frames_[i] > 0) state.counters[kPhases[i].counter] = 1e3 * seconds_[i] / frames_[i];
+  }
+
+ private:
+  struct Phase {
+    const char* stat;
+    const char* counter;
+  };
+  static constexpr std::array<Phase, 4> kPhases = {{{"time.visibility", "visibility_ms"},
+                                                    {"time.shade", "shade_ms"},
+                                                    {"time.zbuffer", "zbuffer_ms"},
+                                                    {"time.trace", "trace_ms"}}};
+  std::array<double, kPhases.size()> seconds_{};
+  std::array<double, kPhases.size()> frames_{};
+};
+
 // Renders frames of one scene with one renderer of the table, or a variant of one. What the
 // renderer builds beforehand (the tracers' BVH) is built here, outside the timed loop.
 class FrameRenderer {
@@ -86,20 +125,24 @@ bool every_object_every_ray(const RendererChoice& c) {
   return options.accel == AccelKind::None;
 }
 
-// Times whole frames of `scene` (already sized) in local mode. The first frame (GL shader JIT,
-// TBB threads) is not timed.
+// Times whole frames of `scene` (already sized) in `mode`, with or without the cost AOV. The
+// first frame (GL shader JIT, TBB threads) is not timed.
 void time_frames(benchmark::State& state, const std::string& renderer_name, const Scene& scene,
-                 int threads = 0) {
+                 RenderMode mode, bool cost_aov, int threads = 0) {
   RenderOptions options;
-  options.mode = RenderMode::Local;
+  options.mode = mode;
+  options.cost_aov = cost_aov;
   options.threads = threads;
   FrameRenderer renderer(renderer_name, scene, options);
   RenderOutput out = renderer.frame();
+  PhaseTimes phases;
   for (auto _ : state) {
     out = renderer.frame();
     benchmark::DoNotOptimize(out.buffers.color.data());
+    phases.add(out);
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
+  phases.report(state);
   if (auto it = out.stats.find("memory.raster_bytes"); it != out.stats.end())
     state.counters["raster_MiB"] = it->second / double(1 << 20);
   if (auto it = out.stats.find("hiz.blocks_rejected"); it != out.stats.end())
@@ -108,12 +151,24 @@ void time_frames(benchmark::State& state, const std::string& renderer_name, cons
     state.counters["fragments"] = it->second;
 }
 
-// A whole frame with one renderer.
-void BM_Frame(benchmark::State& state, std::string renderer_name, std::string scene_name) {
+// The frame sweeps over renderers, scenes, triangle counts and widths: BM_Frame renders whole
+// frames in local mode, BM_Visibility ids and depth only, without the cost AOV (the loop
+// without the shading).
+struct FrameSweep {
+  const char* family;
+  RenderMode mode;
+  bool cost_aov;
+};
+constexpr FrameSweep kFrameSweep{"BM_Frame", RenderMode::Local, true};
+constexpr FrameSweep kVisibilitySweep{"BM_Visibility", RenderMode::Visibility, false};
+
+// A frame of the sweep with one renderer: <scene>:<n> at width x width * 3/4.
+void BM_Frame(benchmark::State& state, FrameSweep sweep, std::string renderer_name,
+              std::string scene_name) {
   Scene scene = builtin(scene_name + ":" + std::to_string(state.range(0)));
   scene.image.width = int(state.range(1));
   scene.image.height = int(state.range(1) * 3 / 4);
-  time_frames(state, renderer_name, scene);
+  time_frames(state, renderer_name, scene, sweep.mode, sweep.cost_aov);
 }
 
 // Parallel scaling of our own loops: the same frame with 1 and with 2 worker threads.
@@ -121,7 +176,7 @@ void BM_Threads(benchmark::State& state, std::string renderer_name) {
   Scene scene = builtin("tessphere:100000");
   scene.image.width = 1024;
   scene.image.height = 768;
-  time_frames(state, renderer_name, scene, int(state.range(0)));
+  time_frames(state, renderer_name, scene, RenderMode::Local, true, int(state.range(0)));
 }
 
 // occluders:N, N quads one behind another, submitted front to back (hi-z skips the hidden ones)
@@ -132,7 +187,7 @@ void BM_DepthComplexity(benchmark::State& state, std::string renderer_name, bool
       builtin((back_to_front ? "occluders_back:" : "occluders:") + std::to_string(state.range(0)));
   scene.image.width = 512;
   scene.image.height = 384;
-  time_frames(state, renderer_name, scene);
+  time_frames(state, renderer_name, scene, RenderMode::Local, true);
 }
 
 // Cornell with exactly one effect switched on (BM_Effects): the scene and options.
@@ -180,24 +235,21 @@ void BM_Effects(benchmark::State& state, std::string effect) {
 
 // The same frames with another renderer of the table (the hybrid: the z-buffer finds the
 // primary hits, the tracer does the effect), built afresh each frame as the tracer's are. The
-// split of its time: zbuffer_ms (visibility pass) and trace_ms (hits rebuilt, shading, rays).
+// split of its time: zbuffer_ms (visibility passes) and trace_ms (hits rebuilt, shading, rays).
 void BM_EffectsWith(benchmark::State& state, std::string renderer_name, std::string effect) {
   Scene scene;
   RenderOptions options;
   effect_scene(effect, scene, options);
   std::unique_ptr<Renderer> renderer = make_renderer(renderer_name).value();
   RenderOutput out = renderer->render(scene, options).value();
-  double zbuffer = 0, trace = 0;
+  PhaseTimes phases;
   for (auto _ : state) {
     out = renderer->render(scene, options).value();
     benchmark::DoNotOptimize(out.buffers.color.data());
-    zbuffer += out.stats["time.zbuffer"];
-    trace += out.stats["time.trace"];
+    phases.add(out);
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
-  double frames = double(std::max<benchmark::IterationCount>(state.iterations(), 1));
-  state.counters["zbuffer_ms"] = 1e3 * zbuffer / frames;
-  state.counters["trace_ms"] = 1e3 * trace / frames;
+  phases.report(state);
 }
 
 std::vector<Ray> make_rays(const Scene& scene, const std::string& kind) {
@@ -471,30 +523,30 @@ void BM_Build(benchmark::State& state, std::string accel) {
   }
 }
 
-void register_all() {
-  // raster, softraster, raytrace, raytrace_bvh2, raytrace_none, embree.
-  for (const RendererChoice& c : choices_with(VariantOf::Accelerator)) {
-    const std::string& r = c.name;
-    for (std::string s : {"tessphere", "soup"}) {
+// One frame sweep: <family>/<renderer>/<scene>/<n>/<width>.
+void register_frame_sweep(const FrameSweep& sweep) {
+  auto add = [&](const std::string& r, const std::string& s, long n, long w) {
+    benchmark::RegisterBenchmark((sweep.family + ("/" + r + "/" + s)).c_str(), BM_Frame, sweep, r,
+                                 s)
+        ->Args({n, w})
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  };
+  // raster, softraster, raytrace, raytrace_bvh2, raytrace_none, embree, hybrid, hybrid_soft.
+  for (const RendererChoice& c : choices_with(VariantOf::Accelerator))
+    for (std::string s : {"tessphere", "soup"})
       for (long n : {100L, 1000L, 10000L, 100000L, 1000000L}) {
         if (every_object_every_ray(c) && n > 1000) continue;
-        for (long w : {256L, 1024L, 2048L}) {
-          benchmark::RegisterBenchmark(("BM_Frame/" + r + "/" + s).c_str(), BM_Frame, r, s)
-              ->Args({n, w})
-              ->Unit(benchmark::kMillisecond)
-              ->UseRealTime();
-        }
+        for (long w : {256L, 1024L, 2048L}) add(c.name, s, n, w);
       }
-    }
-  }
   // Ten million triangles, at 1024 wide only: the z-buffers' linear cost against the tracers'.
   for (const RendererInfo& info : renderers())
-    for (std::string s : {"tessphere", "soup"})
-      benchmark::RegisterBenchmark(("BM_Frame/" + info.name + "/" + s).c_str(), BM_Frame, info.name,
-                                   s)
-          ->Args({10000000L, 1024L})
-          ->Unit(benchmark::kMillisecond)
-          ->UseRealTime();
+    for (std::string s : {"tessphere", "soup"}) add(info.name, s, 10000000L, 1024L);
+}
+
+void register_all() {
+  register_frame_sweep(kFrameSweep);
+  register_frame_sweep(kVisibilitySweep);
   // raster, softraster, softraster_nohiz, raytrace, embree.
   for (bool back : {false, true})
     for (const RendererChoice& c : choices_with(VariantOf::HierarchicalZ))
