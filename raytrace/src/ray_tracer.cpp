@@ -27,7 +27,8 @@
 namespace rvr {
 namespace {
 
-constexpr int kTileSize = 16;
+// Tiles run in parallel: wide and short, so that each writes long runs of every buffer's rows.
+constexpr int kTileWidth = 64, kTileHeight = 8;
 // Primary rays go as packets of kPacketSide x kPacketSide pixel-centre rays (kPacketRays).
 constexpr int kPacketSide = 8;
 static_assert(kPacketSide * kPacketSide == kPacketRays);
@@ -183,42 +184,42 @@ class FrameTracer {
     bool traced[kPacketRays];
     int n_traced = 0;
     const uint64_t background_before = counters.background;
-    for (int k = 0; k < n; ++k) {
-      const int x = x0 + k % w, y = y0 + k / w;
-      const size_t i = size_t(y) * size_t(visible.width) + size_t(x);
-      HitRecord& hit = hits[k];
-      if (visible.object_id[i] == kNoId && !may_hide_a_surface(x, y, visible)) {
-        // Background to the z-buffer, away from every edge it drew and from every shape it
-        // could not draw exactly: background to the tracer too, without a ray.
-        hit = HitRecord{};
-        work[k] = TraversalCounters{};
-        traced[k] = false;
-        counters.background++;
-        continue;
-      }
-      const Ray ray = PrimaryRays::ray_of(packet, k);
-      traced[k] = visible.object_id[i] == kNoId ||
-                  !geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i],
-                                               hit, work[k]);
-      if (traced[k]) {
-        // Nothing drawn, or the z-buffer's polygon covers the centre where the exact surface
-        // does not (silhouettes, shared edges): the tracer decides, below.
-        n_traced++;
-        counters.fallback_missed += visible.object_id[i] != kNoId;
-        continue;
-      }
-      counters.rebuilt++;
-      if (geometry_.has_csg()) {
-        // No z-buffer draws CSG: the ray meets the CSG objects alone; the nearer hit wins, ties
-        // by primitive index as in closest().
-        HitRecord csg;
-        if (geometry_.closest_csg(ray, csg, work[k]) &&
-            (csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive))) {
-          hit = csg;
-          counters.csg_pixels++;
+    for (int y = y0, k = 0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x, ++k) {  // ray k is pixel (x, y)
+        const size_t i = size_t(y) * size_t(visible.width) + size_t(x);
+        HitRecord& hit = hits[k];
+        if (visible.object_id[i] == kNoId && !may_hide_a_surface(x, y, visible)) {
+          // Background to the z-buffer, away from every edge it drew and from every shape it
+          // could not draw exactly: background to the tracer too, without a ray.
+          hit = HitRecord{};
+          work[k] = TraversalCounters{};
+          traced[k] = false;
+          counters.background++;
+          continue;
+        }
+        const Ray ray = PrimaryRays::ray_of(packet, k);
+        traced[k] = visible.object_id[i] == kNoId ||
+                    !geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i],
+                                                 hit, work[k]);
+        if (traced[k]) {
+          // Nothing drawn, or the z-buffer's polygon covers the centre where the exact surface
+          // does not (silhouettes, shared edges): the tracer decides, below.
+          n_traced++;
+          counters.fallback_missed += visible.object_id[i] != kNoId;
+          continue;
+        }
+        counters.rebuilt++;
+        if (geometry_.has_csg()) {
+          // No z-buffer draws CSG: the ray meets the CSG objects alone; the nearer hit wins, ties
+          // by primitive index as in closest().
+          HitRecord csg;
+          if (geometry_.closest_csg(ray, csg, work[k]) &&
+              (csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive))) {
+            hit = csg;
+            counters.csg_pixels++;
+          }
         }
       }
-    }
     counters.fallback_traced += uint64_t(n_traced);
     if (n_traced >= kPacketFallbacks) {
       // Many to trace (an empty background): the whole block as one packet, as render_block
@@ -280,56 +281,59 @@ class FrameTracer {
     size_t batch_pixel[kPacketRays];
     bool mixed = false;  // the batch's pixels have more than one material
     uint32_t batch_material = 0;
-    for (int k = 0; k < packet.count; ++k) {
-      const size_t i = fb.index(x0 + k % w, y0 + k / w);
-      const HitRecord& hit = hits[k];
-      counters.traversal.nodes_visited += work[k].nodes_visited;
-      counters.traversal.primitive_tests += work[k].primitive_tests;
-      const uint64_t work_before =
-          counters.traversal.nodes_visited + counters.traversal.primitive_tests;
-      if (hit.primitive == kNoPrimitive) {
-        fb.set_background(i, scene_.image.background);
-      } else if (mode == RenderMode::Visibility) {
-        // Visibility is the hit's distance and ids: no surface, no shading.
-        const auto [object, primitive] = geometry_.hit_ids(hit);
-        fb.color[i] = scene_.image.background;
-        fb.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
-        fb.object_id[i] = object;
-        fb.primitive_id[i] = primitive;
-        fb.normal[i] = glm::vec3(0.0f);
-      } else {
-        const Ray ray = PrimaryRays::ray_of(packet, k);
-        const SurfaceHit s = geometry_.surface(ray, hit);
-        fb.depth[i] = s.t;
-        fb.object_id[i] = s.object;
-        fb.primitive_id[i] = s.primitive;
-        if (mode == RenderMode::Local) {
-          const int slot = batch.count++;
-          batch_pixel[slot] = i;
-          put_vec3(batch.position, slot, s.position);
-          put_vec3(batch.direction, slot, ray.dir);
-          put_vec3(batch.geometric, slot, s.geometric_normal);
-          put_vec3(batch.shading, slot, s.shading_normal);
-          if (slot == 0) {
-            batch_material = s.material;
-          } else if (!mixed && s.material != batch_material) {
-            mixed = true;  // from now on each slot carries its material
-            for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
-          }
-          if (mixed) put_material(batch, slot, materials_[s.material]);
+    const int y1 = y0 + packet.count / w;
+    for (int y = y0, k = 0; y < y1; ++y)
+      for (int x = x0; x < x0 + w; ++x, ++k) {  // ray k is pixel (x, y)
+        const size_t i = fb.index(x, y);
+        const HitRecord& hit = hits[k];
+        counters.traversal.nodes_visited += work[k].nodes_visited;
+        counters.traversal.primitive_tests += work[k].primitive_tests;
+        const uint64_t work_before =
+            counters.traversal.nodes_visited + counters.traversal.primitive_tests;
+        if (hit.primitive == kNoPrimitive) {
+          fb.set_background(i, scene_.image.background);
+        } else if (mode == RenderMode::Visibility) {
+          // Visibility is the hit's distance and ids: no surface, no shading.
+          const auto [object, primitive] = geometry_.hit_ids(hit);
+          fb.color[i] = scene_.image.background;
+          fb.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
+          fb.object_id[i] = object;
+          fb.primitive_id[i] = primitive;
+          fb.normal[i] = glm::vec3(0.0f);
         } else {
-          const glm::vec3 V = -glm::normalize(ray.dir);
-          const glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
-          fb.normal[i] = N;
-          fb.color[i] = shade(ray, s, N, V, 0, counters, nullptr);
+          const Ray ray = PrimaryRays::ray_of(packet, k);
+          const SurfaceHit s = geometry_.surface(ray, hit);
+          fb.depth[i] = s.t;
+          fb.object_id[i] = s.object;
+          fb.primitive_id[i] = s.primitive;
+          if (mode == RenderMode::Local) {
+            const int slot = batch.count++;
+            batch_pixel[slot] = i;
+            put_vec3(batch.position, slot, s.position);
+            put_vec3(batch.direction, slot, ray.dir);
+            put_vec3(batch.geometric, slot, s.geometric_normal);
+            put_vec3(batch.shading, slot, s.shading_normal);
+            if (slot == 0) {
+              batch_material = s.material;
+            } else if (!mixed && s.material != batch_material) {
+              mixed = true;  // from now on each slot carries its material
+              for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
+            }
+            if (mixed) put_material(batch, slot, materials_[s.material]);
+          } else {
+            const glm::vec3 V = -glm::normalize(ray.dir);
+            const glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
+            fb.normal[i] = N;
+            fb.color[i] = shade(ray, s, N, V, 0, counters, nullptr);
+          }
         }
+        if (supersampled) fb.color[i] = supersample(x, y, counters);
+        // Work for this pixel: its centre ray and every ray its shading traced.
+        fb.cost[i] = options_.cost_aov ? float(work[k].nodes_visited + work[k].primitive_tests +
+                                               counters.traversal.nodes_visited +
+                                               counters.traversal.primitive_tests - work_before)
+                                       : 0.0f;
       }
-      if (supersampled) fb.color[i] = supersample(x0 + k % w, y0 + k / w, counters);
-      // Work for this pixel: its centre ray and every ray its shading traced.
-      fb.cost[i] =
-          float(work[k].nodes_visited + work[k].primitive_tests + counters.traversal.nodes_visited +
-                counters.traversal.primitive_tests - work_before);
-    }
     if (batch.count > 0) {
       pad_batch(batch, mixed);
       batch.material = mixed ? nullptr : &materials_[batch_material];
@@ -534,13 +538,13 @@ std::vector<uint8_t> approximated_mask(const Scene& scene, const TraceGeometry& 
   return mask;
 }
 
-// Runs tile(x0, y0, x1, y1, counters) over the image's kTileSize tiles in parallel on `threads`
+// Runs tile(x0, y0, x1, y1, counters) over the image's tiles in parallel on `threads`
 // (0: all), and returns the counters of every thread added up.
 template <class Tile>
 RayCounters for_each_tile(int w, int h, int threads, const Tile& tile) {
   tbb::combinable<RayCounters> counters;
-  const int tiles_x = (w + kTileSize - 1) / kTileSize;
-  const int tiles_y = (h + kTileSize - 1) / kTileSize;
+  const int tiles_x = (w + kTileWidth - 1) / kTileWidth;
+  const int tiles_y = (h + kTileHeight - 1) / kTileHeight;
   tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
   arena.execute([&] {
     tbb::parallel_for(
@@ -548,8 +552,8 @@ RayCounters for_each_tile(int w, int h, int threads, const Tile& tile) {
         [&](const tbb::blocked_range<int>& range) {
           RayCounters& local = counters.local();
           for (int t = range.begin(); t != range.end(); ++t) {
-            const int x0 = (t % tiles_x) * kTileSize, y0 = (t / tiles_x) * kTileSize;
-            tile(x0, y0, std::min(x0 + kTileSize, w), std::min(y0 + kTileSize, h), local);
+            const int x0 = (t % tiles_x) * kTileWidth, y0 = (t / tiles_x) * kTileHeight;
+            tile(x0, y0, std::min(x0 + kTileWidth, w), std::min(y0 + kTileHeight, h), local);
           }
         },
         tbb::simple_partitioner());

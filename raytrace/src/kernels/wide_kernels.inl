@@ -679,37 +679,38 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
 }
 
 // Sets up lanes [first, first + 8) of a tile; false when a direction has a zero component (such
-// rays take the robust single-ray path).
+// rays take the robust single-ray path). Eight lanes at once: the reciprocal directions are one
+// vector division per axis, each lane rounding as the scalar 1 / d does.
 bool make_packet8(const RayPacket& packet, int first, Packet8& p) {
-  alignas(32) float d[3][8], rdir[3][8], org_rdir[3][8], margin[8];
-  p.valid = 0;
-  for (int a = 0; a < 3; ++a) p.o[a] = packet.origin[a];
+  const int live = packet.count - first < 8 ? packet.count - first : 8;
+  p.valid = (1u << live) - 1u;
+  alignas(32) float d[3][8];
+  for (int a = 0; a < 3; ++a)  // unused lanes copy a live one
+    for (int l = 0; l < 8; ++l) d[a][l] = packet.dir[a][l < live ? first + l : first];
+  const V8 sign_off = bits8(0x7FFFFFFFu);
+  V8 margin = splat8(0.0f);
+  for (int a = 0; a < 3; ++a) {
+    const V8 da = load8(d[a]);
+    if (mask8(lt8(and8(sign_off, da), splat8(kTinyDirection))) != 0) return false;
+    const V8 rdir = div8(splat8(1.0f), da);
+    const V8 org_rdir = mul8(splat8(packet.origin[a]), rdir);
+    // 2^-20: org * rdir's rounding, x16; the largest over the axes, as e > m ? e : m.
+    margin = max8(mul8(and8(sign_off, org_rdir), splat8(1.0f / 1048576.0f)), margin);
+    p.d[a] = da;
+    p.rdir[a] = rdir;
+    p.org_rdir[a] = org_rdir;
+    p.o[a] = packet.origin[a];
+  }
+  p.margin = margin;
+  p.tmin = splat8(packet.tmin);
   for (int l = 0; l < 8; ++l) {
-    int k = first + l < packet.count ? first + l : first;  // unused lanes copy a live one
-    if (first + l < packet.count) p.valid |= 1u << l;
-    float m = 0.0f;
     for (int a = 0; a < 3; ++a) {
-      float da = packet.dir[a][k];
-      if (abs1(da) < kTinyDirection) return false;
-      d[a][l] = da;
-      rdir[a][l] = 1.0f / da;
-      org_rdir[a][l] = packet.origin[a] * rdir[a][l];
-      float e = abs1(org_rdir[a][l]) * (1.0f / 1048576.0f);  // 2^-20: org * rdir's rounding, x16
-      m = e > m ? e : m;
       p.ray[l].origin[a] = packet.origin[a];
-      p.ray[l].dir[a] = da;
+      p.ray[l].dir[a] = d[a][l];
     }
-    margin[l] = m;
     p.ray[l].tmin = packet.tmin;
     p.ray[l].tmax = packet.tmax;
   }
-  for (int a = 0; a < 3; ++a) {
-    p.d[a] = load8(d[a]);
-    p.rdir[a] = load8(rdir[a]);
-    p.org_rdir[a] = load8(org_rdir[a]);
-  }
-  p.margin = load8(margin);
-  p.tmin = splat8(packet.tmin);
   return true;
 }
 
