@@ -214,41 +214,80 @@ TEST(ShadeKernels, BatchesOfOneMaterialAndFlatGroupsShadeAsTheScalarCode) {
 
 namespace {
 
-// A tracer's hit: the surface as given, the ray's direction.
+// A tracer's hit: the ray (from the batch's origin), t and (u, v) on a triangle, or an analytic
+// shape's normals.
 struct SurfacePixel {
-  glm::vec3 position, direction, geometric, shading;
+  float t, u, v;
+  glm::vec3 direction;
+  glm::vec3 e1, e2, normal[3];
+  bool smooth, given;
+  glm::vec3 geometric, shading;  // given
   Material material;
 };
 
-// The tracer's scalar code (ray_tracer.cpp before the kernels): V = -normalize(d), then
-// face_viewer and shade_local.
+const glm::vec3 kOrigin(0.25f, 0.5f, 2.75f);
+
+// The tracer's scalar code (TraceGeometry::surface and ray_tracer.cpp before the kernels):
+// P = o + t d, normalize(cross(e1, e2)), smooth normals interpolated and divided by their
+// length when it is above 0, V = -normalize(d), face_viewer, shade_local.
 Shaded scalar_shade_surface(const SurfacePixel& p, const glm::vec3& ambient,
                             const std::vector<LightSample>& lights) {
+  const glm::vec3 P = kOrigin + p.t * p.direction;
+  glm::vec3 geometric = p.geometric, shading = p.shading;
+  if (!p.given) {
+    geometric = glm::normalize(glm::cross(p.e1, p.e2));
+    shading = geometric;
+    if (p.smooth) {
+      const glm::vec3 n = (1.0f - p.u - p.v) * p.normal[0] + p.u * p.normal[1] + p.v * p.normal[2];
+      const float length = glm::length(n);
+      if (length > 0.0f) shading = n / length;
+    }
+  }
   const glm::vec3 V = -glm::normalize(p.direction);
-  const glm::vec3 N = face_viewer(p.shading, p.geometric, V);
-  return {N, shade_local(p.material, p.position, N, V, ambient, lights)};
+  const glm::vec3 N = face_viewer(shading, geometric, V);
+  return {N, shade_local(p.material, P, N, V, ambient, lights)};
 }
 
-// The deferred pass's pixels as hits: the same surfaces seen along rays from random eyes.
+// The deferred pass's pixels as hits: the same triangles and materials seen along rays from
+// kOrigin; every 9th an analytic shape (given normals), every 29th a smooth triangle whose
+// vertex normals cancel at the hit (length 0: the geometric normal stays).
 std::vector<SurfacePixel> random_surface_pixels() {
   std::mt19937 rng(11);
   std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
   std::vector<SurfacePixel> out;
+  int k = 0;
   for (const Pixel& p : random_pixels()) {
     SurfacePixel s;
-    s.position = p.bary.x * p.vertex[0] + p.bary.y * p.vertex[1] + p.bary.z * p.vertex[2];
-    const glm::vec3 eye = kEye + 0.5f * glm::vec3(unit(rng), unit(rng), unit(rng));
-    s.direction = (s.position - eye) * (1.0f + unit(rng) * 0.5f);  // not unit length
-    s.geometric = glm::normalize(glm::cross(p.vertex[1] - p.vertex[0], p.vertex[2] - p.vertex[0]));
-    s.shading = p.smooth ? glm::normalize(p.normal[0]) : s.geometric;
+    const glm::vec3 P = p.bary.x * p.vertex[0] + p.bary.y * p.vertex[1] + p.bary.z * p.vertex[2];
+    s.t = 0.5f + 2.0f * std::abs(unit(rng));
+    s.direction = (P - kOrigin) / s.t;
+    s.u = p.bary.y;
+    s.v = p.bary.z;
+    s.e1 = p.vertex[1] - p.vertex[0];
+    s.e2 = p.vertex[2] - p.vertex[0];
+    for (int c = 0; c < 3; ++c) s.normal[c] = p.normal[c];
+    s.smooth = p.smooth;
+    s.given = k % 9 == 0;
+    s.geometric = glm::normalize(glm::vec3(unit(rng), unit(rng), unit(rng)));
+    s.shading = k % 2 ? s.geometric : glm::normalize(glm::vec3(unit(rng), unit(rng), unit(rng)));
+    if (k % 29 == 0) {
+      s.smooth = true;
+      s.u = 0.5f;
+      s.v = 0.0f;
+      s.normal[0] = glm::vec3(1.0f, 0.0f, 0.0f);
+      s.normal[1] = glm::vec3(-1.0f, 0.0f, 0.0f);
+    }
     s.material = p.material;
     out.push_back(s);
+    ++k;
   }
   return out;
 }
 
 // Shades the pixels with one kernel as the tracer fills its batches: runs of one material pass
-// it once (the per-slot arrays then NaN), other batches carry it per slot.
+// it once (the per-slot arrays then NaN), other batches carry it per slot; what the tracer does
+// not fill for a lane (vertex normals of flat triangles, triangle data of given lanes, given
+// normals of triangles) is NaN.
 std::vector<Shaded> kernel_shade_surfaces(const ShadeKernels& kernels,
                                           const std::vector<SurfacePixel>& px,
                                           const glm::vec3& ambient,
@@ -257,6 +296,8 @@ std::vector<Shaded> kernel_shade_surfaces(const ShadeKernels& kernels,
   auto batch = std::make_unique<SurfaceBatch>();
   std::vector<Shaded> out;
   const float nan = std::numeric_limits<float>::quiet_NaN();
+  const glm::vec3 nan3(nan);
+  for (int a = 0; a < 3; ++a) batch->origin[a] = kOrigin[a];
   for (size_t first = 0; first < px.size(); first += kShadeBatch) {
     const int n = int(std::min<size_t>(kShadeBatch, px.size() - first));
     bool one_material = true;
@@ -267,10 +308,18 @@ std::vector<Shaded> kernel_shade_surfaces(const ShadeKernels& kernels,
     batch->count = n;
     for (int i = 0; i < n; ++i) {
       const SurfacePixel& p = px[first + size_t(i)];
-      put_vec3(batch->position, i, p.position);
+      batch->t[i] = p.t;
       put_vec3(batch->direction, i, p.direction);
-      put_vec3(batch->geometric, i, p.geometric);
-      put_vec3(batch->shading, i, p.shading);
+      batch->u[i] = p.given ? nan : p.u;
+      batch->v[i] = p.given ? nan : p.v;
+      put_vec3(batch->edge1, i, p.given ? nan3 : p.e1);
+      put_vec3(batch->edge2, i, p.given ? nan3 : p.e2);
+      for (int c = 0; c < 3; ++c)
+        put_vec3(batch->vertex_normal[c], i, p.smooth && !p.given ? p.normal[c] : nan3);
+      batch->smooth[i] = p.smooth && !p.given ? ~0u : 0u;
+      batch->given[i] = p.given ? ~0u : 0u;
+      put_vec3(batch->geometric, i, p.given ? p.geometric : nan3);
+      put_vec3(batch->shading, i, p.given ? p.shading : nan3);
       put_material(*batch, i,
                    one_material
                        ? ShadeMaterial{{nan, nan, nan}, {nan, nan, nan}, {nan, nan, nan}, nan}

@@ -23,12 +23,14 @@
 #include "rvr/shared/shading.h"
 #include "rvr/shared/timer.h"
 #include "screen_bounds.h"
+#include "tile_output.h"
 
 namespace rvr {
 namespace {
 
-// Tiles run in parallel: wide and short, so that each writes long runs of every buffer's rows.
-constexpr int kTileWidth = 64, kTileHeight = 8;
+// Tiles run in parallel, each staged in a TileOutput: wide and short, so that each writes long
+// runs of every buffer's rows.
+constexpr int kTileWidth = TileOutput::kMaxWidth, kTileHeight = TileOutput::kMaxHeight;
 // Primary rays go as packets of kPacketSide x kPacketSide pixel-centre rays (kPacketRays).
 constexpr int kPacketSide = 8;
 static_assert(kPacketSide * kPacketSide == kPacketRays);
@@ -163,18 +165,18 @@ class FrameTracer {
 
   // The pixels [x0, x1) x [y0, y1) of one tile (at most kPacketSide on a side): their centre
   // rays traced together as one packet, then finished (finish_block).
-  void render_block(int x0, int y0, int x1, int y1, FrameBuffers& fb, RayCounters& counters) const {
+  void render_block(int x0, int y0, int x1, int y1, TileOutput& out, RayCounters& counters) const {
     const RayPacket packet = rays_.packet(x0, y0, x1 - x0, y1 - y0);
     HitRecord hits[kPacketRays];
     TraversalCounters work[kPacketRays];
     geometry_.closest_packet(packet, hits, work);
     counters.primary += uint64_t(packet.count);
-    finish_block(x0, y0, x1 - x0, packet, hits, work, fb, counters);
+    finish_block(x0, y0, x1 - x0, packet, hits, work, out, counters);
   }
 
   // The same pixels with their primary hits rebuilt from `visible`'s ids (render_visible).
   void render_block_visible(int x0, int y0, int x1, int y1, const PrimaryVisibility& visible,
-                            FrameBuffers& fb, RayCounters& counters) const {
+                            TileOutput& out, RayCounters& counters) const {
     const int w = x1 - x0;
     // The very rays render_block traces.
     const RayPacket packet = rays_.packet(x0, y0, w, y1 - y0);
@@ -249,7 +251,7 @@ class FrameTracer {
             scene_.objects[geometry_.hit_ids(hits[k]).first].type == ObjectType::Csg)
           counters.csg_pixels++;
     counters.primary += uint64_t(n) - (counters.background - background_before);
-    finish_block(x0, y0, w, packet, hits, work, fb, counters);
+    finish_block(x0, y0, w, packet, hits, work, out, counters);
   }
 
  private:
@@ -267,72 +269,68 @@ class FrameTracer {
 
   // The pixels of one block once the closest hits of their centre rays are known: hits[k] (for
   // ray k of `packet`, row by row, w wide; primitive kNoPrimitive where it missed), found with
-  // work[k]. Every buffer of every pixel is written: the AOVs from the centre hit, the colour
-  // shaded in local mode by the shading kernels, a batch of the block's hits at a time, in full
-  // mode (shadow, reflection and refraction rays) one pixel at a time.
+  // work[k]. Every buffer of every pixel is written into `out`: the AOVs from the centre hit; in
+  // local mode the surface and colour computed by the shading kernels, the block's hits as one
+  // batch; in full mode (shadow, reflection and refraction rays) one pixel at a time.
   void finish_block(int x0, int y0, int w, const RayPacket& packet, const HitRecord* hits,
-                    const TraversalCounters* work, FrameBuffers& fb, RayCounters& counters) const {
+                    const TraversalCounters* work, TileOutput& out, RayCounters& counters) const {
     static_assert(kPacketRays <= kShadeBatch, "a block's hits fit one batch");
     const auto start = Clock::now();
     const RenderMode mode = options_.mode;
     const bool supersampled =
         mode != RenderMode::Visibility && scene_.image.samples_per_pixel > 1 && !centre_only_;
     SurfaceBatch batch;
+    for (int a = 0; a < 3; ++a) batch.origin[a] = packet.origin[a];
     size_t batch_pixel[kPacketRays];
     bool mixed = false;  // the batch's pixels have more than one material
     uint32_t batch_material = 0;
     const int y1 = y0 + packet.count / w;
     for (int y = y0, k = 0; y < y1; ++y)
       for (int x = x0; x < x0 + w; ++x, ++k) {  // ray k is pixel (x, y)
-        const size_t i = fb.index(x, y);
+        const size_t i = out.index(x, y);
         const HitRecord& hit = hits[k];
         counters.traversal.nodes_visited += work[k].nodes_visited;
         counters.traversal.primitive_tests += work[k].primitive_tests;
         const uint64_t work_before =
             counters.traversal.nodes_visited + counters.traversal.primitive_tests;
         if (hit.primitive == kNoPrimitive) {
-          fb.set_background(i, scene_.image.background);
+          out.set_background(i, scene_.image.background);
         } else if (mode == RenderMode::Visibility) {
           // Visibility is the hit's distance and ids: no surface, no shading.
           const auto [object, primitive] = geometry_.hit_ids(hit);
-          fb.color[i] = scene_.image.background;
-          fb.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
-          fb.object_id[i] = object;
-          fb.primitive_id[i] = primitive;
-          fb.normal[i] = glm::vec3(0.0f);
+          out.color[i] = scene_.image.background;
+          out.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
+          out.object_id[i] = object;
+          out.primitive_id[i] = primitive;
+          out.normal[i] = glm::vec3(0.0f);
+        } else if (mode == RenderMode::Local) {
+          const int slot = batch.count++;
+          batch_pixel[slot] = i;
+          const uint32_t material = add_to_batch(batch, slot, packet, k, hit, out, i);
+          if (slot == 0) {
+            batch_material = material;
+          } else if (!mixed && material != batch_material) {
+            mixed = true;  // from now on each slot carries its material
+            for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
+          }
+          if (mixed) put_material(batch, slot, materials_[material]);
         } else {
           const Ray ray = PrimaryRays::ray_of(packet, k);
           const SurfaceHit s = geometry_.surface(ray, hit);
-          fb.depth[i] = s.t;
-          fb.object_id[i] = s.object;
-          fb.primitive_id[i] = s.primitive;
-          if (mode == RenderMode::Local) {
-            const int slot = batch.count++;
-            batch_pixel[slot] = i;
-            put_vec3(batch.position, slot, s.position);
-            put_vec3(batch.direction, slot, ray.dir);
-            put_vec3(batch.geometric, slot, s.geometric_normal);
-            put_vec3(batch.shading, slot, s.shading_normal);
-            if (slot == 0) {
-              batch_material = s.material;
-            } else if (!mixed && s.material != batch_material) {
-              mixed = true;  // from now on each slot carries its material
-              for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
-            }
-            if (mixed) put_material(batch, slot, materials_[s.material]);
-          } else {
-            const glm::vec3 V = -glm::normalize(ray.dir);
-            const glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
-            fb.normal[i] = N;
-            fb.color[i] = shade(ray, s, N, V, 0, counters, nullptr);
-          }
+          const glm::vec3 V = -glm::normalize(ray.dir);
+          const glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
+          out.depth[i] = s.t;
+          out.object_id[i] = s.object;
+          out.primitive_id[i] = s.primitive;
+          out.normal[i] = N;
+          out.color[i] = shade(ray, s, N, V, 0, counters, nullptr);
         }
-        if (supersampled) fb.color[i] = supersample(x, y, counters);
+        if (supersampled) out.color[i] = supersample(x, y, counters);
         // Work for this pixel: its centre ray and every ray its shading traced.
-        fb.cost[i] = options_.cost_aov ? float(work[k].nodes_visited + work[k].primitive_tests +
-                                               counters.traversal.nodes_visited +
-                                               counters.traversal.primitive_tests - work_before)
-                                       : 0.0f;
+        out.cost[i] = options_.cost_aov ? float(work[k].nodes_visited + work[k].primitive_tests +
+                                                counters.traversal.nodes_visited +
+                                                counters.traversal.primitive_tests - work_before)
+                                        : 0.0f;
       }
     if (batch.count > 0) {
       pad_batch(batch, mixed);
@@ -340,13 +338,55 @@ class FrameTracer {
       kernels_.shade_surfaces(batch, light_arrays_.lights());
       for (int slot = 0; slot < batch.count; ++slot) {
         const size_t i = batch_pixel[slot];
-        fb.normal[i] = {batch.shading_normal[0][slot], batch.shading_normal[1][slot],
-                        batch.shading_normal[2][slot]};
+        out.normal[i] = {batch.shading_normal[0][slot], batch.shading_normal[1][slot],
+                         batch.shading_normal[2][slot]};
         if (!supersampled)
-          fb.color[i] = {batch.colour[0][slot], batch.colour[1][slot], batch.colour[2][slot]};
+          out.color[i] = {batch.colour[0][slot], batch.colour[1][slot], batch.colour[2][slot]};
       }
     }
     counters.shade_seconds += seconds_since(start);
+  }
+
+  // Puts ray k's hit into slot `slot` of the batch, for the kernel to compute its surface, and
+  // its depth and ids into pixel i of `out`; returns its material. Every input of the slot is
+  // written (zeros where the kernel selects it away), so no lane reads undefined memory.
+  uint32_t add_to_batch(SurfaceBatch& batch, int slot, const RayPacket& packet, int k,
+                        const HitRecord& hit, TileOutput& out, size_t i) const {
+    static const glm::vec3 kZero(0.0f);
+    batch.t[slot] = hit.t;
+    for (int a = 0; a < 3; ++a) batch.direction[a][slot] = packet.dir[a][k];
+    out.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
+    if (hit.primitive < geometry_.triangle_count()) {
+      const TriangleSurfaceData d = geometry_.triangle_surface_data(hit.primitive);
+      batch.u[slot] = hit.u;
+      batch.v[slot] = hit.v;
+      put_vec3(batch.edge1, slot, d.triangle->e1);
+      put_vec3(batch.edge2, slot, d.triangle->e2);
+      const bool smooth = d.normal[0] != nullptr;
+      for (int c = 0; c < 3; ++c)
+        put_vec3(batch.vertex_normal[c], slot, smooth ? *d.normal[c] : kZero);
+      batch.smooth[slot] = smooth ? ~0u : 0u;
+      batch.given[slot] = 0u;
+      put_vec3(batch.geometric, slot, kZero);
+      put_vec3(batch.shading, slot, kZero);
+      out.object_id[i] = d.object;
+      out.primitive_id[i] = d.primitive;
+      return d.material;
+    }
+    // Spheres, squares and CSG solids: their surface as surface() gives it.
+    const SurfaceHit s = geometry_.surface(PrimaryRays::ray_of(packet, k), hit);
+    batch.u[slot] = 0.0f;
+    batch.v[slot] = 0.0f;
+    put_vec3(batch.edge1, slot, kZero);
+    put_vec3(batch.edge2, slot, kZero);
+    for (int c = 0; c < 3; ++c) put_vec3(batch.vertex_normal[c], slot, kZero);
+    batch.smooth[slot] = 0u;
+    batch.given[slot] = ~0u;
+    put_vec3(batch.geometric, slot, s.geometric_normal);
+    put_vec3(batch.shading, slot, s.shading_normal);
+    out.object_id[i] = s.object;
+    out.primitive_id[i] = s.primitive;
+    return s.material;
   }
 
   // The samples of image_sample (the same place in every pixel, and with an aperture the same
@@ -634,14 +674,17 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
       for_each_tile(w, h, options.threads, [&](int x0, int y0, int x1, int y1, RayCounters& local) {
         const auto t_tile = Clock::now();
         const uint64_t rays_before = local.rays();
+        TileOutput tile;
+        tile.begin(x0, y0, x1, y1);
         for (int by = y0; by < y1; by += kPacketSide)
           for (int bx = x0; bx < x1; bx += kPacketSide) {
             int bx1 = std::min(bx + kPacketSide, x1), by1 = std::min(by + kPacketSide, y1);
             if (visible)
-              tracer.render_block_visible(bx, by, bx1, by1, *visible, out.buffers, local);
+              tracer.render_block_visible(bx, by, bx1, by1, *visible, tile, local);
             else
-              tracer.render_block(bx, by, bx1, by1, out.buffers, local);
+              tracer.render_block(bx, by, bx1, by1, tile, local);
           }
+        tile.write_to(out.buffers);
         if (progress)
           progress->advance(uint64_t(x1 - x0) * uint64_t(y1 - y0), local.rays() - rays_before);
         local.busy_seconds += seconds_since(t_tile);

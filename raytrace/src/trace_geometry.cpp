@@ -561,6 +561,20 @@ std::pair<uint32_t, uint32_t> TraceGeometry::hit_ids(const HitRecord& hit) const
   return {analytic_[hit.primitive - n_triangles].object, 0u};
 }
 
+TriangleSurfaceData TraceGeometry::triangle_surface_data(uint32_t p) const {
+  TriangleSurfaceData d;
+  d.triangle = &triangles_[p];
+  d.object = triangle_object_[p];
+  d.primitive = triangle_id_[p];
+  d.material = object_material_[d.object];
+  const TriangleMesh* mesh = object_mesh_[d.object];
+  if (mesh->smooth()) {
+    const glm::uvec3& v = mesh->triangles[triangle_in_mesh_[p]];
+    for (int c = 0; c < 3; ++c) d.normal[c] = &mesh->normals[v[c]];
+  }
+  return d;
+}
+
 bool TraceGeometry::intersect_visible(const Ray& ray, uint32_t object, uint32_t primitive,
                                       HitRecord& hit, TraversalCounters& counters) const {
   if (object >= object_analytic_.size()) return false;

@@ -71,8 +71,15 @@ void pad_batch(ShadeBatch& b, bool materials) {
 void pad_batch(SurfaceBatch& b, bool materials) {
   const int last = b.count - 1;
   for (int i = b.count; i < padded(b.count); ++i) {
-    copy3(b.position, last, i);
+    b.t[i] = b.t[last];
     copy3(b.direction, last, i);
+    b.u[i] = b.u[last];
+    b.v[i] = b.v[last];
+    copy3(b.edge1, last, i);
+    copy3(b.edge2, last, i);
+    for (int c = 0; c < 3; ++c) copy3(b.vertex_normal[c], last, i);
+    b.smooth[i] = b.smooth[last];
+    b.given[i] = b.given[last];
     copy3(b.geometric, last, i);
     copy3(b.shading, last, i);
     if (materials) copy_material(b, last, i);

@@ -201,6 +201,9 @@ inline VF select(M m, VF a, VF b) {
 }
 #endif
 
+// bits() of a mask with every lane set.
+constexpr unsigned kAllLanes = (1u << kLanes) - 1u;
+
 struct V3 {
   VF x, y, z;
 };
@@ -323,13 +326,32 @@ void shade(ShadeBatch& batch, const float eye_position[3], const ShadeLights& li
 }
 
 void shade_surfaces(SurfaceBatch& batch, const ShadeLights& lights) {
+  const V3 origin = splat3(batch.origin);
   for (int i = 0; i < batch.count; i += kLanes) {
-    const V3 P = load3(batch.position, i);
+    // TraceGeometry::surface: P = o + t d, then the triangle's normals.
     const V3 direction = load3(batch.direction, i);
+    const V3 P = add3(origin, scale(direction, load(batch.t + i)));
+    const M given = load_mask(batch.given + i);
+    const M smooth = load_mask(batch.smooth + i);
+    V3 geometric = load3(batch.geometric, i), shading = load3(batch.shading, i);
+    if (bits(given) != kAllLanes) {
+      const V3 triangle = normalize(cross(load3(batch.edge1, i), load3(batch.edge2, i)));
+      V3 interpolated = triangle;
+      if (bits(smooth) != 0) {
+        const VF u = load(batch.u + i), v = load(batch.v + i);
+        const VF w[3] = {sub(sub(splat(1.0f), u), v), u, v};
+        const V3 n = interpolate(w, batch.vertex_normal, i);
+        const VF length = square_root(dot(n, n));
+        interpolated =
+            select3(both(smooth, greater(length, splat(0.0f))), divide3(n, length), triangle);
+      }
+      geometric = select3(given, geometric, triangle);
+      shading = select3(given, shading, interpolated);
+    }
     // -normalize(direction): the negation is exact.
     const V3 unit = normalize(direction);
     const V3 V = {negate(unit.x), negate(unit.y), negate(unit.z)};
-    const V3 N = face_viewer(load3(batch.shading, i), load3(batch.geometric, i), V);
+    const V3 N = face_viewer(shading, geometric, V);
     store3(batch.shading_normal, i, N);
     store3(batch.colour, i, add_lights(batch, i, P, N, V, lights));
   }

@@ -55,6 +55,16 @@ struct SurfaceHit {
   uint32_t material = 0;
 };
 
+// What surface() computes a triangle hit's surface from: the triangle's edges, its vertex
+// normals (null where its mesh is flat), and its ids and material.
+struct TriangleSurfaceData {
+  const TrianglePrecomputed* triangle = nullptr;
+  const glm::vec3* normal[3] = {nullptr, nullptr, nullptr};
+  uint32_t object = kNoId;
+  uint32_t primitive = kNoId;  // the id reported
+  uint32_t material = 0;
+};
+
 // Embree's build quality: HIGH (spatial splits; what the embree renderer uses) or MEDIUM (binned
 // SAH without spatial splits, the same kind of tree as ours).
 enum class EmbreeQuality { High, Medium };
@@ -94,6 +104,9 @@ class TraceGeometry {
   // The object and the primitive id reported (SurfaceHit's object and primitive) of a hit,
   // without the surface: what visibility needs.
   std::pair<uint32_t, uint32_t> hit_ids(const HitRecord& hit) const;
+  // surface()'s inputs for triangle p (a unified index below triangle_count()), for the shading
+  // kernels, which compute the same surface from them.
+  TriangleSurfaceData triangle_surface_data(uint32_t p) const;
 
   // The hit of `ray` with one thing a visibility buffer named, by the same intersection code as
   // closest(): for a mesh object triangle `primitive` of it; for a sphere or square the object

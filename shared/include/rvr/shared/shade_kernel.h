@@ -51,13 +51,26 @@ struct ShadeBatch : ShadeLanes {
   alignas(64) uint32_t smooth[kShadeBatch];  // ~0u: interpolate normals, 0: flat
 };
 
-// A tracer's hits: the surface as the hit gives it (position o + t d, unit geometric and
-// shading normals as modelled), the viewer along the ray: V = -normalize(direction).
+// A tracer's hits. The kernel computes the surface as the tracer's scalar code does: the point
+// origin + t direction; for a triangle the geometric normal normalize(cross(edge1, edge2)) and,
+// where smooth, the vertex normals weighted by (1 - u - v, u, v) and divided by their length
+// (kept geometric where that length is 0); where `given`, the normals below (other shapes). The
+// viewer lies along the ray: V = -normalize(direction).
 struct SurfaceBatch : ShadeLanes {
-  alignas(64) float position[3][kShadeBatch];
+  float origin[3];  // every lane's ray starts here (primary rays)
+  alignas(64) float t[kShadeBatch];
   alignas(64) float direction[3][kShadeBatch];
-  alignas(64) float geometric[3][kShadeBatch];
-  alignas(64) float shading[3][kShadeBatch];
+  alignas(64) float u[kShadeBatch];
+  alignas(64) float v[kShadeBatch];
+  alignas(64) float edge1[3][kShadeBatch];
+  alignas(64) float edge2[3][kShadeBatch];
+  // [corner][axis]: the triangle's vertex normals if smooth; not read (may be anything) where
+  // flat or given.
+  alignas(64) float vertex_normal[3][3][kShadeBatch];
+  alignas(64) uint32_t smooth[kShadeBatch];     // ~0u: interpolate vertex normals, 0: flat
+  alignas(64) uint32_t given[kShadeBatch];      // ~0u: the normals are geometric and shading
+  alignas(64) float geometric[3][kShadeBatch];  // unit, as modelled; read where given
+  alignas(64) float shading[3][kShadeBatch];    // unit; read where given
 };
 
 // The light samples, structure of arrays, in the order they are summed.
