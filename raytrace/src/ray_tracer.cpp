@@ -177,6 +177,12 @@ class FrameTracer {
   // The same pixels with their primary hits rebuilt from `visible`'s ids (render_visible).
   void render_block_visible(int x0, int y0, int x1, int y1, const PrimaryVisibility& visible,
                             TileOutput& out, RayCounters& counters) const {
+    if (shows_only_background(x0, y0, x1, y1, visible)) {
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) out.set_background(out.index(x, y), scene_.image.background);
+      counters.background += uint64_t(x1 - x0) * uint64_t(y1 - y0);
+      return;
+    }
     const int w = x1 - x0;
     // The very rays render_block traces.
     const RayPacket packet = rays_.packet(x0, y0, w, y1 - y0);
@@ -255,6 +261,28 @@ class FrameTracer {
   }
 
  private:
+  // Whether no pixel of [x0, x1) x [y0, y1) can show anything to the tracer: the z-buffer
+  // covered none of them nor of their neighbours, and none lies where a shape it draws
+  // approximately or not at all may appear (may_hide_a_surface for the whole block at once).
+  bool shows_only_background(int x0, int y0, int x1, int y1,
+                             const PrimaryVisibility& visible) const {
+    const size_t width = size_t(visible.width);
+    if (approximated_mask_)
+      for (int y = y0; y < y1; ++y) {
+        const uint8_t* row = approximated_mask_ + size_t(y) * width;
+        for (int x = x0; x < x1; ++x)
+          if (row[x]) return false;
+      }
+    const int nx0 = std::max(x0 - 1, 0), nx1 = std::min(x1 + 1, visible.width);
+    for (int y = std::max(y0 - 1, 0); y < std::min(y1 + 1, visible.height); ++y) {
+      const uint32_t* row = visible.object_id.data() + size_t(y) * width;
+      uint32_t all = ~0u;  // kNoId where every id is kNoId
+      for (int x = nx0; x < nx1; ++x) all &= row[x];
+      if (all != kNoId) return false;
+    }
+    return true;
+  }
+
   // Whether the tracer may see a surface at empty pixel (x, y) of a z-buffer's ids: next to a
   // pixel it covered (a silhouette or shared edge may fall either way at a centre), or where a
   // shape it draws approximately or not at all may appear.
