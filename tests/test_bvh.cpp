@@ -8,8 +8,10 @@
 #include <cstring>
 #include <functional>
 #include <random>
+#include <tuple>
 
 #include "rvr/raytrace/trace_geometry.h"
+#include "rvr/shared/isa.h"
 #include "rvr/shared/scene_loader.h"
 
 using namespace rvr;
@@ -524,4 +526,87 @@ TEST(Packets, SameHitsAsSingleRays) {
     }
     EXPECT_GT(hits, 500);
   }
+}
+
+// The hybrid's rebuild, a packet at a time: every ray names an object and primitive (the triangle
+// it hits, a neighbour, one far away, a tessellated sphere, an analytic shape, ids out of range),
+// and intersect_visible_packet finds what intersect_visible finds ray by ray, to the bit, with
+// the same counted tests, whichever kernel tests the named triangles eight at a time.
+TEST(Packets, RebuiltHitsAreIntersectVisiblesOwn) {
+  int hits = 0, misses = 0;
+  for (Scene scene :
+       {mixed_scene(), builtin("tessphere:5000"), builtin("cornell"), builtin("soup:3000")}) {
+    for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
+      if (!cpu_supports(isa)) continue;
+      TraceGeometry geometry(scene, SphereMode::Analytic, 24, AccelKind::Bvh,
+                             TriangleTest::MollerTrumbore, isa);
+      ASSERT_TRUE(geometry.error().empty());
+      std::mt19937 rng(23);
+      std::uniform_real_distribution<float> U(-1.0f, 1.0f);
+      for (int tile = 0; tile < 40; ++tile) {
+        RayPacket p;
+        const glm::vec3 o = scene.camera.eye;
+        for (int a = 0; a < 3; ++a) p.origin[a] = o[a];
+        p.tmin = tile % 5 == 1 ? 0.5f : 0.0f;
+        p.tmax = tile % 7 == 2 ? 3.5f : INFINITY;
+        p.count = tile % 4 == 3 ? 1 + tile % 37 : kPacketRays;
+        const glm::vec3 centre = scene.camera.target + 0.5f * glm::vec3(U(rng), U(rng), U(rng)) - o;
+        uint32_t object[kPacketRays], primitive[kPacketRays];
+        bool wanted[kPacketRays];
+        for (int k = 0; k < p.count; ++k) {
+          const glm::vec3 d =
+              centre + 0.02f * glm::length(centre) *
+                           glm::vec3(float(k % 8) - 3.5f, float(k / 8) - 3.5f, 0.0f);
+          for (int a = 0; a < 3; ++a) p.dir[a][k] = d[a];
+          HitRecord h;
+          Ray ray{o, d, p.tmin, p.tmax};
+          object[k] = kNoId;
+          primitive[k] = kNoId;
+          if (geometry.closest(ray, h)) std::tie(object[k], primitive[k]) = geometry.hit_ids(h);
+          switch ((k + tile) % 6) {
+            case 1:  // a neighbour: shared edges, misses
+              primitive[k] += 1;
+              break;
+            case 2:  // far away
+              primitive[k] = uint32_t(rng() % 5000);
+              break;
+            case 3:  // any object
+              object[k] = uint32_t(rng() % (scene.objects.size() + 1));
+              break;
+            default:
+              break;
+          }
+          wanted[k] = object[k] != kNoId || k % 5 == 0;  // some unwanted, some naming nothing
+        }
+        HitRecord packet_hits[kPacketRays];
+        bool found[kPacketRays];
+        TraversalCounters work[kPacketRays];
+        geometry.intersect_visible_packet(p, object, primitive, wanted, packet_hits, found, work);
+        for (int k = 0; k < p.count; ++k) {
+          const std::string what = std::string(to_string(isa)) + " tile " + std::to_string(tile) +
+                                   " ray " + std::to_string(k);
+          if (!wanted[k]) {
+            EXPECT_FALSE(found[k]) << what;
+            continue;
+          }
+          HitRecord single;
+          TraversalCounters single_work;
+          const Ray ray{o, {p.dir[0][k], p.dir[1][k], p.dir[2][k]}, p.tmin, p.tmax};
+          const bool want =
+              geometry.intersect_visible(ray, object[k], primitive[k], single, single_work);
+          ASSERT_EQ(found[k], want) << what;
+          EXPECT_EQ(work[k].primitive_tests, single_work.primitive_tests) << what;
+          (want ? hits : misses)++;
+          if (!want) continue;
+          const HitRecord& h = packet_hits[k];
+          ASSERT_EQ(h.primitive, single.primitive) << what;
+          ASSERT_TRUE(same_bits(h.t, single.t) && same_bits(h.u, single.u) &&
+                      same_bits(h.v, single.v))
+              << what;
+        }
+      }
+    }
+  }
+  EXPECT_GT(hits, 2000);
+  EXPECT_GT(misses, 1000);
 }

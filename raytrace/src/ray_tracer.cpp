@@ -192,42 +192,48 @@ class FrameTracer {
     bool traced[kPacketRays];
     int n_traced = 0;
     const uint64_t background_before = counters.background;
+    // The ids the z-buffer drew, and which pixels need a ray at all.
+    uint32_t object[kPacketRays], primitive[kPacketRays];
+    bool drawn[kPacketRays], rebuilt[kPacketRays];
     for (int y = y0, k = 0; y < y1; ++y)
       for (int x = x0; x < x1; ++x, ++k) {  // ray k is pixel (x, y)
         const size_t i = size_t(y) * size_t(visible.width) + size_t(x);
-        HitRecord& hit = hits[k];
-        if (visible.object_id[i] == kNoId && !may_hide_a_surface(x, y, visible)) {
-          // Background to the z-buffer, away from every edge it drew and from every shape it
-          // could not draw exactly: background to the tracer too, without a ray.
-          hit = HitRecord{};
-          work[k] = TraversalCounters{};
-          traced[k] = false;
-          counters.background++;
-          continue;
-        }
-        const Ray ray = PrimaryRays::ray_of(packet, k);
-        traced[k] = visible.object_id[i] == kNoId ||
-                    !geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i],
-                                                 hit, work[k]);
-        if (traced[k]) {
-          // Nothing drawn, or the z-buffer's polygon covers the centre where the exact surface
-          // does not (silhouettes, shared edges): the tracer decides, below.
-          n_traced++;
-          counters.fallback_missed += visible.object_id[i] != kNoId;
-          continue;
-        }
-        counters.rebuilt++;
-        if (geometry_.has_csg()) {
-          // No z-buffer draws CSG: the ray meets the CSG objects alone; the nearer hit wins, ties
-          // by primitive index as in closest().
-          HitRecord csg;
-          if (geometry_.closest_csg(ray, csg, work[k]) &&
-              (csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive))) {
-            hit = csg;
-            counters.csg_pixels++;
-          }
+        object[k] = visible.object_id[i];
+        primitive[k] = visible.primitive_id[i];
+        drawn[k] = object[k] != kNoId;
+        hits[k] = HitRecord{};
+        work[k] = TraversalCounters{};
+        traced[k] = !drawn[k] && may_hide_a_surface(x, y, visible);
+        // Otherwise background to the z-buffer, away from every edge it drew and from every
+        // shape it could not draw exactly: background to the tracer too, without a ray.
+        if (!drawn[k] && !traced[k]) counters.background++;
+      }
+    geometry_.intersect_visible_packet(packet, object, primitive, drawn, hits, rebuilt, work);
+    for (int k = 0; k < n; ++k) {
+      if (!drawn[k]) {
+        n_traced += traced[k];
+        continue;
+      }
+      if (!rebuilt[k]) {
+        // The z-buffer's polygon covers the centre where the exact surface does not
+        // (silhouettes, shared edges): the tracer decides, below.
+        traced[k] = true;
+        n_traced++;
+        counters.fallback_missed++;
+        continue;
+      }
+      counters.rebuilt++;
+      if (geometry_.has_csg()) {
+        // No z-buffer draws CSG: the ray meets the CSG objects alone; the nearer hit wins, ties
+        // by primitive index as in closest().
+        HitRecord csg;
+        if (geometry_.closest_csg(PrimaryRays::ray_of(packet, k), csg, work[k]) &&
+            (csg.t < hits[k].t || (csg.t == hits[k].t && csg.primitive < hits[k].primitive))) {
+          hits[k] = csg;
+          counters.csg_pixels++;
         }
       }
+    }
     counters.fallback_traced += uint64_t(n_traced);
     if (n_traced >= kPacketFallbacks) {
       // Many to trace (an empty background): the whole block as one packet, as render_block

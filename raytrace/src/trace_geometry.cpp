@@ -619,6 +619,73 @@ bool TraceGeometry::intersect_visible(const Ray& ray, uint32_t object, uint32_t 
   return found;
 }
 
+void TraceGeometry::intersect_visible_packet(const RayPacket& packet, const uint32_t* object,
+                                             const uint32_t* primitive, const bool* wanted,
+                                             HitRecord* hits, bool* found,
+                                             TraversalCounters* counters) const {
+  auto ray_of = [&](int k) {
+    return Ray{{packet.origin[0], packet.origin[1], packet.origin[2]},
+               {packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]},
+               packet.tmin,
+               packet.tmax};
+  };
+  const bool simd = kernels_ && triangle_test_ == TriangleTest::MollerTrumbore;
+  NamedTriangles named;
+  int lane_ray[kPacketRays];
+  uint32_t lane_triangle[kPacketRays];
+  for (int k = 0; k < packet.count; ++k) {
+    found[k] = false;
+    if (!wanted[k]) continue;
+    const uint32_t o = object[k];
+    // One named triangle of a mesh (not a tessellated sphere's, whose ids name none).
+    const bool one_triangle = simd && o < object_analytic_.size() &&
+                              object_analytic_[o] == kNoPrimitive && object_mesh_[o] &&
+                              object_names_triangles_[o] &&
+                              primitive[k] < object_mesh_[o]->triangles.size();
+    if (!one_triangle) {
+      found[k] = intersect_visible(ray_of(k), o, primitive[k], hits[k], counters[k]);
+      continue;
+    }
+    const int lane = named.count++;
+    const uint32_t p = object_first_triangle_[o] + primitive[k];
+    const TrianglePrecomputed& tri = triangles_[p];
+    lane_ray[lane] = k;
+    lane_triangle[lane] = p;
+    for (int a = 0; a < 3; ++a) {
+      named.dir[a][lane] = packet.dir[a][k];
+      named.v0[a][lane] = tri.v0[a];
+      named.e1[a][lane] = tri.e1[a];
+      named.e2[a][lane] = tri.e2[a];
+    }
+  }
+  if (named.count == 0) return;
+  for (int lane = named.count; lane % 8 != 0; ++lane)  // the kernel's last group: repeat a lane
+    for (int a = 0; a < 3; ++a) {
+      named.dir[a][lane] = named.dir[a][0];
+      named.v0[a][lane] = named.v0[a][0];
+      named.e1[a][lane] = named.e1[a][0];
+      named.e2[a][lane] = named.e2[a][0];
+    }
+  KernelHit kernel_hits[kPacketRays];
+  NamedOutcome outcome[kPacketRays];
+  kernels_->intersect_named(packet, named, kernel_hits, outcome);
+  for (int lane = 0; lane < named.count; ++lane) {
+    const int k = lane_ray[lane];
+    if (outcome[lane] == NamedOutcome::NearEdge) {  // decided in double, as intersect_visible does
+      found[k] = intersect_visible(ray_of(k), object[k], primitive[k], hits[k], counters[k]);
+      continue;
+    }
+    counters[k].primitive_tests++;
+    hits[k] = HitRecord{};
+    if (outcome[lane] == NamedOutcome::Miss) continue;
+    hits[k].t = kernel_hits[lane].t;
+    hits[k].u = kernel_hits[lane].u;
+    hits[k].v = kernel_hits[lane].v;
+    hits[k].primitive = lane_triangle[lane];
+    found[k] = true;
+  }
+}
+
 bool TraceGeometry::closest_csg(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
   const uint32_t n_triangles = uint32_t(triangles_.size());
   bool found = false;

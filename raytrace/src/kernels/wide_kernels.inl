@@ -756,10 +756,69 @@ void closest_packet(const WideBvhView& bvh, const RayPacket& packet, KernelHit* 
     closest_packet_impl<false>(bvh, packet, hits, nullptr);
 }
 
+// intersect_triangle_mt's float pass, lane by lane with its operations in its order (glm's
+// cross and dot), eight rays each against its own triangle.
+void intersect_named(const RayPacket& packet, const NamedTriangles& named, KernelHit* hits,
+                     NamedOutcome* outcome) {
+  const V8 zero = splat8(0.0f), sign_bit = bits8(0x80000000u);
+  const V8 tmin = splat8(packet.tmin), tmax = splat8(packet.tmax);
+  for (int first = 0; first < named.count; first += 8) {
+    const V8 dx = load8(named.dir[0] + first), dy = load8(named.dir[1] + first),
+             dz = load8(named.dir[2] + first);
+    const V8 e1x = load8(named.e1[0] + first), e1y = load8(named.e1[1] + first),
+             e1z = load8(named.e1[2] + first);
+    const V8 e2x = load8(named.e2[0] + first), e2y = load8(named.e2[1] + first),
+             e2z = load8(named.e2[2] + first);
+    // p = cross(d, e2), det = dot(e1, p)
+    const V8 px = sub8(mul8(dy, e2z), mul8(e2y, dz));
+    const V8 py = sub8(mul8(dz, e2x), mul8(e2z, dx));
+    const V8 pz = sub8(mul8(dx, e2y), mul8(e2x, dy));
+    const V8 det = add8(add8(mul8(e1x, px), mul8(e1y, py)), mul8(e1z, pz));
+    // sign = signbit(det) ? -1 : 1
+    const V8 sign = or8(and8(sign_bit, det), splat8(1.0f));
+    const V8 abs_det = mul8(det, sign);
+    // s = origin - v0, su = dot(s, p), q = cross(s, e1), sv = dot(d, q)
+    const V8 sx = sub8(splat8(packet.origin[0]), load8(named.v0[0] + first));
+    const V8 sy = sub8(splat8(packet.origin[1]), load8(named.v0[1] + first));
+    const V8 sz = sub8(splat8(packet.origin[2]), load8(named.v0[2] + first));
+    const V8 su = add8(add8(mul8(sx, px), mul8(sy, py)), mul8(sz, pz));
+    const V8 qx = sub8(mul8(sy, e1z), mul8(e1y, sz));
+    const V8 qy = sub8(mul8(sz, e1x), mul8(e1z, sx));
+    const V8 qz = sub8(mul8(sx, e1y), mul8(e1x, sy));
+    const V8 sv = add8(add8(mul8(dx, qx), mul8(dy, qy)), mul8(dz, qz));
+    const V8 U = mul8(su, sign), V = mul8(sv, sign), UV = add8(U, V);
+    const V8 outer_lo = mul8(splat8(-kEdgeBand), abs_det);
+    const V8 outer_hi = mul8(splat8(1.0f + kEdgeBand), abs_det);
+    const V8 inner_lo = mul8(splat8(kEdgeBand), abs_det);
+    const V8 inner_hi = mul8(splat8(1.0f - kEdgeBand), abs_det);
+    const unsigned rejected = mask8(eq8(det, zero)) | mask8(lt8(U, outer_lo)) |
+                              mask8(gt8(U, outer_hi)) | mask8(lt8(V, outer_lo)) |
+                              mask8(gt8(UV, outer_hi));
+    const unsigned near_edge = ~rejected & (mask8(lt8(U, inner_lo)) | mask8(lt8(V, inner_lo)) |
+                                            mask8(gt8(UV, inner_hi)));
+    const V8 inv_det = div8(splat8(1.0f), det);
+    const V8 t = mul8(add8(add8(mul8(e2x, qx), mul8(e2y, qy)), mul8(e2z, qz)), inv_det);
+    const unsigned in_range = mask8(gt8(t, tmin)) & mask8(lt8(t, tmax));
+    const unsigned hit = ~rejected & ~near_edge & in_range;
+    alignas(32) float ts[8], us[8], vs[8];
+    store8(ts, t);
+    store8(us, mul8(su, inv_det));
+    store8(vs, mul8(sv, inv_det));
+    for (int l = 0; l < 8 && first + l < named.count; ++l) {
+      const unsigned bit = 1u << l;
+      outcome[first + l] = (near_edge & bit) ? NamedOutcome::NearEdge
+                           : (hit & bit)     ? NamedOutcome::Hit
+                                             : NamedOutcome::Miss;
+      if (hit & bit) hits[first + l] = {ts[l], us[l], vs[l], 0u};
+    }
+  }
+}
+
 }  // namespace
 
 extern const TraversalKernels kKernels = {RVR_KERNEL_NAME,  closest,          closest_counted,
-                                          occluded,         occluded_counted, closest_packet};
+                                          occluded,         occluded_counted, closest_packet,
+                                          intersect_named};
 
 }  // namespace RVR_KERNEL_NS
 }  // namespace rvr

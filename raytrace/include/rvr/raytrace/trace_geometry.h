@@ -118,6 +118,14 @@ class TraceGeometry {
   // Bounds of the shapes a z-buffer draws only approximately or not at all: analytic spheres
   // (their tessellation lies inside the exact silhouette) and CSG solids.
   std::vector<Aabb> approximated_bounds() const;
+  // intersect_visible for the rays of a packet at once: for each ray k with wanted[k], the
+  // object[k] and primitive[k] a visibility buffer named; found[k] and hits[k] as
+  // intersect_visible gives them, counters[k] its tests. With the wide BVH's kernels, the rays
+  // naming one triangle each are tested eight at a time by the same operations (near an edge,
+  // by intersect_visible itself).
+  void intersect_visible_packet(const RayPacket& packet, const uint32_t* object,
+                                const uint32_t* primitive, const bool* wanted, HitRecord* hits,
+                                bool* found, TraversalCounters* counters) const;
   // True when the scene holds CSG objects (which no z-buffer draws).
   bool has_csg() const { return !csg_primitives_.empty(); }
   // Closest hit among the CSG objects only, with closest()'s tie rule.

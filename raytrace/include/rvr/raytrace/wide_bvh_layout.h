@@ -78,6 +78,20 @@ struct alignas(32) RayPacket {
   float dir[3][kPacketRays];
 };
 
+// Rays of one packet, each with the one triangle it is to be tested against (the hybrid's
+// rebuild of a z-buffer's hits): lane i is ray dir[.][i] from the packet's origin against the
+// triangle v0, e1, e2 [.][i]. Lanes [count, padded to 8) repeat a live lane.
+struct NamedTriangles {
+  int count = 0;
+  alignas(32) float dir[3][kPacketRays];
+  alignas(32) float v0[3][kPacketRays];
+  alignas(32) float e1[3][kPacketRays];
+  alignas(32) float e2[3][kPacketRays];
+};
+// What the test found for a lane: nothing, a hit (t, u, v), or a hit within intersect_triangle_mt's
+// edge band, which the caller decides in double precision as that function does.
+enum class NamedOutcome : uint8_t { Miss, Hit, NearEdge };
+
 // One instruction set's traversal functions. Counting variants fill KernelCounters (for the cost
 // AOV and statistics); the others count nothing, for benchmarks.
 struct TraversalKernels {
@@ -89,6 +103,10 @@ struct TraversalKernels {
   // hits[i] for ray i of the packet; counters[i] per ray (may be null).
   void (*closest_packet)(const WideBvhView&, const RayPacket&, KernelHit* hits,
                          KernelCounters* counters);
+  // intersect_triangle_mt's float pass for each lane of `named`, eight lanes at a time, with the
+  // packet's origin, tmin and tmax: outcome[i], and hits[i] where it is Hit.
+  void (*intersect_named)(const RayPacket& packet, const NamedTriangles& named, KernelHit* hits,
+                          NamedOutcome* outcome);
 };
 
 // Defined in baseline code (wide_bvh.cpp): the double-precision recheck of a hit near a
