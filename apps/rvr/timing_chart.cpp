@@ -33,12 +33,16 @@ struct Phase {
 };
 
 // The hybrid's time.render (the tracer's pixel-centre pass) is part of its time.trace (every
-// traced and rebuilt ray), which stands beside time.zbuffer (its visibility passes).
+// traced and rebuilt ray), which stands beside time.zbuffer (its visibility passes). The
+// tracers' time.shade is their time.render's share after the primary hits (softraster, which
+// has no time.render, stacks its shading pass).
 const std::map<std::string, std::string> kNestedPhases = {{"time.bvh_build", "time.build"},
-                                                          {"time.render", "time.trace"}};
+                                                          {"time.render", "time.trace"},
+                                                          {"time.shade", "time.render"}};
 
 // Totals of other phases (softraster's time.visibility is time.setup + its clear +
-// time.bin + time.raster): never stacked.
+// time.bin + time.raster; the tracers' is their time.render's share until the primary hits):
+// never stacked.
 const std::set<std::string> kTotalPhases = {"time.visibility"};
 
 int phase_rank(const std::string& name) {

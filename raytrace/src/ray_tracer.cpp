@@ -386,7 +386,7 @@ class FrameTracer {
   // written (zeros where the kernel selects it away), so no lane reads undefined memory.
   uint32_t add_to_batch(SurfaceBatch& batch, int slot, const RayPacket& packet, int k,
                         const HitRecord& hit, TileOutput& out, size_t i) const {
-    static const glm::vec3 kZero(0.0f);
+    const glm::vec3 zero(0.0f);
     batch.t[slot] = hit.t;
     for (int a = 0; a < 3; ++a) batch.direction[a][slot] = packet.dir[a][k];
     out.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
@@ -398,11 +398,11 @@ class FrameTracer {
       put_vec3(batch.edge2, slot, d.triangle->e2);
       const bool smooth = d.normal[0] != nullptr;
       for (int c = 0; c < 3; ++c)
-        put_vec3(batch.vertex_normal[c], slot, smooth ? *d.normal[c] : kZero);
+        put_vec3(batch.vertex_normal[c], slot, smooth ? *d.normal[c] : zero);
       batch.smooth[slot] = smooth ? ~0u : 0u;
       batch.given[slot] = 0u;
-      put_vec3(batch.geometric, slot, kZero);
-      put_vec3(batch.shading, slot, kZero);
+      put_vec3(batch.geometric, slot, zero);
+      put_vec3(batch.shading, slot, zero);
       out.object_id[i] = d.object;
       out.primitive_id[i] = d.primitive;
       return d.material;
@@ -411,9 +411,9 @@ class FrameTracer {
     const SurfaceHit s = geometry_.surface(PrimaryRays::ray_of(packet, k), hit);
     batch.u[slot] = 0.0f;
     batch.v[slot] = 0.0f;
-    put_vec3(batch.edge1, slot, kZero);
-    put_vec3(batch.edge2, slot, kZero);
-    for (int c = 0; c < 3; ++c) put_vec3(batch.vertex_normal[c], slot, kZero);
+    put_vec3(batch.edge1, slot, zero);
+    put_vec3(batch.edge2, slot, zero);
+    for (int c = 0; c < 3; ++c) put_vec3(batch.vertex_normal[c], slot, zero);
     batch.smooth[slot] = 0u;
     batch.given[slot] = ~0u;
     put_vec3(batch.geometric, slot, s.geometric_normal);
