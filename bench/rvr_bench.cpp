@@ -30,6 +30,7 @@
 #include <random>
 #include <string>
 
+#include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/renderers/registry.h"
@@ -421,11 +422,12 @@ void BM_Trace(benchmark::State& state, std::string accel, std::string rays_kind,
 // Primary rays of a 1024x768 frame as 8x8 tiles (row-major inside a tile), the packets the
 // raytrace renderer traces. tile_first[k] is the index of tile k's first ray in make_rays order.
 std::vector<RayPacket> make_tiles(const Scene& scene, std::vector<std::vector<int>>& ray_index) {
-  CameraFrame f = make_camera_frame(scene.camera, 1024, 768);
+  const PrimaryRays primary(make_camera_frame(scene.camera, 1024, 768), scene.camera.near,
+                            scene.camera.far);
   std::vector<RayPacket> tiles;
   for (int y0 = 0; y0 < 768; y0 += 8) {
     for (int x0 = 0; x0 < 1024; x0 += 8) {
-      RayPacket p = primary_ray_packet(f, x0, y0, 8, 8, scene.camera.near, scene.camera.far);
+      RayPacket p = primary.packet(x0, y0, 8, 8);
       std::vector<int> index;
       for (int k = 0; k < 64; ++k) index.push_back((y0 + k / 8) * 1024 + x0 + k % 8);
       tiles.push_back(p);

@@ -57,16 +57,9 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   RenderOutput out;
   ProgressSink* const progress = options.progress;
   // The per-pixel kernels: RenderOptions::isa, else RVR_ISA, else the best this CPU runs.
-  Isa isa = Isa::Sse;
-  if (options.isa) {
-    isa = *options.isa;
-  } else {
-    Expected<Isa> selected = selected_isa();
-    if (!selected) return selected.error();
-    isa = *selected;
-  }
-  if (!cpu_supports(isa))
-    return bad_input(std::string("this CPU cannot run the ") + to_string(isa) + " kernels");
+  const Expected<Isa> resolved_isa = resolve_isa(options.isa);
+  if (!resolved_isa) return resolved_isa.error();
+  const Isa isa = *resolved_isa;
   const soft::FillKernels& kernels = soft::fill_kernels(isa);
   out.info["kernel"] = kernels.isa;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);

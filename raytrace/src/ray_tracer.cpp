@@ -581,22 +581,6 @@ std::optional<Error> check_visibility_size(const Scene& scene, const PrimaryVisi
   return std::nullopt;
 }
 
-// The shading kernels of the options' instruction set (else RVR_ISA's, else the best this CPU
-// runs), as the wide BVH's kernels are chosen.
-Expected<const ShadeKernels*> choose_shade_kernels(const RenderOptions& options) {
-  Isa isa = Isa::Sse;
-  if (options.isa) {
-    isa = *options.isa;
-  } else {
-    Expected<Isa> selected = selected_isa();
-    if (!selected) return selected.error();
-    isa = *selected;
-  }
-  if (!cpu_supports(isa))
-    return bad_input(std::string("this CPU cannot run the ") + to_string(isa) + " kernels");
-  return &shade_kernels(isa);
-}
-
 // 1 at the pixels inside the screen bounds of a shape that a z-buffer draws approximately or not
 // at all (TraceGeometry::approximated_bounds), row-major.
 std::vector<uint8_t> approximated_mask(const Scene& scene, const TraceGeometry& geometry) {
@@ -659,9 +643,9 @@ Expected<std::map<std::string, double>> RayTracer::add_visible_sample(
                  ErrorKind::Internal};
   RenderOptions resolved = options;
   resolved.accel = geometry.accel();
-  Expected<const ShadeKernels*> kernels = choose_shade_kernels(options);
-  if (!kernels) return kernels.error();
-  FrameTracer tracer(scene, resolved, geometry, **kernels);
+  const Expected<Isa> isa = resolve_isa(options.isa);
+  if (!isa) return isa.error();
+  FrameTracer tracer(scene, resolved, geometry, shade_kernels(*isa));
   const ImageSample sample =
       image_sample(scene.camera, options.seed, k, spp, options.mode == RenderMode::Full);
   const RayCounters total =
@@ -690,11 +674,12 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   const int w = scene.image.width, h = scene.image.height;
   if (w <= 0 || h <= 0) return bad_input("image size must be positive");
 
-  Expected<const ShadeKernels*> kernels = choose_shade_kernels(options);
-  if (!kernels) return kernels.error();
+  // The shading kernels: chosen as the wide BVH's kernels are.
+  const Expected<Isa> isa = resolve_isa(options.isa);
+  if (!isa) return isa.error();
   auto t_render = Clock::now();
   out.buffers.allocate(w, h);  // every pixel is written below, in parallel
-  FrameTracer tracer(scene, options, geometry, **kernels);
+  FrameTracer tracer(scene, options, geometry, shade_kernels(*isa));
   if (centre_only) tracer.keep_centre_colour();
   std::vector<uint8_t> approximated;
   if (visible) {
@@ -731,7 +716,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   const double shade_share = total.busy_seconds > 0 ? total.shade_seconds / total.busy_seconds : 0;
   out.stats["time.shade"] = render_seconds * shade_share;
   out.stats["time.visibility"] = render_seconds - out.stats["time.shade"];
-  out.info["shade_kernel"] = (*kernels)->isa;
+  out.info["shade_kernel"] = shade_kernels(*isa).isa;
 
   out.stats["rays.primary"] = double(total.primary);
   out.stats["rays.shadow"] = double(total.shadow);

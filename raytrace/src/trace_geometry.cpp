@@ -72,22 +72,6 @@ void csg_boundaries(const CsgNode* node, const Ray& ray, uint32_t& next_leaf,
 
 }  // namespace
 
-RayPacket primary_ray_packet(const CameraFrame& frame, int x0, int y0, int w, int h, float tmin,
-                             float tmax) {
-  RayPacket packet;
-  packet.origin[0] = frame.eye.x;
-  packet.origin[1] = frame.eye.y;
-  packet.origin[2] = frame.eye.z;
-  packet.tmin = tmin;
-  packet.tmax = tmax;
-  packet.count = w * h;
-  for (int k = 0; k < packet.count; ++k) {
-    glm::vec3 d = camera_ray_direction(frame, float(x0 + k % w) + 0.5f, float(y0 + k / w) + 0.5f);
-    for (int a = 0; a < 3; ++a) packet.dir[a][k] = d[a];
-  }
-  return packet;
-}
-
 TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_segments,
                              AccelKind accel, TriangleTest triangle_test, std::optional<Isa> isa,
                              EmbreeQuality embree_quality)

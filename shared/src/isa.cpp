@@ -55,6 +55,13 @@ Expected<Isa> selected_isa() {
   return bad_input(std::string("RVR_ISA=") + forced + ": unknown (use sse, avx2 or avx512)");
 }
 
+Expected<Isa> resolve_isa(const std::optional<Isa>& requested) {
+  if (!requested) return selected_isa();
+  if (!cpu_supports(*requested))
+    return bad_input(std::string("this CPU cannot run the ") + to_string(*requested) + " kernels");
+  return *requested;
+}
+
 std::string describe_isa_choice() {
   Expected<Isa> isa = selected_isa();
   if (!isa) return isa.error().message;

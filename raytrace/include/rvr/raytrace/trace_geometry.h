@@ -69,12 +69,6 @@ struct TriangleSurfaceData {
 // SAH without spatial splits, the same kind of tree as ours).
 enum class EmbreeQuality { High, Medium };
 
-// The rays through the centres of pixels [x0, x0 + w) x [y0, y0 + h) (w * h <= kPacketRays),
-// row by row, from the camera's eye: what closest_packet takes for primary rays. t in
-// (tmin, tmax) is view depth, as for every primary ray.
-RayPacket primary_ray_packet(const CameraFrame& frame, int x0, int y0, int w, int h, float tmin,
-                             float tmax);
-
 class TraceGeometry {
  public:
   // `isa` picks the SIMD kernels of the wide BVH; unset: selected_isa().

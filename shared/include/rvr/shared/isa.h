@@ -3,6 +3,7 @@
 // wider instruction sets, and a kernel is never called on a CPU that lacks its instructions.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "rvr/shared/expected.h"
@@ -20,6 +21,10 @@ Isa best_supported_isa();
 // The kernel set to use: RVR_ISA=sse|avx2|avx512 when set, otherwise the best the CPU offers.
 // A bad value, or an ISA this CPU cannot run, is a BadInput error naming RVR_ISA.
 Expected<Isa> selected_isa();
+
+// The kernels a render runs: `requested` (RenderOptions::isa) when set, else selected_isa(); a
+// BadInput error when this CPU cannot run them.
+Expected<Isa> resolve_isa(const std::optional<Isa>& requested);
 
 // For messages: "avx2 (chosen from the CPU)" or "sse (forced by RVR_ISA)".
 std::string describe_isa_choice();
