@@ -26,7 +26,7 @@ Scene builtin(const std::string& name) {
 
 std::vector<Isa> runnable_isas() {
   std::vector<Isa> isas;
-  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512})
+  for (Isa isa : kAllIsas)
     if (cpu_supports(isa)) isas.push_back(isa);
   return isas;
 }

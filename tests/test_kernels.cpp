@@ -66,7 +66,7 @@ RenderOutput render_soft(const Scene& scene, RenderMode mode, bool hiz, Isa isa,
 
 std::vector<Isa> runnable_isas() {
   std::vector<Isa> isas;
-  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512})
+  for (Isa isa : kAllIsas)
     if (cpu_supports(isa)) isas.push_back(isa);
   return isas;
 }

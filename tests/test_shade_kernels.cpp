@@ -172,7 +172,7 @@ std::vector<Pixel> random_pixels() {
 // Every kernel this CPU runs against scalar_shade, bit for bit.
 void expect_kernels_shade_as_scalar(const std::vector<Pixel>& pixels, bool as_the_pass) {
   int tested = 0;
-  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
+  for (Isa isa : kAllIsas) {
     if (!cpu_supports(isa)) continue;
     ++tested;
     const ShadeKernels& kernels = shade_kernels(isa);
@@ -338,7 +338,7 @@ std::vector<Shaded> kernel_shade_surfaces(const ShadeKernels& kernels,
 
 void expect_surface_kernels_shade_as_scalar(const std::vector<SurfacePixel>& pixels) {
   int tested = 0;
-  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
+  for (Isa isa : kAllIsas) {
     if (!cpu_supports(isa)) continue;
     ++tested;
     const std::vector<Shaded> got =

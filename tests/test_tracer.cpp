@@ -292,7 +292,7 @@ TEST(Tracer, BatchedShadingGivesTheScalarShadingBitForBit) {
     for (SphereMode spheres : {SphereMode::Analytic, SphereMode::Mesh}) {
       TraceGeometry geometry(s, spheres, 24, AccelKind::Bvh);
       ASSERT_TRUE(geometry.error().empty());
-      for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
+      for (Isa isa : kAllIsas) {
         if (!cpu_supports(isa)) continue;
         RenderOptions o;
         o.mode = RenderMode::Local;

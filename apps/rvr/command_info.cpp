@@ -40,11 +40,14 @@ int run_info(const std::string& gl_name) {
   for (const RendererInfo& r : renderers()) std::printf("%s ", r.name.c_str());
   std::printf("\n");
   std::printf("simd: baseline build %s; the CPU has %s\n", built_simd(), cpu_simd().c_str());
-  std::printf("kernels: %s; compiled: sse avx2 avx512; this CPU runs:",
-              describe_isa_choice().c_str());
-  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512})
+  std::printf("kernels: %s; compiled:", describe_isa_choice().c_str());
+  for (Isa isa : kAllIsas) std::printf(" %s", to_string(isa));
+  std::printf("; this CPU runs:");
+  for (Isa isa : kAllIsas)
     if (cpu_supports(isa)) std::printf(" %s", to_string(isa));
-  std::printf(" (RVR_ISA=sse|avx2|avx512 forces one)\n");
+  std::printf(" (RVR_ISA=");
+  for (Isa isa : kAllIsas) std::printf("%s%s", isa == kAllIsas[0] ? "" : "|", to_string(isa));
+  std::printf(" forces one)\n");
   std::printf("embree: %s\nopenimageio: %s\ntbb: %s\n", embree_version().c_str(),
               openimageio_version().c_str(), tbb_version().c_str());
   CommonOptions gl_choice;

@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 
 namespace rvr {
 
@@ -45,14 +46,19 @@ Isa best_supported_isa() {
 Expected<Isa> selected_isa() {
   const char* forced = std::getenv("RVR_ISA");
   if (!forced || !*forced) return best_supported_isa();
-  for (Isa isa : {Isa::Sse, Isa::Avx2, Isa::Avx512}) {
+  for (Isa isa : kAllIsas) {
     if (std::strcmp(forced, to_string(isa)) != 0) continue;
     if (!cpu_supports(isa))
       return bad_input(std::string("RVR_ISA=") + forced + ": this CPU cannot run " + forced +
                        " kernels (best available: " + to_string(best_supported_isa()) + ")");
     return isa;
   }
-  return bad_input(std::string("RVR_ISA=") + forced + ": unknown (use sse, avx2 or avx512)");
+  std::string names;  // "sse, avx2 or avx512"
+  for (Isa isa : kAllIsas) {
+    if (isa != kAllIsas[0]) names += isa == std::end(kAllIsas)[-1] ? " or " : ", ";
+    names += to_string(isa);
+  }
+  return bad_input(std::string("RVR_ISA=") + forced + ": unknown (use " + names + ")");
 }
 
 Expected<Isa> resolve_isa(const std::optional<Isa>& requested) {

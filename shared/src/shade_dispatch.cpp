@@ -3,15 +3,8 @@
 namespace rvr {
 
 const ShadeKernels& shade_kernels(Isa isa) {
-  switch (isa) {
-    case Isa::Avx512:
-      return isa_avx512::kShadeKernels;
-    case Isa::Avx2:
-      return isa_avx2::kShadeKernels;
-    case Isa::Sse:
-      break;
-  }
-  return isa_sse::kShadeKernels;
+  return dispatch_isa(isa, isa_sse::kShadeKernels, isa_avx2::kShadeKernels,
+                      isa_avx512::kShadeKernels);
 }
 
 }  // namespace rvr

@@ -3,15 +3,7 @@
 namespace rvr::soft {
 
 const FillKernels& fill_kernels(Isa isa) {
-  switch (isa) {
-    case Isa::Avx512:
-      return isa_avx512::kFillKernels;
-    case Isa::Avx2:
-      return isa_avx2::kFillKernels;
-    case Isa::Sse:
-      break;
-  }
-  return isa_sse::kFillKernels;
+  return dispatch_isa(isa, isa_sse::kFillKernels, isa_avx2::kFillKernels, isa_avx512::kFillKernels);
 }
 
 }  // namespace rvr::soft

@@ -4,7 +4,6 @@
 // (dot = (x*x' + y*y') + z*z', normalize = v * (1 / sqrt(dot(v, v))), cross), in their order;
 // sqrt and division round as their scalar forms do and these units build with
 // -ffp-contract=off, so the bits do not depend on the kernel.
-#include <immintrin.h>
 #include <math.h>
 
 #include <cstdint>
@@ -15,193 +14,29 @@
 #error "define RVR_KERNEL_NS before including this file"
 #endif
 
+#include "rvr/shared/simd/simd.h"
+
 namespace rvr {
 namespace RVR_KERNEL_NS {
 namespace {
 
-#if defined(__AVX512F__)
-constexpr int kLanes = 16;
-using VF = __m512;
-using M = __mmask16;
+using namespace simd;
+using VF = vfloatx;
+using M = vboolfx;
+constexpr int kLanes = kFloatLanes;
+
 inline VF splat(float x) {
-  return _mm512_set1_ps(x);
+  return VF::splat(x);
 }
 inline VF load(const float* p) {
-  return _mm512_load_ps(p);
-}
-inline void store(float* p, VF v) {
-  _mm512_store_ps(p, v);
-}
-inline M load_mask(const uint32_t* p) {
-  return _mm512_test_epi32_mask(_mm512_load_si512(p), _mm512_set1_epi32(-1));
-}
-inline VF add(VF a, VF b) {
-  return _mm512_add_ps(a, b);
-}
-inline VF sub(VF a, VF b) {
-  return _mm512_sub_ps(a, b);
-}
-inline VF mul(VF a, VF b) {
-  return _mm512_mul_ps(a, b);
-}
-inline VF divide(VF a, VF b) {
-  return _mm512_div_ps(a, b);
-}
-// The zero-masked forms with every lane kept: the plain ones start from an "undefined" vector
-// that gcc 12 warns about (-Wmaybe-uninitialized); the instruction and the bits are the same.
-inline VF square_root(VF a) {
-  return _mm512_maskz_sqrt_ps(__mmask16(0xFFFF), a);
+  return VF::load(p);
 }
 // max(v, 0) = v > 0 ? v : +0, as std::max(0.0f, v) (NaN and -0 give +0).
 inline VF clamp0(VF v) {
-  return _mm512_maskz_max_ps(__mmask16(0xFFFF), v, _mm512_setzero_ps());
+  return max(v, VF::zero());
 }
-inline VF negate(VF v) {
-  return _mm512_castsi512_ps(
-      _mm512_xor_si512(_mm512_castps_si512(v), _mm512_set1_epi32(int(0x80000000u))));
-}
-inline M less(VF a, VF b) {
-  return _mm512_cmp_ps_mask(a, b, _CMP_LT_OQ);
-}
-inline M greater(VF a, VF b) {
-  return _mm512_cmp_ps_mask(a, b, _CMP_GT_OQ);
-}
-inline M not_equal(VF a, VF b) {
-  return _mm512_cmp_ps_mask(a, b, _CMP_NEQ_UQ);
-}
-inline M both(M a, M b) {
-  return M(a & b);
-}
-inline M either(M a, M b) {
-  return M(a | b);
-}
-inline unsigned bits(M m) {
-  return unsigned(m);
-}
-// m ? a : b, lane by lane.
-inline VF select(M m, VF a, VF b) {
-  return _mm512_mask_blend_ps(m, b, a);
-}
-#elif defined(__AVX2__)
-constexpr int kLanes = 8;
-using VF = __m256;
-using M = __m256;
-inline VF splat(float x) {
-  return _mm256_set1_ps(x);
-}
-inline VF load(const float* p) {
-  return _mm256_load_ps(p);
-}
-inline void store(float* p, VF v) {
-  _mm256_store_ps(p, v);
-}
-inline M load_mask(const uint32_t* p) {
-  return _mm256_castsi256_ps(_mm256_load_si256(reinterpret_cast<const __m256i*>(p)));
-}
-inline VF add(VF a, VF b) {
-  return _mm256_add_ps(a, b);
-}
-inline VF sub(VF a, VF b) {
-  return _mm256_sub_ps(a, b);
-}
-inline VF mul(VF a, VF b) {
-  return _mm256_mul_ps(a, b);
-}
-inline VF divide(VF a, VF b) {
-  return _mm256_div_ps(a, b);
-}
-inline VF square_root(VF a) {
-  return _mm256_sqrt_ps(a);
-}
-inline VF clamp0(VF v) {
-  return _mm256_max_ps(v, _mm256_setzero_ps());
-}
-inline VF negate(VF v) {
-  return _mm256_xor_ps(v, _mm256_set1_ps(-0.0f));
-}
-inline M less(VF a, VF b) {
-  return _mm256_cmp_ps(a, b, _CMP_LT_OQ);
-}
-inline M greater(VF a, VF b) {
-  return _mm256_cmp_ps(a, b, _CMP_GT_OQ);
-}
-inline M not_equal(VF a, VF b) {
-  return _mm256_cmp_ps(a, b, _CMP_NEQ_UQ);
-}
-inline M both(M a, M b) {
-  return _mm256_and_ps(a, b);
-}
-inline M either(M a, M b) {
-  return _mm256_or_ps(a, b);
-}
-inline unsigned bits(M m) {
-  return unsigned(_mm256_movemask_ps(m));
-}
-inline VF select(M m, VF a, VF b) {
-  return _mm256_blendv_ps(b, a, m);
-}
-#else
-constexpr int kLanes = 4;
-using VF = __m128;
-using M = __m128;
-inline VF splat(float x) {
-  return _mm_set1_ps(x);
-}
-inline VF load(const float* p) {
-  return _mm_load_ps(p);
-}
-inline void store(float* p, VF v) {
-  _mm_store_ps(p, v);
-}
-inline M load_mask(const uint32_t* p) {
-  return _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(p)));
-}
-inline VF add(VF a, VF b) {
-  return _mm_add_ps(a, b);
-}
-inline VF sub(VF a, VF b) {
-  return _mm_sub_ps(a, b);
-}
-inline VF mul(VF a, VF b) {
-  return _mm_mul_ps(a, b);
-}
-inline VF divide(VF a, VF b) {
-  return _mm_div_ps(a, b);
-}
-inline VF square_root(VF a) {
-  return _mm_sqrt_ps(a);
-}
-inline VF clamp0(VF v) {
-  return _mm_max_ps(v, _mm_setzero_ps());
-}
-inline VF negate(VF v) {
-  return _mm_xor_ps(v, _mm_set1_ps(-0.0f));
-}
-inline M less(VF a, VF b) {
-  return _mm_cmplt_ps(a, b);
-}
-inline M greater(VF a, VF b) {
-  return _mm_cmpgt_ps(a, b);
-}
-inline M not_equal(VF a, VF b) {
-  return _mm_cmpneq_ps(a, b);
-}
-inline M both(M a, M b) {
-  return _mm_and_ps(a, b);
-}
-inline M either(M a, M b) {
-  return _mm_or_ps(a, b);
-}
-inline unsigned bits(M m) {
-  return unsigned(_mm_movemask_ps(m));
-}
-// No blendv in the baseline: and / andnot / or, bit for bit the same choice.
-inline VF select(M m, VF a, VF b) {
-  return _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b));
-}
-#endif
 
-// bits() of a mask with every lane set.
+// movemask() of a mask with every lane set.
 constexpr unsigned kAllLanes = (1u << kLanes) - 1u;
 
 struct V3 {
@@ -219,30 +54,29 @@ inline void store3(float (&p)[3][kShadeBatch], int i, const V3& v) {
   store(p[2] + i, v.z);
 }
 inline V3 add3(const V3& a, const V3& b) {
-  return {add(a.x, b.x), add(a.y, b.y), add(a.z, b.z)};
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
 }
 inline V3 sub3(const V3& a, const V3& b) {
-  return {sub(a.x, b.x), sub(a.y, b.y), sub(a.z, b.z)};
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
 }
 inline V3 mul3(const V3& a, const V3& b) {
-  return {mul(a.x, b.x), mul(a.y, b.y), mul(a.z, b.z)};
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
 }
 inline V3 scale(const V3& a, VF s) {
-  return {mul(a.x, s), mul(a.y, s), mul(a.z, s)};
+  return {a.x * s, a.y * s, a.z * s};
 }
 // glm's vec3 / scalar divides each component (no reciprocal).
 inline V3 divide3(const V3& a, VF s) {
-  return {divide(a.x, s), divide(a.y, s), divide(a.z, s)};
+  return {a.x / s, a.y / s, a.z / s};
 }
 inline VF dot(const V3& a, const V3& b) {
-  return add(add(mul(a.x, b.x), mul(a.y, b.y)), mul(a.z, b.z));
+  return a.x * b.x + a.y * b.y + a.z * b.z;
 }
 inline V3 cross(const V3& a, const V3& b) {
-  return {sub(mul(a.y, b.z), mul(b.y, a.z)), sub(mul(a.z, b.x), mul(b.z, a.x)),
-          sub(mul(a.x, b.y), mul(b.x, a.y))};
+  return {a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y};
 }
 inline V3 normalize(const V3& v) {
-  return scale(v, divide(splat(1.0f), square_root(dot(v, v))));
+  return scale(v, splat(1.0f) / sqrt(dot(v, v)));
 }
 inline V3 select3(M m, const V3& a, const V3& b) {
   return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
@@ -279,17 +113,16 @@ V3 add_lights(const ShadeLanes& batch, int i, const V3& P, const V3& N, const V3
                           splat(lights.intensity[2][l])};
     const V3 to_light = sub3(position, P);
     const VF dist2 = dot(to_light, to_light);
-    M lit = greater(dist2, zero);  // !(dist2 > 0): the sample adds nothing
-    if (bits(lit) == 0) continue;
-    const V3 Ld = divide3(to_light, square_root(dist2));
+    M lit = dist2 > zero;  // !(dist2 > 0): the sample adds nothing
+    if (movemask(lit) == 0) continue;
+    const V3 Ld = divide3(to_light, sqrt(dist2));
     const VF n_dot_l = clamp0(dot(N, Ld));
     const V3 H = normalize(add3(Ld, V));
     const VF n_dot_h = clamp0(dot(N, H));
     const VF power = specular_power(n_dot_h, shininess);
     const V3 brdf = add3(scale(diffuse, n_dot_l), scale(specular, power));
     // brdf == vec3(0) skips the sample (its term could be NaN: 0 * inf).
-    lit = both(lit, either(either(not_equal(brdf.x, zero), not_equal(brdf.y, zero)),
-                           not_equal(brdf.z, zero)));
+    lit = lit & (((brdf.x != zero) | (brdf.y != zero)) | (brdf.z != zero));
     // vis * brdf * I / dist2 with vis = 1: 1 * brdf is brdf, bit for bit.
     const V3 term = divide3(mul3(brdf, intensity), dist2);
     colour = select3(lit, add3(colour, term), colour);
@@ -299,8 +132,8 @@ V3 add_lights(const ShadeLanes& batch, int i, const V3& P, const V3& N, const V3
 
 // face_viewer: dot(geometric, V) < 0 turns the shading normal.
 inline V3 face_viewer(const V3& shading, const V3& geometric, const V3& V) {
-  const M back = less(dot(geometric, V), splat(0.0f));
-  return select3(back, {negate(shading.x), negate(shading.y), negate(shading.z)}, shading);
+  const M back = dot(geometric, V) < splat(0.0f);
+  return select3(back, {-shading.x, -shading.y, -shading.z}, shading);
 }
 
 void shade(ShadeBatch& batch, const float eye_position[3], const ShadeLights& lights) {
@@ -314,8 +147,8 @@ void shade(ShadeBatch& batch, const float eye_position[3], const ShadeLights& li
         normalize(cross(sub3(load3(batch.vertex[1], i), p0), sub3(load3(batch.vertex[2], i), p0)));
     // Flat lanes take the geometric normal whatever their vertex normals hold: a group with no
     // smooth lane skips the interpolation (the selection would discard it).
-    const M smooth = load_mask(batch.smooth + i);
-    const V3 shading = bits(smooth) == 0
+    const M smooth = M::load(batch.smooth + i);
+    const V3 shading = movemask(smooth) == 0
                            ? geometric
                            : select3(smooth, normalize(interpolate(b, batch.normal, i)), geometric);
     const V3 V = normalize(sub3(eye, P));
@@ -331,26 +164,25 @@ void shade_surfaces(SurfaceBatch& batch, const ShadeLights& lights) {
     // TraceGeometry::surface: P = o + t d, then the triangle's normals.
     const V3 direction = load3(batch.direction, i);
     const V3 P = add3(origin, scale(direction, load(batch.t + i)));
-    const M given = load_mask(batch.given + i);
-    const M smooth = load_mask(batch.smooth + i);
+    const M given = M::load(batch.given + i);
+    const M smooth = M::load(batch.smooth + i);
     V3 geometric = load3(batch.geometric, i), shading = load3(batch.shading, i);
-    if (bits(given) != kAllLanes) {
+    if (movemask(given) != kAllLanes) {
       const V3 triangle = normalize(cross(load3(batch.edge1, i), load3(batch.edge2, i)));
       V3 interpolated = triangle;
-      if (bits(smooth) != 0) {
+      if (movemask(smooth) != 0) {
         const VF u = load(batch.u + i), v = load(batch.v + i);
-        const VF w[3] = {sub(sub(splat(1.0f), u), v), u, v};
+        const VF w[3] = {splat(1.0f) - u - v, u, v};
         const V3 n = interpolate(w, batch.vertex_normal, i);
-        const VF length = square_root(dot(n, n));
-        interpolated =
-            select3(both(smooth, greater(length, splat(0.0f))), divide3(n, length), triangle);
+        const VF length = sqrt(dot(n, n));
+        interpolated = select3(smooth & (length > splat(0.0f)), divide3(n, length), triangle);
       }
       geometric = select3(given, geometric, triangle);
       shading = select3(given, shading, interpolated);
     }
     // -normalize(direction): the negation is exact.
     const V3 unit = normalize(direction);
-    const V3 V = {negate(unit.x), negate(unit.y), negate(unit.z)};
+    const V3 V = {-unit.x, -unit.y, -unit.z};
     const V3 N = face_viewer(shading, geometric, V);
     store3(batch.shading_normal, i, N);
     store3(batch.colour, i, add_lights(batch, i, P, N, V, lights));

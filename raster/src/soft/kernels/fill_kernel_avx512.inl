@@ -8,26 +8,19 @@
 
 #include <cstdint>
 
+#include "rvr/shared/simd/simd.h"
 #include "soft/fill_kernel.h"
 
 namespace rvr::soft {
 namespace RVR_KERNEL_NS {
 namespace {
 
+using namespace simd;
 constexpr int kLanes = 8;
 
 // Each bit of an 8-lane mask three times: the mask of those lanes' interleaved barycentrics.
 inline uint32_t triple_bits(uint32_t m) {
   return _pdep_u32(m, 0x249249u) | _pdep_u32(m, 0x492492u) | _pdep_u32(m, 0x924924u);
-}
-
-// Through the zero-masking forms with every lane set: the plain intrinsics pass gcc 12 an
-// undefined vector that it warns about (-Wmaybe-uninitialized); instruction and bits are the same.
-inline __m512d max_pd(__m512d a, __m512d b) {
-  return _mm512_maskz_max_pd(__mmask8(0xFF), a, b);
-}
-inline __m256 to_float(__m512d v) {
-  return _mm512_maskz_cvtpd_ps(__mmask8(0xFF), v);
 }
 
 // Float p of 3 x 8 interleaved barycentrics (lane p / 3, coordinate p % 3) taken from
@@ -38,26 +31,26 @@ constexpr int interleaved_source(int p) {
 
 void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x1, int y1,
           bool full, FillResult& result) {
-  const __m512i lane_index = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
-  __m512i lane_edge[3], group_step[3];
-  __m512d q0[3], qa[3], qb[3];
+  const vllong8 lane_index = vllong8::iota();
+  vllong8 lane_edge[3], group_step[3];
+  vdouble8 q0[3], qa[3], qb[3];
   for (int i = 0; i < 3; ++i) {
     // k steps to the right: step_x * k, exact in 64-bit integers as the scalar formula.
-    lane_edge[i] = _mm512_mullo_epi64(_mm512_set1_epi64(t.step_x[i]), lane_index);
-    group_step[i] = _mm512_set1_epi64(t.step_x[i] * kLanes);
-    q0[i] = _mm512_set1_pd(t.q0[i]);
-    qa[i] = _mm512_set1_pd(t.qa[i]);
-    qb[i] = _mm512_set1_pd(t.qb[i]);
+    lane_edge[i] = vllong8::splat(t.step_x[i]) * lane_index;
+    group_step[i] = vllong8::splat(t.step_x[i] * kLanes);
+    q0[i] = vdouble8::splat(t.q0[i]);
+    qa[i] = vdouble8::splat(t.qa[i]);
+    qb[i] = vdouble8::splat(t.qb[i]);
   }
-  const __m512d ox = _mm512_set1_pd(t.ox);
-  const __m512d lane_offsets = _mm512_setr_pd(0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0);
-  const __m512d half = _mm512_set1_pd(0.5), one = _mm512_set1_pd(1.0);
-  const __m512d zero = _mm512_setzero_pd(), infinity = _mm512_set1_pd(__builtin_inf());
-  const __m512d near_plane = _mm512_set1_pd(target.near_plane);
-  const __m512d far_plane = _mm512_set1_pd(target.far_plane);
-  const __m256i object = _mm256_set1_epi32(int32_t(t.object));
-  const __m256i primitive = _mm256_set1_epi32(int32_t(t.primitive));
-  const __m256i one_fragment = _mm256_set1_epi32(1);
+  const vdouble8 ox = vdouble8::splat(t.ox);
+  const vdouble8 lane_offsets = vdouble8::iota();
+  const vdouble8 half = vdouble8::splat(0.5), one = vdouble8::splat(1.0);
+  const vdouble8 zero = vdouble8::zero(), infinity = vdouble8::splat(__builtin_inf());
+  const vdouble8 near_plane = vdouble8::splat(target.near_plane);
+  const vdouble8 far_plane = vdouble8::splat(target.far_plane);
+  const vint8 object = vint8::splat(int32_t(t.object));
+  const vint8 primitive = vint8::splat(int32_t(t.primitive));
+  const vint8 one_fragment = vint8::splat(1);
   const __m512i interleave_lo = _mm512_setr_epi32(
       interleaved_source(0), interleaved_source(1), interleaved_source(2), interleaved_source(3),
       interleaved_source(4), interleaved_source(5), interleaved_source(6), interleaved_source(7),
@@ -71,49 +64,42 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
 
   int64_t row[3] = {t.row0[0], t.row0[1], t.row0[2]};
   for (int y = y0; y <= y1; ++y) {
-    __m512i e[3];
-    for (int i = 0; i < 3; ++i) e[i] = _mm512_add_epi64(_mm512_set1_epi64(row[i]), lane_edge[i]);
-    const __m512d dy = _mm512_set1_pd(double(y) + 0.5 - t.oy);  // (py - oy), as the scalar formula
+    vllong8 e[3];
+    for (int i = 0; i < 3; ++i) e[i] = vllong8::splat(row[i]) + lane_edge[i];
+    const vdouble8 dy =
+        vdouble8::splat(double(y) + 0.5 - t.oy);  // (py - oy), as the scalar formula
     const size_t row_start = size_t(y) * size_t(target.width);
     for (int x = x0; x <= x1; x += kLanes) {
       const int n = x1 - x + 1 < kLanes ? x1 - x + 1 : kLanes;
-      __mmask8 mask = __mmask8((1u << n) - 1);
+      vboold8 mask = vboold8::from_bits((1u << n) - 1);
       // A negative edge function (sign bit set) puts the centre outside.
-      if (!full)
-        mask &= __mmask8(~_mm512_movepi64_mask(_mm512_or_si512(_mm512_or_si512(e[0], e[1]), e[2])));
-      if (mask) {
+      if (!full) mask = mask & ~sign_bits((e[0] | e[1]) | e[2]);
+      if (movemask(mask)) {
         // px = x + k + 0.5, then the perspective planes, as the scalar formula.
-        const __m512d dx =
-            _mm512_add_pd(_mm512_add_pd(_mm512_set1_pd(double(x)), lane_offsets), half);
-        const __m512d rel = _mm512_sub_pd(dx, ox);
-        __m512d q[3];
-        for (int j = 0; j < 3; ++j)
-          q[j] = max_pd(  // max(v, 0) as std::max(0.0, v): NaN and -0 give +0
-              _mm512_add_pd(_mm512_add_pd(q0[j], _mm512_mul_pd(qa[j], rel)),
-                            _mm512_mul_pd(qb[j], dy)),
-              zero);
-        const __m512d s = _mm512_add_pd(_mm512_add_pd(q[0], q[1]), q[2]);
-        const __m512d depth = _mm512_div_pd(one, s);
-        result.generated += unsigned(__builtin_popcount(mask));
+        const vdouble8 dx = (vdouble8::splat(double(x)) + lane_offsets) + half;
+        const vdouble8 rel = dx - ox;
+        vdouble8 q[3];
+        // max(v, 0) as std::max(0.0, v): NaN and -0 give +0.
+        for (int j = 0; j < 3; ++j) q[j] = max((q0[j] + qa[j] * rel) + qb[j] * dy, zero);
+        const vdouble8 s = (q[0] + q[1]) + q[2];
+        const vdouble8 depth = one / s;
+        result.generated += unsigned(__builtin_popcount(movemask(mask)));
         const size_t i = row_start + size_t(x);
         if (!target.depth_only) {
           uint32_t* fragments = target.fragments + i;
-          _mm256_mask_storeu_epi32(
-              fragments, mask,
-              _mm256_add_epi32(_mm256_maskz_loadu_epi32(mask, fragments), one_fragment));
+          storeu(mask, fragments, loadu(mask, fragments) + one_fragment);
         }
         // The depth test; the depth range clips what lies beyond far (and rounding just
         // inside near). Ordered compares: a NaN depth fails, as in the scalar test.
-        const __m512d stored = _mm512_maskz_loadu_pd(mask, target.depth + i);
-        __mmask8 passed = _mm512_mask_cmp_pd_mask(mask, depth, stored, _CMP_LT_OQ);
-        passed = _mm512_mask_cmp_pd_mask(passed, depth, near_plane, _CMP_GE_OQ);
-        passed = _mm512_mask_cmp_pd_mask(passed, depth, far_plane, _CMP_LE_OQ);
-        if (passed) {
+        const vdouble8 stored = vdouble8::loadu(mask, target.depth + i);
+        vboold8 passed = less(mask, depth, stored);
+        passed = greater_equal(passed, depth, near_plane);
+        passed = less_equal(passed, depth, far_plane);
+        if (movemask(passed)) {
           result.drawn = true;
           // Pixels drawn for the first time leave their 8x8 block's count of empty pixels: the
           // group's lanes lie in block x / 8 and, from lane 8 - x % 8 on, in the next one.
-          if (const unsigned first =
-                  _mm512_mask_cmp_pd_mask(passed, stored, infinity, _CMP_EQ_OQ)) {
+          if (const unsigned first = movemask(equal(passed, stored, infinity))) {
             const int in_first_block = kLanes - (x & 7);
             uint16_t* empty =
                 target.block_empty + size_t(y >> 3) * size_t(target.blocks_x) + size_t(x >> 3);
@@ -122,17 +108,18 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
             if (const unsigned next = first >> in_first_block)
               empty[1] = uint16_t(empty[1] - __builtin_popcount(next));
           }
-          _mm512_mask_storeu_pd(target.depth + i, passed, depth);
+          storeu(passed, target.depth + i, depth);
           if (!target.depth_only) {
-            _mm256_mask_storeu_epi32(target.object + i, passed, object);
-            _mm256_mask_storeu_epi32(target.primitive + i, passed, primitive);
-            // The barycentrics (q / s, rounded to float as the scalar cast does), interleaved.
-            const __m256 b0 = to_float(_mm512_div_pd(q[0], s));
-            const __m256 b1 = to_float(_mm512_div_pd(q[1], s));
-            const __m256 b2 = to_float(_mm512_div_pd(q[2], s));
-            const __m512 b01 = _mm512_insertf32x8(_mm512_castps256_ps512(b0), b1, 1);
-            const __m512 b2x = _mm512_castps256_ps512(b2);
-            const uint32_t lanes = triple_bits(passed);
+            storeu(passed, target.object + i, object);
+            storeu(passed, target.primitive + i, primitive);
+            // The barycentrics (q / s, rounded to float as the scalar cast does), interleaved
+            // with AVX-512's two-source permutes and 16-lane masked stores.
+            const vfloat8 b0 = to_float(q[0] / s);
+            const vfloat8 b1 = to_float(q[1] / s);
+            const vfloat8 b2 = to_float(q[2] / s);
+            const __m512 b01 = _mm512_insertf32x8(_mm512_castps256_ps512(b0.v), b1.v, 1);
+            const __m512 b2x = _mm512_castps256_ps512(b2.v);
+            const uint32_t lanes = triple_bits(movemask(passed));
             float* bary = target.bary + 3 * i;
             _mm512_mask_storeu_ps(bary, __mmask16(lanes & 0xFFFFu),
                                   _mm512_permutex2var_ps(b01, interleave_lo, b2x));
@@ -141,7 +128,7 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
           }
         }
       }
-      for (int i = 0; i < 3; ++i) e[i] = _mm512_add_epi64(e[i], group_step[i]);
+      for (int i = 0; i < 3; ++i) e[i] = e[i] + group_step[i];
     }
     for (int i = 0; i < 3; ++i) row[i] += t.step_y[i];
   }

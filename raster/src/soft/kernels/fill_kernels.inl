@@ -11,54 +11,32 @@
 #if defined(__AVX512F__)
 #include "fill_kernel_avx512.inl"
 #else
-#include <immintrin.h>
-
 #include <cstdint>
 
+#include "rvr/shared/simd/simd.h"
 #include "soft/fill_kernel.h"
 
 namespace rvr::soft {
 namespace RVR_KERNEL_NS {
 namespace {
 
-#if defined(__AVX2__)  // 4 pixels a group
-constexpr int kLanes = 4;
-using VD = __m256d;
-using VI = __m256i;
-inline VD splat(double x) { return _mm256_set1_pd(x); }
-inline VD add(VD a, VD b) { return _mm256_add_pd(a, b); }
-inline VD sub(VD a, VD b) { return _mm256_sub_pd(a, b); }
-inline VD mul(VD a, VD b) { return _mm256_mul_pd(a, b); }
-inline VD divide(VD a, VD b) { return _mm256_div_pd(a, b); }
-// max(v, 0) = v > 0 ? v : +0, as std::max(0.0, v) (NaN and -0 give +0).
-inline VD clamp0(VD v) { return _mm256_max_pd(v, _mm256_setzero_pd()); }
-inline VD lane_offsets() { return _mm256_setr_pd(0.0, 1.0, 2.0, 3.0); }
-inline VI isplat(int64_t x) { return _mm256_set1_epi64x(x); }
-inline VI iadd(VI a, VI b) { return _mm256_add_epi64(a, b); }
-inline VI ior(VI a, VI b) { return _mm256_or_si256(a, b); }
-inline VI iload(const int64_t* p) { return _mm256_loadu_si256(reinterpret_cast<const VI*>(p)); }
-inline unsigned sign_mask(VI v) { return unsigned(_mm256_movemask_pd(_mm256_castsi256_pd(v))); }
-inline void store(double* p, VD v) { _mm256_storeu_pd(p, v); }
-#else
-constexpr int kLanes = 2;
-using VD = __m128d;
-using VI = __m128i;
-inline VD splat(double x) { return _mm_set1_pd(x); }
-inline VD add(VD a, VD b) { return _mm_add_pd(a, b); }
-inline VD sub(VD a, VD b) { return _mm_sub_pd(a, b); }
-inline VD mul(VD a, VD b) { return _mm_mul_pd(a, b); }
-inline VD divide(VD a, VD b) { return _mm_div_pd(a, b); }
-inline VD clamp0(VD v) { return _mm_max_pd(v, _mm_setzero_pd()); }
-inline VD lane_offsets() { return _mm_setr_pd(0.0, 1.0); }
-inline VI isplat(int64_t x) { return _mm_set1_epi64x(x); }
-inline VI iadd(VI a, VI b) { return _mm_add_epi64(a, b); }
-inline VI ior(VI a, VI b) { return _mm_or_si128(a, b); }
-inline VI iload(const int64_t* p) { return _mm_loadu_si128(reinterpret_cast<const VI*>(p)); }
-inline unsigned sign_mask(VI v) { return unsigned(_mm_movemask_pd(_mm_castsi128_pd(v))); }
-inline void store(double* p, VD v) { _mm_storeu_pd(p, v); }
-#endif
+using namespace simd;
+// 2 (SSE) or 4 (AVX2) pixels a group.
+using VD = vdoublex;
+using VI = vllongx;
+constexpr int kLanes = kDoubleLanes;
 
-inline unsigned lowest_bit(unsigned m) { return unsigned(__builtin_ctz(m)); }
+inline VD splat(double x) {
+  return VD::splat(x);
+}
+// max(v, 0) = v > 0 ? v : +0, as std::max(0.0, v) (NaN and -0 give +0).
+inline VD clamp0(VD v) {
+  return max(v, VD::zero());
+}
+
+inline unsigned lowest_bit(unsigned m) {
+  return unsigned(__builtin_ctz(m));
+}
 // Set bits of a 4-bit mask (no popcnt instruction in the baseline kernel).
 constexpr uint8_t kBits[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
 
@@ -68,9 +46,9 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
   int64_t offsets[3][kLanes];
   for (int i = 0; i < 3; ++i)
     for (int k = 0; k < kLanes; ++k) offsets[i][k] = t.step_x[i] * k;
-  const VI lane_edge[3] = {iload(offsets[0]), iload(offsets[1]), iload(offsets[2])};
-  const VI group_step[3] = {isplat(t.step_x[0] * kLanes), isplat(t.step_x[1] * kLanes),
-                            isplat(t.step_x[2] * kLanes)};
+  const VI lane_edge[3] = {VI::loadu(offsets[0]), VI::loadu(offsets[1]), VI::loadu(offsets[2])};
+  const VI group_step[3] = {VI::splat(t.step_x[0] * kLanes), VI::splat(t.step_x[1] * kLanes),
+                            VI::splat(t.step_x[2] * kLanes)};
   const VD q0[3] = {splat(t.q0[0]), splat(t.q0[1]), splat(t.q0[2])};
   const VD qa[3] = {splat(t.qa[0]), splat(t.qa[1]), splat(t.qa[2])};
   const VD qb[3] = {splat(t.qb[0]), splat(t.qb[1]), splat(t.qb[2])};
@@ -78,20 +56,20 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
   int64_t row[3] = {t.row0[0], t.row0[1], t.row0[2]};
   alignas(32) double depth_lane[kLanes], q_lane[3][kLanes];
   for (int y = y0; y <= y1; ++y) {
-    VI e[3] = {iadd(isplat(row[0]), lane_edge[0]), iadd(isplat(row[1]), lane_edge[1]),
-               iadd(isplat(row[2]), lane_edge[2])};
+    VI e[3] = {VI::splat(row[0]) + lane_edge[0], VI::splat(row[1]) + lane_edge[1],
+               VI::splat(row[2]) + lane_edge[2]};
     const VD dy = splat(double(y) + 0.5 - t.oy);  // (py - oy), as the scalar formula
     for (int x = x0; x <= x1; x += kLanes) {
       const int n = x1 - x + 1 < kLanes ? x1 - x + 1 : kLanes;
       unsigned mask = (1u << n) - 1;
-      if (!full) mask &= ~sign_mask(ior(ior(e[0], e[1]), e[2]));
+      if (!full) mask &= ~sign_bits((e[0] | e[1]) | e[2]);
       if (mask) {
-        const VD dx = add(add(splat(double(x)), lane_offsets()), splat(0.5));  // px = x + k + 0.5
-        const VD rel = sub(dx, ox);
+        const VD dx = (splat(double(x)) + VD::iota()) + splat(0.5);  // px = x + k + 0.5
+        const VD rel = dx - ox;
         VD q[3], s;
-        for (int j = 0; j < 3; ++j) q[j] = clamp0(add(add(q0[j], mul(qa[j], rel)), mul(qb[j], dy)));
-        s = add(add(q[0], q[1]), q[2]);
-        store(depth_lane, divide(splat(1.0), s));
+        for (int j = 0; j < 3; ++j) q[j] = clamp0((q0[j] + qa[j] * rel) + qb[j] * dy);
+        s = (q[0] + q[1]) + q[2];
+        storeu(depth_lane, splat(1.0) / s);
         result.generated += kBits[mask];  // mask < 16
         // The depth test first: the barycentrics' divisions only for groups that pass it.
         unsigned passed = 0;
@@ -107,7 +85,7 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
         if (passed) {
           result.drawn = true;
           if (!target.depth_only)
-            for (int j = 0; j < 3; ++j) store(q_lane[j], divide(q[j], s));
+            for (int j = 0; j < 3; ++j) storeu(q_lane[j], q[j] / s);
         }
         for (; passed; passed &= passed - 1) {
           const int k = int(lowest_bit(passed));
@@ -123,7 +101,7 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
           }
         }
       }
-      for (int i = 0; i < 3; ++i) e[i] = iadd(e[i], group_step[i]);
+      for (int i = 0; i < 3; ++i) e[i] = e[i] + group_step[i];
     }
     for (int i = 0; i < 3; ++i) row[i] += t.step_y[i];
   }

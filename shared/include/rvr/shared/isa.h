@@ -10,7 +10,10 @@
 
 namespace rvr {
 
+// The instruction sets the kernels are compiled for (RVR_SIMD_ISAS in the top-level
+// CMakeLists.txt lists the same, in the same order), narrowest first.
 enum class Isa { Sse, Avx2, Avx512 };
+inline constexpr Isa kAllIsas[] = {Isa::Sse, Isa::Avx2, Isa::Avx512};
 
 const char* to_string(Isa isa);  // "sse", "avx2", "avx512"
 
@@ -28,5 +31,20 @@ Expected<Isa> resolve_isa(const std::optional<Isa>& requested);
 
 // For messages: "avx2 (chosen from the CPU)" or "sse (forced by RVR_ISA)".
 std::string describe_isa_choice();
+
+// The kernel table of `isa` among one table per instruction set (each kernel family's
+// dispatcher: traversal, softraster's fill and setup, shading). Called from baseline code only.
+template <class Table>
+const Table& dispatch_isa(Isa isa, const Table& sse, const Table& avx2, const Table& avx512) {
+  switch (isa) {
+    case Isa::Avx512:
+      return avx512;
+    case Isa::Avx2:
+      return avx2;
+    case Isa::Sse:
+      break;
+  }
+  return sse;
+}
 
 }  // namespace rvr
