@@ -2,6 +2,14 @@
 // models with known noise, recovered within their intervals; the intervals' coverage over
 // seeded replicates; crossovers where the curves cross, or reported outside the swept range;
 // and the whole sweep within its budget on a simulated clock.
+//
+// Planted bugs these tests were seen to catch (each planted, run, restored):
+// - a pairs bootstrap (points drawn with replacement instead of each point's repetitions):
+//   IntervalCoverageOverSeededReplicates (86% coverage) and
+//   IdenticalRepetitionsGiveIntervalsOfNoWidth;
+// - log2 of the pixels instead of the triangles in the tracer's model:
+//   TracerFeaturesTakeTheLogOfTheTriangles, RecoversKnownCoefficientsWithinTheirIntervals,
+//   IntervalCoverageOverSeededReplicates, OutsideTheSweptRangeIsReportedAsSuch.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -332,4 +340,6 @@ TEST(StudyMarkdown, NumbersInPowersOfTen) {
   EXPECT_EQ(format_number(2.1e6), "2.1×10^6");
   EXPECT_EQ(format_number(123.456), "123");
   EXPECT_EQ(format_number(9.97e5), "1.0×10^6");
+  EXPECT_EQ(format_number(1000), "1000");
+  EXPECT_EQ(format_number(0.5), "0.5");
 }
