@@ -8,7 +8,7 @@ PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-d
 	clang-14 libclang-rt-14-dev python3-glad libegl-dev libegl-mesa0 chromium python3-websocket \
 	python3-jsonschema
 
-.PHONY: all deps build demo test check sanitize fuzz bench clean format
+.PHONY: all deps build demo test check sanitize fuzz bench study clean format
 
 all: build
 
@@ -100,8 +100,16 @@ bench: build
 		--benchmark_out=bench/results/latest.json --benchmark_out_format=json
 	/usr/bin/python3 bench/plot.py bench/results/latest.json bench/charts
 
+# The headline study (docs/cli.md#rvr-study-what-each-loop-order-costs-computed-with-confidence):
+# tessphere and soup, one renderer per loop order, local mode, 1024 wide, within STUDY_BUDGET
+# seconds of sweeping (plus the fits: under 10 minutes in all).
+STUDY_BUDGET ?= 540
+study: build
+	$(BUILD_DIR)/bin/rvr study builtin:tessphere builtin:soup --width 1024 --mode local \
+		--budget $(STUDY_BUDGET) -o study-out
+
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')
 
 clean:
-	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) rvr-out
+	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) rvr-out study-out

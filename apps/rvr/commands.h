@@ -89,4 +89,22 @@ int run_scenes(const ScenesArgs& a);
 
 int run_info(const std::string& gl_name);
 
+struct StudyArgs {
+  std::vector<std::string> scenes{"builtin:tessphere", "builtin:soup"};
+  std::vector<std::string> renderers;  // -r: added to one renderer per loop order
+  int width = 1024;
+  std::string mode = "local";
+  double budget = 300;
+  int repetitions = 5;
+  uint64_t seed = 1;
+  std::string out_dir;
+  bool quiet = false;
+};
+
+// The renderers a study runs by default: one per loop order.
+std::vector<std::string> default_study_renderers();
+
+void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd);
+int run_study(const StudyArgs& a, const std::string& command_line);
+
 }  // namespace rvr::cli

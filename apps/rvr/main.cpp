@@ -104,6 +104,10 @@ int run(int argc, char** argv) {
   info_cmd->add_option("--gl", info_gl, "GL back end to describe: osmesa | egl (default as render)")
       ->check(CLI::IsMember({"osmesa", "egl"}));
 
+  StudyArgs study;
+  CLI::App* study_cmd = nullptr;
+  add_study_command(app, study, study_cmd);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -121,6 +125,7 @@ int run(int argc, char** argv) {
   if (diff_cmd->parsed()) return run_diff(diff);
   if (scenes_cmd->parsed()) return run_scenes(scenes);
   if (info_cmd->parsed()) return run_info(info_gl);
+  if (study_cmd->parsed()) return run_study(study, join_args(argc, argv));
   return 2;
 }
 

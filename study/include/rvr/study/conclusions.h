@@ -1,0 +1,24 @@
+// The conclusions computed from a study's measurements: each renderer's model per scene, the
+// crossover (or the winner over the whole range) of every pair of loop orders, scaling
+// exponents per decade and time per triangle and per ray.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rvr/study/bootstrap.h"
+#include "rvr/study/study.h"
+
+namespace rvr::study {
+
+// The model form of a renderer in the table, by its loop order.
+ModelForm model_form_of(const std::string& renderer);
+
+// The least-squares slope of log t against log n over the points with n in [from, to]; NaN
+// with fewer than two distinct n.
+double loglog_slope(const std::vector<Measurement>& points, double from, double to);
+
+// Fills result.models, crossovers, dominance, scaling and costs from result.points.
+void conclude(StudyResult& result, const BootstrapOptions& boot);
+
+}  // namespace rvr::study

@@ -1,0 +1,53 @@
+// Where two renderers' measured curves cross along the swept axis, with a 95% interval from
+// the bootstrap over repetitions; or which one wins over the whole range, and by how much.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "rvr/study/bootstrap.h"
+#include "rvr/study/fit.h"
+#include "rvr/study/measurement.h"
+
+namespace rvr::study {
+
+struct Crossover {
+  std::string a, b, scene, axis;
+  double value = 0;  // the axis value where t_a = t_b
+  // 95% interval; −inf / +inf when over 2.5% of the replicates put it below / above the range.
+  Interval ci95;
+  double pixels = 0;
+  bool a_faster_below = true;            // a is the faster one below `value`
+  bool measured = true;                  // false: the fitted models', outside the swept range
+  double range_low = 0, range_high = 0;  // the swept axis range
+};
+
+// Neither curve crosses the other over the swept range.
+struct Dominance {
+  std::string faster, slower, scene, axis;
+  double min_ratio = 0;  // the slower's time over the faster's, at its smallest over the range
+  double at = 0;         // where that smallest ratio is
+  double pixels = 0;
+  double range_low = 0, range_high = 0;
+};
+
+struct CurveComparison {
+  std::vector<Crossover> crossovers;   // one per sign change of log(t_a / t_b), along the axis
+  std::optional<Dominance> dominance;  // when there is none
+};
+
+// Compares a's and b's medians at the axis values both measured (points matched by n; a and b
+// each one renderer's points of one scene at one pixel count). A crossing lies between two
+// neighbouring points where log(t_a / t_b) changes sign, placed by linear interpolation of
+// log(t_a / t_b) in log n. Each bootstrap replicate resamples every point's repetitions and
+// takes the crossing nearest the measured one.
+CurveComparison compare_curves(const std::vector<Measurement>& a, const std::vector<Measurement>& b,
+                               const std::string& axis, const BootstrapOptions& boot);
+
+// Where the fitted models cross outside [low, high] (searched up to 1000× beyond either end),
+// when both fit and one does: the crossover reported as outside the swept range.
+std::optional<double> extrapolated_crossing(const ModelFit& fa, const ModelFit& fb, double pixels,
+                                            double low, double high);
+
+}  // namespace rvr::study

@@ -1,0 +1,63 @@
+// A cost model fitted to a renderer's sweep: weighted least squares on relative error, 95%
+// intervals from the bootstrap over repetitions, and whether the model fits at all.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "rvr/shared/expected.h"
+#include "rvr/study/bootstrap.h"
+#include "rvr/study/cost_model.h"
+#include "rvr/study/measurement.h"
+
+namespace rvr::study {
+
+struct Coefficient {
+  std::string name;
+  double value = 0;
+  Interval ci95;
+  // False for b when every point had the same pixel count: a then holds a + b·P.
+  bool identifiable = true;
+};
+
+// What a model must achieve before the study draws conclusions from it.
+struct FitThresholds {
+  double min_r2 = 0.9;
+  double max_rel_residual = 0.25;
+  double max_loo_rel_error = 0.25;
+};
+
+struct ModelFit {
+  ModelForm form = ModelForm::ZBuffer;
+  std::vector<Coefficient> coefficients;
+  double r2 = 0;                // weighted (1/t²) coefficient of determination
+  double max_rel_residual = 0;  // largest |t − model| / t over the points
+  double loo_rel_error = 0;     // root mean square of each point's error when left out
+  size_t points = 0;
+  bool fits = false;
+  std::string verdict;      // "fits", or why the model does not
+  double fixed_pixels = 0;  // > 0: every point had this P, so b is folded into a
+};
+
+// Which coefficients can be fitted to these points: all but b when P never varies.
+std::vector<bool> identifiable_terms(ModelForm form, const std::vector<Measurement>& points);
+
+// The coefficients fitted to `medians` (one per point), each weighted by 1/scale², so that
+// the fit minimizes relative error; `scale` is the medians themselves when empty (a bootstrap
+// replicate passes the measured medians: the weights are the design, not a resampled value).
+Expected<std::vector<double>> fit_coefficients(ModelForm form,
+                                               const std::vector<Measurement>& points,
+                                               const std::vector<double>& medians,
+                                               const std::vector<bool>& use,
+                                               const std::vector<double>& scale = {});
+
+// The model fitted to the points' medians, its intervals from `boot` replicates of the
+// bootstrap over repetitions, its quality and verdict against `limits`. Too few points, or
+// terms that cannot be told apart, give fits = false with the reason, not an error.
+ModelFit fit_model(ModelForm form, const std::vector<Measurement>& points,
+                   const BootstrapOptions& boot, const FitThresholds& limits = {});
+
+// The coefficients as fitted (b, when folded into a, as 0): for predict().
+std::vector<double> coefficient_values(const ModelFit& fit);
+
+}  // namespace rvr::study

@@ -1,0 +1,54 @@
+// Running a study: for each scene family, a log-spaced sweep of N within a share of the time
+// budget, each point's frames timed with the renderers' repetitions interleaved in random
+// order, points added near every crossover while the budget allows, then the conclusions.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rvr/shared/expected.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/study/study.h"
+
+namespace rvr::study {
+
+struct StudyRequest {
+  std::vector<std::string> scenes;     // "builtin:tessphere", ...
+  std::vector<std::string> renderers;  // names or variants in the renderer table
+  int width = 1024;                    // height = width * 3/4
+  RenderMode mode = RenderMode::Local;
+  double budget_seconds = 300;
+  int repetitions = 5;
+  uint64_t seed = 1;
+  int bootstrap_replicates = 1000;
+};
+
+// One scene size with every renderer of the study ready to render it (what they build per
+// scene already built, a first frame already rendered).
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  virtual double axis_value() const = 0;  // triangles drawn (or occluders' N)
+  virtual double pixels() const = 0;
+  // The wall time of one frame of renderer `index` (in the request's order).
+  virtual Expected<double> time_frame(size_t index) = 0;
+};
+
+// Makes the FrameSource of builtin:<family>:<n>.
+using PrepareFrames =
+    std::function<Expected<std::unique_ptr<FrameSource>>(const std::string& family, size_t n)>;
+
+struct StudyHooks {
+  PrepareFrames prepare;
+  std::function<double()> now;  // seconds on a steady clock; null: std::chrono::steady_clock
+  std::function<void(const std::string& what)> on_progress;  // null: nothing shown
+};
+
+// Validates the request (families, renderer names, budget, width, repetitions: BadInput errors
+// before any work), sweeps, fits and concludes. The machine facts are left for the caller.
+Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& hooks);
+
+}  // namespace rvr::study

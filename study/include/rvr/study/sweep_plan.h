@@ -1,0 +1,43 @@
+// Which scene sizes a study measures: the families it sweeps, their log-spaced grids, the
+// points added near a crossover, and the cost of a point predicted from those measured.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "rvr/shared/expected.h"
+
+namespace rvr::study {
+
+struct Family {
+  std::string name;          // "tessphere"
+  std::string axis;          // "triangles", or "depth" for occluders (quads one behind another)
+  size_t low = 0, high = 0;  // the N of builtin:name:N swept
+  int points = 0;            // log-spaced between them
+};
+
+// "builtin:tessphere" (or "tessphere"); a BadInput error naming the families for any other.
+Expected<Family> find_family(const std::string& name);
+
+// `count` values from low to high, evenly spaced in log, rounded, without repeats.
+std::vector<size_t> log_spaced(size_t low, size_t high, int count);
+
+// The rounded geometric mean of two neighbours: the point that halves a bracket in log; 0 when
+// they are too close to hold one.
+size_t log_midpoint(size_t low, size_t high);
+
+// Predicts the wall time of measuring a point at N from the points measured so far: their
+// cost grown along the log-log slope of the last two (clamped to 0 .. 1.5; 1 from one point),
+// or the cost of the nearest point above N.
+class CostPredictor {
+ public:
+  void add(size_t n, double seconds) { measured_[n] = seconds; }
+  bool empty() const { return measured_.empty(); }
+  double predict(size_t n) const;
+
+ private:
+  std::map<size_t, double> measured_;
+};
+
+}  // namespace rvr::study

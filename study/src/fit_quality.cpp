@@ -1,0 +1,65 @@
+// R², the largest relative residual and the leave-one-out error of a fit (see fit_quality.h).
+#include "rvr/study/fit_quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "rvr/study/fit.h"
+
+namespace rvr::study {
+namespace {
+
+double weighted_r2(const std::vector<double>& t, const std::vector<double>& model) {
+  double sw = 0, swt = 0;
+  for (double v : t) {
+    sw += 1 / (v * v);
+    swt += v / (v * v);
+  }
+  const double mean = swt / sw;
+  double residual = 0, total = 0;
+  for (size_t i = 0; i < t.size(); ++i) {
+    double w = 1 / (t[i] * t[i]);
+    residual += w * (t[i] - model[i]) * (t[i] - model[i]);
+    total += w * (t[i] - mean) * (t[i] - mean);
+  }
+  return total > 0 ? 1 - residual / total : (residual == 0 ? 1.0 : 0.0);
+}
+
+// Each point predicted by the model fitted to all the others.
+double leave_one_out(ModelForm form, const std::vector<Measurement>& points,
+                     const std::vector<double>& medians, const std::vector<bool>& use) {
+  double sum = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    std::vector<Measurement> rest;
+    std::vector<double> rest_medians;
+    for (size_t j = 0; j < points.size(); ++j)
+      if (j != i) {
+        rest.push_back(points[j]);
+        rest_medians.push_back(medians[j]);
+      }
+    Expected<std::vector<double>> c = fit_coefficients(form, rest, rest_medians, use);
+    if (!c) return std::numeric_limits<double>::infinity();
+    double e = (medians[i] - predict(form, *c, points[i].pixels, points[i].n)) / medians[i];
+    sum += e * e;
+  }
+  return std::sqrt(sum / double(points.size()));
+}
+
+}  // namespace
+
+FitQuality fit_quality(ModelForm form, const std::vector<Measurement>& points,
+                       const std::vector<double>& medians, const std::vector<double>& coefficients,
+                       const std::vector<bool>& use) {
+  FitQuality q;
+  std::vector<double> model;
+  for (const Measurement& p : points) model.push_back(predict(form, coefficients, p.pixels, p.n));
+  q.r2 = weighted_r2(medians, model);
+  for (size_t i = 0; i < points.size(); ++i)
+    q.max_rel_residual =
+        std::max(q.max_rel_residual, std::fabs(medians[i] - model[i]) / medians[i]);
+  q.loo_rel_error = leave_one_out(form, points, medians, use);
+  return q;
+}
+
+}  // namespace rvr::study

@@ -1,0 +1,203 @@
+// The study's sweep within its budget (see run_study.h).
+#include "rvr/study/run_study.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "rvr/renderers/registry.h"
+#include "rvr/study/bootstrap.h"
+#include "rvr/study/conclusions.h"
+#include "rvr/study/sweep_plan.h"
+
+namespace rvr::study {
+namespace {
+
+// Of the budget share of a scene, what the log-spaced sweep may use; the rest is for the
+// points added near crossovers.
+constexpr double kBaseShare = 0.8;
+constexpr int kRefinementRounds = 3;
+
+Status validate(const StudyRequest& r) {
+  if (r.scenes.empty()) return bad_input("study: no scene family given");
+  for (const std::string& s : r.scenes)
+    if (Expected<Family> f = find_family(s); !f) return f.error();
+  if (r.renderers.empty()) return bad_input("--renderers: no renderer given");
+  for (const std::string& name : r.renderers)
+    if (Expected<RendererChoice> c = find_renderer_choice(name); !c) return c.error();
+  if (!(r.budget_seconds > 0) || !std::isfinite(r.budget_seconds))
+    return bad_input(fmt::format("--budget: must be > 0 seconds, got {}", r.budget_seconds));
+  if (r.width < 16 || r.width > 16384)
+    return bad_input(fmt::format("--width: must be in 16 .. 16384, got {}", r.width));
+  // Fewer, and the bootstrap's 95% intervals hold the truth only ~85% of the time (test_study).
+  if (r.repetitions < 5)
+    return bad_input(fmt::format("--repetitions: must be >= 5, got {}", r.repetitions));
+  return ok_status();
+}
+
+// The state of one running study.
+class Sweep {
+ public:
+  Sweep(const StudyRequest& request, const StudyHooks& hooks, StudyResult& result)
+      : request_(request), hooks_(hooks), result_(result), rng_(request.seed) {
+    if (!hooks_.now) {
+      hooks_.now = [] {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch())
+            .count();
+      };
+    }
+    start_ = hooks_.now();
+  }
+
+  double elapsed() const { return hooks_.now() - start_; }
+
+  Status run_scene(const Family& family, double share_end);
+
+ private:
+  Status measure(const Family& family, size_t n, double deadline);
+  void time_rounds(const Family& family, size_t n, FrameSource& frames, double deadline,
+                   std::vector<Measurement>& points, Status& status);
+  std::vector<size_t> crossover_midpoints(const Family& family) const;
+  void progress(const std::string& what) const {
+    if (hooks_.on_progress) hooks_.on_progress(what);
+  }
+
+  const StudyRequest& request_;
+  StudyHooks hooks_;
+  StudyResult& result_;
+  Rng rng_;
+  double start_ = 0;
+  std::set<std::pair<std::string, size_t>> measured_;
+};
+
+// Times `request.repetitions` rounds; in each, every renderer once, in a fresh random order.
+// Stops after the fifth round once `deadline` has passed.
+void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, double deadline,
+                        std::vector<Measurement>& points, Status& status) {
+  std::vector<size_t> order(points.size());
+  for (int round = 0; round < request_.repetitions; ++round) {
+    if (round >= 5 && elapsed() > deadline) break;
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng_.below(i)]);
+    for (size_t k = 0; k < order.size(); ++k) {
+      progress(fmt::format("{} N={} round {}/{} {}", family.name, n, round + 1,
+                           request_.repetitions, request_.renderers[order[k]]));
+      Expected<double> t = frames.time_frame(order[k]);
+      if (!t) {
+        status = t.error();
+        return;
+      }
+      points[order[k]].seconds.push_back(*t);
+      points[order[k]].order.push_back(int(k));
+    }
+  }
+}
+
+// Measures builtin:<family>:<n> with every renderer; the points join the result.
+Status Sweep::measure(const Family& family, size_t n, double deadline) {
+  progress(fmt::format("{} N={}: preparing", family.name, n));
+  Expected<std::unique_ptr<FrameSource>> frames = hooks_.prepare(family.name, n);
+  if (!frames) return frames.error();
+  std::vector<Measurement> points;
+  for (const std::string& name : request_.renderers) {
+    Measurement m;
+    m.renderer = name;
+    m.scene = family.name;
+    m.scene_n = double(n);
+    m.n = (*frames)->axis_value();
+    m.pixels = (*frames)->pixels();
+    m.width = request_.width;
+    m.height = request_.width * 3 / 4;
+    points.push_back(m);
+  }
+  Status status = ok_status();
+  time_rounds(family, n, **frames, deadline, points, status);
+  if (!status) return status;
+  for (Measurement& m : points) result_.points.push_back(std::move(m));
+  measured_.insert({family.name, n});
+  return ok_status();
+}
+
+// The midpoints (in log N) of every bracket of measured points between which two renderers of
+// different loop orders change places.
+std::vector<size_t> Sweep::crossover_midpoints(const Family& family) const {
+  std::map<size_t, std::map<std::string, double>> t;  // n -> renderer -> median
+  for (const Measurement& m : result_.points)
+    if (m.scene == family.name) t[size_t(m.scene_n)][m.renderer] = typical_seconds(m);
+  std::set<size_t> mids;
+  for (size_t i = 0; i < request_.renderers.size(); ++i)
+    for (size_t j = i + 1; j < request_.renderers.size(); ++j) {
+      const std::string &a = request_.renderers[i], &b = request_.renderers[j];
+      if (find_renderer_choice(a)->info->order == find_renderer_choice(b)->info->order) continue;
+      for (auto it = t.begin(); it != t.end() && std::next(it) != t.end(); ++it) {
+        auto next = std::next(it);
+        bool before = it->second.at(a) < it->second.at(b);
+        bool after = next->second.at(a) < next->second.at(b);
+        if (before != after)
+          if (size_t mid = log_midpoint(it->first, next->first)) mids.insert(mid);
+      }
+    }
+  return {mids.begin(), mids.end()};
+}
+
+// The log-spaced sweep up to kBaseShare of the scene's share, then points near crossovers.
+Status Sweep::run_scene(const Family& family, double share_end) {
+  const double share_start = elapsed();
+  const double base_end = share_start + kBaseShare * (share_end - share_start);
+  CostPredictor cost;
+  auto try_point = [&](size_t n, double limit) -> Expected<bool> {
+    if (measured_.count({family.name, n})) return false;
+    if (!cost.empty() && elapsed() + cost.predict(n) > limit) return false;
+    double before = elapsed();
+    if (Status s = measure(family, n, share_end); !s) return s.error();
+    cost.add(n, elapsed() - before);
+    return true;
+  };
+  for (size_t n : log_spaced(family.low, family.high, family.points)) {
+    Expected<bool> done = try_point(n, base_end);
+    if (!done) return done.error();
+    if (!*done) {
+      result_.notes.push_back(
+          fmt::format("{}: the sweep stopped below N={} (its points would have overrun the budget)",
+                      family.name, n));
+      break;
+    }
+  }
+  for (int round = 0; round < kRefinementRounds; ++round)
+    for (size_t mid : crossover_midpoints(family))
+      if (Expected<bool> done = try_point(mid, share_end); !done) return done.error();
+  return ok_status();
+}
+
+}  // namespace
+
+Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& hooks) {
+  if (Status s = validate(request); !s) return s.error();
+  StudyResult result;
+  result.renderers = request.renderers;
+  result.width = request.width;
+  result.height = request.width * 3 / 4;
+  result.mode = to_string(request.mode);
+  result.budget_seconds = request.budget_seconds;
+  result.repetitions = request.repetitions;
+  result.seed = request.seed;
+  result.bootstrap_replicates = request.bootstrap_replicates;
+  Sweep sweep(request, hooks, result);
+  for (size_t i = 0; i < request.scenes.size(); ++i) {
+    Family family = *find_family(request.scenes[i]);
+    result.scenes.push_back(family.name);
+    result.axes[family.name] = family.axis;
+    double left = request.budget_seconds - sweep.elapsed();
+    double share_end = sweep.elapsed() + left / double(request.scenes.size() - i);
+    if (Status s = sweep.run_scene(family, share_end); !s) return s.error();
+  }
+  result.elapsed_seconds = sweep.elapsed();
+  BootstrapOptions boot{request.bootstrap_replicates, request.seed};
+  conclude(result, boot);
+  return result;
+}
+
+}  // namespace rvr::study

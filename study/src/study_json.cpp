@@ -1,0 +1,147 @@
+// study.json (see study_json.h).
+#include "rvr/study/study_json.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+namespace rvr::study {
+namespace {
+
+using nlohmann::json;
+
+json number(double v) {
+  return std::isfinite(v) ? json(v) : json(nullptr);
+}
+
+json interval(const Interval& i) {
+  return json::array({number(i.low), number(i.high)});
+}
+
+json fit_json(const ModelFit& f) {
+  json coefficients = json::object();
+  for (const Coefficient& c : f.coefficients)
+    coefficients[c.name] = {{"value", c.identifiable ? number(c.value) : json(nullptr)},
+                            {"ci95", c.identifiable ? interval(c.ci95) : json(nullptr)},
+                            {"identifiable", c.identifiable}};
+  return {{"coefficients", coefficients},
+          {"r2", number(f.r2)},
+          {"max_rel_residual", number(f.max_rel_residual)},
+          {"loo_rel_error", number(f.loo_rel_error)},
+          {"points", f.points},
+          {"fits", f.fits},
+          {"verdict", f.verdict},
+          {"fixed_pixels", f.fixed_pixels > 0 ? json(f.fixed_pixels) : json(nullptr)}};
+}
+
+json renderers_json(const StudyResult& r) {
+  json out = json::object();
+  for (const RendererModels& m : r.models) {
+    json fits = json::object();
+    for (const auto& [scene, f] : m.fits) fits[scene] = fit_json(f);
+    out[m.name] = {{"loop_order", m.loop_order},
+                   {"model", to_string(m.form)},
+                   {"formula", formula(m.form)},
+                   {"fits", fits}};
+  }
+  return out;
+}
+
+json crossovers_json(const StudyResult& r) {
+  json out = json::array();
+  for (const Crossover& c : r.crossovers)
+    out.push_back({{"a", c.a},
+                   {"b", c.b},
+                   {"scene", c.scene},
+                   {"axis", c.axis},
+                   {"value", number(c.value)},
+                   {"ci95", interval(c.ci95)},
+                   {"pixels", c.pixels},
+                   {"a_faster_below", c.a_faster_below},
+                   {"measured", c.measured},
+                   {"range", json::array({c.range_low, c.range_high})}});
+  return out;
+}
+
+void conclusions_json(const StudyResult& r, json& doc) {
+  json dominance = json::array();
+  for (const Dominance& d : r.dominance)
+    dominance.push_back({{"faster", d.faster},
+                         {"slower", d.slower},
+                         {"scene", d.scene},
+                         {"axis", d.axis},
+                         {"min_ratio", number(d.min_ratio)},
+                         {"at", d.at},
+                         {"pixels", d.pixels},
+                         {"range", json::array({d.range_low, d.range_high})}});
+  json scaling = json::array();
+  for (const ScalingExponent& s : r.scaling)
+    scaling.push_back({{"renderer", s.renderer},
+                       {"scene", s.scene},
+                       {"from", s.from},
+                       {"to", s.to},
+                       {"exponent", number(s.exponent)}});
+  json costs = json::array();
+  for (const UnitCost& c : r.costs)
+    costs.push_back({{"renderer", c.renderer},
+                     {"scene", c.scene},
+                     {"n", c.n},
+                     {"seconds", number(c.seconds)},
+                     {"ns_per_triangle", number(c.ns_per_triangle)},
+                     {"ns_per_ray", number(c.ns_per_ray)}});
+  doc["dominance"] = dominance;
+  doc["scaling"] = scaling;
+  doc["costs"] = costs;
+}
+
+json points_json(const StudyResult& r) {
+  json out = json::array();
+  for (const Measurement& m : r.points) {
+    json seconds = json::array();
+    for (double s : m.seconds) seconds.push_back(number(s));
+    out.push_back({{"renderer", m.renderer},
+                   {"scene", m.scene},
+                   {"scene_n", m.scene_n},
+                   {"n", m.n},
+                   {"width", m.width},
+                   {"height", m.height},
+                   {"pixels", m.pixels},
+                   {"seconds", seconds},
+                   {"order", m.order},
+                   {"median", number(median_seconds(m))},
+                   {"hd_median", number(typical_seconds(m))},
+                   {"relative_mad", number(relative_mad(m))}});
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string study_json(const StudyResult& r) {
+  json scenes = json::array();
+  for (const std::string& s : r.scenes) scenes.push_back({{"name", s}, {"axis", r.axes.at(s)}});
+  json doc = {{"format", kStudyFormat},
+              {"command", r.command},
+              {"scenes", scenes},
+              {"renderer_order", r.renderers},
+              {"width", r.width},
+              {"height", r.height},
+              {"mode", r.mode},
+              {"budget_seconds", r.budget_seconds},
+              {"elapsed_seconds", number(r.elapsed_seconds)},
+              {"repetitions", r.repetitions},
+              {"seed", r.seed},
+              {"bootstrap_replicates", r.bootstrap_replicates},
+              {"machine",
+               {{"cpu", r.machine.cpu},
+                {"threads", r.machine.threads},
+                {"kernels", r.machine.kernels},
+                {"versions", r.machine.versions}}},
+              {"renderers", renderers_json(r)},
+              {"crossovers", crossovers_json(r)},
+              {"notes", r.notes}};
+  conclusions_json(r, doc);
+  doc["points"] = points_json(r);
+  return doc.dump(2) + "\n";
+}
+
+}  // namespace rvr::study

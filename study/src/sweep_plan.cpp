@@ -1,0 +1,49 @@
+// The sweep's grid and the cost predictions that keep it within the budget (see sweep_plan.h).
+#include "rvr/study/sweep_plan.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rvr::study {
+
+Expected<Family> find_family(const std::string& name) {
+  std::string bare = name.rfind("builtin:", 0) == 0 ? name.substr(8) : name;
+  if (bare == "tessphere") return Family{"tessphere", "triangles", 100, 1000000, 13};
+  if (bare == "soup") return Family{"soup", "triangles", 100, 1000000, 13};
+  if (bare == "occluders") return Family{"occluders", "depth", 1, 256, 9};
+  return bad_input(name +
+                   ": not a scene family the study sweeps (builtin:tessphere, builtin:soup, "
+                   "builtin:occluders; the study chooses N)");
+}
+
+std::vector<size_t> log_spaced(size_t low, size_t high, int count) {
+  std::vector<size_t> out;
+  for (int i = 0; i < count; ++i) {
+    double f = count > 1 ? double(i) / double(count - 1) : 0.0;
+    size_t v = size_t(std::llround(double(low) * std::pow(double(high) / double(low), f)));
+    if (out.empty() || v != out.back()) out.push_back(v);
+  }
+  return out;
+}
+
+size_t log_midpoint(size_t low, size_t high) {
+  size_t mid = size_t(std::llround(std::sqrt(double(low) * double(high))));
+  return mid > low && mid < high ? mid : 0;
+}
+
+double CostPredictor::predict(size_t n) const {
+  if (measured_.empty()) return 0;
+  auto above = measured_.lower_bound(n);
+  if (above != measured_.end()) return above->second;
+  auto last = std::prev(measured_.end());
+  double slope = 1.0;
+  if (measured_.size() >= 2) {
+    auto before = std::prev(last);
+    slope = std::log(last->second / before->second) /
+            std::log(double(last->first) / double(before->first));
+    slope = std::clamp(std::isfinite(slope) ? slope : 1.0, 0.0, 1.5);
+  }
+  return last->second * std::pow(double(n) / double(last->first), slope);
+}
+
+}  // namespace rvr::study

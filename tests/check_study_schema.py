@@ -1,0 +1,117 @@
+#!/usr/bin/python3
+"""Checks `rvr study` as a user runs it, and docs/rvr-study-1.schema.json against its output.
+
+1. The schema is a valid draft 2020-12 schema.
+2. A small study (builtin:tessphere, --width 128, --budget 20) exits 0, writes study.json that
+   the schema accepts (every renderer of the default set with a fit for tessphere, every point
+   with its repetitions) and study.md with its sections, within the budget and a margin.
+3. Bad input (an unknown family, --budget 0 or negative, an unknown renderer) exits 2 with one
+   line starting "error: " and creates nothing.
+
+Usage: check_study_schema.py --rvr build/bin/rvr --source-dir . [--work-dir DIR]
+Exits 1 with one line per failure.
+"""
+
+import argparse
+import json
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+try:
+    import jsonschema
+except ImportError:
+    print("FAIL: python3-jsonschema is missing (make deps)")
+    sys.exit(1)
+
+FAILURES = []
+
+
+def failure(message):
+    FAILURES.append(message)
+    print("FAIL: " + message)
+
+
+def run(cmd, timeout=100):
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+
+
+def check_study(rvr, validator, work):
+    out = work / "study"
+    start = time.monotonic()
+    r = run([rvr, "study", "builtin:tessphere", "--budget", "20", "--width", "128", "--quiet",
+             "-o", str(out)])
+    seconds = time.monotonic() - start
+    if r.returncode != 0:
+        failure(f"rvr study: exit {r.returncode}: {r.stderr.strip()}")
+        return
+    if seconds > 40:
+        failure(f"rvr study --budget 20 took {seconds:.0f} s")
+    doc = json.loads((out / "study.json").read_text())
+    for e in validator.iter_errors(doc):
+        path = "/".join(str(p) for p in e.absolute_path) or "(top)"
+        failure(f"study.json: schema: {path}: {e.message}")
+    for name in ["softraster", "raytrace", "hybrid_soft"]:
+        if "tessphere" not in doc["renderers"].get(name, {}).get("fits", {}):
+            failure(f"study.json: renderers.{name}.fits.tessphere missing")
+    if len(doc["points"]) < 3 * 3:
+        failure(f"study.json: only {len(doc['points'])} points")
+    md = (out / "study.md").read_text()
+    for section in ["## Crossovers", "## Cost models", "## Scaling"]:
+        if section not in md:
+            failure(f"study.md: no '{section}' section")
+    print(f"study: {len(doc['points'])} points in {seconds:.1f} s; "
+          f"{len(doc['crossovers'])} crossovers, {len(doc['dominance'])} without")
+
+
+def check_refused(rvr, work):
+    cases = [
+        ("an unknown family", ["builtin:cornell"], "builtin:cornell: "),
+        ("budget 0", ["builtin:tessphere", "--budget", "0"], "--budget"),
+        ("a negative budget", ["builtin:tessphere", "--budget=-3"], "--budget"),
+        ("an unknown renderer", ["builtin:tessphere", "-r", "nosuch"], "nosuch"),
+    ]
+    for what, args, words in cases:
+        out = work / "refused"
+        shutil.rmtree(out, ignore_errors=True)
+        r = run([rvr, "study", *args, "-o", str(out)])
+        lines = r.stderr.strip().splitlines()
+        if r.returncode != 2 or len(lines) != 1 or not lines[0].startswith("error: ") \
+                or words not in lines[0]:
+            failure(f"{what}: want exit 2 and one 'error: ...{words}...' line, got exit "
+                    f"{r.returncode}: {r.stderr.strip()}")
+        if out.exists():
+            failure(f"{what}: the output folder was created")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--rvr", required=True)
+    ap.add_argument("--source-dir", required=True)
+    ap.add_argument("--work-dir", help="default: a temporary folder")
+    args = ap.parse_args()
+    source = Path(args.source_dir).resolve()
+    work = Path(args.work_dir or tempfile.mkdtemp(prefix="rvr-study-schema-"))
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    schema = json.loads((source / "docs/rvr-study-1.schema.json").read_text())
+    Validator = jsonschema.Draft202012Validator
+    try:
+        Validator.check_schema(schema)
+    except jsonschema.exceptions.SchemaError as e:
+        failure(f"schema: not a valid draft 2020-12 schema: {e.message}")
+        return 1
+    check_refused(args.rvr, work)
+    check_study(args.rvr, Validator(schema), work)
+    if FAILURES:
+        print(f"{len(FAILURES)} failure(s)")
+        return 1
+    print("PASS")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
