@@ -454,16 +454,9 @@ TEST(GlRaster, NoCostAovLeavesEveryOtherBufferAsItWas) {
     options.cost_aov = false;
     Expected<RenderOutput> without = r.render(s, options);
     ASSERT_TRUE(without.ok()) << without.error().message;
-    const FrameBuffers &a = with->buffers, &b = without->buffers;
-    EXPECT_TRUE(test::same_bytes(a.color, b.color)) << to_string(mode);
-    EXPECT_TRUE(test::same_bytes(a.normal, b.normal)) << to_string(mode);
-    EXPECT_TRUE(test::same_bytes(a.depth, b.depth)) << to_string(mode);
-    EXPECT_TRUE(test::same_bytes(a.object_id, b.object_id)) << to_string(mode);
-    EXPECT_TRUE(test::same_bytes(a.primitive_id, b.primitive_id)) << to_string(mode);
-    EXPECT_TRUE(std::all_of(b.cost.begin(), b.cost.end(), [](float c) {
-      return std::signbit(c) == 0 && c == 0.0f;
-    })) << to_string(mode);
-    EXPECT_TRUE(std::any_of(a.cost.begin(), a.cost.end(), [](float c) { return c > 1.0f; }));
+    test::expect_only_the_cost_left_out(with->buffers, without->buffers, to_string(mode));
+    const PixelVector<float>& cost = with->buffers.cost;  // overdraw counted: some pixel above 1
+    EXPECT_TRUE(std::any_of(cost.begin(), cost.end(), [](float c) { return c > 1.0f; }));
   }
 }
 

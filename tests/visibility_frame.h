@@ -81,4 +81,23 @@ inline void expect_visibility_frame(const Scene& scene, const FrameBuffers& loca
   EXPECT_TRUE(same_bytes(no_cost.normal, visibility.normal)) << label;
 }
 
+// The same frame drawn with the cost AOV (`with`) and without it (`without`): every other
+// buffer the same bytes, the cost +0 everywhere without, and work counted with.
+inline void expect_only_the_cost_left_out(const FrameBuffers& with, const FrameBuffers& without,
+                                          const std::string& what) {
+  EXPECT_TRUE(same_bytes(with.color, without.color)) << what;
+  EXPECT_TRUE(same_bytes(with.normal, without.normal)) << what;
+  EXPECT_TRUE(same_bytes(with.depth, without.depth)) << what;
+  EXPECT_TRUE(same_bytes(with.object_id, without.object_id)) << what;
+  EXPECT_TRUE(same_bytes(with.primitive_id, without.primitive_id)) << what;
+  for (float c : without.cost)
+    if (std::signbit(c) || c != 0.0f) {
+      ADD_FAILURE() << what << ": cost " << c << " without the cost AOV";
+      break;
+    }
+  bool counted = false;
+  for (float c : with.cost) counted = counted || c > 0.0f;
+  EXPECT_TRUE(counted) << what << ": no work counted with the cost AOV";
+}
+
 }  // namespace rvr::test
