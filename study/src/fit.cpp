@@ -78,6 +78,7 @@ ModelFit fit_model(ModelForm form, const std::vector<Measurement>& points,
                    const BootstrapOptions& boot, const FitThresholds& limits) {
   ModelFit f;
   f.form = form;
+  f.formula = formula(form);
   f.points = points.size();
   f.fixed_pixels = shared_pixels(points);
   std::vector<bool> use = identifiable_terms(form, points);
@@ -119,6 +120,10 @@ std::vector<double> coefficient_values(const ModelFit& fit) {
   std::vector<double> v;
   for (const Coefficient& c : fit.coefficients) v.push_back(c.identifiable ? c.value : 0.0);
   return v;
+}
+
+double predict_seconds(const ModelFit& fit, double pixels, double n) {
+  return predict(fit.form, coefficient_values(fit), pixels, n);
 }
 
 }  // namespace rvr::study

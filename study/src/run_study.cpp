@@ -53,6 +53,7 @@ class Sweep {
   }
 
   double elapsed() const { return hooks_.now() - start_; }
+  bool cancelled() const { return hooks_.cancelled && hooks_.cancelled(); }
 
   Status run_scene(const Family& family, double share_end);
 
@@ -85,6 +86,7 @@ void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, dou
     for (size_t k = 0; k < order.size(); ++k) {
       progress(fmt::format("{} N={} round {}/{} {}", family.name, n, round + 1,
                            request_.repetitions, request_.renderers[order[k]]));
+      if (cancelled()) return;
       Expected<double> t = frames.time_frame(order[k]);
       if (!t) {
         status = t.error();
@@ -116,6 +118,7 @@ Status Sweep::measure(const Family& family, size_t n, double deadline) {
   Status status = ok_status();
   time_rounds(family, n, **frames, deadline, points, status);
   if (!status) return status;
+  if (cancelled()) return ok_status();  // the point is incomplete: dropped
   for (Measurement& m : points) result_.points.push_back(std::move(m));
   measured_.insert({family.name, n});
   return ok_status();
@@ -157,6 +160,7 @@ Status Sweep::run_scene(const Family& family, double share_end) {
     return true;
   };
   for (size_t n : log_spaced(family.low, family.high, family.points)) {
+    if (cancelled()) return ok_status();
     Expected<bool> done = try_point(n, base_end);
     if (!done) return done.error();
     if (!*done) {
@@ -168,7 +172,8 @@ Status Sweep::run_scene(const Family& family, double share_end) {
   }
   for (int round = 0; round < kRefinementRounds; ++round)
     for (size_t mid : crossover_midpoints(family))
-      if (Expected<bool> done = try_point(mid, share_end); !done) return done.error();
+      if (cancelled()) return ok_status();
+      else if (Expected<bool> done = try_point(mid, share_end); !done) return done.error();
   return ok_status();
 }
 
@@ -193,6 +198,12 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
     double left = request.budget_seconds - sweep.elapsed();
     double share_end = sweep.elapsed() + left / double(request.scenes.size() - i);
     if (Status s = sweep.run_scene(family, share_end); !s) return s.error();
+    if (sweep.cancelled()) break;
+  }
+  if (sweep.cancelled()) {
+    result.interrupted = true;
+    result.notes.push_back("the study was interrupted: it is concluded from the points measured "
+                           "before the interruption");
   }
   result.elapsed_seconds = sweep.elapsed();
   BootstrapOptions boot{request.bootstrap_replicates, request.seed};

@@ -23,7 +23,8 @@ json fit_json(const ModelFit& f) {
     coefficients[c.name] = {{"value", c.identifiable ? number(c.value) : json(nullptr)},
                             {"ci95", c.identifiable ? interval(c.ci95) : json(nullptr)},
                             {"identifiable", c.identifiable}};
-  return {{"coefficients", coefficients},
+  return {{"formula", f.formula},
+          {"coefficients", coefficients},
           {"r2", number(f.r2)},
           {"max_rel_residual", number(f.max_rel_residual)},
           {"loo_rel_error", number(f.loo_rel_error)},
@@ -56,6 +57,7 @@ json crossovers_json(const StudyResult& r) {
                    {"value", number(c.value)},
                    {"ci95", interval(c.ci95)},
                    {"pixels", c.pixels},
+                   {"n", c.n},
                    {"a_faster_below", c.a_faster_below},
                    {"measured", c.measured},
                    {"range", json::array({c.range_low, c.range_high})}});
@@ -72,6 +74,7 @@ void conclusions_json(const StudyResult& r, json& doc) {
                          {"min_ratio", number(d.min_ratio)},
                          {"at", d.at},
                          {"pixels", d.pixels},
+                         {"n", d.n},
                          {"range", json::array({d.range_low, d.range_high})}});
   json scaling = json::array();
   for (const ScalingExponent& s : r.scaling)
@@ -138,7 +141,8 @@ std::string study_json(const StudyResult& r) {
                 {"versions", r.machine.versions}}},
               {"renderers", renderers_json(r)},
               {"crossovers", crossovers_json(r)},
-              {"notes", r.notes}};
+              {"notes", r.notes},
+              {"interrupted", r.interrupted}};
   conclusions_json(r, doc);
   doc["points"] = points_json(r);
   return doc.dump(2) + "\n";

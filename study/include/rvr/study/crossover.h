@@ -17,7 +17,8 @@ struct Crossover {
   double value = 0;  // the axis value where t_a = t_b
   // 95% interval; −inf / +inf when over 2.5% of the replicates put it below / above the range.
   Interval ci95;
-  double pixels = 0;
+  double pixels = 0;  // the pixel count held fixed (axis "triangles" or "depth")
+  double n = 0;       // the axis value held fixed when the axis is "pixels"
   bool a_faster_below = true;            // a is the faster one below `value`
   bool measured = true;                  // false: the fitted models', outside the swept range
   double range_low = 0, range_high = 0;  // the swept axis range
@@ -29,6 +30,7 @@ struct Dominance {
   double min_ratio = 0;  // the slower's time over the faster's, at its smallest over the range
   double at = 0;         // where that smallest ratio is
   double pixels = 0;
+  double n = 0;  // as in Crossover
   double range_low = 0, range_high = 0;
 };
 

@@ -29,6 +29,7 @@ struct FitThresholds {
 
 struct ModelFit {
   ModelForm form = ModelForm::ZBuffer;
+  std::string formula;  // the model fitted, with any extension the data demanded
   std::vector<Coefficient> coefficients;
   double r2 = 0;                // weighted (1/t²) coefficient of determination
   double max_rel_residual = 0;  // largest |t − model| / t over the points
@@ -59,5 +60,8 @@ ModelFit fit_model(ModelForm form, const std::vector<Measurement>& points,
 
 // The coefficients as fitted (b, when folded into a, as 0): for predict().
 std::vector<double> coefficient_values(const ModelFit& fit);
+
+// The fitted model's time of a frame of P pixels and axis value N (what charts draw).
+double predict_seconds(const ModelFit& fit, double pixels, double n);
 
 }  // namespace rvr::study

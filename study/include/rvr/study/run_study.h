@@ -45,6 +45,9 @@ struct StudyHooks {
   PrepareFrames prepare;
   std::function<double()> now;  // seconds on a steady clock; null: std::chrono::steady_clock
   std::function<void(const std::string& what)> on_progress;  // null: nothing shown
+  // Polled between frames; true stops the sweep (the point being measured is dropped) and the
+  // study is concluded from the points measured so far, with `interrupted` set.
+  std::function<bool()> cancelled;
 };
 
 // Validates the request (families, renderer names, budget, width, repetitions: BadInput errors

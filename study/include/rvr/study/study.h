@@ -61,6 +61,7 @@ struct StudyResult {
   std::vector<ScalingExponent> scaling;
   std::vector<UnitCost> costs;
   std::vector<std::string> notes;  // what the budget cut short, and the like
+  bool interrupted = false;        // the sweep was stopped (Ctrl-C) before its end
 };
 
 }  // namespace rvr::study
