@@ -54,11 +54,12 @@ class RendererFrames : public FrameSource {
 }  // namespace
 
 PrepareFrames renderer_frames(const StudyRequest& request) {
-  return [request](const std::string& family, size_t n) -> Expected<std::unique_ptr<FrameSource>> {
+  return [request](const std::string& family, size_t n,
+                   int width) -> Expected<std::unique_ptr<FrameSource>> {
     Expected<Scene> scene = make_builtin_scene(family + ":" + std::to_string(n));
     if (!scene) return scene.error();
-    scene->image.width = request.width;
-    scene->image.height = request.width * 3 / 4;
+    scene->image.width = width;
+    scene->image.height = width * 3 / 4;
     double axis = axis_value_of(*scene, family, n);
     auto frames =
         std::make_unique<RendererFrames>(std::make_unique<Scene>(std::move(*scene)), axis);

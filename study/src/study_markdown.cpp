@@ -20,10 +20,18 @@ std::string interval_text(const Crossover& c) {
   return fmt::format("(95%: {} – {})", lo, hi);
 }
 
+// "at 1024×768 on tessphere", or on the pixels axis "on tessphere with 1.0×10^6 triangles".
+std::string where_text(const StudyResult& r, const std::string& scene, const std::string& axis,
+                       double n) {
+  if (axis == kPixelsAxis)
+    return fmt::format("on {} with {} {}", scene, format_number(n), r.axes.at(scene));
+  return fmt::format("at {}×{} on {}", r.width, r.height, scene);
+}
+
 std::string crossover_sentence(const StudyResult& r, const Crossover& c) {
   const std::string& below = c.a_faster_below ? c.a : c.b;
   const std::string& above = c.a_faster_below ? c.b : c.a;
-  std::string where = fmt::format("at {}×{} on {}", r.width, r.height, c.scene);
+  std::string where = where_text(r, c.scene, c.axis, c.n);
   if (!c.measured)
     return fmt::format(
         "- {}, the fitted models put the crossover of {} and {} at {} {}, outside the swept "
@@ -36,10 +44,10 @@ std::string crossover_sentence(const StudyResult& r, const Crossover& c) {
 
 std::string dominance_sentence(const StudyResult& r, const Dominance& d) {
   return fmt::format(
-      "- at {}×{} on {}, {} is faster than {} over the whole swept range {}, by at least {:.2f}× "
-      "(at {} {}).\n",
-      r.width, r.height, d.scene, d.faster, d.slower, range_text(d.range_low, d.range_high, d.axis),
-      d.min_ratio, format_number(d.at), d.axis);
+      "- {}, {} is faster than {} over the whole swept range {}, by at least {:.2f}× (at {} "
+      "{}).\n",
+      where_text(r, d.scene, d.axis, d.n), d.faster, d.slower,
+      range_text(d.range_low, d.range_high, d.axis), d.min_ratio, format_number(d.at), d.axis);
 }
 
 std::string coefficient_text(const Coefficient& c) {
@@ -54,16 +62,16 @@ std::string coefficient_text(const Coefficient& c) {
 std::string model_sentence(const RendererModels& m, const std::string& scene, const ModelFit& f) {
   if (!f.fits)
     return fmt::format("- {} on {}: the model {} {}; no conclusion is drawn from it.\n", m.name,
-                       scene, formula(m.form), f.verdict);
+                       scene, f.formula, f.verdict);
   std::string terms;
   for (const Coefficient& c : f.coefficients)
     if (c.identifiable) terms += (terms.empty() ? "" : ", ") + coefficient_text(c);
   std::string folded = f.fixed_pixels > 0 ? " (one image size: a includes b·P)" : "";
   return fmt::format(
       "- {} on {}: {} with {}{}; R² {:.3f}, largest residual {:.0f}%, leave-one-out error "
-      "{:.0f}%.\n",
-      m.name, scene, formula(m.form), terms, folded, f.r2, 100 * f.max_rel_residual,
-      100 * f.loo_rel_error);
+      "{:.0f}% (median); {}.\n",
+      m.name, scene, f.formula, terms, folded, f.r2, 100 * f.max_rel_residual,
+      100 * f.loo_rel_error, f.selection);
 }
 
 std::string header(const StudyResult& r) {
@@ -85,8 +93,13 @@ std::string header(const StudyResult& r) {
 std::string scaling_section(const StudyResult& r) {
   std::string text = "\n## Scaling (log-log slope per decade)\n\n";
   for (const ScalingExponent& s : r.scaling)
-    text += fmt::format("- {} on {}: time grows as N^{:.2f} from {} to {}.\n", s.renderer, s.scene,
-                        s.exponent, format_number(s.from), format_number(s.to));
+    text +=
+        s.axis == kPixelsAxis
+            ? fmt::format("- {} on {} with {} {}: time grows as P^{:.2f} from {} to {} pixels.\n",
+                          s.renderer, s.scene, format_number(s.n), r.axes.at(s.scene), s.exponent,
+                          format_number(s.from), format_number(s.to))
+            : fmt::format("- {} on {}: time grows as N^{:.2f} from {} to {}.\n", s.renderer,
+                          s.scene, s.exponent, format_number(s.from), format_number(s.to));
   text += "\n## Cost per triangle and per ray\n\n";
   for (const UnitCost& c : r.costs)
     text += fmt::format("- {} on {} at {} {}: {} ms a frame, {} ns per triangle, {} ns per ray.\n",

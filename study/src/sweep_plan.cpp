@@ -26,6 +26,28 @@ std::vector<size_t> log_spaced(size_t low, size_t high, int count) {
   return out;
 }
 
+std::vector<int> pixel_sweep_widths(int width) {
+  std::vector<int> out;
+  for (int k = 4; k >= 1; --k) {
+    int w = 4 * int(std::lround(double(width) * std::pow(2.0, -0.5 * k) / 4));
+    w = std::max(w, 16);
+    if (w < width && (out.empty() || w != out.back())) out.push_back(w);
+  }
+  return out;
+}
+
+std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured) {
+  if (measured.empty()) return {};
+  const double middle = std::sqrt(double(measured.front()) * double(measured.back()));  // in log N
+  size_t nearest = measured.front();
+  for (size_t n : measured)
+    if (std::fabs(std::log(double(n) / middle)) < std::fabs(std::log(double(nearest) / middle)))
+      nearest = n;
+  std::vector<size_t> out = {measured.front(), nearest, measured.back()};
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
 size_t log_midpoint(size_t low, size_t high) {
   size_t mid = size_t(std::llround(std::sqrt(double(low) * double(high))));
   return mid > low && mid < high ? mid : 0;

@@ -23,6 +23,15 @@ Expected<Family> find_family(const std::string& name);
 // `count` values from low to high, evenly spaced in log, rounded, without repeats.
 std::vector<size_t> log_spaced(size_t low, size_t high, int count);
 
+// The narrower widths of the pixel sweep under `width`: width·2^(−k/2) for k = 1 … 4 (so the
+// pixel count falls by 16× in steps of 2×), rounded to multiples of 4, at least 16, in
+// increasing order, without repeats.
+std::vector<int> pixel_sweep_widths(int width);
+
+// The N at which the pixel sweep is taken, of those measured at the full width (in increasing
+// order): the smallest, the one nearest their geometric middle, and the largest.
+std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured);
+
 // The rounded geometric mean of two neighbours: the point that halves a bracket in log; 0 when
 // they are too close to hold one.
 size_t log_midpoint(size_t low, size_t high);
