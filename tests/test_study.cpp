@@ -371,7 +371,7 @@ TEST(StudyRun, SweepsWithinTheBudgetAndRefinesNearTheCrossover) {
   request.bootstrap_replicates = 200;
   StudyHooks hooks;
   hooks.now = [&] { return clock; };
-  hooks.prepare = [&](const std::string&, size_t n,
+  hooks.prepare = [&](const Family&, size_t n,
                       int width) -> Expected<std::unique_ptr<FrameSource>> {
     return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, clock, rng));
   };
@@ -403,7 +403,7 @@ TEST(StudyRun, SweepsWithinTheBudgetAndRefinesNearTheCrossover) {
 TEST(StudyRun, RefusesBadInputBeforeAnyWork) {
   bool prepared = false;
   StudyHooks hooks;
-  hooks.prepare = [&](const std::string&, size_t, int) -> Expected<std::unique_ptr<FrameSource>> {
+  hooks.prepare = [&](const Family&, size_t, int) -> Expected<std::unique_ptr<FrameSource>> {
     prepared = true;
     return internal_error("not reached");
   };

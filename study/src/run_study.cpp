@@ -110,7 +110,7 @@ void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, dou
 // Measures builtin:<family>:<n> at `width` with every renderer; the points join the result.
 Status Sweep::measure(const Family& family, size_t n, int width, double deadline) {
   progress(fmt::format("{} N={} {}×{}: preparing", family.name, n, width, width * 3 / 4));
-  Expected<std::unique_ptr<FrameSource>> frames = hooks_.prepare(family.name, n, width);
+  Expected<std::unique_ptr<FrameSource>> frames = hooks_.prepare(family, n, width);
   if (!frames) return frames.error();
   std::vector<Measurement> points;
   for (const std::string& name : request_.renderers) {

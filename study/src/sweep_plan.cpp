@@ -3,17 +3,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+
+#include "rvr/shared/scene_loader.h"
 
 namespace rvr::study {
 
+namespace {
+
+// A scene or model file as a family: copies of it, as many as hold kFileFamilyTriangles.
+Expected<Family> file_family(const std::string& path) {
+  Expected<Scene> scene = load_scene(path);
+  if (!scene) return scene.error();
+  double per_copy = 0;
+  for (const Object& o : scene->objects)
+    if (o.type == ObjectType::Triangles)
+      per_copy += double(o.mesh.triangle_count());
+    else if (o.type == ObjectType::Sphere)
+      per_copy += 1;
+  if (per_copy == 0)
+    return bad_input(path + ": objects: no mesh or sphere to copy for the study's sweep");
+  size_t high = size_t(std::clamp(std::floor(kFileFamilyTriangles / per_copy), 4.0, 1024.0));
+  return Family{std::filesystem::path(path).filename().string(), "triangles", 1, high, 9, path};
+}
+
+}  // namespace
+
 Expected<Family> find_family(const std::string& name) {
-  std::string bare = name.rfind("builtin:", 0) == 0 ? name.substr(8) : name;
-  if (bare == "tessphere") return Family{"tessphere", "triangles", 100, 1000000, 13};
-  if (bare == "soup") return Family{"soup", "triangles", 100, 1000000, 13};
-  if (bare == "occluders") return Family{"occluders", "depth", 1, 256, 9};
+  const bool builtin = name.rfind("builtin:", 0) == 0;
+  std::string bare = builtin ? name.substr(8) : name;
+  if (bare == "tessphere") return Family{"tessphere", "triangles", 100, 1000000, 13, ""};
+  if (bare == "soup") return Family{"soup", "triangles", 100, 1000000, 13, ""};
+  if (bare == "occluders") return Family{"occluders", "depth", 1, 256, 9, ""};
+  if (!builtin && std::filesystem::exists(name)) return file_family(name);
   return bad_input(name +
                    ": not a scene family the study sweeps (builtin:tessphere, builtin:soup, "
-                   "builtin:occluders; the study chooses N)");
+                   "builtin:occluders, or a scene or model file; the study chooses N)");
 }
 
 std::vector<size_t> log_spaced(size_t low, size_t high, int count) {

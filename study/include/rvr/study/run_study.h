@@ -13,6 +13,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/study/study.h"
+#include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 
@@ -38,9 +39,10 @@ class FrameSource {
   virtual Expected<double> time_frame(size_t index) = 0;
 };
 
-// Makes the FrameSource of builtin:<family>:<n> at `width` × width·3/4 pixels.
-using PrepareFrames = std::function<Expected<std::unique_ptr<FrameSource>>(
-    const std::string& family, size_t n, int width)>;
+// Makes the FrameSource of builtin:<family>:<n> (or n copies of the family's file) at
+// `width` × width·3/4 pixels.
+using PrepareFrames = std::function<Expected<std::unique_ptr<FrameSource>>(const Family& family,
+                                                                           size_t n, int width)>;
 
 struct StudyHooks {
   PrepareFrames prepare;

@@ -11,13 +11,19 @@
 namespace rvr::study {
 
 struct Family {
-  std::string name;          // "tessphere"
+  std::string name;          // "tessphere", or a file's name: "bunny.obj"
   std::string axis;          // "triangles", or "depth" for occluders (quads one behind another)
-  size_t low = 0, high = 0;  // the N of builtin:name:N swept
+  size_t low = 0, high = 0;  // the N of builtin:name:N swept, or the number of copies of a file
   int points = 0;            // log-spaced between them
+  std::string source;        // a scene or model file, grown by grid_of_copies; "" for built-ins
 };
 
-// "builtin:tessphere" (or "tessphere"); a BadInput error naming the families for any other.
+// The most triangles a file's grid of copies is grown to.
+constexpr double kFileFamilyTriangles = 2e6;
+
+// "builtin:tessphere" (or "tessphere"), or the path of a scene or model file: 1 … K copies of
+// it with K such that they hold about kFileFamilyTriangles (4 … 1024). A BadInput error naming
+// the families for any other built-in, and the loader's error for a file that does not load.
 Expected<Family> find_family(const std::string& name);
 
 // `count` values from low to high, evenly spaced in log, rounded, without repeats.
