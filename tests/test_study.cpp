@@ -10,11 +10,17 @@
 // - log2 of the pixels instead of the triangles in the tracer's model:
 //   TracerFeaturesTakeTheLogOfTheTriangles, RecoversKnownCoefficientsWithinTheirIntervals,
 //   IntervalCoverageOverSeededReplicates, OutsideTheSweptRangeIsReportedAsSuch.
+// - study.html's escape_html returning its input: EscapesEveryStringFromTheData;
+// - no interval band drawn for a crossover: MarksTheCrossoverWithItsInterval.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
@@ -23,6 +29,7 @@
 #include "rvr/study/fit.h"
 #include "rvr/study/least_squares.h"
 #include "rvr/study/run_study.h"
+#include "rvr/study/study_html.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/study_markdown.h"
 #include "rvr/study/sweep_plan.h"
@@ -437,4 +444,134 @@ TEST(StudyMarkdown, NumbersInPowersOfTen) {
   EXPECT_EQ(format_number(9.97e5), "1.0×10^6");
   EXPECT_EQ(format_number(1000), "1000");
   EXPECT_EQ(format_number(0.5), "0.5");
+}
+
+namespace {
+
+// A concluded study of softraster and raytrace on two scenes: "synthetic", where the curves
+// cross inside the swept range, and one whose name, like the command, a note and the CPU, holds
+// markup that study.html must escape.
+const std::string kMarkup = "<script>alert('x')</script>";
+
+StudyResult html_study() {
+  Rng rng(5);
+  StudyResult r;
+  r.scenes = {"synthetic", "odd" + kMarkup};
+  r.renderers = {"softraster", "raytrace"};
+  r.width = 1024;
+  r.height = 768;
+  r.mode = "local";
+  for (const std::string& scene : r.scenes) {
+    r.axes[scene] = "triangles";
+    for (const auto& [name, cost] : {std::pair{"softraster", kZCurve}, {"raytrace", kTCurve}})
+      for (Measurement m : sweep(name, cost, {kP}, 5, 0.03, rng)) {
+        m.scene = scene;
+        m.width = r.width;
+        m.height = r.height;
+        r.points.push_back(m);
+      }
+  }
+  conclude(r, {200, 1});
+  r.command = "rvr study " + kMarkup;
+  r.notes = {"a note " + kMarkup};
+  r.machine.cpu = kMarkup;
+  return r;
+}
+
+size_t occurrences(const std::string& text, const std::string& what) {
+  size_t k = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++k;
+  return k;
+}
+
+// The SVG of each chart, in page order.
+std::vector<std::string> charts_of(const std::string& html) {
+  std::vector<std::string> out;
+  for (size_t at = html.find("<svg class=\"study-chart\""); at != std::string::npos;
+       at = html.find("<svg class=\"study-chart\"", at + 1))
+    out.push_back(html.substr(at, html.find("</svg>", at) - at));
+  return out;
+}
+
+// The point marks of one renderer's series in a chart.
+size_t marks_of(const std::string& chart, const std::string& renderer) {
+  size_t from = chart.find("<g class=\"series\" data-renderer=\"" + renderer + "\">");
+  if (from == std::string::npos) return 0;
+  size_t to = chart.find("<g class=\"series\"", from + 1);
+  return occurrences(chart.substr(from, to == std::string::npos ? to : to - from),
+                     "<circle class=\"mark\"");
+}
+
+// The number in attribute `name` of the first element with class `cls` in `svg`.
+double attribute(const std::string& svg, const std::string& cls, const std::string& name) {
+  size_t at = svg.find("class=\"" + cls + "\"");
+  if (at == std::string::npos) return std::nan("");
+  at = svg.find(" " + name + "=\"", at);
+  return std::stod(svg.substr(at + name.size() + 3));
+}
+
+}  // namespace
+
+TEST(StudyHtml, OneChartPerSceneWithEveryRenderersPointsAndModel) {
+  StudyResult r = html_study();
+  std::string html = study_html(r);
+  std::vector<std::string> charts = charts_of(html);
+  ASSERT_EQ(charts.size(), r.scenes.size()) << "one pixel count: one chart per scene";
+  const size_t per_scene = log_spaced(100, 1000000, 13).size();
+  for (const std::string& chart : charts)
+    for (const std::string& name : r.renderers) {
+      EXPECT_EQ(marks_of(chart, name), per_scene) << name;
+      EXPECT_EQ(occurrences(chart, "class=\"model fits\" data-renderer=\"" + name + "\""), 1u)
+          << name;
+    }
+  EXPECT_NE(html.find("×10<sup>"), std::string::npos) << "powers of ten raised";
+}
+
+// The measured crossover's line lies within its shaded interval; an open end shades to the
+// chart's edge.
+TEST(StudyHtml, MarksTheCrossoverWithItsInterval) {
+  StudyResult r = html_study();
+  ASSERT_FALSE(r.crossovers.empty());
+  std::string chart = charts_of(study_html(r))[0];
+  ASSERT_EQ(occurrences(chart, "<rect class=\"ci-band\""), 1u);
+  double x = attribute(chart, "ci-band", "x"), width = attribute(chart, "ci-band", "width");
+  double line = attribute(chart, "crossover-line", "x1");
+  EXPECT_GT(width, 1.0);
+  EXPECT_LE(x, line);
+  EXPECT_GE(x + width, line);
+
+  r.crossovers[0].ci95.high = std::numeric_limits<double>::infinity();
+  std::string open = charts_of(study_html(r))[0];
+  double plot_right = attribute(open, "plot", "x") + attribute(open, "plot", "width");
+  EXPECT_DOUBLE_EQ(attribute(open, "ci-band", "x") + attribute(open, "ci-band", "width"),
+                   plot_right);
+}
+
+TEST(StudyHtml, EscapesEveryStringFromTheData) {
+  std::string html = study_html(html_study());
+  EXPECT_EQ(html.find("<script"), std::string::npos) << "markup from the data got through";
+  EXPECT_EQ(html.find("alert('x')"), std::string::npos);
+  EXPECT_NE(html.find("&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt;"), std::string::npos);
+}
+
+// A scene measured at a second pixel count gets, for each N measured at both, a chart of time
+// against pixels with each renderer's two points and its model.
+TEST(StudyHtml, ChartsAgainstPixelsWhereASceneWasMeasuredAtSeveral) {
+  StudyResult r = html_study();
+  const size_t points = r.points.size();
+  for (size_t i = 0; i < points; ++i)
+    if (r.points[i].scene == "synthetic") {
+      Measurement m = r.points[i];
+      m.pixels = kP / 4;
+      for (double& s : m.seconds) s /= 2;
+      r.points.push_back(m);
+    }
+  std::vector<std::string> charts = charts_of(study_html(r));
+  const size_t per_scene = log_spaced(100, 1000000, 13).size();
+  ASSERT_EQ(charts.size(), r.scenes.size() + per_scene);
+  for (const std::string& name : r.renderers) {
+    EXPECT_EQ(marks_of(charts[0], name), per_scene) << "the main chart: one pixel count";
+    EXPECT_EQ(marks_of(charts[1], name), 2u) << "against pixels: one point at each";
+    EXPECT_EQ(occurrences(charts[1], "data-renderer=\"" + name + "\" d=\""), 1u) << name;
+  }
 }
