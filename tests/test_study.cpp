@@ -22,11 +22,14 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/shared/camera.h"
+#include "rvr/shared/scene_loader.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/cost_model.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
+#include "rvr/study/grid_of_copies.h"
 #include "rvr/study/least_squares.h"
 #include "rvr/study/run_study.h"
 #include "rvr/study/study_html.h"
@@ -574,4 +577,62 @@ TEST(StudyHtml, ChartsAgainstPixelsWhereASceneWasMeasuredAtSeveral) {
     EXPECT_EQ(marks_of(charts[1], name), 2u) << "against pixels: one point at each";
     EXPECT_EQ(occurrences(charts[1], "data-renderer=\"" + name + "\" d=\""), 1u) << name;
   }
+}
+
+// A model file grown by copies: the triangles grow as the copies, the floor stays one, and the
+// framed camera sees every copy's centre (the projection computed here from the camera's frame).
+TEST(StudyGrid, CopiesGrowTheTrianglesAndStayInView) {
+  Scene base;
+  base.source = "test";
+  base.image.width = 64;
+  base.image.height = 48;
+  Object floor;
+  floor.type = ObjectType::Plane;
+  base.objects.push_back(floor);
+  Object tri;
+  tri.type = ObjectType::Triangles;
+  tri.mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  tri.mesh.triangles = {{0, 1, 2}};
+  base.objects.push_back(tri);
+  base.camera.eye = {0.5f, 0.5f, 3.0f};
+  base.camera.target = {0.5f, 0.5f, 0.0f};
+  for (size_t copies : {1u, 5u, 16u}) {
+    Expected<Scene> grid = grid_of_copies(base, copies);
+    ASSERT_TRUE(grid.ok()) << grid.error().message;
+    size_t planes = 0, meshes = 0;
+    for (const Object& o : grid->objects) {
+      planes += o.type == ObjectType::Plane;
+      meshes += o.type == ObjectType::Triangles;
+    }
+    EXPECT_EQ(planes, 1u);
+    EXPECT_EQ(meshes, copies);
+    CameraFrame f = make_camera_frame(grid->camera, 64, 48);
+    for (const Object& o : grid->objects) {
+      if (o.type != ObjectType::Triangles) continue;
+      glm::vec3 centre = (o.mesh.positions[0] + o.mesh.positions[1] + o.mesh.positions[2]) / 3.0f;
+      glm::vec3 v = centre - f.eye;
+      float depth = glm::dot(v, f.forward);
+      ASSERT_GT(depth, 0.0f);
+      EXPECT_LE(std::fabs(glm::dot(v, f.right)) / depth, f.tan_half_fov_y * f.aspect) << o.name;
+      EXPECT_LE(std::fabs(glm::dot(v, f.up)) / depth, f.tan_half_fov_y) << o.name;
+    }
+  }
+  Scene empty = base;
+  empty.objects.resize(1);  // the floor alone
+  EXPECT_FALSE(grid_of_copies(empty, 4).ok());
+}
+
+// A model file is a family: 1 … K copies, K so that they hold about 2×10^6 triangles.
+TEST(StudyGrid, AModelFileIsAFamily) {
+  Expected<Family> f = find_family(RVR_SOURCE_DIR "/scenes/models/torus.obj");
+  ASSERT_TRUE(f.ok()) << f.error().message;
+  EXPECT_EQ(f->name, "torus.obj");
+  EXPECT_EQ(f->axis, "triangles");
+  EXPECT_EQ(f->low, 1u);
+  Expected<Scene> one = load_scene(f->source);
+  ASSERT_TRUE(one.ok());
+  double per_copy = double(one->triangle_count());
+  EXPECT_LE(double(f->high) * per_copy, kFileFamilyTriangles);
+  EXPECT_GT(double(f->high + 1) * per_copy, kFileFamilyTriangles);
+  EXPECT_FALSE(find_family("no-such-file.obj").ok());
 }

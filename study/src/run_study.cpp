@@ -40,6 +40,11 @@ Status validate(const StudyRequest& r) {
   return ok_status();
 }
 
+// A point of a family in words: "N=1000", or "12 copies" of a file.
+std::string point_name(const Family& family, size_t n) {
+  return family.source.empty() ? fmt::format("N={}", n) : fmt::format("{} copies", n);
+}
+
 // The state of one running study.
 class Sweep {
  public:
@@ -93,7 +98,7 @@ void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, dou
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
     for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng_.below(i)]);
     for (size_t k = 0; k < order.size(); ++k) {
-      progress(fmt::format("{} N={} round {}/{} {}", family.name, n, round + 1,
+      progress(fmt::format("{} {} round {}/{} {}", family.name, point_name(family, n), round + 1,
                            request_.repetitions, request_.renderers[order[k]]));
       if (cancelled()) return;
       Expected<double> t = frames.time_frame(order[k]);
@@ -109,7 +114,8 @@ void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, dou
 
 // Measures builtin:<family>:<n> at `width` with every renderer; the points join the result.
 Status Sweep::measure(const Family& family, size_t n, int width, double deadline) {
-  progress(fmt::format("{} N={} {}×{}: preparing", family.name, n, width, width * 3 / 4));
+  progress(fmt::format("{} {} {}×{}: preparing", family.name, point_name(family, n), width,
+                       width * 3 / 4));
   Expected<std::unique_ptr<FrameSource>> frames = hooks_.prepare(family, n, width);
   if (!frames) return frames.error();
   std::vector<Measurement> points;
@@ -175,8 +181,8 @@ Status Sweep::sweep_n(const Family& family, double limit, double share_end) {
     if (!done) return done.error();
     if (!*done) {
       result_.notes.push_back(
-          fmt::format("{}: the sweep stopped below N={} (its points would have overrun the budget)",
-                      family.name, n));
+          fmt::format("{}: the sweep stopped below {} (its points would have overrun the budget)",
+                      family.name, point_name(family, n)));
       break;
     }
   }
@@ -197,8 +203,8 @@ Status Sweep::sweep_pixels(const Family& family, double limit, double share_end)
       if (!done) return done.error();
       if (!*done && !measured_.count({family.name, n, width})) {
         result_.notes.push_back(fmt::format(
-            "{}: the pixel sweep stopped at N={}, {} wide (it would have overrun the budget)",
-            family.name, n, width));
+            "{}: the pixel sweep stopped at {}, {} wide (it would have overrun the budget)",
+            family.name, point_name(family, n), width));
         return ok_status();
       }
     }
