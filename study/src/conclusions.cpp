@@ -9,6 +9,7 @@
 #include <set>
 
 #include "rvr/renderers/registry.h"
+#include "rvr/study/study_markdown.h"
 
 namespace rvr::study {
 namespace {
@@ -122,10 +123,10 @@ void compare_pairs(StudyResult& r, const BootstrapOptions& boot) {
           for (const Crossover& x : p.crossovers) r.crossovers.push_back(x);
           if (p.dominance) r.dominance.push_back(*p.dominance);
           if (p.tie)
-            r.notes.push_back(
-                fmt::format("{} at N={}: {} and {} are within the timing noise of "
-                            "each other at every pixel count measured",
-                            scene, n, a, b));
+            r.notes.push_back(fmt::format(
+                "{} with {} {}: {} and {} are within the timing noise of each other at every "
+                "pixel count measured",
+                scene, format_number(along_pixels(r, a, scene, n)[0].n), r.axes[scene], a, b));
         }
       }
 }
