@@ -421,8 +421,8 @@ TEST(StudyRun, SweepsWithinTheBudgetAndRefinesNearTheCrossover) {
 }
 
 // Something else runs for 3 of the 30 simulated seconds, doubling every frame's time: the points
-// measured then are found by their reference frames and measured again, so that no point off
-// its curve is left in the fits.
+// measured then are found by their reference frames and measured again as the budget allows;
+// every point left in the fits is on its curve, and those still busy are said to be.
 TEST(StudyRun, PointsMeasuredWhileTheMachineWasBusyAreMeasuredAgain) {
   double clock = 0;
   Rng rng(6);
@@ -439,12 +439,23 @@ TEST(StudyRun, PointsMeasuredWhileTheMachineWasBusyAreMeasuredAgain) {
   };
   Expected<StudyResult> r = run_study(request, hooks);
   ASSERT_TRUE(r.ok()) << r.error().message;
+  bool still_busy = false;
   for (const Measurement& m : r->points) {
     const CostFn& truth = m.renderer == "softraster" ? kZCurve : kTCurve;
-    EXPECT_FALSE(m.busy) << m.renderer << " N=" << m.n;
-    EXPECT_LT(std::fabs(std::log(typical_seconds(m) / truth(m.pixels, m.n))), std::log(1.15))
-        << m.renderer << " N=" << m.n << " " << m.width << " wide: off its curve";
+    still_busy |= m.busy;
+    if (!m.busy)
+      EXPECT_LT(std::fabs(std::log(typical_seconds(m) / truth(m.pixels, m.n))), std::log(1.15))
+          << m.renderer << " N=" << m.n << " " << m.width << " wide: off its curve";
   }
+  auto noted = [&](const std::string& words) {
+    for (const std::string& note : r->notes)
+      if (note.find(words) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(noted("were measured again"));
+  EXPECT_EQ(still_busy, noted("left out of the fits"));
+  ASSERT_FALSE(r->crossovers.empty()) << study_markdown(*r);
+  EXPECT_LT(std::fabs(std::log10(r->crossovers[0].value / true_crossing())), 0.1);
 }
 
 TEST(StudyRun, RefusesBadInputBeforeAnyWork) {

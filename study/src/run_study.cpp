@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <tuple>
 
@@ -22,6 +23,9 @@ namespace {
 constexpr double kBaseShare = 0.6;
 constexpr double kPixelShare = 0.8;
 constexpr int kRefinementRounds = 3;
+// How long one timing of the reference frame takes at least, in frames in a row.
+constexpr double kReferenceSeconds = 2e-3;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 Status validate(const StudyRequest& r) {
   if (r.scenes.empty()) return bad_input("study: no scene family given");
@@ -90,35 +94,45 @@ class Sweep {
   std::set<std::tuple<std::string, size_t, int>> measured_;  // family, n, width
   CostPredictor cost_;                      // of the current family's points at the full width
   std::unique_ptr<FrameSource> reference_;  // the current family's reference frame
-  double quickest_reference_ = 0;           // its quickest time in the study so far
+  int reference_frames_ = 1;                // frames in a row per reference time
+  double quickest_reference_ = kInfinity;   // its quickest time in the family so far
   double slowest_reference_ = 0;            // its slowest time while measuring one point
 };
 
-// The reference frame of a family: its smallest point at full width, the first renderer; its
-// quickest time starts as the median of five frames.
+// The reference frame of a family: its smallest point at full width, the first renderer, run
+// often enough in a row to take kReferenceSeconds (a frame of a few microseconds alone would
+// measure the timer and the scheduler); its quickest time starts as the median of five.
 Status Sweep::start_reference(const Family& family) {
   Expected<std::unique_ptr<FrameSource>> frames =
       hooks_.prepare(family, family.low, request_.width);
   if (!frames) return frames.error();
   reference_ = std::move(*frames);
+  reference_frames_ = 1;
+  Expected<double> one = time_reference();
+  if (!one) return one.error();
+  reference_frames_ = int(std::clamp(std::ceil(kReferenceSeconds / *one), 1.0, 1000.0));
+  quickest_reference_ = kInfinity;  // the single frame above is not a reference time
   std::vector<double> times;
   for (int k = 0; k < 5; ++k) {
-    Expected<double> t = reference_->time_frame(0);
+    Expected<double> t = time_reference();
     if (!t) return t.error();
     times.push_back(*t);
   }
-  double typical = median(times);
-  if (quickest_reference_ == 0 || typical < quickest_reference_) quickest_reference_ = typical;
+  quickest_reference_ = median(times);
   return ok_status();
 }
 
-// One reference frame: its time joins the point's slowest and the study's quickest.
+// The reference frames in a row: their time joins the point's slowest and the study's quickest.
 Expected<double> Sweep::time_reference() {
-  Expected<double> t = reference_->time_frame(0);
-  if (!t) return t.error();
-  slowest_reference_ = std::max(slowest_reference_, *t);
-  quickest_reference_ = std::min(quickest_reference_, *t);
-  return *t;
+  double total = 0;
+  for (int k = 0; k < reference_frames_; ++k) {
+    Expected<double> t = reference_->time_frame(0);
+    if (!t) return t.error();
+    total += *t;
+  }
+  slowest_reference_ = std::max(slowest_reference_, total);
+  quickest_reference_ = std::min(quickest_reference_, total);
+  return total;
 }
 
 // Times `request.repetitions` rounds; in each, every renderer once, in a fresh random order.
@@ -258,6 +272,7 @@ Status Sweep::measure_busy_points_again(const Family& family, double share_end) 
   std::set<std::pair<size_t, int>> busy;
   for (const Measurement& m : result_.points)
     if (m.scene == family.name && m.busy) busy.insert({size_t(m.scene_n), m.width});
+  size_t again = 0;
   for (auto [n, width] : busy) {
     if (cancelled() || elapsed() + cost_.predict(n) > share_end) break;
     auto same_point = [&, n = n, width = width](const Measurement& m) {
@@ -269,9 +284,17 @@ Status Sweep::measure_busy_points_again(const Family& family, double share_end) 
     std::erase_if(result_.points, same_point);
     measured_.erase({family.name, n, width});
     if (Status s = measure(family, n, width, share_end); !s) return s;
-    if (!measured_.count({family.name, n, width}))  // cancelled: the first measurement stays
+    if (!measured_.count({family.name, n, width})) {  // cancelled: the first measurement stays
       for (Measurement& m : before) result_.points.push_back(std::move(m));
+      break;
+    }
+    ++again;
   }
+  if (again > 0)
+    result_.notes.push_back(
+        fmt::format("{}: {} points measured while the machine was busy with "
+                    "something else were measured again",
+                    family.name, again));
   size_t still = 0;
   double worst = 0;
   for (const Measurement& m : result_.points)

@@ -16,7 +16,7 @@ struct Measurement {
   std::vector<double> seconds;  // every repetition, in the order they were timed
   std::vector<int> order;       // each repetition's position in its interleaved round
   // The reference frame timed between the rounds, at its slowest, over its quickest in the
-  // study so far: how much busier the machine was than at its quietest (run_study.h).
+  // family so far: how much busier the machine was than at its quietest (run_study.h).
   double reference_ratio = 0;
   bool busy = false;  // reference_ratio over kBusyRatio: left out of fits and crossovers
 };
