@@ -13,6 +13,7 @@
 #include "rvr/renderers/registry.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
+#include "rvr/study/prediction_checks.h"
 #include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
@@ -340,8 +341,10 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   result.seed = request.seed;
   result.bootstrap_replicates = request.bootstrap_replicates;
   Sweep sweep(request, hooks, result);
+  std::vector<Family> families;
   for (size_t i = 0; i < request.scenes.size(); ++i) {
     Family family = *find_family(request.scenes[i]);
+    families.push_back(family);
     result.scenes.push_back(family.name);
     result.axes[family.name] = family.axis;
     double left = request.budget_seconds - sweep.elapsed();
@@ -358,6 +361,8 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   result.elapsed_seconds = sweep.elapsed();
   BootstrapOptions boot{request.bootstrap_replicates, request.seed};
   conclude(result, boot);
+  if (!result.interrupted && request.check_predictions)
+    if (Status s = check_predictions(request, hooks, families, result); !s) return s.error();
   return result;
 }
 

@@ -34,6 +34,9 @@ struct StudyRequest {
   int repetitions = 5;
   uint64_t seed = 1;
   int bootstrap_replicates = 1000;
+  // After the conclusions, each crossover along N is measured again at a third of and three
+  // times its value (prediction_checks.h); outside the budget.
+  bool check_predictions = true;
 };
 
 // One scene size with every renderer of the study ready to render it (what they build per
