@@ -104,7 +104,7 @@ bench: build
 # tessphere and soup, one renderer per loop order, local mode, 1024 wide, within STUDY_BUDGET
 # seconds of sweeping (plus the fits: under 10 minutes in all), into bench/study/; its study.md
 # is pasted into bench/README.md.
-STUDY_BUDGET ?= 540
+STUDY_BUDGET ?= 480
 study: build
 	$(BUILD_DIR)/bin/rvr study builtin:tessphere builtin:soup --width 1024 --mode local \
 		--budget $(STUDY_BUDGET) -o bench/study

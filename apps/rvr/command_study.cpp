@@ -72,7 +72,7 @@ void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
   cmd->add_option("--mode", a.mode, "visibility | local | full (default local)")
       ->check(CLI::IsMember({"visibility", "local", "full"}));
   cmd->add_option("--budget", a.budget, "seconds the sweep may take (default 300)");
-  cmd->add_option("--repetitions", a.repetitions, "frames timed per renderer and point (>= 3)");
+  cmd->add_option("--repetitions", a.repetitions, "frames timed per renderer and point (>= 5, default 5)");
   cmd->add_option("--seed", a.seed, "seed of the interleaving order and the bootstrap");
   cmd->add_option("-o,--output", a.out_dir, "output folder: study.json, study.md, study.html")
       ->required();

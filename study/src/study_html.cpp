@@ -364,6 +364,10 @@ std::string conclusions_html(const StudyResult& r, const std::string& scene) {
     if (d.scene == scene)
       items += fmt::format("<li class=\"dominance-sentence\">{}</li>\n",
                            html_with_powers(dominance_sentence(r, d)));
+  for (const PredictionCheck& c : r.checks)
+    if (c.scene == scene)
+      items += fmt::format("<li class=\"check-sentence {}\">Checked after the fit: {}</li>\n",
+                           c.holds ? "holds" : "fails", html_with_powers(check_sentence(c)));
   if (items.empty()) return "<p>No pair of loop orders was measured.</p>\n";
   return "<ul class=\"conclusions\">\n" + items + "</ul>\n";
 }
