@@ -6,12 +6,14 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "rvr/shared/expected.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/study/study.h"
+#include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 
@@ -24,6 +26,9 @@ struct StudyRequest {
   int repetitions = 5;
   uint64_t seed = 1;
   int bootstrap_replicates = 1000;
+  // Measure only this shard's planned points, and add none near crossovers (they depend on the
+  // other shards' points): for studies merged afterwards (merge.h).
+  std::optional<Shard> shard;
 };
 
 // One scene size with every renderer of the study ready to render it (what they build per

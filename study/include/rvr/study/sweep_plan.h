@@ -1,5 +1,6 @@
 // Which scene sizes a study measures: the families it sweeps, their log-spaced grids, the
-// points added near a crossover, and the cost of a point predicted from those measured.
+// points added near a crossover, the share of the planned points a shard measures, and the
+// cost of a point predicted from those measured.
 #pragma once
 
 #include <map>
@@ -26,6 +27,19 @@ std::vector<size_t> log_spaced(size_t low, size_t high, int count);
 // The rounded geometric mean of two neighbours: the point that halves a bracket in log; 0 when
 // they are too close to hold one.
 size_t log_midpoint(size_t low, size_t high);
+
+// One of `count` studies that together measure a sweep's planned points (--shard I/N).
+struct Shard {
+  size_t index = 0;  // 0 .. count-1
+  size_t count = 1;
+};
+
+// "I/N" with 0 <= I < N; a BadInput error "--shard: ..." for anything else.
+Expected<Shard> parse_shard(const std::string& text);
+
+// Whether the point at `plan_index` in the sweep's planned points is the shard's to measure:
+// every point whose index is ≡ shard.index mod shard.count.
+bool in_shard(size_t plan_index, const Shard& shard);
 
 // Predicts the wall time of measuring a point at N from the points measured so far: their
 // cost grown along the log-log slope of the last two (clamped to 0 .. 1.5; 1 from one point),
