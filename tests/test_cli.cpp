@@ -760,10 +760,10 @@ TEST_F(Cli, CtrlCDuringAStudyWritesThePartialStudy) {
   Interrupted r = interrupt_and_wait(pid);
   std::string message = slurp(err);
   EXPECT_EQ(r.status, 130) << message;
-  EXPECT_EQ(
-      message.rfind(
-          "rvr study: interrupted; wrote " + out.string() + "/{study.json,study.md} from ", 0),
-      0u)
+  EXPECT_EQ(message.rfind("rvr study: interrupted; wrote " + out.string() +
+                              "/{study.json,study.md,study.html} from ",
+                          0),
+            0u)
       << message;
   EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
   ASSERT_TRUE(fs::exists(out / "study.md"));

@@ -1,6 +1,7 @@
 // rvr study: sweeps of the built-in families timed with every loop order, the cost models
-// fitted, crossovers and conclusions computed (rvr::study), written as study.json and study.md;
-// or, with --merge, studies written before pooled by machine type and concluded again.
+// fitted, crossovers and conclusions computed (rvr::study), written as study.json, study.md and
+// study.html; or, with --merge, studies written before pooled by machine type and concluded
+// again.
 #include <fmt/format.h>
 #include <signal.h>
 
@@ -21,6 +22,7 @@
 #include "rvr/study/merge.h"
 #include "rvr/study/renderer_frames.h"
 #include "rvr/study/run_study.h"
+#include "rvr/study/study_html.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/study_markdown.h"
 #include "terminal_progress.h"
@@ -95,6 +97,7 @@ void write_study(const std::string& dir, const study::StudyResult& result,
                  const std::string& markdown) {
   check(write_text_file(dir + "/study.json", study::study_json(result)));
   check(write_text_file(dir + "/study.md", markdown));
+  check(write_text_file(dir + "/study.html", study::study_html(result)));
 }
 
 // --merge: the studies in a.merge pooled by machine type; one study into a.out_dir, or one per
@@ -113,15 +116,16 @@ int run_merge(const StudyArgs& a, const std::string& command_line) {
   if (groups.size() == 1) {
     std::string markdown = study::study_markdown(groups[0].study);
     write_study(a.out_dir, groups[0].study, markdown);
-    std::printf("%s\nwrote %s/{study.json,study.md}\n", markdown.c_str(), a.out_dir.c_str());
+    std::printf("%s\nwrote %s/{study.json,study.md,study.html}\n", markdown.c_str(),
+                a.out_dir.c_str());
     return 0;
   }
   for (const study::MachineGroup& g : groups)
     write_study(a.out_dir + "/" + g.slug, g.study, study::study_markdown(g.study));
   std::string comparison = study::comparison_markdown(groups);
   check(write_text_file(a.out_dir + "/comparison.md", comparison));
-  std::printf("%s\nwrote %s/comparison.md and {study.json,study.md} in", comparison.c_str(),
-              a.out_dir.c_str());
+  std::printf("%s\nwrote %s/comparison.md and {study.json,study.md,study.html} in",
+              comparison.c_str(), a.out_dir.c_str());
   for (const study::MachineGroup& g : groups) std::printf(" %s/", g.slug.c_str());
   std::printf("\n");
   return 0;
@@ -161,7 +165,8 @@ void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
        {"scenes", "--renderers", "--width", "--mode", "--budget", "--repetitions", "--seed"})
     merge->excludes(cmd->get_option(sweep_only));
   merge->excludes(shard);
-  cmd->add_option("-o,--output", a.out_dir, "output folder: study.json, study.md")->required();
+  cmd->add_option("-o,--output", a.out_dir, "output folder: study.json, study.md, study.html")
+      ->required();
 }
 
 int run_study(const StudyArgs& a, const std::string& command_line) {
@@ -183,11 +188,13 @@ int run_study(const StudyArgs& a, const std::string& command_line) {
   std::string markdown = study::study_markdown(result);
   write_study(a.out_dir, result, markdown);
   progress.stop();
-  std::printf("%s\nwrote %s/{study.json,study.md}\n", markdown.c_str(), a.out_dir.c_str());
+  std::printf("%s\nwrote %s/{study.json,study.md,study.html}\n", markdown.c_str(),
+              a.out_dir.c_str());
   if (!result.interrupted) return 0;
   std::fflush(stdout);
-  std::fprintf(stderr, "rvr study: interrupted; wrote %s/{study.json,study.md} from %zu points\n",
-               a.out_dir.c_str(), result.points.size());
+  std::fprintf(
+      stderr, "rvr study: interrupted; wrote %s/{study.json,study.md,study.html} from %zu points\n",
+      a.out_dir.c_str(), result.points.size());
   return 130;
 }
 

@@ -218,12 +218,13 @@ Expected<std::vector<MachineGroup>> merge_studies(const std::vector<StudySource>
 
 namespace {
 
-// A pair of renderers compared on one family along one axis, the pair in name order.
-using PairKey = std::tuple<std::string, std::string, std::string, std::string>;
+// A pair of renderers compared on one family along one axis (the pixel axis at one N), the pair
+// in name order.
+using PairKey = std::tuple<std::string, std::string, double, std::string, std::string>;
 
 PairKey pair_key(const std::string& a, const std::string& b, const std::string& scene,
-                 const std::string& axis) {
-  return {scene, axis, std::min(a, b), std::max(a, b)};
+                 const std::string& axis, double n) {
+  return {scene, axis, n, std::min(a, b), std::max(a, b)};
 }
 
 std::string crossover_text(const Crossover& c) {
@@ -254,9 +255,9 @@ std::string comparison_markdown(const std::vector<MachineGroup>& groups) {
   };
   for (size_t g = 0; g < groups.size(); ++g) {
     for (const Crossover& c : groups[g].study.crossovers)
-      cell(pair_key(c.a, c.b, c.scene, c.axis), g, crossover_text(c));
+      cell(pair_key(c.a, c.b, c.scene, c.axis, c.n), g, crossover_text(c));
     for (const Dominance& d : groups[g].study.dominance)
-      cell(pair_key(d.faster, d.slower, d.scene, d.axis), g, dominance_text(d));
+      cell(pair_key(d.faster, d.slower, d.scene, d.axis, d.n), g, dominance_text(d));
   }
   std::string text = "# rvr study: machine types compared\n\n";
   text +=
@@ -273,8 +274,9 @@ std::string comparison_markdown(const std::vector<MachineGroup>& groups) {
   for (size_t g = 0; g < groups.size(); ++g) text += "---|";
   text += "\n";
   for (const PairKey& key : rows) {
-    const auto& [scene, axis, a, b] = key;
-    text += fmt::format("| {} | {} vs {} | {} |", scene, a, b, axis);
+    const auto& [scene, axis, n, a, b] = key;
+    std::string along = n > 0 ? fmt::format("{} at N = {}", axis, format_number(n)) : axis;
+    text += fmt::format("| {} | {} vs {} | {} |", scene, a, b, along);
     for (const std::string& c : cells[key]) text += " " + (c.empty() ? "not compared" : c) + " |";
     text += "\n";
   }

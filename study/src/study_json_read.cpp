@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "rvr/renderers/registry.h"
+#include "rvr/study/conclusions.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/sweep_plan.h"
 
@@ -131,20 +132,23 @@ const std::vector<std::string> kPointKeys = {"renderer", "scene",  "scene_n",   
                                              "width",    "height", "pixels",    "seconds",
                                              "order",    "median", "hd_median", "relative_mad"};
 
+// A family is a built-in (its axis fixed) or a file grown by copies (axis "triangles").
 void read_scenes(const Fields& top, StudyResult& r) {
   const json& scenes = top.array("scenes");
   if (scenes.empty()) fail("scenes", "must name at least one family");
   for (size_t i = 0; i < scenes.size(); ++i) {
     Fields s(scenes[i], index_path("scenes", i), {"name", "axis"});
-    Expected<Family> family = find_family(s.string("name"));
-    if (!family || family->name != s.string("name"))
-      fail(s.path("name"), "must be tessphere, soup or occluders, got " + describe(s.at("name")));
-    if (s.string("axis") != family->axis)
-      fail(s.path("axis"), fmt::format("must be \"{}\" for {}, got {}", family->axis, family->name,
-                                       describe(s.at("axis"))));
-    if (r.axes.count(family->name)) fail(s.path("name"), "names a family already listed");
-    r.scenes.push_back(family->name);
-    r.axes[family->name] = family->axis;
+    const std::string& name = s.string("name");
+    const std::string& axis = s.string("axis");
+    if (name.empty()) fail(s.path("name"), "must not be empty");
+    Expected<Family> builtin = find_family("builtin:" + name);
+    std::string want = builtin ? builtin->axis : "triangles";
+    if (axis != want)
+      fail(s.path("axis"),
+           fmt::format("must be \"{}\" for {}, got {}", want, name, describe(s.at("axis"))));
+    if (r.axes.count(name)) fail(s.path("name"), "names a family already listed");
+    r.scenes.push_back(name);
+    r.axes[name] = axis;
   }
 }
 
@@ -197,7 +201,8 @@ void read_request(const Fields& top, StudyResult& r) {
   for (size_t i = 0; i < notes.size(); ++i) {
     if (!notes[i].is_string())
       fail(index_path("notes", i), "must be a string, got " + describe(notes[i]));
-    r.notes.push_back(notes[i].get<std::string>());
+    if (!is_conclusion_note(notes[i].get<std::string>()))
+      r.notes.push_back(notes[i].get<std::string>());
   }
   r.interrupted = top.boolean("interrupted");
   // Studies written before --shard have no "shard": they measured every point.

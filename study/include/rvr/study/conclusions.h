@@ -14,9 +14,14 @@ namespace rvr::study {
 // The model form of a renderer in the table, by its loop order.
 ModelForm model_form_of(const std::string& renderer);
 
-// The least-squares slope of log t against log n over the points with n in [from, to]; NaN
-// with fewer than two distinct n.
-double loglog_slope(const std::vector<Measurement>& points, double from, double to);
+// The least-squares slope of log t against log x over the points with x in [from, to], x their
+// N, or their pixel count when `axis` is "pixels"; NaN with fewer than two distinct x.
+double loglog_slope(const std::vector<Measurement>& points, double from, double to,
+                    const std::string& axis = "triangles");
+
+// Whether `note` is one conclude() adds (a tie), not one of the sweep's: a study read back drops
+// these, for conclude() to add them again.
+bool is_conclusion_note(const std::string& note);
 
 // Fills result.models, crossovers, dominance, scaling and costs from result.points.
 void conclude(StudyResult& result, const BootstrapOptions& boot);
