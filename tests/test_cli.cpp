@@ -773,18 +773,19 @@ TEST_F(Cli, CtrlCDuringAStudyWritesThePartialStudy) {
   EXPECT_LT(r.seconds, 30.0) << "the sweep went on after the interrupt";
 }
 
-// --merge of two studies of this machine pools them (a point both measured keeps the
-// repetitions of each); with the SIMD kernels of one edited, they are not pooled: one study
-// per machine type and comparison.md.
+// --merge of two studies of this machine (one of them shard 1/2) pools them (a point both
+// measured keeps the repetitions of each); with the SIMD kernels of one edited, they are not
+// pooled: one study per machine type and comparison.md.
 TEST_F(Cli, StudyMergePoolsOneMachineTypeAndComparesTwo) {
   const std::string tiny = "study builtin:tessphere --width 32 --budget 3 -q -o ";
   for (const char* name : {"a", "b"}) {
-    RunResult r = run(tiny + (dir_ / name).string());
+    RunResult r = run(tiny + (dir_ / name).string() + (name[0] == 'b' ? " --shard 1/2" : ""));
     ASSERT_EQ(r.status, 0) << r.err;
   }
   nlohmann::json a = nlohmann::json::parse(slurp(dir_ / "a" / "study.json"));
   nlohmann::json b = nlohmann::json::parse(slurp(dir_ / "b" / "study.json"));
   EXPECT_TRUE(a["shard"].is_null());
+  EXPECT_EQ(b["shard"], (nlohmann::json{{"index", 1}, {"count", 2}}));
 
   fs::path pooled = dir_ / "pooled";
   RunResult merged = run("study --merge " + (dir_ / "a").string() + " " + (dir_ / "b").string() +

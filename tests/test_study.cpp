@@ -12,14 +12,17 @@
 //   IntervalCoverageOverSeededReplicates, OutsideTheSweptRangeIsReportedAsSuch.
 // - study.html's escape_html returning its input: EscapesEveryStringFromTheData;
 // - no interval band drawn for a crossover: MarksTheCrossoverWithItsInterval.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -886,4 +889,59 @@ TEST(StudyMerge, DifferentKernelsAreNotPooled) {
             std::string::npos)
       << md;
   for (const MachineGroup& group : g) EXPECT_NE(md.find(group.label), std::string::npos) << md;
+}
+
+// Shards 0..2 of 3 of a sweep of two families, with budget to spare, measure every planned
+// point exactly once between them and nothing else (no points near crossovers); merged, they
+// hold the plan.
+TEST(StudyRun, ShardsMeasureEveryPlannedPointOnce) {
+  double clock = 0;
+  Rng rng(9);
+  StudyRequest request;
+  request.scenes = {"builtin:tessphere", "builtin:occluders"};
+  request.renderers = {"softraster", "raytrace"};
+  request.budget_seconds = 1e5;
+  request.bootstrap_replicates = 50;
+  StudyHooks hooks;
+  hooks.now = [&] { return clock; };
+  hooks.prepare = [&](const Family&, size_t n,
+                      int width) -> Expected<std::unique_ptr<FrameSource>> {
+    return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, clock, rng));
+  };
+  using Key = std::tuple<std::string, double, int>;  // family, N, width
+  std::map<Key, int> planned;
+  for (const char* family : {"tessphere", "occluders"})
+    for (const PlannedPoint& p : planned_points(*find_family(family), request.width))
+      planned[{family, double(p.n), p.width}] = 0;
+  std::vector<StudySource> shards;
+  for (size_t i = 0; i < 3; ++i) {
+    request.shard = Shard{i, 3};
+    Expected<StudyResult> r = run_study(request, hooks);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    ASSERT_TRUE(r->shard.has_value());
+    EXPECT_EQ(r->shard->index, i);
+    ASSERT_FALSE(r->notes.empty());
+    EXPECT_EQ(r->notes[0].rfind(fmt::format("shard {}/3: ", i), 0), 0u) << r->notes[0];
+    for (const Measurement& m : r->points) {
+      if (m.renderer != "softraster") continue;
+      auto it = planned.find({m.scene, m.scene_n, m.width});
+      ASSERT_NE(it, planned.end())
+          << "not planned: " << m.scene << " " << m.scene_n << " " << m.width;
+      ++it->second;
+    }
+    shards.push_back({fmt::format("shard-{}", i), *r});
+  }
+  for (const auto& [key, times] : planned)
+    EXPECT_EQ(times, 1) << std::get<0>(key) << " N=" << std::get<1>(key) << " w"
+                        << std::get<2>(key);
+  Expected<std::vector<MachineGroup>> merged = merge_studies(shards);
+  ASSERT_TRUE(merged.ok()) << merged.error().message;
+  ASSERT_EQ(merged->size(), 1u);
+  EXPECT_EQ((*merged)[0].study.points.size(), 2 * planned.size());
+
+  request.shard.reset();
+  Expected<StudyResult> whole = run_study(request, hooks);
+  ASSERT_TRUE(whole.ok());
+  EXPECT_FALSE(whole->shard.has_value());
+  EXPECT_GT(whole->points.size(), 2 * planned.size()) << "the whole adds points near crossovers";
 }

@@ -37,6 +37,9 @@ Status validate(const StudyRequest& r) {
   // Fewer, and the bootstrap's 95% intervals hold the truth only ~85% of the time (test_study).
   if (r.repetitions < 5)
     return bad_input(fmt::format("--repetitions: must be >= 5, got {}", r.repetitions));
+  if (r.shard && (r.shard->count < 1 || r.shard->index >= r.shard->count))
+    return bad_input(fmt::format("--shard: must be I/N with 0 <= I < N, got {}/{}", r.shard->index,
+                                 r.shard->count));
   return ok_status();
 }
 
@@ -75,6 +78,7 @@ class Sweep {
   Status sweep_n(const Family& family, double limit, double share_end);
   Status sweep_pixels(const Family& family, double limit, double share_end);
   std::vector<size_t> crossover_midpoints(const Family& family) const;
+  bool in_this_shard(size_t n, int width) const;
   void progress(const std::string& what) const {
     if (hooks_.on_progress) hooks_.on_progress(what);
   }
@@ -85,8 +89,20 @@ class Sweep {
   Rng rng_;
   double start_ = 0;
   std::set<std::tuple<std::string, size_t, int>> measured_;  // family, n, width
-  CostPredictor cost_;  // of the current family's points at the full width
+  CostPredictor cost_;              // of the current family's points at the full width
+  std::vector<PlannedPoint> plan_;  // the current family's
+  size_t plan_offset_ = 0;          // the index of its first point in the study's plan
 };
+
+// Whether the current family's planned point (n, width) is this shard's to measure (every
+// point is, unsharded).
+bool Sweep::in_this_shard(size_t n, int width) const {
+  if (!request_.shard) return true;
+  for (size_t i = 0; i < plan_.size(); ++i)
+    if (plan_[i].n == n && plan_[i].width == width)
+      return in_shard(plan_offset_ + i, *request_.shard);
+  return false;
+}
 
 // Times `request.repetitions` rounds; in each, every renderer once, in a fresh random order.
 // Stops after the fifth round once `deadline` has passed.
@@ -177,6 +193,7 @@ Expected<bool> Sweep::try_point(const Family& family, size_t n, int width, doubl
 Status Sweep::sweep_n(const Family& family, double limit, double share_end) {
   for (size_t n : log_spaced(family.low, family.high, family.points)) {
     if (cancelled()) return ok_status();
+    if (!in_this_shard(n, request_.width)) continue;
     Expected<bool> done = try_point(family, n, request_.width, limit, share_end);
     if (!done) return done.error();
     if (!*done) {
@@ -196,9 +213,12 @@ Status Sweep::sweep_pixels(const Family& family, double limit, double share_end)
   for (const auto& [name, n, width] : measured_)
     if (name == family.name && width == request_.width) measured.push_back(n);
   std::sort(measured.begin(), measured.end());
+  // A shard takes the pixel sweep at the N planned: the other shards measure the rest of them.
+  if (request_.shard) measured = log_spaced(family.low, family.high, family.points);
   for (size_t n : pixel_sweep_ns(measured))
     for (int width : pixel_sweep_widths(request_.width)) {
       if (cancelled()) return ok_status();
+      if (!in_this_shard(n, width)) continue;
       Expected<bool> done = try_point(family, n, width, limit, share_end);
       if (!done) return done.error();
       if (!*done && !measured_.count({family.name, n, width})) {
@@ -217,8 +237,11 @@ Status Sweep::run_scene(const Family& family, double share_end) {
   const double share_start = elapsed();
   const double length = share_end - share_start;
   cost_ = CostPredictor();
+  plan_offset_ += plan_.size();
+  plan_ = planned_points(family, request_.width);
   if (Status s = sweep_n(family, share_start + kBaseShare * length, share_end); !s) return s;
   if (Status s = sweep_pixels(family, share_start + kPixelShare * length, share_end); !s) return s;
+  if (request_.shard) return ok_status();  // the points near crossovers need every shard's
   for (int round = 0; round < kRefinementRounds; ++round)
     for (size_t mid : crossover_midpoints(family)) {
       if (cancelled()) return ok_status();
@@ -241,6 +264,13 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   result.repetitions = request.repetitions;
   result.seed = request.seed;
   result.bootstrap_replicates = request.bootstrap_replicates;
+  result.shard = request.shard;
+  if (request.shard)
+    result.notes.push_back(fmt::format(
+        "shard {}/{}: only the planned points whose index is {} mod {} were measured, and none "
+        "near crossovers (they depend on the other shards' points); rvr study --merge pools the "
+        "shards",
+        request.shard->index, request.shard->count, request.shard->index, request.shard->count));
   Sweep sweep(request, hooks, result);
   for (size_t i = 0; i < request.scenes.size(); ++i) {
     Family family = *find_family(request.scenes[i]);

@@ -76,6 +76,15 @@ std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured) {
   return out;
 }
 
+std::vector<PlannedPoint> planned_points(const Family& family, int width) {
+  std::vector<PlannedPoint> plan;
+  std::vector<size_t> ns = log_spaced(family.low, family.high, family.points);
+  for (size_t n : ns) plan.push_back({n, width});
+  for (size_t n : pixel_sweep_ns(ns))
+    for (int narrower : pixel_sweep_widths(width)) plan.push_back({n, narrower});
+  return plan;
+}
+
 size_t log_midpoint(size_t low, size_t high) {
   size_t mid = size_t(std::llround(std::sqrt(double(low) * double(high))));
   return mid > low && mid < high ? mid : 0;

@@ -39,6 +39,19 @@ std::vector<int> pixel_sweep_widths(int width);
 // order): the smallest, the one nearest their geometric middle, and the largest.
 std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured);
 
+// A point a sweep plans: builtin:<family>:<n> (or n copies of the family's file) at `width`.
+struct PlannedPoint {
+  size_t n = 0;
+  int width = 0;
+};
+
+// The points a sweep of `family` at `width` plans, in the order it takes them: the log-spaced N
+// at the full width, then the pixel sweep's narrower widths at pixel_sweep_ns of those N (a
+// sweep the budget stops takes them at pixel_sweep_ns of the N it measured). Points near
+// crossovers depend on the measurements and are not planned. --shard divides these points,
+// numbered through the families in the order the study takes them.
+std::vector<PlannedPoint> planned_points(const Family& family, int width);
+
 // The rounded geometric mean of two neighbours: the point that halves a bracket in log; 0 when
 // they are too close to hold one.
 size_t log_midpoint(size_t low, size_t high);
