@@ -102,14 +102,16 @@ bench: build
 
 # The headline study (docs/cli.md#rvr-study-what-each-loop-order-costs-computed-with-confidence):
 # tessphere and soup, one renderer per loop order, local mode, 1024 wide, within STUDY_BUDGET
-# seconds of sweeping (plus the fits: under 10 minutes in all).
+# seconds of sweeping (plus the fits: under 10 minutes in all), into bench/study/; its study.md
+# is pasted into bench/README.md.
 STUDY_BUDGET ?= 540
 study: build
 	$(BUILD_DIR)/bin/rvr study builtin:tessphere builtin:soup --width 1024 --mode local \
-		--budget $(STUDY_BUDGET) -o study-out
+		--budget $(STUDY_BUDGET) -o bench/study
+	/usr/bin/python3 bench/paste_study.py bench/study/study.md bench/README.md
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')
 
 clean:
-	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) rvr-out study-out
+	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) rvr-out

@@ -356,14 +356,23 @@ namespace {
 // 1 µs a triangle) advance.
 class SimulatedFrames : public FrameSource {
  public:
-  SimulatedFrames(double n, int width, double& clock, Rng& rng)
-      : n_(n), pixels_(double(width) * (width * 3 / 4)), clock_(clock), rng_(rng) {
+  // Frames started while the clock is in [busy_from, busy_to) take twice as long: something
+  // else is running.
+  SimulatedFrames(double n, int width, double& clock, Rng& rng, double busy_from = 0,
+                  double busy_to = 0)
+      : n_(n),
+        pixels_(double(width) * (width * 3 / 4)),
+        clock_(clock),
+        rng_(rng),
+        busy_from_(busy_from),
+        busy_to_(busy_to) {
     clock_ += 1e-6 * n;
   }
   double axis_value() const override { return n_; }
   double pixels() const override { return pixels_; }
   Expected<double> time_frame(size_t index) override {
     double t = (index == 0 ? kZCurve : kTCurve)(pixels_, n_) * std::exp(0.03 * rng_.normal());
+    if (clock_ >= busy_from_ && clock_ < busy_to_) t *= 2;
     clock_ += t;
     return t;
   }
@@ -372,6 +381,7 @@ class SimulatedFrames : public FrameSource {
   double n_, pixels_;
   double& clock_;
   Rng& rng_;
+  double busy_from_, busy_to_;
 };
 
 }  // namespace
@@ -413,6 +423,44 @@ TEST(StudyRun, SweepsWithinTheBudgetAndRefinesNearTheCrossover) {
   }
   for (const Measurement& m : r->points) EXPECT_EQ(m.seconds.size(), 5u);
   EXPECT_NE(study_json(*r).find("\"format\": \"rvr-study/1\""), std::string::npos);
+}
+
+// Something else runs for 3 of the 30 simulated seconds, doubling every frame's time: the points
+// measured then are found by their reference frames and measured again as the budget allows;
+// every point left in the fits is on its curve, and those still busy are said to be.
+TEST(StudyRun, PointsMeasuredWhileTheMachineWasBusyAreMeasuredAgain) {
+  double clock = 0;
+  Rng rng(6);
+  StudyRequest request;
+  request.scenes = {"builtin:tessphere"};
+  request.renderers = {"softraster", "raytrace"};
+  request.budget_seconds = 30;
+  request.bootstrap_replicates = 200;
+  StudyHooks hooks;
+  hooks.now = [&] { return clock; };
+  hooks.prepare = [&](const Family&, size_t n,
+                      int width) -> Expected<std::unique_ptr<FrameSource>> {
+    return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, clock, rng, 4, 7));
+  };
+  Expected<StudyResult> r = run_study(request, hooks);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  bool still_busy = false;
+  for (const Measurement& m : r->points) {
+    const CostFn& truth = m.renderer == "softraster" ? kZCurve : kTCurve;
+    still_busy |= m.busy;
+    if (!m.busy)
+      EXPECT_LT(std::fabs(std::log(typical_seconds(m) / truth(m.pixels, m.n))), std::log(1.15))
+          << m.renderer << " N=" << m.n << " " << m.width << " wide: off its curve";
+  }
+  auto noted = [&](const std::string& words) {
+    for (const std::string& note : r->notes)
+      if (note.find(words) != std::string::npos) return true;
+    return false;
+  };
+  EXPECT_TRUE(noted("were measured again"));
+  EXPECT_EQ(still_busy, noted("left out of the fits"));
+  ASSERT_FALSE(r->crossovers.empty()) << study_markdown(*r);
+  EXPECT_LT(std::fabs(std::log10(r->crossovers[0].value / true_crossing())), 0.1);
 }
 
 TEST(StudyRun, RefusesBadInputBeforeAnyWork) {
@@ -671,6 +719,7 @@ StudyResult synthetic_study(uint64_t seed) {
       m.width = r.width;
       m.height = r.height;
       m.order = {0, 1, 1, 0, 1};
+      m.reference_ratio = 1.0 + 0.01 * double(r.points.size() % 7);
       r.points.push_back(m);
     }
   return r;
@@ -721,6 +770,8 @@ TEST(StudyJsonRead, RoundTripsEveryFieldConcludeNeeds) {
   StudyResult r = synthetic_study(31);
   r.interrupted = true;
   r.shard = Shard{1, 4};
+  r.points[5].busy = true;
+  r.points[5].reference_ratio = 1.6;
   conclude(r, {r.bootstrap_replicates, r.seed});
   StudyResult back = read_back(r);
   EXPECT_EQ(back.scenes, r.scenes);
@@ -756,6 +807,8 @@ TEST(StudyJsonRead, RoundTripsEveryFieldConcludeNeeds) {
     EXPECT_EQ(a.height, b.height);
     EXPECT_EQ(a.seconds, b.seconds);
     EXPECT_EQ(a.order, b.order);
+    EXPECT_EQ(a.reference_ratio, b.reference_ratio);
+    EXPECT_EQ(a.busy, b.busy);
   }
   EXPECT_TRUE(back.models.empty()) << "conclusions are computed again, not read";
   conclude(back, {back.bootstrap_replicates, back.seed});
@@ -852,6 +905,17 @@ TEST(StudyMerge, APointMeasuredTwiceKeepsEveryRepetition) {
     both.insert(both.end(), r.points[i].seconds.begin(), r.points[i].seconds.end());
     EXPECT_EQ(m.points[i].seconds, both);
     EXPECT_EQ(m.points[i].order.size(), both.size());
+  }
+  // A point measured on a busy machine by one study and a quiet one by the other: the quiet's.
+  StudyResult busy = r;
+  busy.points[0].busy = true;
+  busy.points[0].seconds = {9, 9, 9, 9, 9};
+  for (const auto& order : {std::vector<StudySource>{{"a", r}, {"b", busy}},
+                            std::vector<StudySource>{{"b", busy}, {"a", r}}}) {
+    Expected<std::vector<MachineGroup>> quiet = merge_studies(order);
+    ASSERT_TRUE(quiet.ok());
+    EXPECT_EQ((*quiet)[0].study.points[0].seconds, r.points[0].seconds);
+    EXPECT_FALSE((*quiet)[0].study.points[0].busy);
   }
   StudyResult moved = r;
   moved.points[0].n += 1;

@@ -21,7 +21,7 @@ std::vector<Measurement> points_of(const StudyResult& r, const std::string& rend
                                    const std::string& scene) {
   std::vector<Measurement> out;
   for (const Measurement& m : r.points)
-    if (m.renderer == renderer && m.scene == scene) out.push_back(m);
+    if (m.renderer == renderer && m.scene == scene && !m.busy) out.push_back(m);
   return out;
 }
 
@@ -47,7 +47,7 @@ std::vector<Measurement> along_pixels(const StudyResult& r, const std::string& r
 std::vector<double> pixel_sweep_columns(const StudyResult& r, const std::string& scene) {
   std::map<double, std::set<double>> widths;
   for (const Measurement& m : r.points)
-    if (m.scene == scene) widths[m.scene_n].insert(m.pixels);
+    if (m.scene == scene && !m.busy) widths[m.scene_n].insert(m.pixels);
   std::vector<double> out;
   for (const auto& [n, w] : widths)
     if (w.size() > 1) out.push_back(n);

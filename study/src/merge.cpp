@@ -57,7 +57,8 @@ size_t index_in(const std::vector<std::string>& list, const std::string& item) {
 }
 
 // Unites the points of the group's studies: a point measured by several keeps every
-// repetition of each, in the order the studies were given.
+// repetition of each, in the order the studies were given, but for those measured while the
+// machine was busy when another study measured it on a quiet one.
 class PointPool {
  public:
   Status add(const StudySource& source) {
@@ -76,9 +77,15 @@ class PointPool {
             "not the same point",
             source.name, m.renderer, m.scene, m.scene_n, m.width, m.n, m.pixels, pooled.n,
             first_source_[it->second], pooled.pixels));
+      repeated_ = true;
+      if (m.busy && !pooled.busy) continue;  // the quiet measurement alone
+      if (pooled.busy && !m.busy) {
+        pooled = m;
+        continue;
+      }
       pooled.seconds.insert(pooled.seconds.end(), m.seconds.begin(), m.seconds.end());
       pooled.order.insert(pooled.order.end(), m.order.begin(), m.order.end());
-      repeated_ = true;
+      pooled.reference_ratio = std::max(pooled.reference_ratio, m.reference_ratio);
     }
     return ok_status();
   }

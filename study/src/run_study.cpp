@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <tuple>
 
@@ -22,6 +23,9 @@ namespace {
 constexpr double kBaseShare = 0.6;
 constexpr double kPixelShare = 0.8;
 constexpr int kRefinementRounds = 3;
+// How long one timing of the reference frame takes at least, in frames in a row.
+constexpr double kReferenceSeconds = 2e-3;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 Status validate(const StudyRequest& r) {
   if (r.scenes.empty()) return bad_input("study: no scene family given");
@@ -75,6 +79,9 @@ class Sweep {
   Status measure(const Family& family, size_t n, int width, double deadline);
   void time_rounds(const Family& family, size_t n, FrameSource& frames, double deadline,
                    std::vector<Measurement>& points, Status& status);
+  Status start_reference(const Family& family);
+  Expected<double> time_reference();
+  Status measure_busy_points_again(const Family& family, double share_end);
   Status sweep_n(const Family& family, double limit, double share_end);
   Status sweep_pixels(const Family& family, double limit, double share_end);
   std::vector<size_t> crossover_midpoints(const Family& family) const;
@@ -89,10 +96,50 @@ class Sweep {
   Rng rng_;
   double start_ = 0;
   std::set<std::tuple<std::string, size_t, int>> measured_;  // family, n, width
-  CostPredictor cost_;              // of the current family's points at the full width
-  std::vector<PlannedPoint> plan_;  // the current family's
-  size_t plan_offset_ = 0;          // the index of its first point in the study's plan
+  CostPredictor cost_;                      // of the current family's points at the full width
+  std::unique_ptr<FrameSource> reference_;  // the current family's reference frame
+  int reference_frames_ = 1;                // frames in a row per reference time
+  double quickest_reference_ = kInfinity;   // its quickest time in the family so far
+  double slowest_reference_ = 0;            // its slowest time while measuring one point
+  std::vector<PlannedPoint> plan_;          // the current family's
+  size_t plan_offset_ = 0;                  // the index of its first point in the study's plan
 };
+
+// The reference frame of a family: its smallest point at full width, the first renderer, run
+// often enough in a row to take kReferenceSeconds (a frame of a few microseconds alone would
+// measure the timer and the scheduler); its quickest time starts as the median of five.
+Status Sweep::start_reference(const Family& family) {
+  Expected<std::unique_ptr<FrameSource>> frames =
+      hooks_.prepare(family, family.low, request_.width);
+  if (!frames) return frames.error();
+  reference_ = std::move(*frames);
+  reference_frames_ = 1;
+  Expected<double> one = time_reference();
+  if (!one) return one.error();
+  reference_frames_ = int(std::clamp(std::ceil(kReferenceSeconds / *one), 1.0, 1000.0));
+  quickest_reference_ = kInfinity;  // the single frame above is not a reference time
+  std::vector<double> times;
+  for (int k = 0; k < 5; ++k) {
+    Expected<double> t = time_reference();
+    if (!t) return t.error();
+    times.push_back(*t);
+  }
+  quickest_reference_ = median(times);
+  return ok_status();
+}
+
+// The reference frames in a row: their time joins the point's slowest and the study's quickest.
+Expected<double> Sweep::time_reference() {
+  double total = 0;
+  for (int k = 0; k < reference_frames_; ++k) {
+    Expected<double> t = reference_->time_frame(0);
+    if (!t) return t.error();
+    total += *t;
+  }
+  slowest_reference_ = std::max(slowest_reference_, total);
+  quickest_reference_ = std::min(quickest_reference_, total);
+  return total;
+}
 
 // Whether the current family's planned point (n, width) is this shard's to measure (every
 // point is, unsharded).
@@ -109,7 +156,9 @@ bool Sweep::in_this_shard(size_t n, int width) const {
 void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, double deadline,
                         std::vector<Measurement>& points, Status& status) {
   std::vector<size_t> order(points.size());
-  for (int round = 0; round < request_.repetitions; ++round) {
+  slowest_reference_ = 0;
+  if (Expected<double> t = time_reference(); !t) status = t.error();
+  for (int round = 0; status && round < request_.repetitions; ++round) {
     if (round >= 5 && elapsed() > deadline) break;
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
     for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng_.below(i)]);
@@ -125,6 +174,7 @@ void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, dou
       points[order[k]].seconds.push_back(*t);
       points[order[k]].order.push_back(int(k));
     }
+    if (Expected<double> t = time_reference(); !t) status = t.error();
   }
 }
 
@@ -150,7 +200,12 @@ Status Sweep::measure(const Family& family, size_t n, int width, double deadline
   time_rounds(family, n, **frames, deadline, points, status);
   if (!status) return status;
   if (cancelled()) return ok_status();  // the point is incomplete: dropped
-  for (Measurement& m : points) result_.points.push_back(std::move(m));
+  const double ratio = slowest_reference_ / quickest_reference_;
+  for (Measurement& m : points) {
+    m.reference_ratio = ratio;
+    m.busy = ratio > kBusyRatio;
+    result_.points.push_back(std::move(m));
+  }
   measured_.insert({family.name, n, width});
   return ok_status();
 }
@@ -231,24 +286,67 @@ Status Sweep::sweep_pixels(const Family& family, double limit, double share_end)
   return ok_status();
 }
 
+// The points of the family measured while the machine was busy, measured again (the busy ones
+// replaced) while the share lasts; those still busy are said in the notes.
+Status Sweep::measure_busy_points_again(const Family& family, double share_end) {
+  std::set<std::pair<size_t, int>> busy;
+  for (const Measurement& m : result_.points)
+    if (m.scene == family.name && m.busy) busy.insert({size_t(m.scene_n), m.width});
+  size_t again = 0;
+  for (auto [n, width] : busy) {
+    if (cancelled() || elapsed() + cost_.predict(n) > share_end) break;
+    auto same_point = [&, n = n, width = width](const Measurement& m) {
+      return m.scene == family.name && size_t(m.scene_n) == n && m.width == width;
+    };
+    std::vector<Measurement> before;
+    for (const Measurement& m : result_.points)
+      if (same_point(m)) before.push_back(m);
+    std::erase_if(result_.points, same_point);
+    measured_.erase({family.name, n, width});
+    if (Status s = measure(family, n, width, share_end); !s) return s;
+    if (!measured_.count({family.name, n, width})) {  // cancelled: the first measurement stays
+      for (Measurement& m : before) result_.points.push_back(std::move(m));
+      break;
+    }
+    ++again;
+  }
+  if (again > 0)
+    result_.notes.push_back(
+        fmt::format("{}: {} points measured while the machine was busy with "
+                    "something else were measured again",
+                    family.name, again));
+  size_t still = 0;
+  double worst = 0;
+  for (const Measurement& m : result_.points)
+    if (m.scene == family.name && m.busy) ++still, worst = std::max(worst, m.reference_ratio);
+  if (still > 0)
+    result_.notes.push_back(fmt::format(
+        "{}: {} measurements were taken while the machine was busy with something else (the "
+        "reference frame up to {:.1f}× slower than its quickest) and are left out of the fits "
+        "and crossovers: run the study on a quiet machine",
+        family.name, still, worst));
+  return ok_status();
+}
+
 // The sweep of N up to kBaseShare of the scene's share, of the pixel count up to kPixelShare,
-// then points near crossovers.
+// then points near crossovers, then busy points again.
 Status Sweep::run_scene(const Family& family, double share_end) {
   const double share_start = elapsed();
   const double length = share_end - share_start;
   cost_ = CostPredictor();
   plan_offset_ += plan_.size();
   plan_ = planned_points(family, request_.width);
+  if (Status s = start_reference(family); !s) return s;
   if (Status s = sweep_n(family, share_start + kBaseShare * length, share_end); !s) return s;
   if (Status s = sweep_pixels(family, share_start + kPixelShare * length, share_end); !s) return s;
-  if (request_.shard) return ok_status();  // the points near crossovers need every shard's
-  for (int round = 0; round < kRefinementRounds; ++round)
+  // A shard adds none near crossovers: where they go depends on the other shards' points.
+  for (int round = 0; round < (request_.shard ? 0 : kRefinementRounds); ++round)
     for (size_t mid : crossover_midpoints(family)) {
       if (cancelled()) return ok_status();
       Expected<bool> done = try_point(family, mid, request_.width, share_end, share_end);
       if (!done) return done.error();
     }
-  return ok_status();
+  return measure_busy_points_again(family, share_end);
 }
 
 }  // namespace

@@ -115,7 +115,9 @@ json points_json(const StudyResult& r) {
                    {"order", m.order},
                    {"median", number(median_seconds(m))},
                    {"hd_median", number(typical_seconds(m))},
-                   {"relative_mad", number(relative_mad(m))}});
+                   {"relative_mad", number(relative_mad(m))},
+                   {"reference_ratio", number(m.reference_ratio)},
+                   {"busy", m.busy}});
   }
   return out;
 }

@@ -128,9 +128,9 @@ const std::vector<std::string> kTopKeys = {
     "machine",         "renderers",   "crossovers", "dominance",
     "scaling",         "costs",       "notes",      "interrupted",
     "shard",           "points"};
-const std::vector<std::string> kPointKeys = {"renderer", "scene",  "scene_n",   "n",
-                                             "width",    "height", "pixels",    "seconds",
-                                             "order",    "median", "hd_median", "relative_mad"};
+const std::vector<std::string> kPointKeys = {
+    "renderer", "scene", "scene_n", "n",         "width",        "height",          "pixels",
+    "seconds",  "order", "median",  "hd_median", "relative_mad", "reference_ratio", "busy"};
 
 // A family is a built-in (its axis fixed) or a file grown by copies (axis "triangles").
 void read_scenes(const Fields& top, StudyResult& r) {
@@ -252,6 +252,9 @@ Measurement read_point(const json& v, const std::string& path, const StudyResult
   for (size_t k = 0; k < order.size(); ++k)
     m.order.push_back(int(Fields::whole_at(order[k], index_path(p.path("order"), k), 0, 1u << 20)));
   for (const char* derived : {"median", "hd_median", "relative_mad"}) p.at(derived);
+  // Studies written before the reference frame have neither: measured as if quiet.
+  if (p.has("reference_ratio")) m.reference_ratio = p.number_or_nan("reference_ratio");
+  if (p.has("busy")) m.busy = p.boolean("busy");
   return m;
 }
 

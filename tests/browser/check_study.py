@@ -129,7 +129,9 @@ def chart_problems(study, scene, label, chart, counts, crossovers):
             problems.append(f"{where}: {name} has {s['spreads']} spread bars for "
                             f"{s['marks']} points")
         fit = study["renderers"].get(name, {}).get("fits", {}).get(scene)
-        if fit and fit.get("coefficients"):
+        fitted = fit and any(c.get("value") not in (None, 0)
+                             for c in fit.get("coefficients", {}).values())
+        if fitted:
             models = s["models"]
             if len(models) != 1 or models[0]["length"] <= 0:
                 problems.append(f"{where}: {name}'s model curve is missing or not drawn")

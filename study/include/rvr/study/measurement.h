@@ -15,7 +15,15 @@ struct Measurement {
   int width = 0, height = 0;
   std::vector<double> seconds;  // every repetition, in the order they were timed
   std::vector<int> order;       // each repetition's position in its interleaved round
+  // The reference frame timed between the rounds, at its slowest, over its quickest in the
+  // family so far: how much busier the machine was than at its quietest (run_study.h).
+  double reference_ratio = 0;
+  bool busy = false;  // reference_ratio over kBusyRatio: left out of fits and crossovers
 };
+
+// A point whose reference frame ran this much slower than its quickest was measured on a
+// machine busy with something else.
+constexpr double kBusyRatio = 1.3;
 
 // The median of `values` (the mean of the middle two for an even count); 0 for none.
 double median(std::vector<double> values);

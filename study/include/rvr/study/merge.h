@@ -28,7 +28,8 @@ struct MachineGroup {
 
 // Groups the studies by machine type and mode, in the order first seen; in each, the points are
 // united (a point measured by several studies, same renderer, scene, scene_n and width, keeps
-// every repetition of each), ordered by family, N, width and renderer, and concluded with the
+// every repetition of each, or of those that measured it on a quiet machine if any did: not
+// `busy`), ordered by family, N, width and renderer, and concluded with the
 // first study's seed and bootstrap replicates. Renderers and families are united; budgets and
 // elapsed times add up; `notes` says which studies were pooled, which shards are missing and
 // each source's own notes. A BadInput error when studies pooled differ in image size, or give

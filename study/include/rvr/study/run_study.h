@@ -2,6 +2,14 @@
 // sweep of N at the full width, a sweep of the pixel count at three of those N, and points added
 // near every crossover; each point's frames timed with the renderers' repetitions interleaved in
 // random order; then the conclusions.
+//
+// Whether the machine stayed quiet is watched: a reference frame (the family's smallest point,
+// the first renderer, run enough times in a row to take 2 ms) is timed before the first round of
+// every point and after each round. A point whose reference ran kBusyRatio slower than the
+// quickest reference of the family was
+// measured while something else ran: it is measured again at the end of the family's share if
+// the budget allows, and a point still busy is kept (busy: true) but left out of the fits and
+// crossovers.
 #pragma once
 
 #include <cstdint>
