@@ -422,6 +422,15 @@ TEST(StudyRun, SweepsWithinTheBudgetAndRefinesNearTheCrossover) {
     EXPECT_TRUE(c.a_faster_below == false) << "the tracer wins with few pixels";
   }
   for (const Measurement& m : r->points) EXPECT_EQ(m.seconds.size(), 5u);
+  // The crossover along N checked after the fit, below and above it, the z-buffer faster below.
+  ASSERT_EQ(r->checks.size(), 2u);
+  for (const PredictionCheck& c : r->checks) {
+    const bool below = c.at < c.crossover;
+    EXPECT_NEAR(std::log10(c.at / c.crossover), below ? -std::log10(3.0) : std::log10(3.0), 0.1);
+    const bool z_faster = kZCurve(kP, c.at) < kTCurve(kP, c.at);  // the truth at that N
+    EXPECT_EQ(c.predicted_faster, z_faster ? "softraster" : "raytrace");
+    EXPECT_TRUE(c.holds) << c.at;
+  }
   EXPECT_NE(study_json(*r).find("\"format\": \"rvr-study/1\""), std::string::npos);
 }
 
@@ -984,6 +993,7 @@ TEST(StudyRun, ShardsMeasureEveryPlannedPointOnce) {
     ASSERT_TRUE(r.ok()) << r.error().message;
     ASSERT_TRUE(r->shard.has_value());
     EXPECT_EQ(r->shard->index, i);
+    EXPECT_TRUE(r->checks.empty()) << "a shard's crossovers are checked";
     ASSERT_FALSE(r->notes.empty());
     EXPECT_EQ(r->notes[0].rfind(fmt::format("shard {}/3: ", i), 0), 0u) << r->notes[0];
     for (const Measurement& m : r->points) {

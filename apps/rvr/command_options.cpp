@@ -76,6 +76,10 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
                  "softraster: hierarchical z, each 8x8 block's farthest depth rejecting what lies "
                  "behind it: on | off (the textbook z-buffer)")
       ->check(CLI::IsMember({"on", "off"}));
+  cmd.add_option("--depth-format", o.depth_format,
+                 "rasterizers' z-buffer: d24 | d32f | d32f_reversed (default: the most precise "
+                 "the renderer has)")
+      ->check(CLI::IsMember({"d24", "d32f", "d32f_reversed"}));
   cmd.add_flag("--quiet,-q", o.quiet, "no progress output");
   cmd.add_option("--max-samples", o.limits.max_samples,
                  "refuse more than N pixels x samples (default 2^30)")
@@ -117,6 +121,7 @@ RenderOptions render_options(const CommonOptions& o, const std::string& default_
   r.shadow_bias = o.shadow_bias;
   r.shadow_pcf = o.shadow_pcf;
   r.hiz = o.hiz == "on";
+  if (!o.depth_format.empty()) r.depth_format = parse_depth_format(o.depth_format);
   return r;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rvr/raster/gl_rasterizer.h"
+#include "rvr/shared/compare.h"
 #include "rvr/shared/limits.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
@@ -39,6 +40,7 @@ struct CommonOptions {
   float shadow_bias = 0.01f;
   bool shadow_pcf = false;
   std::string hiz = "on";
+  std::string depth_format;  // --depth-format: d24 | d32f | d32f_reversed (empty: the best)
   bool quiet = false;
   Limits limits;
   uint64_t max_memory_mb = 0;
@@ -75,7 +77,8 @@ int run_compare(const CompareArgs& a, const std::string& command_line);
 
 struct DiffArgs {
   std::string a, b, out;
-  std::optional<double> fail_above;
+  std::optional<double> fail_above;  // FAILURE also when the RMS error is above this
+  DiffThresholds thresholds;         // idiff's --fail, --failpercent, --hardfail, --warn...
 };
 
 int run_diff(const DiffArgs& d);

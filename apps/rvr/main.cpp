@@ -88,7 +88,19 @@ int run(int argc, char** argv) {
   diff_cmd->add_option("image_a", diff.a, "first image")->required();
   diff_cmd->add_option("image_b", diff.b, "second image")->required();
   diff_cmd->add_option("-o,--output", diff.out, "heat map of the difference (.png)");
-  diff_cmd->add_option("--fail-above", diff.fail_above, "exit 1 when the RMSE is above this");
+  diff_cmd->add_option("--fail", diff.thresholds.fail,
+                       "a pixel fails when a channel differs by more than this (default 1e-6)");
+  diff_cmd->add_option("--failpercent", diff.thresholds.fail_percent,
+                       "FAILURE only when more than this % of the pixels fail (default 0)");
+  diff_cmd->add_option("--hardfail", diff.thresholds.hard_fail,
+                       "FAILURE when any channel differs by more than this (default inf)");
+  diff_cmd->add_option("--warn", diff.thresholds.warn,
+                       "a pixel warns when a channel differs by more than this (default 1e-6)");
+  diff_cmd->add_option("--warnpercent", diff.thresholds.warn_percent,
+                       "WARNING only when more than this % of the pixels warn (default 0)");
+  diff_cmd->add_option("--hardwarn", diff.thresholds.hard_warn,
+                       "WARNING when any channel differs by more than this (default inf)");
+  diff_cmd->add_option("--fail-above", diff.fail_above, "FAILURE also when the RMSE is above this");
 
   ScenesArgs scenes;
   CLI::App* scenes_cmd =

@@ -174,7 +174,26 @@ struct ScenePass {
   const SceneUpload& upload;
   const ShadowPlan& shadows;
   glm::mat4 view, projection;
+  DepthFormat depth_format;
 };
+
+// Renderbuffer format of a z-buffer format.
+GLenum depth_internal_format(DepthFormat format) {
+  return format == DepthFormat::D24 ? GLenum(GL_DEPTH_COMPONENT24) : GLenum(GL_DEPTH_COMPONENT32F);
+}
+
+// `projection` (OpenGL's, window z 0 at near and 1 at far) with its z row replaced so that, with
+// glClipControl's GL_ZERO_TO_ONE depth, window z is n (f - d) / (d (f - n)) at view depth d:
+// 1 at near, 0 at far. Only the z row changes, so x, y and w (and any jitter or shear of an
+// image sample in the rows of x and y) are those of `projection`.
+glm::mat4 reversed_z_projection(glm::mat4 projection, float near_plane, float far_plane) {
+  const double n = near_plane, f = far_plane;
+  projection[0][2] = 0.0f;
+  projection[1][2] = 0.0f;
+  projection[2][2] = float(n / (f - n));
+  projection[3][2] = float(n * f / (f - n));
+  return projection;
+}
 
 // What a z-buffer cannot do, named for this scene only (shadows it does, with shadow maps).
 void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& options,
@@ -234,10 +253,12 @@ struct GlRasterizer::Impl {
   GLuint vao = 0, vertex_buffer = 0, light_buffer = 0, light_texture = 0, query = 0;
   GLint max_size = 0;  // largest framebuffer side the driver accepts
   GLint max_samples = 1, max_texture_size = 0, max_layers = 0;
+  bool clip_control = false;  // ARB_clip_control: reversed-Z depth (d32f_reversed)
 
   // Render targets, re-made when the image size changes.
   int width = 0, height = 0;
   GLuint scene_fbo = 0, cost_fbo = 0, depth_buffer = 0;
+  GLenum depth_format = GL_DEPTH_COMPONENT32F;  // of depth_buffer and msaa_depth
   std::array<GLuint, kTargetCount> targets{};
   // Multisampled colour + depth (spp > 1), re-made when size or sample count change.
   GLuint msaa_fbo = 0, msaa_colour = 0, msaa_depth = 0;
@@ -256,7 +277,10 @@ struct GlRasterizer::Impl {
   // Context, programs and buffers: done once per GlRasterizer.
   Status init();
   Status create_resources();
-  Status resize(int w, int h);
+  Status resize(int w, int h, GLenum depth);
+  // The clip-space depth convention of the camera passes (reversed: GL_ZERO_TO_ONE) or GL's
+  // default (shadow maps, and between renders).
+  void use_depth_convention(bool reversed);
   Status ensure_msaa(int samples);
   Status ensure_shadow_maps(int size, int layers);
   Status render_shadow_maps(const std::vector<LightSample>& samples, size_t first, size_t end,
@@ -273,7 +297,7 @@ struct GlRasterizer::Impl {
                                     const std::vector<LightSample>& samples, RenderOutput& out);
   Status scene_passes(const ScenePass& pass, int msaa, RenderOutput& out);
   void draw_scene(const ScenePass& pass, bool shade_pass, size_t first, size_t end, bool base);
-  void clear_scene_targets(const Scene& scene);
+  void clear_scene_targets(const Scene& scene, GLfloat depth_clear);
   void draw_to_every_target();
   Status cost_pass(const ScenePass& pass);
   Status readback(int w, int h, const ScenePass& pass, FrameBuffers& fb, uint64_t& samples_passed);
@@ -362,12 +386,18 @@ Status GlRasterizer::Impl::create_resources() {
   gl().GetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture_size);
   gl().GetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &max_layers);
   max_samples = std::max(max_samples, 1);
+  clip_control = gl().ARB_clip_control && gl().ClipControl != nullptr;
   RVR_GL_CHECK("GL setup");
   return ok_status();
 }
 
-Status GlRasterizer::Impl::resize(int w, int h) {
-  if (w == width && h == height && scene_fbo != 0) return ok_status();
+void GlRasterizer::Impl::use_depth_convention(bool reversed) {
+  if (clip_control)
+    gl().ClipControl(GL_LOWER_LEFT, reversed ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
+}
+
+Status GlRasterizer::Impl::resize(int w, int h, GLenum depth) {
+  if (w == width && h == height && depth == depth_format && scene_fbo != 0) return ok_status();
   if (w > max_size || h > max_size)
     return internal_error(fmt::format(
         "image {}x{} exceeds the GL driver's largest framebuffer ({} per side)", w, h, max_size));
@@ -379,7 +409,8 @@ Status GlRasterizer::Impl::resize(int w, int h) {
   }
   gl().GenRenderbuffers(1, &depth_buffer);
   gl().BindRenderbuffer(GL_RENDERBUFFER, depth_buffer);
-  gl().RenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
+  gl().RenderbufferStorage(GL_RENDERBUFFER, depth, w, h);
+  depth_format = depth;
   RVR_GL_CHECK("allocating render targets");
 
   gl().GenFramebuffers(1, &scene_fbo);
@@ -420,8 +451,7 @@ Status GlRasterizer::Impl::ensure_msaa(int samples) {
   gl().RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA32F, width, height);
   gl().GenRenderbuffers(1, &msaa_depth);
   gl().BindRenderbuffer(GL_RENDERBUFFER, msaa_depth);
-  gl().RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT32F, width,
-                                      height);
+  gl().RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, depth_format, width, height);
   gl().GenFramebuffers(1, &msaa_fbo);
   gl().BindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
   gl().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, msaa_colour);
@@ -689,13 +719,12 @@ void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size
   }
 }
 
-void GlRasterizer::Impl::clear_scene_targets(const Scene& scene) {
+void GlRasterizer::Impl::clear_scene_targets(const Scene& scene, GLfloat depth_clear) {
   const float inf = std::numeric_limits<float>::infinity();
   const glm::vec4 background(scene.image.background, 1.0f);
   const glm::vec4 zero(0.0f);
   const GLuint no_id[4] = {kNoId, kNoId, kNoId, kNoId};
   const GLfloat far_view[4] = {inf, 0.0f, 0.0f, 0.0f};
-  const GLfloat depth_one = 1.0f;
   gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
   draw_to_every_target();
   gl().ClearBufferfv(GL_COLOR, kColour, glm::value_ptr(background));
@@ -703,7 +732,7 @@ void GlRasterizer::Impl::clear_scene_targets(const Scene& scene) {
   gl().ClearBufferuiv(GL_COLOR, kPrimitiveId, no_id);
   gl().ClearBufferfv(GL_COLOR, kViewDepth, far_view);
   gl().ClearBufferfv(GL_COLOR, kNormal, glm::value_ptr(zero));
-  gl().ClearBufferfv(GL_DEPTH, 0, &depth_one);
+  gl().ClearBufferfv(GL_DEPTH, 0, &depth_clear);
 }
 
 void GlRasterizer::Impl::draw_to_every_target() {
@@ -719,7 +748,10 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
   const ShadowPlan& shadows = pass.shadows;
   const bool shade = pass.options.mode != RenderMode::Visibility;
   const glm::vec4 background(pass.scene.image.background, 1.0f);
-  const GLfloat depth_one = 1.0f;
+  // Reversed-Z: the far plane is 0 and nearer is greater.
+  const bool reversed = pass.depth_format == DepthFormat::D32FReversed;
+  const GLfloat depth_clear = reversed ? 0.0f : 1.0f;
+  const GLenum nearer = reversed ? GL_GREATER : GL_LESS;
   const GLenum colour_only = GL_COLOR_ATTACHMENT0;
   ProgressSink* progress = pass.options.progress;
   double shadow_time = 0.0;
@@ -744,23 +776,25 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
     const size_t first = b * shadows.batch, end = std::min(samples.size(), first + shadows.batch);
     if (shadows.enabled) {
       auto ts = Clock::now();
+      use_depth_convention(false);
       RVR_TRY(render_shadow_maps(samples, first, end, shadows.light_projection,
                                  GLsizei(vertices.size())));
       gl().Finish();
       shadow_time += seconds_since(ts);
     }
+    use_depth_convention(reversed);
     gl().Viewport(0, 0, w, h);
     gl().Enable(GL_DEPTH_TEST);
     if (b == 0) {
       // Base pass: emission, ambient and the first batch of lights; ids etc. when single-sampled.
-      gl().DepthFunc(GL_LESS);
+      gl().DepthFunc(nearer);
       gl().DepthMask(GL_TRUE);
       if (msaa > 1) {
         gl().BindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
         gl().ClearBufferfv(GL_COLOR, 0, glm::value_ptr(background));
-        gl().ClearBufferfv(GL_DEPTH, 0, &depth_one);
+        gl().ClearBufferfv(GL_DEPTH, 0, &depth_clear);
       } else {
-        clear_scene_targets(pass.scene);
+        clear_scene_targets(pass.scene, depth_clear);
         gl().BeginQuery(GL_SAMPLES_PASSED, query);
       }
       draw_scene(pass, shade, first, end, true);
@@ -776,7 +810,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
       draw_scene(pass, true, first, end, false);
       gl().Disable(GL_BLEND);
       gl().DepthMask(GL_TRUE);
-      gl().DepthFunc(GL_LESS);
+      gl().DepthFunc(nearer);
     }
     if (progress && batches > 1) {
       const uint64_t triangles = vertices.size() / 3;
@@ -786,7 +820,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
   if (msaa > 1) {
     // The per-pixel AOVs (ids, depth, normal) come from one sample at the pixel centre; the
     // colour is the multisampled one, resolved (averaged) over each pixel's samples.
-    clear_scene_targets(pass.scene);
+    clear_scene_targets(pass.scene, depth_clear);
     gl().BeginQuery(GL_SAMPLES_PASSED, query);
     draw_scene(pass, false, 0, 0, true);
     gl().EndQuery(GL_SAMPLES_PASSED);
@@ -799,6 +833,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
   gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
   draw_to_every_target();
   gl().Finish();
+  use_depth_convention(false);
   RVR_GL_CHECK("scene pass");
   out.stats["time.render"] = seconds_since(t) - shadow_time;
   if (shadows.enabled) {
@@ -824,7 +859,10 @@ Status GlRasterizer::Impl::cost_pass(const ScenePass& pass) {
   gl().UseProgram(cost_program);
   gl().UniformMatrix4fv(cost_view, 1, GL_FALSE, glm::value_ptr(pass.view));
   gl().UniformMatrix4fv(cost_projection, 1, GL_FALSE, glm::value_ptr(pass.projection));
+  // The same clipping as the scene passes (their projection's z range).
+  use_depth_convention(pass.depth_format == DepthFormat::D32FReversed);
   if (!vertices.empty()) gl().DrawArrays(GL_TRIANGLES, 0, GLsizei(vertices.size()));
+  use_depth_convention(false);
   gl().Disable(GL_BLEND);
   gl().Finish();
   RVR_GL_CHECK("cost pass");
@@ -903,7 +941,14 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   auto t = Clock::now();
   RVR_TRY(init());
   out.warnings = context_warnings;
-  RVR_TRY(resize(w, h));
+  // Unset: the most precise this GL offers. Reversed-Z needs ARB_clip_control: without it
+  // window z is (z_ndc + 1) / 2, whose float rounding near 1 undoes the reversal.
+  const DepthFormat depth_format =
+      options.depth_format.value_or(clip_control ? DepthFormat::D32FReversed : DepthFormat::D32F);
+  if (depth_format == DepthFormat::D32FReversed && !clip_control)
+    return bad_input("--depth-format d32f_reversed: this GL does not offer ARB_clip_control");
+  out.info["depth_format"] = to_string(depth_format);
+  RVR_TRY(resize(w, h, depth_internal_format(depth_format)));
   out.stats["time.setup"] = seconds_since(t);
 
   if (progress) progress->begin("upload");  // mostly one glBufferData: time only
@@ -927,6 +972,9 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   }
 
   // One accumulation-buffer pass (the hybrid's): the camera as that sample sees it.
+  const glm::mat4 camera_projection =
+      options.image_sample ? sample_projection_matrix(scene.camera, w, h, *options.image_sample)
+                           : projection_matrix(scene.camera, w, h);
   const ScenePass pass{
       scene,
       options,
@@ -934,8 +982,10 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
       *shadows,
       options.image_sample ? sample_view_matrix(scene.camera, *options.image_sample)
                            : view_matrix(scene.camera),
-      options.image_sample ? sample_projection_matrix(scene.camera, w, h, *options.image_sample)
-                           : projection_matrix(scene.camera, w, h)};
+      depth_format == DepthFormat::D32FReversed
+          ? reversed_z_projection(camera_projection, scene.camera.near, scene.camera.far)
+          : camera_projection,
+      depth_format};
   RVR_TRY(scene_passes(pass, msaa, out));
 
   if (options.cost_aov) {

@@ -125,6 +125,14 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
       kept.emplace(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels);
   });
   DepthTarget& target = *kept;
+  // The camera pass's depth test as the format would store depth (unset: the view depth in
+  // double precision); shadow maps keep exact distances.
+  target.set_depth_format(!options.depth_format                        ? soft::kDepthExact
+                          : *options.depth_format == DepthFormat::D24  ? soft::kDepthD24
+                          : *options.depth_format == DepthFormat::D32F ? soft::kDepthD32F
+                                                                       : soft::kDepthD32FReversed);
+  out.info["depth_format"] =
+      options.depth_format ? to_string(*options.depth_format) : "exact (view depth, double)";
   // The fraction in triangles, the speed in fragments.
   if (progress) progress->begin("draw", submitted, "triangles", "fragments");
   const DrawResult drawn = soft::draw_triangles(list, view_projection, target, arena, progress);

@@ -285,7 +285,7 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) 
   return m;
 }
 
-Expected<ImageDiff> diff_images(const Image& a, const Image& b) {
+Expected<ImageDiff> diff_images(const Image& a, const Image& b, const DiffThresholds& thresholds) {
   try {
     if (a.width != b.width || a.height != b.height)
       return bad_input("images differ in size: " + std::to_string(a.width) + "x" +
@@ -294,37 +294,85 @@ Expected<ImageDiff> diff_images(const Image& a, const Image& b) {
     if (a.channels != b.channels)
       return bad_input("images differ in channel count: " + std::to_string(a.channels) + " vs " +
                        std::to_string(b.channels));
-    const size_t count = size_t(a.width) * a.height * a.channels;
+    const size_t pixels = size_t(a.width) * a.height;
+    const size_t channels = size_t(a.channels);
+    const size_t count = pixels * channels;
     if (a.pixels.size() != count || b.pixels.size() != count)
       return internal_error("image pixel buffers do not match their size");
     ImageDiff d;
+    d.pixels = pixels;
     if (count == 0) {
       d.psnr_db = kInf;
       return d;
     }
+    const double warn = thresholds.warn, fail = thresholds.fail;
     double sum = 0.0, sq = 0.0;
     size_t worst = 0;
-    for (size_t i = 0; i < count; ++i) {
-      double e = std::fabs(double(a.pixels[i]) - double(b.pixels[i]));
-      if (std::isnan(e)) e = (std::isnan(a.pixels[i]) && std::isnan(b.pixels[i])) ? 0.0 : kInf;
-      sum += e;
-      sq += e * e;
-      if (e > d.max_abs) {
-        d.max_abs = e;
-        worst = i;
+    for (size_t p = 0; p < pixels; ++p) {
+      bool warned = false, failed = false;
+      for (size_t c = 0; c < channels; ++c) {
+        const size_t i = p * channels + c;
+        const double va = a.pixels[i], vb = b.pixels[i];
+        double e;
+        if (std::isfinite(va) && std::isfinite(vb)) {
+          e = std::fabs(va - vb);
+        } else {
+          const bool same = std::isnan(va) == std::isnan(vb) && std::isinf(va) == std::isinf(vb);
+          e = same ? 0.0 : kInf;
+        }
+        sum += e;
+        sq += e * e;
+        if (e > d.max_abs) {
+          d.max_abs = e;
+          worst = i;
+        }
+        if (!warned && e > warn) {
+          warned = true;
+          ++d.warn_pixels;
+        }
+        if (!failed && e > fail) {
+          failed = true;
+          ++d.fail_pixels;
+        }
       }
     }
     d.mean_abs = sum / double(count);
     d.rmse = std::sqrt(sq / double(count));
     d.psnr_db = psnr_of(d.rmse);
-    d.max_channel = int(worst % size_t(a.channels));
-    size_t pixel = worst / size_t(a.channels);
+    d.max_channel = int(worst % channels);
+    size_t pixel = worst / channels;
     d.max_x = int(pixel % size_t(a.width));
     d.max_y = int(pixel / size_t(a.width));
     return d;
   } catch (const std::exception& e) {
     return internal_error(std::string("image diff failed: ") + e.what());
   }
+}
+
+const char* to_string(DiffVerdict verdict) {
+  switch (verdict) {
+    case DiffVerdict::Pass:
+      return "PASS";
+    case DiffVerdict::Warning:
+      return "WARNING";
+    case DiffVerdict::Failure:
+      return "FAILURE";
+  }
+  return "FAILURE";
+}
+
+DiffVerdict diff_verdict(const ImageDiff& diff, const DiffThresholds& t) {
+  // A 0x0 image counts as one pixel, so the allowed fraction is never of nothing.
+  const double pixels = double(std::max<size_t>(diff.pixels, 1));
+  // No failing pixel passes, whatever the warnings (idiff's -allowfailures, default 0).
+  if (diff.fail_pixels == 0) return DiffVerdict::Pass;
+  if (double(diff.fail_pixels) > double(t.fail_percent) / 100.0 * pixels ||
+      diff.max_abs > double(t.hard_fail))
+    return DiffVerdict::Failure;
+  if (double(diff.warn_pixels) > double(t.warn_percent) / 100.0 * pixels ||
+      diff.max_abs > double(t.hard_warn))
+    return DiffVerdict::Warning;
+  return DiffVerdict::Pass;
 }
 
 Image diff_heat_map(const Image& a, const Image& b, float scale) {

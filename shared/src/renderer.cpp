@@ -1,5 +1,8 @@
 #include "rvr/shared/renderer.h"
 
+#include <optional>
+#include <string>
+
 namespace rvr {
 
 const char* to_string(RenderMode mode) {
@@ -26,6 +29,24 @@ const char* to_string(AccelKind accel) {
       return "embree";
   }
   return "?";
+}
+
+const char* to_string(DepthFormat format) {
+  switch (format) {
+    case DepthFormat::D24:
+      return "d24";
+    case DepthFormat::D32F:
+      return "d32f";
+    case DepthFormat::D32FReversed:
+      return "d32f_reversed";
+  }
+  return "?";
+}
+
+std::optional<DepthFormat> parse_depth_format(const std::string& name) {
+  for (DepthFormat f : {DepthFormat::D24, DepthFormat::D32F, DepthFormat::D32FReversed})
+    if (name == to_string(f)) return f;
+  return std::nullopt;
 }
 
 }  // namespace rvr

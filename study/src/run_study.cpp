@@ -13,6 +13,7 @@
 #include "rvr/renderers/registry.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
+#include "rvr/study/prediction_checks.h"
 #include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
@@ -365,13 +366,15 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   result.shard = request.shard;
   if (request.shard)
     result.notes.push_back(fmt::format(
-        "shard {}/{}: only the planned points whose index is {} mod {} were measured, and none "
-        "near crossovers (they depend on the other shards' points); rvr study --merge pools the "
-        "shards",
+        "shard {}/{}: only the planned points whose index is {} mod {} were measured, none near "
+        "crossovers, and no crossover is checked (they depend on the other shards' points); rvr "
+        "study --merge pools the shards",
         request.shard->index, request.shard->count, request.shard->index, request.shard->count));
   Sweep sweep(request, hooks, result);
+  std::vector<Family> families;
   for (size_t i = 0; i < request.scenes.size(); ++i) {
     Family family = *find_family(request.scenes[i]);
+    families.push_back(family);
     result.scenes.push_back(family.name);
     result.axes[family.name] = family.axis;
     double left = request.budget_seconds - sweep.elapsed();
@@ -388,6 +391,8 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   result.elapsed_seconds = sweep.elapsed();
   BootstrapOptions boot{request.bootstrap_replicates, request.seed};
   conclude(result, boot);
+  if (!result.interrupted && request.check_predictions && !request.shard)
+    if (Status s = check_predictions(request, hooks, families, result); !s) return s.error();
   return result;
 }
 

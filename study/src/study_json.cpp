@@ -94,6 +94,20 @@ void conclusions_json(const StudyResult& r, json& doc) {
                      {"seconds", number(c.seconds)},
                      {"ns_per_triangle", number(c.ns_per_triangle)},
                      {"ns_per_ray", number(c.ns_per_ray)}});
+  json checks = json::array();
+  for (const PredictionCheck& c : r.checks)
+    checks.push_back({{"a", c.a},
+                      {"b", c.b},
+                      {"scene", c.scene},
+                      {"axis", c.axis},
+                      {"crossover", number(c.crossover)},
+                      {"at", number(c.at)},
+                      {"pixels", c.pixels},
+                      {"predicted_faster", c.predicted_faster},
+                      {"measured_faster", c.measured_faster},
+                      {"ratio", number(c.ratio)},
+                      {"holds", c.holds}});
+  doc["checks"] = checks;
   doc["dominance"] = dominance;
   doc["scaling"] = scaling;
   doc["costs"] = costs;

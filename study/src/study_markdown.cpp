@@ -110,6 +110,18 @@ std::string model_sentence(const RendererModels& m, const std::string& scene, co
       100 * f.loo_rel_error, f.selection);
 }
 
+std::string check_sentence(const PredictionCheck& c) {
+  const std::string& other = c.predicted_faster == c.a ? c.b : c.a;
+  return fmt::format(
+      "on {} at {} {} ({} the crossover at {}), {} should be faster than {}: {}, {:.2f}×{}.",
+      c.scene, format_number(c.at), c.axis, c.at < c.crossover ? "below" : "above",
+      format_number(c.crossover), c.predicted_faster, other, c.holds ? "it is" : "it is not",
+      c.ratio,
+      c.holds ? ""
+              : fmt::format(" the other way ({} is faster): the prediction does not hold",
+                            c.measured_faster));
+}
+
 std::string format_number(double v) {
   if (!std::isfinite(v)) return std::isnan(v) ? "n/a" : (v > 0 ? "∞" : "−∞");
   double a = std::fabs(v);
@@ -127,6 +139,12 @@ std::string study_markdown(const StudyResult& r) {
   for (const Crossover& c : r.crossovers) text += "- " + crossover_sentence(r, c) + "\n";
   for (const Dominance& d : r.dominance) text += "- " + dominance_sentence(r, d) + "\n";
   if (r.crossovers.empty() && r.dominance.empty()) text += "No pair of loop orders was measured.\n";
+  if (!r.checks.empty()) {
+    text +=
+        "\n## Predictions checked\n\nEach crossover measured again after the fit, at a third of "
+        "and three times its value:\n\n";
+    for (const PredictionCheck& c : r.checks) text += "- " + check_sentence(c) + "\n";
+  }
   text += "\n## Cost models\n\n";
   for (const RendererModels& m : r.models)
     for (const auto& [scene, f] : m.fits) text += "- " + model_sentence(m, scene, f) + "\n";

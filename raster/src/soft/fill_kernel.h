@@ -21,6 +21,14 @@ struct FillTriangle {
   uint32_t object, primitive;
 };
 
+// What the depth test compares (FillTarget::depth_format): the view depth itself (exact), or the
+// value a z-buffer of that format would store for it (kernels/depth_key.inl). The stored array
+// always holds the view depth: the value a format stores is a function of it.
+constexpr int kDepthExact = 0;
+constexpr int kDepthD24 = 1;
+constexpr int kDepthD32F = 2;
+constexpr int kDepthD32FReversed = 3;
+
 // The frame's z-buffer state (DepthTarget's arrays).
 struct FillTarget {
   double* depth;
@@ -33,6 +41,7 @@ struct FillTarget {
   int blocks_x;
   double near_plane, far_plane;
   bool depth_only;
+  int depth_format;  // kDepthExact, kDepthD24, ...
 };
 
 struct FillResult {

@@ -56,7 +56,7 @@ void DepthTarget::clear() {
   fill_target_ = {depth_.data(), object_.data(),    primitive_.data(),
                   bary_.data(),  fragments_.data(), block_empty_.data(),
                   width_,        blocks_x_,         near_,
-                  far_,          depth_only_};
+                  far_,          depth_only_,       depth_format_};
   for (int by = 0; by < blocks_y_; ++by)
     for (int bx = 0; bx < blocks_x_; ++bx)
       block_empty_[size_t(by) * size_t(blocks_x_) + size_t(bx)] = uint16_t(

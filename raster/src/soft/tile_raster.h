@@ -34,6 +34,11 @@ class DepthTarget {
               const FillKernels& kernels, bool depth_only = false);
   // Back to nothing drawn, for the next pass through the same target.
   void clear();
+  // What the depth test compares from now on (fill_kernel.h: kDepthExact, kDepthD24, ...).
+  void set_depth_format(int format) {
+    depth_format_ = format;
+    fill_target_.depth_format = format;
+  }
   // Whether this target was made with these arguments (and can be cleared instead of rebuilt).
   bool same_setup(int width, int height, double near_plane, double far_plane, bool hiz,
                   const FillKernels& kernels) const {
@@ -100,6 +105,7 @@ class DepthTarget {
   int width_, height_, tiles_x_, tiles_y_, blocks_x_, blocks_y_;
   double near_, far_;
   bool hiz_, depth_only_;
+  int depth_format_ = kDepthExact;
   const FillKernels* kernels_;
   FillTarget fill_target_;     // pointers into the arrays below, for the kernels
   PixelVector<double> depth_;  // +inf until drawn

@@ -16,6 +16,7 @@ namespace RVR_KERNEL_NS {
 namespace {
 
 using namespace simd;
+#include "depth_key.inl"
 constexpr int kLanes = 8;
 
 // Each bit of an 8-lane mask three times: the mask of those lanes' interleaved barycentrics.
@@ -93,6 +94,18 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
         // inside near). Ordered compares: a NaN depth fails, as in the scalar test.
         const vdouble8 stored = vdouble8::loadu(mask, target.depth + i);
         vboold8 passed = less(mask, depth, stored);
+        if (target.depth_format != kDepthExact) {
+          // A z-buffer format's test, lane by lane (depth_key.inl).
+          alignas(64) double depth_lane[kLanes], stored_lane[kLanes];
+          _mm512_store_pd(depth_lane, depth.v);
+          _mm512_store_pd(stored_lane, stored.v);
+          unsigned bits = 0;
+          for (unsigned m = movemask(mask); m; m &= m - 1) {
+            const int k = __builtin_ctz(m);
+            if (passes_depth_test(depth_lane[k], stored_lane[k], target)) bits |= 1u << k;
+          }
+          passed = vboold8::from_bits(bits);
+        }
         passed = greater_equal(passed, depth, near_plane);
         passed = less_equal(passed, depth, far_plane);
         if (movemask(passed)) {

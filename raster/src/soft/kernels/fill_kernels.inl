@@ -21,6 +21,7 @@ namespace RVR_KERNEL_NS {
 namespace {
 
 using namespace simd;
+#include "depth_key.inl"
 // 2 (SSE) or 4 (AVX2) pixels a group.
 using VD = vdoublex;
 using VI = vllongx;
@@ -79,7 +80,8 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
           if (!target.depth_only) ++target.fragments[i];
           const double depth = depth_lane[k];
           // The depth range clips what lies beyond far (and rounding just inside near).
-          if (depth < target.depth[i] && depth >= target.near_plane && depth <= target.far_plane)
+          if (passes_depth_test(depth, target.depth[i], target) && depth >= target.near_plane &&
+              depth <= target.far_plane)
             passed |= 1u << k;
         }
         if (passed) {

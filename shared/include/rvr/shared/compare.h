@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -81,16 +82,44 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b);
 // A pixel whose (object, primitive) id differs from one of its 4 neighbours.
 std::vector<bool> id_boundaries(const FrameBuffers& fb);
 
-// Statistics of the difference of two images, like idiff.
+// Thresholds of an image diff, with OpenImageIO idiff's meanings and defaults. A pixel "fails"
+// (or "warns") when any of its channels differs by more than `fail` (`warn`); the verdict is
+// PASS when no pixel fails (whatever the warnings, as idiff 2.4 with -allowfailures 0), else
+// FAILURE when more than `fail_percent` % of the pixels fail or the largest channel difference
+// is above `hard_fail`, else WARNING when more than `warn_percent` % warn or the largest
+// difference is above `hard_warn`, else PASS. Thresholds are single precision, as idiff's are,
+// so a difference is compared with the float nearest the value given.
+struct DiffThresholds {
+  float fail = 1e-6f;
+  float fail_percent = 0.0f;
+  float hard_fail = std::numeric_limits<float>::max();
+  float warn = 1e-6f;
+  float warn_percent = 0.0f;
+  float hard_warn = std::numeric_limits<float>::max();
+};
+
+// Statistics of the difference of two images, like idiff: errors are per channel; mean and RMS
+// over every channel of every pixel; the maximum is the first channel (in pixel order) with the
+// largest difference. Two NaNs (or two infinities) in one channel are no difference; a NaN or
+// infinity against anything else is a difference of +inf.
 struct ImageDiff {
   double mean_abs = 0.0;
   double rmse = 0.0;
-  double psnr_db = 0.0;
+  double psnr_db = 0.0;  // 20 log10(1 / rmse), peak 1; +inf when identical
   double max_abs = 0.0;
   int max_x = 0, max_y = 0, max_channel = 0;
+  size_t pixels = 0;       // width x height
+  size_t warn_pixels = 0;  // pixels with a channel differing by more than the warn threshold
+  size_t fail_pixels = 0;  // ... by more than the fail threshold
 };
 // Errors (exit 2) when sizes or channel counts differ.
-Expected<ImageDiff> diff_images(const Image& a, const Image& b);
+Expected<ImageDiff> diff_images(const Image& a, const Image& b,
+                                const DiffThresholds& thresholds = {});
+
+enum class DiffVerdict { Pass, Warning, Failure };
+const char* to_string(DiffVerdict verdict);  // "PASS", "WARNING", "FAILURE"
+// The verdict of a diff made with `thresholds` (see DiffThresholds).
+DiffVerdict diff_verdict(const ImageDiff& diff, const DiffThresholds& thresholds);
 
 // Colour heat map of the per-pixel max channel difference, scaled so `scale` maps to the top of
 // the colour map ("inferno").

@@ -24,9 +24,16 @@ enum class SphereMode { Analytic, Mesh };
 // Intel Embree 3 answers the queries.
 enum class AccelKind { Bvh, Bvh2, None, Embree };
 enum class TriangleTest { MollerTrumbore, Chapter };
+// How a rasterizer's z-buffer stores depth (docs/cli.md, --depth-format). D24: window-space z
+// (0 at near, 1 at far, hyperbolic in view depth) as a 24-bit unsigned normalized integer;
+// D32F: the same z as a 32-bit float; D32FReversed: z reversed (1 at near, 0 at far, float's
+// dense exponents near 0 where the hyperbola is flattest), tested with "greater".
+enum class DepthFormat { D24, D32F, D32FReversed };
 
 const char* to_string(RenderMode mode);
-const char* to_string(AccelKind accel);  // bvh, bvh2, none, embree
+const char* to_string(AccelKind accel);     // bvh, bvh2, none, embree
+const char* to_string(DepthFormat format);  // d24, d32f, d32f_reversed
+std::optional<DepthFormat> parse_depth_format(const std::string& name);
 
 struct RenderOptions {
   RenderMode mode = RenderMode::Local;
@@ -45,6 +52,11 @@ struct RenderOptions {
   int shadow_map_size = 1024;
   float shadow_bias = 0.01f;
   bool shadow_pcf = false;
+  // Rasterizers: the z-buffer's depth format; only which surface wins a pixel changes, the
+  // depth AOV stays the linear view depth. Unset: the most precise the renderer has (raster:
+  // d32f_reversed when the GL offers ARB_clip_control, else d32f; softraster: view depth in
+  // double precision, finer than any of the formats). The tracers ignore it.
+  std::optional<DepthFormat> depth_format;
   // softraster: hierarchical z (each 8x8 block's farthest depth rejects triangles behind it).
   bool hiz = true;
   // Cost AOV: false: the caller does not read the cost AOV, which is then 0 everywhere (the

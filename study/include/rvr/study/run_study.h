@@ -35,6 +35,9 @@ struct StudyRequest {
   int repetitions = 5;
   uint64_t seed = 1;
   int bootstrap_replicates = 1000;
+  // After the conclusions, each crossover along N is measured again at a third of and three
+  // times its value (prediction_checks.h); outside the budget. Not in a shard.
+  bool check_predictions = true;
   // Measure only this shard's planned points, and add none near crossovers (they depend on the
   // other shards' points): for studies merged afterwards (merge.h).
   std::optional<Shard> shard;

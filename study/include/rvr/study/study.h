@@ -47,6 +47,18 @@ struct UnitCost {
   double ns_per_triangle = 0, ns_per_ray = 0;
 };
 
+// A crossover's prediction checked by new measurements after the fit: at a third of and at
+// three times the crossover, the renderer the study says is faster there, and which one was.
+struct PredictionCheck {
+  std::string a, b, scene, axis;
+  double crossover = 0;  // the crossover's value on the axis
+  double at = 0;         // where the check measured: the axis value of its point
+  double pixels = 0;
+  std::string predicted_faster, measured_faster;
+  double ratio = 0;  // the measured slower's time over the faster's
+  bool holds = false;
+};
+
 struct StudyResult {
   std::vector<std::string> scenes;          // families: "tessphere"
   std::vector<std::string> renderers;       // in the order asked for
@@ -65,6 +77,7 @@ struct StudyResult {
   std::vector<Dominance> dominance;
   std::vector<ScalingExponent> scaling;
   std::vector<UnitCost> costs;
+  std::vector<PredictionCheck> checks;
   std::vector<std::string> notes;  // what the budget cut short, and the like
   bool interrupted = false;        // the sweep was stopped (Ctrl-C) before its end
   std::optional<Shard> shard;      // the share of the planned points measured (--shard)

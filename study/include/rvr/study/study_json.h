@@ -15,7 +15,8 @@ std::string study_json(const StudyResult& result);
 
 // A study.json read back: the request's fields, the machine, the sweep's notes, the shard and
 // every point with its repetitions; models, crossovers, the other conclusions and the notes
-// conclude() adds are left out, for conclude() to compute again. Unknown keys and bad values are
+// conclude() adds are left out, for conclude() to compute again, and so are the prediction
+// checks (they tested the crossovers as concluded before). Unknown keys and bad values are
 // BadInput errors "PATH: json.path: what is wrong" (`path` names the text in messages).
 Expected<StudyResult> read_study_json(const std::string& text, const std::string& path);
 

@@ -19,6 +19,8 @@ std::string study_markdown(const StudyResult& result);
 std::string crossover_sentence(const StudyResult& r, const Crossover& c);
 std::string dominance_sentence(const StudyResult& r, const Dominance& d);
 std::string model_sentence(const RendererModels& m, const std::string& scene, const ModelFit& f);
+// A crossover's prediction checked after the fit: held or not, by how much.
+std::string check_sentence(const PredictionCheck& c);
 
 // "a = 1.2 ms (95%: 0.9 – 1.5)" (ns for the per-pixel, per-triangle and per-ray terms); empty
 // for a coefficient that is not identifiable.
