@@ -7,6 +7,10 @@
    with its repetitions) and study.md with its sections, within the budget and a margin.
 3. Bad input (an unknown family, --budget 0 or negative, an unknown renderer) exits 2 with one
    line starting "error: " and creates nothing.
+4. A study stopped by Ctrl-C (SIGINT after 3 s) exits 130 and writes a study.json the schema
+   accepts, marked interrupted, with at least one point.
+5. --merge of the study with itself, and with a copy whose SIMD kernels say another machine
+   type, writes studies the schema accepts (one pooled; one per machine type and comparison.md).
 
 Usage: check_study_schema.py --rvr build/bin/rvr --source-dir . [--work-dir DIR]
 Exits 1 with one line per failure.
@@ -15,6 +19,7 @@ Exits 1 with one line per failure.
 import argparse
 import json
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
@@ -39,6 +44,56 @@ def run(cmd, timeout=100):
     return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
 
 
+def validate(validator, path):
+    doc = json.loads(path.read_text())
+    for e in validator.iter_errors(doc):
+        where = "/".join(str(p) for p in e.absolute_path) or "(top)"
+        failure(f"{path}: schema: {where}: {e.message}")
+    return doc
+
+
+def check_interrupted(rvr, validator, work):
+    out = work / "interrupted"
+    p = subprocess.Popen([rvr, "study", "builtin:tessphere", "--budget", "600", "--width", "128",
+                          "--quiet", "-o", str(out)],
+                         stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    time.sleep(3)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    if p.returncode != 130 or not err.startswith("rvr study: interrupted; wrote "):
+        failure(f"interrupted study: want exit 130 and 'rvr study: interrupted; ...', got exit "
+                f"{p.returncode}: {err.strip()}")
+        return
+    doc = validate(validator, out / "study.json")
+    if doc.get("interrupted") is not True or len(doc.get("points", [])) < 1:
+        failure(f"interrupted study: interrupted {doc.get('interrupted')}, "
+                f"{len(doc.get('points', []))} points")
+
+
+def check_merge(rvr, validator, work):
+    study = work / "study"
+    if not (study / "study.json").exists():
+        return  # check_study has said why
+    other = work / "other-machine"
+    other.mkdir()
+    doc = json.loads((study / "study.json").read_text())
+    doc["machine"]["kernels"] = "sse (edited: another machine type)"
+    (other / "study.json").write_text(json.dumps(doc))
+    for name, inputs in [("pooled", [study, study]), ("compared", [study, other])]:
+        out = work / name
+        r = run([rvr, "study", "--merge", *map(str, inputs), "-o", str(out)])
+        if r.returncode != 0:
+            failure(f"--merge ({name}): exit {r.returncode}: {r.stderr.strip()}")
+            continue
+        written = sorted(out.glob("**/study.json"))
+        if len(written) != (1 if name == "pooled" else 2):
+            failure(f"--merge ({name}): wrote {[str(p) for p in written]}")
+        for path in written:
+            validate(validator, path)
+        if name == "compared" and not (out / "comparison.md").exists():
+            failure("--merge (compared): no comparison.md")
+
+
 def check_study(rvr, validator, work):
     out = work / "study"
     start = time.monotonic()
@@ -50,10 +105,7 @@ def check_study(rvr, validator, work):
         return
     if seconds > 40:
         failure(f"rvr study --budget 20 took {seconds:.0f} s")
-    doc = json.loads((out / "study.json").read_text())
-    for e in validator.iter_errors(doc):
-        path = "/".join(str(p) for p in e.absolute_path) or "(top)"
-        failure(f"study.json: schema: {path}: {e.message}")
+    doc = validate(validator, out / "study.json")
     for name in ["softraster", "raytrace", "hybrid_soft"]:
         if "tessphere" not in doc["renderers"].get(name, {}).get("fits", {}):
             failure(f"study.json: renderers.{name}.fits.tessphere missing")
@@ -106,6 +158,8 @@ def main():
         return 1
     check_refused(args.rvr, work)
     check_study(args.rvr, Validator(schema), work)
+    check_merge(args.rvr, Validator(schema), work)
+    check_interrupted(args.rvr, Validator(schema), work)
     if FAILURES:
         print(f"{len(FAILURES)} failure(s)")
         return 1

@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
@@ -451,13 +452,19 @@ TEST_F(Cli, OutputsGoIntoNewFoldersButNeverOverAnInput) {
 
 namespace {
 
-// Starts rvr with `args` (stdin, stdout and stderr on /dev/null) and returns its pid.
-pid_t spawn_rvr(const std::vector<std::string>& args) {
+// Starts rvr with `args` (stdin, stdout and stderr on /dev/null, or stderr into `err_file`)
+// and returns its pid.
+pid_t spawn_rvr(const std::vector<std::string>& args, const fs::path& err_file = {}) {
   pid_t pid = ::fork();
   if (pid == 0) {
     int null = ::open("/dev/null", O_RDWR);
     if (null < 0) ::_exit(127);
     for (int fd : {0, 1, 2}) ::dup2(null, fd);
+    if (!err_file.empty()) {
+      int err = ::open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (err < 0) ::_exit(127);
+      ::dup2(err, 2);
+    }
     std::vector<char*> argv{const_cast<char*>(RVR_BINARY)};
     for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
     argv.push_back(nullptr);
@@ -738,4 +745,105 @@ TEST_F(Cli, GlBackendsAndTheFallbackToEgl) {
   EXPECT_EQ(refused.err.rfind("error: ", 0), 0u) << refused.err;
   EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
   EXPECT_FALSE(fs::exists(dir_ / "refused.png"));
+}
+
+// docs/cli.md, "rvr study": the first Ctrl-C stops the sweep, and the study of the points
+// measured so far is written, valid and marked interrupted; exit 130 with one line on stderr.
+TEST_F(Cli, CtrlCDuringAStudyWritesThePartialStudy) {
+  fs::path out = dir_ / "study", err = dir_ / "stderr.txt";
+  pid_t pid = spawn_rvr({"study", "builtin:tessphere", "builtin:soup", "--width", "128", "--budget",
+                         "600", "-q", "-o", out.string()},
+                        err);
+  ASSERT_GE(pid, 0);
+  ReapOnExit reap{pid};
+  ASSERT_TRUE(wait_until_catching_sigint(pid));
+  std::this_thread::sleep_for(std::chrono::seconds(3));  // the first points take milliseconds
+  Interrupted r = interrupt_and_wait(pid);
+  std::string message = slurp(err);
+  EXPECT_EQ(r.status, 130) << message;
+  EXPECT_EQ(message.rfind("rvr study: interrupted; wrote " + out.string() +
+                              "/{study.json,study.md,study.html} from ",
+                          0),
+            0u)
+      << message;
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+  ASSERT_TRUE(fs::exists(out / "study.md"));
+  nlohmann::json study = nlohmann::json::parse(slurp(out / "study.json"));
+  EXPECT_EQ(study["interrupted"], true);
+  EXPECT_GE(study["points"].size(), 1u);
+  EXPECT_LT(r.seconds, 30.0) << "the sweep went on after the interrupt";
+}
+
+// --merge of two studies of this machine (one of them shard 1/2) pools them (a point both
+// measured keeps the repetitions of each); with the SIMD kernels of one edited, they are not
+// pooled: one study per machine type and comparison.md.
+TEST_F(Cli, StudyMergePoolsOneMachineTypeAndComparesTwo) {
+  const std::string tiny = "study builtin:tessphere --width 32 --budget 3 -q -o ";
+  for (const char* name : {"a", "b"}) {
+    RunResult r = run(tiny + (dir_ / name).string() + (name[0] == 'b' ? " --shard 1/2" : ""));
+    ASSERT_EQ(r.status, 0) << r.err;
+  }
+  nlohmann::json a = nlohmann::json::parse(slurp(dir_ / "a" / "study.json"));
+  nlohmann::json b = nlohmann::json::parse(slurp(dir_ / "b" / "study.json"));
+  EXPECT_TRUE(a["shard"].is_null());
+  EXPECT_EQ(b["shard"], (nlohmann::json{{"index", 1}, {"count", 2}}));
+
+  fs::path pooled = dir_ / "pooled";
+  RunResult merged = run("study --merge " + (dir_ / "a").string() + " " + (dir_ / "b").string() +
+                         " -o " + pooled.string());
+  ASSERT_EQ(merged.status, 0) << merged.err;
+  nlohmann::json p = nlohmann::json::parse(slurp(pooled / "study.json"));
+  EXPECT_TRUE(fs::exists(pooled / "study.md"));
+  // A point both measured keeps every repetition, but for one measured busy beside a quiet one.
+  std::map<std::string, std::pair<size_t, size_t>> by_point;  // quiet, busy repetitions
+  for (const nlohmann::json* doc : {&a, &b})
+    for (const nlohmann::json& point : (*doc)["points"]) {
+      std::string key = point["renderer"].dump() + point["scene_n"].dump() + point["width"].dump();
+      (point["busy"] == true ? by_point[key].second : by_point[key].first) +=
+          point["seconds"].size();
+    }
+  size_t repetitions = 0;
+  for (const auto& [key, counts] : by_point)
+    repetitions += counts.first > 0 ? counts.first : counts.second;
+  size_t pooled_repetitions = 0;
+  for (const nlohmann::json& point : p["points"]) pooled_repetitions += point["seconds"].size();
+  EXPECT_EQ(pooled_repetitions, repetitions);
+  EXPECT_LE(p["points"].size(), a["points"].size() + b["points"].size());
+  EXPECT_GE(p["points"].size(), std::max(a["points"].size(), b["points"].size()));
+  EXPECT_EQ(p["budget_seconds"], 6.0);
+
+  b["machine"]["kernels"] = "sse (edited: another machine type)";
+  fs::create_directories(dir_ / "b_sse");
+  std::ofstream(dir_ / "b_sse" / "study.json") << b.dump(2);
+  fs::path compared = dir_ / "compared";
+  RunResult apart = run("study --merge " + (dir_ / "a").string() + " " + (dir_ / "b_sse").string() +
+                        " -o " + compared.string());
+  ASSERT_EQ(apart.status, 0) << apart.err;
+  ASSERT_TRUE(fs::exists(compared / "comparison.md"));
+  EXPECT_NE(slurp(compared / "comparison.md").find("sse (edited"), std::string::npos);
+  int studies = 0;
+  for (const fs::directory_entry& e : fs::directory_iterator(compared))
+    if (e.is_directory()) studies += fs::exists(e.path() / "study.json");
+  EXPECT_EQ(studies, 2);
+}
+
+TEST_F(Cli, StudyShardAndMergeRefuseBadInput) {
+  struct Case {
+    std::string args, words;
+  };
+  const std::string out = " -o " + (dir_ / "out").string();
+  for (const Case& c : std::vector<Case>{
+           {"study --shard 8/8" + out, "error: --shard: "},
+           {"study --shard 1" + out, "error: --shard: "},
+           {"study --merge " + (dir_ / "none").string() + out, "/none/study.json: "},
+           {"study --merge " + dir_.string() + " --shard 0/2" + out, "--shard"},
+           {"study --merge " + write("study.json", "{}").parent_path().string() + out,
+            "study.json: format: is required"},
+       }) {
+    RunResult r = run(c.args);
+    EXPECT_EQ(r.status, 2) << c.args << ": " << r.err;
+    EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find(c.words), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "out")) << c.args;
+  }
 }

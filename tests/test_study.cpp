@@ -12,13 +12,17 @@
 //   IntervalCoverageOverSeededReplicates, OutsideTheSweptRangeIsReportedAsSuch.
 // - study.html's escape_html returning its input: EscapesEveryStringFromTheData;
 // - no interval band drawn for a crossover: MarksTheCrossoverWithItsInterval.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -31,6 +35,7 @@
 #include "rvr/study/fit.h"
 #include "rvr/study/grid_of_copies.h"
 #include "rvr/study/least_squares.h"
+#include "rvr/study/merge.h"
 #include "rvr/study/run_study.h"
 #include "rvr/study/study_html.h"
 #include "rvr/study/study_json.h"
@@ -692,4 +697,325 @@ TEST(StudyGrid, AModelFileIsAFamily) {
   EXPECT_LE(double(f->high) * per_copy, kFileFamilyTriangles);
   EXPECT_GT(double(f->high + 1) * per_copy, kFileFamilyTriangles);
   EXPECT_FALSE(find_family("no-such-file.obj").ok());
+}
+
+namespace {
+
+// A whole study as run_study leaves it before conclude(): softraster and raytrace on
+// tessphere at 13 N, every field study.json holds set.
+StudyResult synthetic_study(uint64_t seed) {
+  Rng rng(seed);
+  StudyResult r;
+  r.scenes = {"tessphere"};
+  r.axes["tessphere"] = "triangles";
+  r.renderers = {"softraster", "raytrace"};
+  r.width = 1024;
+  r.height = 768;
+  r.mode = "local";
+  r.budget_seconds = 60;
+  r.elapsed_seconds = 41.5;
+  r.repetitions = 5;
+  r.seed = 7;
+  r.bootstrap_replicates = 200;
+  r.command = "rvr study builtin:tessphere -o out";
+  r.machine = {"Test CPU 9000", 2, "avx2 (the widest this CPU runs)", {{"rvr", "0.1"}}};
+  r.notes = {"tessphere: the sweep stopped below N=1000000"};
+  for (size_t n : log_spaced(100, 1000000, 13))
+    for (const std::string& name : r.renderers) {
+      Measurement m =
+          synthetic(name, name == "softraster" ? kZCurve : kTCurve, kP, double(n), 5, 0.03, rng);
+      m.scene = "tessphere";
+      m.width = r.width;
+      m.height = r.height;
+      m.order = {0, 1, 1, 0, 1};
+      m.reference_ratio = 1.0 + 0.01 * double(r.points.size() % 7);
+      r.points.push_back(m);
+    }
+  return r;
+}
+
+StudyResult read_back(const StudyResult& r) {
+  Expected<StudyResult> back = read_study_json(study_json(r), "study.json");
+  EXPECT_TRUE(back.ok()) << back.error().message;
+  return back.ok() ? *back : StudyResult{};
+}
+
+// The study with only the points at every `count`-th N from the `index`-th, as shard
+// index/count of it.
+StudyResult shard_of(const StudyResult& whole, size_t index, size_t count) {
+  StudyResult part = whole;
+  part.shard = Shard{index, count};
+  part.points.clear();
+  for (size_t i = 0; i < whole.points.size(); ++i)
+    if (in_shard(i / whole.renderers.size(), *part.shard)) part.points.push_back(whole.points[i]);
+  return part;
+}
+
+void expect_same_conclusions(const StudyResult& a, const StudyResult& b) {
+  ASSERT_EQ(a.models.size(), b.models.size());
+  for (size_t i = 0; i < a.models.size(); ++i) {
+    const ModelFit &fa = a.models[i].fits.at("tessphere"), &fb = b.models[i].fits.at("tessphere");
+    EXPECT_EQ(fa.fits, fb.fits);
+    ASSERT_EQ(fa.coefficients.size(), fb.coefficients.size());
+    for (size_t k = 0; k < fa.coefficients.size(); ++k) {
+      EXPECT_DOUBLE_EQ(fa.coefficients[k].value, fb.coefficients[k].value) << a.models[i].name;
+      EXPECT_DOUBLE_EQ(fa.coefficients[k].ci95.low, fb.coefficients[k].ci95.low);
+      EXPECT_DOUBLE_EQ(fa.coefficients[k].ci95.high, fb.coefficients[k].ci95.high);
+    }
+  }
+  ASSERT_EQ(a.crossovers.size(), b.crossovers.size());
+  for (size_t i = 0; i < a.crossovers.size(); ++i) {
+    EXPECT_DOUBLE_EQ(a.crossovers[i].value, b.crossovers[i].value);
+    EXPECT_DOUBLE_EQ(a.crossovers[i].ci95.low, b.crossovers[i].ci95.low);
+    EXPECT_DOUBLE_EQ(a.crossovers[i].ci95.high, b.crossovers[i].ci95.high);
+  }
+}
+
+}  // namespace
+
+// Everything conclude() and study.md need comes back: concluded again, the study is written
+// out the same, byte for byte.
+TEST(StudyJsonRead, RoundTripsEveryFieldConcludeNeeds) {
+  StudyResult r = synthetic_study(31);
+  r.interrupted = true;
+  r.shard = Shard{1, 4};
+  r.points[5].busy = true;
+  r.points[5].reference_ratio = 1.6;
+  conclude(r, {r.bootstrap_replicates, r.seed});
+  StudyResult back = read_back(r);
+  EXPECT_EQ(back.scenes, r.scenes);
+  EXPECT_EQ(back.axes, r.axes);
+  EXPECT_EQ(back.renderers, r.renderers);
+  EXPECT_EQ(back.width, r.width);
+  EXPECT_EQ(back.height, r.height);
+  EXPECT_EQ(back.mode, r.mode);
+  EXPECT_EQ(back.budget_seconds, r.budget_seconds);
+  EXPECT_EQ(back.elapsed_seconds, r.elapsed_seconds);
+  EXPECT_EQ(back.repetitions, r.repetitions);
+  EXPECT_EQ(back.seed, r.seed);
+  EXPECT_EQ(back.bootstrap_replicates, r.bootstrap_replicates);
+  EXPECT_EQ(back.command, r.command);
+  EXPECT_EQ(back.machine.cpu, r.machine.cpu);
+  EXPECT_EQ(back.machine.threads, r.machine.threads);
+  EXPECT_EQ(back.machine.kernels, r.machine.kernels);
+  EXPECT_EQ(back.machine.versions, r.machine.versions);
+  EXPECT_EQ(back.notes, r.notes);
+  EXPECT_TRUE(back.interrupted);
+  ASSERT_TRUE(back.shard.has_value());
+  EXPECT_EQ(back.shard->index, 1u);
+  EXPECT_EQ(back.shard->count, 4u);
+  ASSERT_EQ(back.points.size(), r.points.size());
+  for (size_t i = 0; i < r.points.size(); ++i) {
+    const Measurement &a = back.points[i], &b = r.points[i];
+    EXPECT_EQ(a.renderer, b.renderer);
+    EXPECT_EQ(a.scene, b.scene);
+    EXPECT_EQ(a.scene_n, b.scene_n);
+    EXPECT_EQ(a.n, b.n);
+    EXPECT_EQ(a.pixels, b.pixels);
+    EXPECT_EQ(a.width, b.width);
+    EXPECT_EQ(a.height, b.height);
+    EXPECT_EQ(a.seconds, b.seconds);
+    EXPECT_EQ(a.order, b.order);
+    EXPECT_EQ(a.reference_ratio, b.reference_ratio);
+    EXPECT_EQ(a.busy, b.busy);
+  }
+  EXPECT_TRUE(back.models.empty()) << "conclusions are computed again, not read";
+  conclude(back, {back.bootstrap_replicates, back.seed});
+  EXPECT_EQ(study_json(back), study_json(r));
+  r.shard.reset();
+  EXPECT_FALSE(read_back(r).shard.has_value());
+}
+
+TEST(StudyJsonRead, RefusesMalformedInputNamingFileAndPath) {
+  StudyResult r = synthetic_study(32);
+  conclude(r, {50, 1});
+  const nlohmann::json good = nlohmann::json::parse(study_json(r));
+  auto refused = [&](const std::function<void(nlohmann::json&)>& edit, const std::string& words) {
+    nlohmann::json doc = good;
+    edit(doc);
+    Expected<StudyResult> out = read_study_json(doc.dump(), "d/study.json");
+    ASSERT_FALSE(out.ok()) << words;
+    EXPECT_EQ(out.error().kind, ErrorKind::BadInput);
+    EXPECT_NE(out.error().message.find(words), std::string::npos) << out.error().message;
+  };
+  refused([](nlohmann::json& d) { d["pointz"] = 1; }, "d/study.json: pointz: unknown key");
+  refused([](nlohmann::json& d) { d["format"] = "rvr-study/2"; }, "d/study.json: format: must be");
+  refused([](nlohmann::json& d) { d.erase("machine"); }, "d/study.json: machine: is required");
+  refused([](nlohmann::json& d) { d["points"][3]["seconds"][1] = -1.0; },
+          "d/study.json: points[3].seconds[1]: must be >= 0");
+  refused([](nlohmann::json& d) { d["points"][0]["renderer"] = "embree"; },
+          "points[0].renderer: string \"embree\" is not in renderer_order");
+  refused([](nlohmann::json& d) { d["points"][2]["order"] = {0}; }, "points[2].order:");
+  refused([](nlohmann::json& d) { d["width"] = "wide"; }, "width: must be a whole number");
+  refused([](nlohmann::json& d) { d["renderer_order"][1] = "nosuch"; }, "renderer_order[1]:");
+  refused([](nlohmann::json& d) { d["shard"] = {{"index", 4}, {"count", 4}}; }, "shard.index");
+  refused([](nlohmann::json& d) { d["scenes"][0]["axis"] = "depth"; }, "scenes[0].axis");
+  Expected<StudyResult> syntax = read_study_json("{\"format\": ", "d/study.json");
+  ASSERT_FALSE(syntax.ok());
+  EXPECT_NE(syntax.error().message.find("d/study.json: JSON syntax"), std::string::npos);
+}
+
+TEST(StudyShard, ShardsCoverThePlanExactlyOnce) {
+  for (size_t count = 1; count <= 9; ++count)
+    for (size_t i = 0; i < 40; ++i) {
+      int owners = 0;
+      for (size_t index = 0; index < count; ++index) owners += in_shard(i, Shard{index, count});
+      EXPECT_EQ(owners, 1) << "point " << i << " of shards of " << count;
+    }
+  Expected<Shard> s = parse_shard("3/8");
+  ASSERT_TRUE(s.ok());
+  EXPECT_EQ(s->index, 3u);
+  EXPECT_EQ(s->count, 8u);
+  for (const char* bad : {"8/8", "-1/8", "1/0", "a/b", "3", "3/8x", "/8", ""}) {
+    Expected<Shard> out = parse_shard(bad);
+    ASSERT_FALSE(out.ok()) << bad;
+    EXPECT_EQ(out.error().kind, ErrorKind::BadInput);
+    EXPECT_EQ(out.error().message.rfind("--shard: ", 0), 0u) << out.error().message;
+  }
+}
+
+// Shards 0 and 1 of 2, written and read back, pool into the study that measured every point:
+// the same models, intervals and crossovers.
+TEST(StudyMerge, TwoHalvesGiveTheModelsOfTheWhole) {
+  StudyResult whole = synthetic_study(33);
+  conclude(whole, {whole.bootstrap_replicates, whole.seed});
+  std::vector<StudySource> halves;
+  for (size_t i = 0; i < 2; ++i)
+    halves.push_back({"shard-" + std::to_string(i), read_back(shard_of(whole, i, 2))});
+  std::swap(halves[0], halves[1]);  // the order given does not matter
+  Expected<std::vector<MachineGroup>> merged = merge_studies(halves);
+  ASSERT_TRUE(merged.ok()) << merged.error().message;
+  ASSERT_EQ(merged->size(), 1u);
+  const StudyResult& m = (*merged)[0].study;
+  EXPECT_EQ(m.points.size(), whole.points.size());
+  EXPECT_FALSE(m.shard.has_value());
+  EXPECT_EQ(m.budget_seconds, 2 * whole.budget_seconds);
+  ASSERT_EQ(whole.crossovers.size(), 1u);
+  expect_same_conclusions(m, whole);
+  for (const std::string& note : m.notes) EXPECT_EQ(note.find("missing"), std::string::npos);
+
+  std::vector<StudySource> one_half = {halves[0]};
+  Expected<std::vector<MachineGroup>> partial = merge_studies(one_half);
+  ASSERT_TRUE(partial.ok());
+  bool said = false;
+  for (const std::string& note : (*partial)[0].study.notes)
+    said = said || note.find("shard 0 of 2 missing") != std::string::npos;
+  EXPECT_TRUE(said) << "a missing shard is not noted";
+}
+
+TEST(StudyMerge, APointMeasuredTwiceKeepsEveryRepetition) {
+  StudyResult r = synthetic_study(34);
+  Expected<std::vector<MachineGroup>> merged = merge_studies({{"a", r}, {"b", r}});
+  ASSERT_TRUE(merged.ok()) << merged.error().message;
+  const StudyResult& m = (*merged)[0].study;
+  ASSERT_EQ(m.points.size(), r.points.size());
+  for (size_t i = 0; i < r.points.size(); ++i) {
+    std::vector<double> both = r.points[i].seconds;
+    both.insert(both.end(), r.points[i].seconds.begin(), r.points[i].seconds.end());
+    EXPECT_EQ(m.points[i].seconds, both);
+    EXPECT_EQ(m.points[i].order.size(), both.size());
+  }
+  // A point measured on a busy machine by one study and a quiet one by the other: the quiet's.
+  StudyResult busy = r;
+  busy.points[0].busy = true;
+  busy.points[0].seconds = {9, 9, 9, 9, 9};
+  for (const auto& order : {std::vector<StudySource>{{"a", r}, {"b", busy}},
+                            std::vector<StudySource>{{"b", busy}, {"a", r}}}) {
+    Expected<std::vector<MachineGroup>> quiet = merge_studies(order);
+    ASSERT_TRUE(quiet.ok());
+    EXPECT_EQ((*quiet)[0].study.points[0].seconds, r.points[0].seconds);
+    EXPECT_FALSE((*quiet)[0].study.points[0].busy);
+  }
+  StudyResult moved = r;
+  moved.points[0].n += 1;
+  Expected<std::vector<MachineGroup>> clash = merge_studies({{"a", r}, {"b", moved}});
+  ASSERT_FALSE(clash.ok());
+  EXPECT_NE(clash.error().message.find("not the same point"), std::string::npos);
+  StudyResult wider = r;
+  wider.width = 2048;
+  Expected<std::vector<MachineGroup>> sizes = merge_studies({{"a", r}, {"b", wider}});
+  ASSERT_FALSE(sizes.ok());
+  EXPECT_NE(sizes.error().message.find("one image size"), std::string::npos);
+}
+
+// Another machine type (here: other SIMD kernels) or another mode is concluded apart and
+// compared side by side.
+TEST(StudyMerge, DifferentKernelsAreNotPooled) {
+  StudyResult avx2 = synthetic_study(35), avx512 = synthetic_study(36), full = synthetic_study(37);
+  avx512.machine.kernels = "avx512 (the widest this CPU runs)";
+  full.mode = "full";
+  Expected<std::vector<MachineGroup>> merged =
+      merge_studies({{"x", avx2}, {"y", avx512}, {"z", full}, {"x2", avx2}});
+  ASSERT_TRUE(merged.ok()) << merged.error().message;
+  ASSERT_EQ(merged->size(), 3u);
+  const std::vector<MachineGroup>& g = *merged;
+  EXPECT_EQ(g[0].sources, (std::vector<std::string>{"x", "x2"}));
+  EXPECT_EQ(g[1].sources, std::vector<std::string>{"y"});
+  EXPECT_EQ(g[2].sources, std::vector<std::string>{"z"});
+  EXPECT_EQ(g[1].study.points.size(), avx512.points.size());
+  EXPECT_EQ(g[1].study.machine.kernels, avx512.machine.kernels);
+  EXPECT_EQ(g[0].slug, "test-cpu-9000-2t-avx2-local");
+  EXPECT_EQ(g[1].slug, "test-cpu-9000-2t-avx512-local");
+  EXPECT_EQ(g[2].slug, "test-cpu-9000-2t-avx2-full");
+  std::string md = comparison_markdown(g);
+  EXPECT_NE(md.find("| tessphere | raytrace vs softraster | triangles | crossover "),
+            std::string::npos)
+      << md;
+  for (const MachineGroup& group : g) EXPECT_NE(md.find(group.label), std::string::npos) << md;
+}
+
+// Shards 0..2 of 3 of a sweep of two families, with budget to spare, measure every planned
+// point exactly once between them and nothing else (no points near crossovers); merged, they
+// hold the plan.
+TEST(StudyRun, ShardsMeasureEveryPlannedPointOnce) {
+  double clock = 0;
+  Rng rng(9);
+  StudyRequest request;
+  request.scenes = {"builtin:tessphere", "builtin:occluders"};
+  request.renderers = {"softraster", "raytrace"};
+  request.budget_seconds = 1e5;
+  request.bootstrap_replicates = 50;
+  StudyHooks hooks;
+  hooks.now = [&] { return clock; };
+  hooks.prepare = [&](const Family&, size_t n,
+                      int width) -> Expected<std::unique_ptr<FrameSource>> {
+    return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, clock, rng));
+  };
+  using Key = std::tuple<std::string, double, int>;  // family, N, width
+  std::map<Key, int> planned;
+  for (const char* family : {"tessphere", "occluders"})
+    for (const PlannedPoint& p : planned_points(*find_family(family), request.width))
+      planned[{family, double(p.n), p.width}] = 0;
+  std::vector<StudySource> shards;
+  for (size_t i = 0; i < 3; ++i) {
+    request.shard = Shard{i, 3};
+    Expected<StudyResult> r = run_study(request, hooks);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    ASSERT_TRUE(r->shard.has_value());
+    EXPECT_EQ(r->shard->index, i);
+    EXPECT_TRUE(r->checks.empty()) << "a shard's crossovers are checked";
+    ASSERT_FALSE(r->notes.empty());
+    EXPECT_EQ(r->notes[0].rfind(fmt::format("shard {}/3: ", i), 0), 0u) << r->notes[0];
+    for (const Measurement& m : r->points) {
+      if (m.renderer != "softraster") continue;
+      auto it = planned.find({m.scene, m.scene_n, m.width});
+      ASSERT_NE(it, planned.end())
+          << "not planned: " << m.scene << " " << m.scene_n << " " << m.width;
+      ++it->second;
+    }
+    shards.push_back({fmt::format("shard-{}", i), *r});
+  }
+  for (const auto& [key, times] : planned)
+    EXPECT_EQ(times, 1) << std::get<0>(key) << " N=" << std::get<1>(key) << " w"
+                        << std::get<2>(key);
+  Expected<std::vector<MachineGroup>> merged = merge_studies(shards);
+  ASSERT_TRUE(merged.ok()) << merged.error().message;
+  ASSERT_EQ(merged->size(), 1u);
+  EXPECT_EQ((*merged)[0].study.points.size(), 2 * planned.size());
+
+  request.shard.reset();
+  Expected<StudyResult> whole = run_study(request, hooks);
+  ASSERT_TRUE(whole.ok());
+  EXPECT_FALSE(whole->shard.has_value());
+  EXPECT_GT(whole->points.size(), 2 * planned.size()) << "the whole adds points near crossovers";
 }

@@ -100,6 +100,8 @@ struct StudyArgs {
   double budget = 300;
   int repetitions = 5;
   uint64_t seed = 1;
+  std::string shard;               // --shard I/N
+  std::vector<std::string> merge;  // --merge DIR...: study folders to pool instead of a sweep
   std::string out_dir;
   bool quiet = false;
 };

@@ -14,6 +14,9 @@
 namespace rvr::study {
 namespace {
 
+// In every note conclude() adds: a pair tied within the noise.
+constexpr const char* kTieWords = "are within the timing noise of each other";
+
 std::vector<Measurement> points_of(const StudyResult& r, const std::string& renderer,
                                    const std::string& scene) {
   std::vector<Measurement> out;
@@ -113,10 +116,8 @@ void compare_pairs(StudyResult& r, const BootstrapOptions& boot) {
           add_extrapolated(r, *c.dominance);
         }
         if (c.tie)
-          r.notes.push_back(
-              fmt::format("{}: {} and {} are within the timing noise of each other "
-                          "at every {} measured",
-                          scene, a, b, r.axes[scene]));
+          r.notes.push_back(fmt::format("{}: {} and {} {} at every {} measured", scene, a, b,
+                                        kTieWords, r.axes[scene]));
         for (double n : pixel_sweep_columns(r, scene)) {
           CurveComparison p = compare_curves(along_pixels(r, a, scene, n),
                                              along_pixels(r, b, scene, n), kPixelsAxis, boot);
@@ -124,9 +125,8 @@ void compare_pairs(StudyResult& r, const BootstrapOptions& boot) {
           if (p.dominance) r.dominance.push_back(*p.dominance);
           if (p.tie)
             r.notes.push_back(fmt::format(
-                "{} with {} {}: {} and {} are within the timing noise of each other at every "
-                "pixel count measured",
-                scene, format_number(along_pixels(r, a, scene, n)[0].n), r.axes[scene], a, b));
+                "{} with {} {}: {} and {} {} at every pixel count measured", scene,
+                format_number(along_pixels(r, a, scene, n)[0].n), r.axes[scene], a, b, kTieWords));
         }
       }
 }
@@ -203,6 +203,10 @@ double loglog_slope(const std::vector<Measurement>& points, double from, double 
   double denominator = n * sxx - sx * sx;
   if (n < 2 || denominator <= 1e-12) return std::numeric_limits<double>::quiet_NaN();
   return (n * sxy - sx * sy) / denominator;
+}
+
+bool is_conclusion_note(const std::string& note) {
+  return note.find(kTieWords) != std::string::npos;
 }
 
 void conclude(StudyResult& result, const BootstrapOptions& boot) {

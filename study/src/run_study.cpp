@@ -42,6 +42,9 @@ Status validate(const StudyRequest& r) {
   // Fewer, and the bootstrap's 95% intervals hold the truth only ~85% of the time (test_study).
   if (r.repetitions < 5)
     return bad_input(fmt::format("--repetitions: must be >= 5, got {}", r.repetitions));
+  if (r.shard && (r.shard->count < 1 || r.shard->index >= r.shard->count))
+    return bad_input(fmt::format("--shard: must be I/N with 0 <= I < N, got {}/{}", r.shard->index,
+                                 r.shard->count));
   return ok_status();
 }
 
@@ -83,6 +86,7 @@ class Sweep {
   Status sweep_n(const Family& family, double limit, double share_end);
   Status sweep_pixels(const Family& family, double limit, double share_end);
   std::vector<size_t> crossover_midpoints(const Family& family) const;
+  bool in_this_shard(size_t n, int width) const;
   void progress(const std::string& what) const {
     if (hooks_.on_progress) hooks_.on_progress(what);
   }
@@ -98,6 +102,8 @@ class Sweep {
   int reference_frames_ = 1;                // frames in a row per reference time
   double quickest_reference_ = kInfinity;   // its quickest time in the family so far
   double slowest_reference_ = 0;            // its slowest time while measuring one point
+  std::vector<PlannedPoint> plan_;          // the current family's
+  size_t plan_offset_ = 0;                  // the index of its first point in the study's plan
 };
 
 // The reference frame of a family: its smallest point at full width, the first renderer, run
@@ -134,6 +140,16 @@ Expected<double> Sweep::time_reference() {
   slowest_reference_ = std::max(slowest_reference_, total);
   quickest_reference_ = std::min(quickest_reference_, total);
   return total;
+}
+
+// Whether the current family's planned point (n, width) is this shard's to measure (every
+// point is, unsharded).
+bool Sweep::in_this_shard(size_t n, int width) const {
+  if (!request_.shard) return true;
+  for (size_t i = 0; i < plan_.size(); ++i)
+    if (plan_[i].n == n && plan_[i].width == width)
+      return in_shard(plan_offset_ + i, *request_.shard);
+  return false;
 }
 
 // Times `request.repetitions` rounds; in each, every renderer once, in a fresh random order.
@@ -233,6 +249,7 @@ Expected<bool> Sweep::try_point(const Family& family, size_t n, int width, doubl
 Status Sweep::sweep_n(const Family& family, double limit, double share_end) {
   for (size_t n : log_spaced(family.low, family.high, family.points)) {
     if (cancelled()) return ok_status();
+    if (!in_this_shard(n, request_.width)) continue;
     Expected<bool> done = try_point(family, n, request_.width, limit, share_end);
     if (!done) return done.error();
     if (!*done) {
@@ -252,9 +269,12 @@ Status Sweep::sweep_pixels(const Family& family, double limit, double share_end)
   for (const auto& [name, n, width] : measured_)
     if (name == family.name && width == request_.width) measured.push_back(n);
   std::sort(measured.begin(), measured.end());
+  // A shard takes the pixel sweep at the N planned: the other shards measure the rest of them.
+  if (request_.shard) measured = log_spaced(family.low, family.high, family.points);
   for (size_t n : pixel_sweep_ns(measured))
     for (int width : pixel_sweep_widths(request_.width)) {
       if (cancelled()) return ok_status();
+      if (!in_this_shard(n, width)) continue;
       Expected<bool> done = try_point(family, n, width, limit, share_end);
       if (!done) return done.error();
       if (!*done && !measured_.count({family.name, n, width})) {
@@ -315,10 +335,13 @@ Status Sweep::run_scene(const Family& family, double share_end) {
   const double share_start = elapsed();
   const double length = share_end - share_start;
   cost_ = CostPredictor();
+  plan_offset_ += plan_.size();
+  plan_ = planned_points(family, request_.width);
   if (Status s = start_reference(family); !s) return s;
   if (Status s = sweep_n(family, share_start + kBaseShare * length, share_end); !s) return s;
   if (Status s = sweep_pixels(family, share_start + kPixelShare * length, share_end); !s) return s;
-  for (int round = 0; round < kRefinementRounds; ++round)
+  // A shard adds none near crossovers: where they go depends on the other shards' points.
+  for (int round = 0; round < (request_.shard ? 0 : kRefinementRounds); ++round)
     for (size_t mid : crossover_midpoints(family)) {
       if (cancelled()) return ok_status();
       Expected<bool> done = try_point(family, mid, request_.width, share_end, share_end);
@@ -340,6 +363,13 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   result.repetitions = request.repetitions;
   result.seed = request.seed;
   result.bootstrap_replicates = request.bootstrap_replicates;
+  result.shard = request.shard;
+  if (request.shard)
+    result.notes.push_back(fmt::format(
+        "shard {}/{}: only the planned points whose index is {} mod {} were measured, none near "
+        "crossovers, and no crossover is checked (they depend on the other shards' points); rvr "
+        "study --merge pools the shards",
+        request.shard->index, request.shard->count, request.shard->index, request.shard->count));
   Sweep sweep(request, hooks, result);
   std::vector<Family> families;
   for (size_t i = 0; i < request.scenes.size(); ++i) {
@@ -361,7 +391,7 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   result.elapsed_seconds = sweep.elapsed();
   BootstrapOptions boot{request.bootstrap_replicates, request.seed};
   conclude(result, boot);
-  if (!result.interrupted && request.check_predictions)
+  if (!result.interrupted && request.check_predictions && !request.shard)
     if (Status s = check_predictions(request, hooks, families, result); !s) return s.error();
   return result;
 }

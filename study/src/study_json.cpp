@@ -161,7 +161,9 @@ std::string study_json(const StudyResult& r) {
               {"renderers", renderers_json(r)},
               {"crossovers", crossovers_json(r)},
               {"notes", r.notes},
-              {"interrupted", r.interrupted}};
+              {"interrupted", r.interrupted},
+              {"shard", r.shard ? json{{"index", r.shard->index}, {"count", r.shard->count}}
+                                : json(nullptr)}};
   conclusions_json(r, doc);
   doc["points"] = points_json(r);
   return doc.dump(2) + "\n";

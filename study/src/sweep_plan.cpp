@@ -1,7 +1,10 @@
 // The sweep's grid and the cost predictions that keep it within the budget (see sweep_plan.h).
 #include "rvr/study/sweep_plan.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 
@@ -73,9 +76,41 @@ std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured) {
   return out;
 }
 
+std::vector<PlannedPoint> planned_points(const Family& family, int width) {
+  std::vector<PlannedPoint> plan;
+  std::vector<size_t> ns = log_spaced(family.low, family.high, family.points);
+  for (size_t n : ns) plan.push_back({n, width});
+  for (size_t n : pixel_sweep_ns(ns))
+    for (int narrower : pixel_sweep_widths(width)) plan.push_back({n, narrower});
+  return plan;
+}
+
 size_t log_midpoint(size_t low, size_t high) {
   size_t mid = size_t(std::llround(std::sqrt(double(low) * double(high))));
   return mid > low && mid < high ? mid : 0;
+}
+
+Expected<Shard> parse_shard(const std::string& text) {
+  auto bad = [&](const std::string& why) {
+    return bad_input(fmt::format("--shard: {}, got \"{}\"", why, text));
+  };
+  size_t slash = text.find('/');
+  if (slash == std::string::npos) return bad("must be I/N (shard I of N, 0-based), e.g. 3/8");
+  auto whole = [](const std::string& s, size_t& value) {
+    const char* end = s.data() + s.size();
+    auto [stop, ec] = std::from_chars(s.data(), end, value);
+    return !s.empty() && ec == std::errc() && stop == end;
+  };
+  Shard shard;
+  if (!whole(text.substr(0, slash), shard.index) || !whole(text.substr(slash + 1), shard.count))
+    return bad("I and N must be whole numbers (I/N, e.g. 3/8)");
+  if (shard.count < 1) return bad("N must be >= 1");
+  if (shard.index >= shard.count) return bad("I must be in 0 .. N-1");
+  return shard;
+}
+
+bool in_shard(size_t plan_index, const Shard& shard) {
+  return plan_index % shard.count == shard.index;
 }
 
 double CostPredictor::predict(size_t n) const {

@@ -19,6 +19,10 @@ ModelForm model_form_of(const std::string& renderer);
 double loglog_slope(const std::vector<Measurement>& points, double from, double to,
                     const std::string& axis = "triangles");
 
+// Whether `note` is one conclude() adds (a tie), not one of the sweep's: a study read back drops
+// these, for conclude() to add them again.
+bool is_conclusion_note(const std::string& note);
+
 // Fills result.models, crossovers, dominance, scaling and costs from result.points.
 void conclude(StudyResult& result, const BootstrapOptions& boot);
 

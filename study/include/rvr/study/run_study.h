@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -35,8 +36,11 @@ struct StudyRequest {
   uint64_t seed = 1;
   int bootstrap_replicates = 1000;
   // After the conclusions, each crossover along N is measured again at a third of and three
-  // times its value (prediction_checks.h); outside the budget.
+  // times its value (prediction_checks.h); outside the budget. Not in a shard.
   bool check_predictions = true;
+  // Measure only this shard's planned points, and add none near crossovers (they depend on the
+  // other shards' points): for studies merged afterwards (merge.h).
+  std::optional<Shard> shard;
 };
 
 // One scene size with every renderer of the study ready to render it (what they build per

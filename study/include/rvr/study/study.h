@@ -3,12 +3,14 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
+#include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 
@@ -78,6 +80,7 @@ struct StudyResult {
   std::vector<PredictionCheck> checks;
   std::vector<std::string> notes;  // what the budget cut short, and the like
   bool interrupted = false;        // the sweep was stopped (Ctrl-C) before its end
+  std::optional<Shard> shard;      // the share of the planned points measured (--shard)
 };
 
 }  // namespace rvr::study

@@ -1,5 +1,6 @@
 // Which scene sizes a study measures: the families it sweeps, their log-spaced grids, the
-// points added near a crossover, and the cost of a point predicted from those measured.
+// points added near a crossover, the share of the planned points a shard measures, and the
+// cost of a point predicted from those measured.
 #pragma once
 
 #include <map>
@@ -38,9 +39,35 @@ std::vector<int> pixel_sweep_widths(int width);
 // order): the smallest, the one nearest their geometric middle, and the largest.
 std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured);
 
+// A point a sweep plans: builtin:<family>:<n> (or n copies of the family's file) at `width`.
+struct PlannedPoint {
+  size_t n = 0;
+  int width = 0;
+};
+
+// The points a sweep of `family` at `width` plans, in the order it takes them: the log-spaced N
+// at the full width, then the pixel sweep's narrower widths at pixel_sweep_ns of those N (a
+// sweep the budget stops takes them at pixel_sweep_ns of the N it measured). Points near
+// crossovers depend on the measurements and are not planned. --shard divides these points,
+// numbered through the families in the order the study takes them.
+std::vector<PlannedPoint> planned_points(const Family& family, int width);
+
 // The rounded geometric mean of two neighbours: the point that halves a bracket in log; 0 when
 // they are too close to hold one.
 size_t log_midpoint(size_t low, size_t high);
+
+// One of `count` studies that together measure a sweep's planned points (--shard I/N).
+struct Shard {
+  size_t index = 0;  // 0 .. count-1
+  size_t count = 1;
+};
+
+// "I/N" with 0 <= I < N; a BadInput error "--shard: ..." for anything else.
+Expected<Shard> parse_shard(const std::string& text);
+
+// Whether the point at `plan_index` in the sweep's planned points is the shard's to measure:
+// every point whose index is ≡ shard.index mod shard.count.
+bool in_shard(size_t plan_index, const Shard& shard);
 
 // Predicts the wall time of measuring a point at N from the points measured so far: their
 // cost grown along the log-log slope of the last two (clamped to 0 .. 1.5; 1 from one point),

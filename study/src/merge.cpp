@@ -1,0 +1,294 @@
+// Pooling studies by machine type and comparing machine types (see merge.h).
+#include "rvr/study/merge.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <map>
+#include <set>
+#include <tuple>
+
+#include "rvr/study/conclusions.h"
+#include "rvr/study/study_markdown.h"
+
+namespace rvr::study {
+namespace {
+
+// What makes two studies poolable: the machine type and the mode.
+using GroupKey = std::tuple<std::string, unsigned, std::string, std::string>;
+
+GroupKey key_of(const StudyResult& s) {
+  return {s.machine.cpu, s.machine.threads, s.machine.kernels, s.mode};
+}
+
+// Lower-case letters and digits, every other run of characters one '-'.
+std::string slug_words(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (std::isalnum(static_cast<unsigned char>(c)))
+      out += char(std::tolower(static_cast<unsigned char>(c)));
+    else if (!out.empty() && out.back() != '-')
+      out += '-';
+  }
+  while (!out.empty() && out.back() == '-') out.pop_back();
+  return out;
+}
+
+std::string slug_of(const StudyResult& s) {
+  std::string kernels = s.machine.kernels.substr(0, s.machine.kernels.find(' '));
+  return fmt::format("{}-{}t-{}-{}", slug_words(s.machine.cpu), s.machine.threads,
+                     slug_words(kernels), slug_words(s.mode));
+}
+
+std::string join(const std::vector<std::string>& words, const char* sep = ", ") {
+  std::string out;
+  for (const std::string& w : words) out += (out.empty() ? "" : sep) + w;
+  return out;
+}
+
+void add_unique(std::vector<std::string>& list, const std::string& item) {
+  if (std::find(list.begin(), list.end(), item) == list.end()) list.push_back(item);
+}
+
+size_t index_in(const std::vector<std::string>& list, const std::string& item) {
+  return size_t(std::find(list.begin(), list.end(), item) - list.begin());
+}
+
+// Unites the points of the group's studies: a point measured by several keeps every
+// repetition of each, in the order the studies were given, but for those measured while the
+// machine was busy when another study measured it on a quiet one.
+class PointPool {
+ public:
+  Status add(const StudySource& source) {
+    for (const Measurement& m : source.study.points) {
+      auto key = std::make_tuple(m.renderer, m.scene, m.scene_n, m.width);
+      auto [it, fresh] = index_.try_emplace(key, points_.size());
+      if (fresh) {
+        points_.push_back(m);
+        first_source_.push_back(source.name);
+        continue;
+      }
+      Measurement& pooled = points_[it->second];
+      if (pooled.n != m.n || pooled.pixels != m.pixels)
+        return bad_input(fmt::format(
+            "{}: {} on {}:{} at width {} has n {} and {} pixels, but {} in {} and {} pixels: "
+            "not the same point",
+            source.name, m.renderer, m.scene, m.scene_n, m.width, m.n, m.pixels, pooled.n,
+            first_source_[it->second], pooled.pixels));
+      repeated_ = true;
+      if (m.busy && !pooled.busy) continue;  // the quiet measurement alone
+      if (pooled.busy && !m.busy) {
+        pooled = m;
+        continue;
+      }
+      pooled.seconds.insert(pooled.seconds.end(), m.seconds.begin(), m.seconds.end());
+      pooled.order.insert(pooled.order.end(), m.order.begin(), m.order.end());
+      pooled.reference_ratio = std::max(pooled.reference_ratio, m.reference_ratio);
+    }
+    return ok_status();
+  }
+
+  bool repeated() const { return repeated_; }
+
+  // By family, N, width and renderer, in the study's orders of families and renderers.
+  std::vector<Measurement> sorted(const StudyResult& r) const {
+    std::vector<Measurement> out = points_;
+    auto rank = [&](const Measurement& m) {
+      return std::make_tuple(index_in(r.scenes, m.scene), m.scene_n, m.width,
+                             index_in(r.renderers, m.renderer));
+    };
+    std::stable_sort(out.begin(), out.end(),
+                     [&](const Measurement& a, const Measurement& b) { return rank(a) < rank(b); });
+    return out;
+  }
+
+ private:
+  std::map<std::tuple<std::string, std::string, double, int>, size_t> index_;
+  std::vector<Measurement> points_;
+  std::vector<std::string> first_source_;
+  bool repeated_ = false;
+};
+
+// Which shards of which count the sources are; a note for each count whose shards are not all
+// there.
+std::vector<std::string> shard_notes(const std::vector<const StudySource*>& sources) {
+  std::map<size_t, std::set<size_t>> present;  // count -> indices
+  for (const StudySource* s : sources)
+    if (s->study.shard) present[s->study.shard->count].insert(s->study.shard->index);
+  std::vector<std::string> notes;
+  for (const auto& [count, indices] : present) {
+    std::vector<std::string> missing;
+    for (size_t i = 0; i < count; ++i)
+      if (!indices.count(i)) missing.push_back(std::to_string(i));
+    if (!missing.empty())
+      notes.push_back(fmt::format("shard{} {} of {} missing: their points were not measured",
+                                  missing.size() > 1 ? "s" : "", join(missing), count));
+  }
+  if (present.size() > 1) notes.push_back("shards of different counts were merged");
+  return notes;
+}
+
+// Each source's notes, a note given by several once, naming them.
+std::vector<std::string> source_notes(const std::vector<const StudySource*>& sources) {
+  std::vector<std::string> order;
+  std::map<std::string, std::vector<std::string>> by_note;
+  for (const StudySource* s : sources)
+    for (const std::string& note : s->study.notes) {
+      add_unique(order, note);
+      by_note[note].push_back(s->name);
+    }
+  std::vector<std::string> out;
+  for (const std::string& note : order) out.push_back(join(by_note[note]) + ": " + note);
+  return out;
+}
+
+// The group's request fields from its first study, with the others' renderers and families
+// added; image sizes must agree.
+Status pool_request(const std::vector<const StudySource*>& sources, StudyResult& r) {
+  const StudyResult& first = sources[0]->study;
+  r.width = first.width, r.height = first.height;
+  r.mode = first.mode;
+  r.repetitions = first.repetitions;
+  r.seed = first.seed;
+  r.bootstrap_replicates = first.bootstrap_replicates;
+  r.machine = first.machine;
+  for (const StudySource* s : sources) {
+    const StudyResult& study = s->study;
+    if (study.width != first.width || study.height != first.height)
+      return bad_input(fmt::format(
+          "{}: {}×{}, but {} (same machine type and mode) is {}×{}: studies pooled must have "
+          "one image size",
+          s->name, study.width, study.height, sources[0]->name, first.width, first.height));
+    for (const std::string& scene : study.scenes) {
+      add_unique(r.scenes, scene);
+      r.axes[scene] = study.axes.at(scene);
+    }
+    for (const std::string& name : study.renderers) add_unique(r.renderers, name);
+    r.budget_seconds += study.budget_seconds;
+    if (std::isfinite(study.elapsed_seconds)) r.elapsed_seconds += study.elapsed_seconds;
+    r.interrupted = r.interrupted || study.interrupted;
+  }
+  return ok_status();
+}
+
+Expected<StudyResult> pool(const std::vector<const StudySource*>& sources) {
+  StudyResult r;
+  if (Status s = pool_request(sources, r); !s) return s.error();
+  PointPool points;
+  for (const StudySource* s : sources)
+    if (Status added = points.add(*s); !added) return added.error();
+  r.points = points.sorted(r);
+  std::vector<std::string> names;
+  for (const StudySource* s : sources) names.push_back(s->name);
+  r.notes.push_back(fmt::format("merged from {} stud{}: {}", sources.size(),
+                                sources.size() > 1 ? "ies" : "y", join(names)));
+  if (points.repeated())
+    r.notes.push_back("points measured by more than one study hold the repetitions of each");
+  for (const std::string& note : shard_notes(sources)) r.notes.push_back(note);
+  for (const std::string& note : source_notes(sources)) r.notes.push_back(note);
+  conclude(r, BootstrapOptions{r.bootstrap_replicates, r.seed});
+  return r;
+}
+
+}  // namespace
+
+Expected<std::vector<MachineGroup>> merge_studies(const std::vector<StudySource>& sources) {
+  if (sources.empty()) return bad_input("--merge: no study given");
+  std::vector<GroupKey> keys;
+  std::map<GroupKey, std::vector<const StudySource*>> members;
+  for (const StudySource& s : sources) {
+    GroupKey key = key_of(s.study);
+    if (!members.count(key)) keys.push_back(key);
+    members[key].push_back(&s);
+  }
+  std::vector<MachineGroup> groups;
+  std::set<std::string> slugs;
+  for (const GroupKey& key : keys) {
+    const std::vector<const StudySource*>& group = members[key];
+    Expected<StudyResult> study = pool(group);
+    if (!study) return study.error();
+    MachineGroup g;
+    const MachineInfo& m = study->machine;
+    g.label = fmt::format("{}, {} threads, kernels {}, {} mode", m.cpu, m.threads, m.kernels,
+                          study->mode);
+    g.slug = slug_of(*study);
+    for (int k = 2; slugs.count(g.slug); ++k) g.slug = fmt::format("{}-{}", slug_of(*study), k);
+    slugs.insert(g.slug);
+    for (const StudySource* s : group) g.sources.push_back(s->name);
+    g.study = std::move(*study);
+    groups.push_back(std::move(g));
+  }
+  return groups;
+}
+
+namespace {
+
+// A pair of renderers compared on one family along one axis (the pixel axis at one N), the pair
+// in name order.
+using PairKey = std::tuple<std::string, std::string, double, std::string, std::string>;
+
+PairKey pair_key(const std::string& a, const std::string& b, const std::string& scene,
+                 const std::string& axis, double n) {
+  return {scene, axis, n, std::min(a, b), std::max(a, b)};
+}
+
+std::string crossover_text(const Crossover& c) {
+  if (!c.measured)
+    return fmt::format("crossover {} (extrapolated, outside {}–{})", format_number(c.value),
+                       format_number(c.range_low), format_number(c.range_high));
+  auto end = [](double v, const char* beyond) {
+    return std::isinf(v) ? std::string(beyond) : format_number(v);
+  };
+  return fmt::format("crossover {} ({}–{})", format_number(c.value), end(c.ci95.low, "below range"),
+                     end(c.ci95.high, "above range"));
+}
+
+std::string dominance_text(const Dominance& d) {
+  return fmt::format("{} faster throughout {}–{} (≥ {:.2f}×)", d.faster, format_number(d.range_low),
+                     format_number(d.range_high), d.min_ratio);
+}
+
+}  // namespace
+
+std::string comparison_markdown(const std::vector<MachineGroup>& groups) {
+  std::vector<PairKey> rows;
+  std::map<PairKey, std::vector<std::string>> cells;  // one per group
+  auto cell = [&](const PairKey& key, size_t group, const std::string& text) {
+    if (!cells.count(key)) rows.push_back(key), cells[key].resize(groups.size());
+    std::string& c = cells[key][group];
+    c += (c.empty() ? "" : "; ") + text;
+  };
+  for (size_t g = 0; g < groups.size(); ++g) {
+    for (const Crossover& c : groups[g].study.crossovers)
+      cell(pair_key(c.a, c.b, c.scene, c.axis, c.n), g, crossover_text(c));
+    for (const Dominance& d : groups[g].study.dominance)
+      cell(pair_key(d.faster, d.slower, d.scene, d.axis, d.n), g, dominance_text(d));
+  }
+  std::string text = "# rvr study: machine types compared\n\n";
+  text +=
+      "Studies from different machine types (CPU, threads, SIMD kernels) or modes are never "
+      "pooled: each column is one machine type's study, concluded from its own points. "
+      "Crossovers are given with their 95% interval.\n\n";
+  for (size_t g = 0; g < groups.size(); ++g)
+    text += fmt::format("{}. {} ({}×{}; {} points from {}): `{}/`\n", g + 1, groups[g].label,
+                        groups[g].study.width, groups[g].study.height,
+                        groups[g].study.points.size(), join(groups[g].sources), groups[g].slug);
+  text += "\n| family | renderers | axis |";
+  for (size_t g = 0; g < groups.size(); ++g) text += fmt::format(" {} |", g + 1);
+  text += "\n|---|---|---|";
+  for (size_t g = 0; g < groups.size(); ++g) text += "---|";
+  text += "\n";
+  for (const PairKey& key : rows) {
+    const auto& [scene, axis, n, a, b] = key;
+    std::string along = n > 0 ? fmt::format("{} at N = {}", axis, format_number(n)) : axis;
+    text += fmt::format("| {} | {} vs {} | {} |", scene, a, b, along);
+    for (const std::string& c : cells[key]) text += " " + (c.empty() ? "not compared" : c) + " |";
+    text += "\n";
+  }
+  if (rows.empty()) text += "\nNo pair of loop orders was compared on any machine type.\n";
+  return text;
+}
+
+}  // namespace rvr::study
