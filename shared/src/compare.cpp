@@ -160,6 +160,26 @@ bool on_outline(const FrameBuffers& a, const FrameBuffers& b, int x, int y) {
 
 }  // namespace
 
+namespace {
+
+// The covered pixels (a hit in either image) and the agreement over them.
+VisibilityMetrics with_coverage(VisibilityMetrics v, const FrameBuffers& a, const FrameBuffers& b) {
+  for (size_t i = 0; i < a.pixel_count(); ++i) {
+    const bool hit_a = a.object_id[i] != kNoId, hit_b = b.object_id[i] != kNoId;
+    v.covered_a += hit_a;
+    v.covered_b += hit_b;
+    v.covered_pixels += hit_a || hit_b;
+  }
+  v.covered_fraction = v.pixels ? double(v.covered_pixels) / double(v.pixels) : 0.0;
+  // Every mismatch is covered: background against background is never one.
+  v.covered_agreement =
+      v.covered_pixels ? double(v.covered_pixels - v.mismatched_pixels) / double(v.covered_pixels)
+                       : 0.0;
+  return v;
+}
+
+}  // namespace
+
 const char* to_string(DepthOutlierCause cause) {
   return cause == DepthOutlierCause::Silhouette ? "silhouette" : "elsewhere";
 }
@@ -220,7 +240,8 @@ std::vector<bool> id_boundaries(const FrameBuffers& fb) {
   return edge;
 }
 
-ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) {
+ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b,
+                                  const MismatchContext& context) {
   ComparisonMetrics m;
   const size_t n = a.pixel_count();
   m.visibility.pixels = n;
@@ -232,6 +253,7 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) 
     m.visibility.id_agreement = 0.0;
     m.visibility.mismatched_pixels = n;
     m.visibility.mismatched_off_edge = n;
+    m.visibility.classes.coverage = n;
     m.depth.max_rel_error = m.depth.mean_rel_error = 1.0;
     m.depth.p99_rel_error = m.depth.p999_rel_error = 1.0;
     m.color = ColorMetrics{1.0, 0.0, 1.0, 0.0};
@@ -263,6 +285,8 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) 
   m.visibility.mismatched_pixels = mismatched;
   m.visibility.mismatched_off_edge = off_edge;
   m.visibility.id_agreement = double(n - mismatched) / double(n);
+  m.visibility = with_coverage(m.visibility, a, b);
+  m.visibility.classes = count_classes(classify_mismatches(a, b, context));
   m.depth = depth_metrics(a, b);
 
   // Colour, linear values, peak 1.
