@@ -10,10 +10,17 @@
 // - log2 of the pixels instead of the triangles in the tracer's model:
 //   TracerFeaturesTakeTheLogOfTheTriangles, RecoversKnownCoefficientsWithinTheirIntervals,
 //   IntervalCoverageOverSeededReplicates, OutsideTheSweptRangeIsReportedAsSuch.
+// - study.html's escape_html returning its input: EscapesEveryStringFromTheData;
+// - no interval band drawn for a crossover: MarksTheCrossoverWithItsInterval.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
@@ -22,6 +29,7 @@
 #include "rvr/study/fit.h"
 #include "rvr/study/least_squares.h"
 #include "rvr/study/run_study.h"
+#include "rvr/study/study_html.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/study_markdown.h"
 #include "rvr/study/sweep_plan.h"
@@ -57,8 +65,8 @@ std::vector<Measurement> sweep(const std::string& renderer, const CostFn& cost,
   return out;
 }
 
-CostFn model_cost(ModelForm form, std::vector<double> c) {
-  return [form, c](double p, double n) { return predict(form, c, p, n); };
+CostFn model_cost(CostModel model, std::vector<double> c) {
+  return [model, c](double p, double n) { return predict(model, c, p, n); };
 }
 
 // Known coefficients of the size the renderers have (seconds, per pixel, per triangle...).
@@ -195,6 +203,65 @@ TEST(StudyFit, AModelThatDoesNotFitSaysSo) {
   EXPECT_FALSE(fit_model(ModelForm::ZBuffer, two, {100, 1}).fits);
 }
 
+// On data from the textbook forms, an extension is almost never taken: over 40 seeded studies
+// at two image sizes with 5% noise, at most 4 take one.
+TEST(StudyModelChoice, TextbookDataKeepTheTextbookForm) {
+  for (auto [form, truth] :
+       {std::pair{ModelForm::ZBuffer, kZBuffer}, std::pair{ModelForm::Tracer, kTracer}}) {
+    int extended = 0;
+    for (int i = 0; i < 40; ++i) {
+      Rng rng(300 + i);
+      std::vector<Measurement> points =
+          sweep("r", model_cost(form, truth), {256.0 * 192, kP}, 5, 0.05, rng);
+      extended += fit_chosen_model(form, points, {50, 1}).model.extended();
+    }
+    EXPECT_LE(extended, 4) << to_string(form);
+  }
+}
+
+// A z-buffer whose triangles' edges cost e·√(P·N): the edge term is taken, its coefficient
+// recovered within its interval, and the textbook form is said not to fit.
+TEST(StudyModelChoice, AnEdgeTermInTheDataIsFound) {
+  const std::vector<double> truth = {0.2e-3, 9e-9, 12e-9, 25e-9};
+  CostFn cost = [&](double p, double n) {
+    return truth[0] + truth[1] * p + truth[2] * n + truth[3] * std::sqrt(p * n);
+  };
+  Rng rng(17);
+  std::vector<Measurement> points = sweep("r", cost, {256.0 * 192, 512.0 * 384, kP}, 5, 0.03, rng);
+  EXPECT_FALSE(fit_model(ModelForm::ZBuffer, points, {100, 1}).fits);
+  ModelFit f = fit_chosen_model(ModelForm::ZBuffer, points, {1000, 1});
+  ASSERT_TRUE(f.fits) << f.verdict;
+  EXPECT_TRUE(f.model.edges) << f.formula;
+  EXPECT_EQ(f.model.knee, 0) << f.formula;
+  ASSERT_EQ(f.coefficients.size(), 4u);
+  EXPECT_EQ(f.coefficients[3].name, "e");
+  EXPECT_TRUE(covers(f.coefficients[3], truth[3]))
+      << f.coefficients[3].ci95.low << " " << f.coefficients[3].ci95.high;
+  EXPECT_NE(f.selection.find("extended"), std::string::npos) << f.selection;
+}
+
+// A tracer whose cost per level steepens past N = 46416 (the working set leaving a cache): the
+// cache term is taken with its knee at that N.
+TEST(StudyModelChoice, AChangeOfSlopeIsFoundAtItsKnee) {
+  const double knee = double(log_spaced(100, 1000000, 13)[7]);
+  const std::vector<double> truth = {1e-3, 20e-9, 1.5e-9, 12e-9};
+  CostFn cost = [&](double p, double n) {
+    return truth[0] + p * (truth[1] + truth[2] * std::log2(n)) +
+           truth[3] * p * std::max(0.0, std::log2(n / knee));
+  };
+  Rng rng(23);
+  std::vector<Measurement> points = sweep("r", cost, {256.0 * 192, kP}, 5, 0.03, rng);
+  ModelFit f = fit_chosen_model(ModelForm::Tracer, points, {500, 1});
+  ASSERT_TRUE(f.fits) << f.verdict;
+  EXPECT_EQ(f.model.knee, knee) << f.formula;
+  EXPECT_FALSE(f.model.edges) << f.formula;
+  ASSERT_EQ(f.coefficients.size(), truth.size());
+  for (size_t j = 0; j < truth.size(); ++j)
+    EXPECT_TRUE(covers(f.coefficients[j], truth[j]))
+        << f.coefficients[j].name << " = " << truth[j] << " not in [" << f.coefficients[j].ci95.low
+        << ", " << f.coefficients[j].ci95.high << "]";
+}
+
 namespace {
 
 // softraster's and raytrace's costs crossing at a known N, on one curve each.
@@ -226,6 +293,25 @@ TEST(StudyCrossover, PlacedWhereTheMeasuredCurvesCross) {
   EXPECT_LE(x.ci95.low, truth);
   EXPECT_GE(x.ci95.high, truth);
   EXPECT_FALSE(c.dominance.has_value());
+}
+
+// Two renderers of the same cost, timed with 5% noise: their measured curves cross many times,
+// but none of those crossings is beyond the noise: no crossover, a tie. 30% apart, one wins.
+TEST(StudyCrossover, NoiseAloneMakesNoCrossover) {
+  Rng rng(31);
+  std::vector<Measurement> z = sweep("softraster", kZCurve, {kP}, 5, 0.05, rng);
+  std::vector<Measurement> same = sweep("raytrace", kZCurve, {kP}, 5, 0.05, rng);
+  CurveComparison tie = compare_curves(z, same, "triangles", {1000, 2});
+  EXPECT_TRUE(tie.crossovers.empty())
+      << tie.crossovers.size() << " crossovers, first at " << tie.crossovers[0].value;
+  EXPECT_TRUE(tie.tie);
+  const CostFn slower = [](double p, double n) { return 1.3 * kZCurve(p, n); };
+  CurveComparison apart =
+      compare_curves(z, sweep("raytrace", slower, {kP}, 5, 0.05, rng), "triangles", {1000, 2});
+  EXPECT_TRUE(apart.crossovers.empty());
+  ASSERT_TRUE(apart.dominance.has_value());
+  EXPECT_EQ(apart.dominance->faster, "softraster");
+  EXPECT_GT(apart.dominance->min_ratio, 1.1);
 }
 
 // Measured up to 2000 only, raytrace never catches up: softraster wins over the whole range,
@@ -262,19 +348,20 @@ namespace {
 // 1 µs a triangle) advance.
 class SimulatedFrames : public FrameSource {
  public:
-  SimulatedFrames(double n, double& clock, Rng& rng) : n_(n), clock_(clock), rng_(rng) {
+  SimulatedFrames(double n, int width, double& clock, Rng& rng)
+      : n_(n), pixels_(double(width) * (width * 3 / 4)), clock_(clock), rng_(rng) {
     clock_ += 1e-6 * n;
   }
   double axis_value() const override { return n_; }
-  double pixels() const override { return kP; }
+  double pixels() const override { return pixels_; }
   Expected<double> time_frame(size_t index) override {
-    double t = (index == 0 ? kZCurve : kTCurve)(kP, n_) * std::exp(0.03 * rng_.normal());
+    double t = (index == 0 ? kZCurve : kTCurve)(pixels_, n_) * std::exp(0.03 * rng_.normal());
     clock_ += t;
     return t;
   }
 
  private:
-  double n_;
+  double n_, pixels_;
   double& clock_;
   Rng& rng_;
 };
@@ -291,16 +378,31 @@ TEST(StudyRun, SweepsWithinTheBudgetAndRefinesNearTheCrossover) {
   request.bootstrap_replicates = 200;
   StudyHooks hooks;
   hooks.now = [&] { return clock; };
-  hooks.prepare = [&](const std::string&, size_t n) -> Expected<std::unique_ptr<FrameSource>> {
-    return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), clock, rng));
+  hooks.prepare = [&](const Family&, size_t n,
+                      int width) -> Expected<std::unique_ptr<FrameSource>> {
+    return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, clock, rng));
   };
   Expected<StudyResult> r = run_study(request, hooks);
   ASSERT_TRUE(r.ok()) << r.error().message;
   EXPECT_LE(r->elapsed_seconds, request.budget_seconds * 1.1);
   size_t base = log_spaced(100, 1000000, 13).size();
-  EXPECT_GT(r->points.size(), 2 * base) << "no points added near the crossover";
-  ASSERT_EQ(r->crossovers.size(), 1u);
-  EXPECT_LT(std::fabs(std::log10(r->crossovers[0].value / true_crossing())), 0.1);
+  size_t full_width = 0, narrower = 0;
+  for (const Measurement& m : r->points) (m.width == request.width ? full_width : narrower)++;
+  EXPECT_GT(full_width, 2 * base) << "no points added near the crossover";
+  // Three N at four narrower widths, two renderers.
+  EXPECT_EQ(narrower, 3u * 4u * 2u);
+  std::vector<Crossover> along_n, along_pixels;
+  for (const Crossover& c : r->crossovers)
+    (c.axis == kPixelsAxis ? along_pixels : along_n).push_back(c);
+  ASSERT_EQ(along_n.size(), 1u);
+  EXPECT_FALSE(along_pixels.empty());
+  EXPECT_LT(std::fabs(std::log10(along_n[0].value / true_crossing())), 0.1);
+  // Along the pixel count, where the tracer's P·log2 N reaches the z-buffer's cost at that N.
+  for (const Crossover& c : along_pixels) {
+    double truth = (kZCurve(0, c.n) - 1e-3) / (0.5e-9 * std::log2(c.n));
+    EXPECT_LT(std::fabs(std::log10(c.value / truth)), 0.1) << "N = " << c.n;
+    EXPECT_TRUE(c.a_faster_below == false) << "the tracer wins with few pixels";
+  }
   for (const Measurement& m : r->points) EXPECT_EQ(m.seconds.size(), 5u);
   EXPECT_NE(study_json(*r).find("\"format\": \"rvr-study/1\""), std::string::npos);
 }
@@ -308,7 +410,7 @@ TEST(StudyRun, SweepsWithinTheBudgetAndRefinesNearTheCrossover) {
 TEST(StudyRun, RefusesBadInputBeforeAnyWork) {
   bool prepared = false;
   StudyHooks hooks;
-  hooks.prepare = [&](const std::string&, size_t) -> Expected<std::unique_ptr<FrameSource>> {
+  hooks.prepare = [&](const Family&, size_t, int) -> Expected<std::unique_ptr<FrameSource>> {
     prepared = true;
     return internal_error("not reached");
   };
@@ -342,4 +444,134 @@ TEST(StudyMarkdown, NumbersInPowersOfTen) {
   EXPECT_EQ(format_number(9.97e5), "1.0×10^6");
   EXPECT_EQ(format_number(1000), "1000");
   EXPECT_EQ(format_number(0.5), "0.5");
+}
+
+namespace {
+
+// A concluded study of softraster and raytrace on two scenes: "synthetic", where the curves
+// cross inside the swept range, and one whose name, like the command, a note and the CPU, holds
+// markup that study.html must escape.
+const std::string kMarkup = "<script>alert('x')</script>";
+
+StudyResult html_study() {
+  Rng rng(5);
+  StudyResult r;
+  r.scenes = {"synthetic", "odd" + kMarkup};
+  r.renderers = {"softraster", "raytrace"};
+  r.width = 1024;
+  r.height = 768;
+  r.mode = "local";
+  for (const std::string& scene : r.scenes) {
+    r.axes[scene] = "triangles";
+    for (const auto& [name, cost] : {std::pair{"softraster", kZCurve}, {"raytrace", kTCurve}})
+      for (Measurement m : sweep(name, cost, {kP}, 5, 0.03, rng)) {
+        m.scene = scene;
+        m.width = r.width;
+        m.height = r.height;
+        r.points.push_back(m);
+      }
+  }
+  conclude(r, {200, 1});
+  r.command = "rvr study " + kMarkup;
+  r.notes = {"a note " + kMarkup};
+  r.machine.cpu = kMarkup;
+  return r;
+}
+
+size_t occurrences(const std::string& text, const std::string& what) {
+  size_t k = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++k;
+  return k;
+}
+
+// The SVG of each chart, in page order.
+std::vector<std::string> charts_of(const std::string& html) {
+  std::vector<std::string> out;
+  for (size_t at = html.find("<svg class=\"study-chart\""); at != std::string::npos;
+       at = html.find("<svg class=\"study-chart\"", at + 1))
+    out.push_back(html.substr(at, html.find("</svg>", at) - at));
+  return out;
+}
+
+// The point marks of one renderer's series in a chart.
+size_t marks_of(const std::string& chart, const std::string& renderer) {
+  size_t from = chart.find("<g class=\"series\" data-renderer=\"" + renderer + "\">");
+  if (from == std::string::npos) return 0;
+  size_t to = chart.find("<g class=\"series\"", from + 1);
+  return occurrences(chart.substr(from, to == std::string::npos ? to : to - from),
+                     "<circle class=\"mark\"");
+}
+
+// The number in attribute `name` of the first element with class `cls` in `svg`.
+double attribute(const std::string& svg, const std::string& cls, const std::string& name) {
+  size_t at = svg.find("class=\"" + cls + "\"");
+  if (at == std::string::npos) return std::nan("");
+  at = svg.find(" " + name + "=\"", at);
+  return std::stod(svg.substr(at + name.size() + 3));
+}
+
+}  // namespace
+
+TEST(StudyHtml, OneChartPerSceneWithEveryRenderersPointsAndModel) {
+  StudyResult r = html_study();
+  std::string html = study_html(r);
+  std::vector<std::string> charts = charts_of(html);
+  ASSERT_EQ(charts.size(), r.scenes.size()) << "one pixel count: one chart per scene";
+  const size_t per_scene = log_spaced(100, 1000000, 13).size();
+  for (const std::string& chart : charts)
+    for (const std::string& name : r.renderers) {
+      EXPECT_EQ(marks_of(chart, name), per_scene) << name;
+      EXPECT_EQ(occurrences(chart, "class=\"model fits\" data-renderer=\"" + name + "\""), 1u)
+          << name;
+    }
+  EXPECT_NE(html.find("×10<sup>"), std::string::npos) << "powers of ten raised";
+}
+
+// The measured crossover's line lies within its shaded interval; an open end shades to the
+// chart's edge.
+TEST(StudyHtml, MarksTheCrossoverWithItsInterval) {
+  StudyResult r = html_study();
+  ASSERT_FALSE(r.crossovers.empty());
+  std::string chart = charts_of(study_html(r))[0];
+  ASSERT_EQ(occurrences(chart, "<rect class=\"ci-band\""), 1u);
+  double x = attribute(chart, "ci-band", "x"), width = attribute(chart, "ci-band", "width");
+  double line = attribute(chart, "crossover-line", "x1");
+  EXPECT_GT(width, 1.0);
+  EXPECT_LE(x, line);
+  EXPECT_GE(x + width, line);
+
+  r.crossovers[0].ci95.high = std::numeric_limits<double>::infinity();
+  std::string open = charts_of(study_html(r))[0];
+  double plot_right = attribute(open, "plot", "x") + attribute(open, "plot", "width");
+  EXPECT_DOUBLE_EQ(attribute(open, "ci-band", "x") + attribute(open, "ci-band", "width"),
+                   plot_right);
+}
+
+TEST(StudyHtml, EscapesEveryStringFromTheData) {
+  std::string html = study_html(html_study());
+  EXPECT_EQ(html.find("<script"), std::string::npos) << "markup from the data got through";
+  EXPECT_EQ(html.find("alert('x')"), std::string::npos);
+  EXPECT_NE(html.find("&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt;"), std::string::npos);
+}
+
+// A scene measured at a second pixel count gets, for each N measured at both, a chart of time
+// against pixels with each renderer's two points and its model.
+TEST(StudyHtml, ChartsAgainstPixelsWhereASceneWasMeasuredAtSeveral) {
+  StudyResult r = html_study();
+  const size_t points = r.points.size();
+  for (size_t i = 0; i < points; ++i)
+    if (r.points[i].scene == "synthetic") {
+      Measurement m = r.points[i];
+      m.pixels = kP / 4;
+      for (double& s : m.seconds) s /= 2;
+      r.points.push_back(m);
+    }
+  std::vector<std::string> charts = charts_of(study_html(r));
+  const size_t per_scene = log_spaced(100, 1000000, 13).size();
+  ASSERT_EQ(charts.size(), r.scenes.size() + per_scene);
+  for (const std::string& name : r.renderers) {
+    EXPECT_EQ(marks_of(charts[0], name), per_scene) << "the main chart: one pixel count";
+    EXPECT_EQ(marks_of(charts[1], name), 2u) << "against pixels: one point at each";
+    EXPECT_EQ(occurrences(charts[1], "data-renderer=\"" + name + "\" d=\""), 1u) << name;
+  }
 }

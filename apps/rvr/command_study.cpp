@@ -1,5 +1,6 @@
 // rvr study: sweeps of the built-in families timed with every loop order, the cost models
-// fitted, crossovers and conclusions computed (rvr::study), written as study.json and study.md.
+// fitted, crossovers and conclusions computed (rvr::study), written as study.json, study.md and
+// study.html.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -16,6 +17,7 @@
 #include "rvr/shared/isa.h"
 #include "rvr/study/renderer_frames.h"
 #include "rvr/study/run_study.h"
+#include "rvr/study/study_html.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/study_markdown.h"
 #include "terminal_progress.h"
@@ -71,7 +73,8 @@ void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
   cmd->add_option("--budget", a.budget, "seconds the sweep may take (default 300)");
   cmd->add_option("--repetitions", a.repetitions, "frames timed per renderer and point (>= 3)");
   cmd->add_option("--seed", a.seed, "seed of the interleaving order and the bootstrap");
-  cmd->add_option("-o,--output", a.out_dir, "output folder: study.json, study.md")->required();
+  cmd->add_option("-o,--output", a.out_dir, "output folder: study.json, study.md, study.html")
+      ->required();
   cmd->add_flag("-q,--quiet", a.quiet, "no progress line");
 }
 
@@ -88,8 +91,10 @@ int run_study(const StudyArgs& a, const std::string& command_line) {
   std::string markdown = study::study_markdown(result);
   check(write_text_file(a.out_dir + "/study.json", study::study_json(result)));
   check(write_text_file(a.out_dir + "/study.md", markdown));
+  check(write_text_file(a.out_dir + "/study.html", study::study_html(result)));
   progress.stop();
-  std::printf("%s\nwrote %s/{study.json,study.md}\n", markdown.c_str(), a.out_dir.c_str());
+  std::printf("%s\nwrote %s/{study.json,study.md,study.html}\n", markdown.c_str(),
+              a.out_dir.c_str());
   return 0;
 }
 

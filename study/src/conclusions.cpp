@@ -1,8 +1,12 @@
 // Conclusions from the measurements (see conclusions.h).
 #include "rvr/study/conclusions.h"
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <limits>
+#include <map>
+#include <set>
 
 #include "rvr/renderers/registry.h"
 
@@ -14,6 +18,35 @@ std::vector<Measurement> points_of(const StudyResult& r, const std::string& rend
   std::vector<Measurement> out;
   for (const Measurement& m : r.points)
     if (m.renderer == renderer && m.scene == scene) out.push_back(m);
+  return out;
+}
+
+// The points along the family's axis: those at the study's full image size.
+std::vector<Measurement> along_n(const StudyResult& r, const std::string& renderer,
+                                 const std::string& scene) {
+  std::vector<Measurement> out;
+  for (const Measurement& m : points_of(r, renderer, scene))
+    if (m.pixels == double(r.width) * double(r.height)) out.push_back(m);
+  return out;
+}
+
+// The points of the pixel sweep at one N (all its widths, the full one included).
+std::vector<Measurement> along_pixels(const StudyResult& r, const std::string& renderer,
+                                      const std::string& scene, double scene_n) {
+  std::vector<Measurement> out;
+  for (const Measurement& m : points_of(r, renderer, scene))
+    if (m.scene_n == scene_n) out.push_back(m);
+  return out;
+}
+
+// The N of a scene at which more than one width was measured, in increasing order.
+std::vector<double> pixel_sweep_columns(const StudyResult& r, const std::string& scene) {
+  std::map<double, std::set<double>> widths;
+  for (const Measurement& m : r.points)
+    if (m.scene == scene) widths[m.scene_n].insert(m.pixels);
+  std::vector<double> out;
+  for (const auto& [n, w] : widths)
+    if (w.size() > 1) out.push_back(n);
   return out;
 }
 
@@ -29,7 +62,7 @@ void fit_models(StudyResult& r, const BootstrapOptions& boot) {
     m.loop_order = short_name(order_of(name));
     m.form = model_form_of(name);
     for (const std::string& scene : r.scenes)
-      m.fits[scene] = fit_model(m.form, points_of(r, name, scene), boot);
+      m.fits[scene] = fit_chosen_model(m.form, points_of(r, name, scene), boot);
     r.models.push_back(m);
   }
 }
@@ -63,6 +96,8 @@ void add_extrapolated(StudyResult& r, const Dominance& d) {
   r.crossovers.push_back(c);
 }
 
+// Every pair of renderers of different loop orders, along N at the full width and along the
+// pixel count at each N of the pixel sweep.
 void compare_pairs(StudyResult& r, const BootstrapOptions& boot) {
   for (const std::string& scene : r.scenes)
     for (size_t i = 0; i < r.renderers.size(); ++i)
@@ -70,26 +105,54 @@ void compare_pairs(StudyResult& r, const BootstrapOptions& boot) {
         const std::string &a = r.renderers[i], &b = r.renderers[j];
         if (order_of(a) == order_of(b)) continue;
         CurveComparison c =
-            compare_curves(points_of(r, a, scene), points_of(r, b, scene), r.axes[scene], boot);
+            compare_curves(along_n(r, a, scene), along_n(r, b, scene), r.axes[scene], boot);
         for (const Crossover& x : c.crossovers) r.crossovers.push_back(x);
         if (c.dominance) {
           r.dominance.push_back(*c.dominance);
           add_extrapolated(r, *c.dominance);
         }
+        if (c.tie)
+          r.notes.push_back(
+              fmt::format("{}: {} and {} are within the timing noise of each other "
+                          "at every {} measured",
+                          scene, a, b, r.axes[scene]));
+        for (double n : pixel_sweep_columns(r, scene)) {
+          CurveComparison p = compare_curves(along_pixels(r, a, scene, n),
+                                             along_pixels(r, b, scene, n), kPixelsAxis, boot);
+          for (const Crossover& x : p.crossovers) r.crossovers.push_back(x);
+          if (p.dominance) r.dominance.push_back(*p.dominance);
+          if (p.tie)
+            r.notes.push_back(
+                fmt::format("{} at N={}: {} and {} are within the timing noise of "
+                            "each other at every pixel count measured",
+                            scene, n, a, b));
+        }
       }
 }
 
-// The slope over every decade [10^k, 10^(k+1)] the points span.
+// The slope along N over every decade [10^k, 10^(k+1)] the full-width points span, and along
+// the pixel count over each pixel sweep.
 void scaling(StudyResult& r) {
   for (const std::string& name : r.renderers)
     for (const std::string& scene : r.scenes) {
-      std::vector<Measurement> p = points_of(r, name, scene);
+      const std::string& axis = r.axes[scene];
+      std::vector<Measurement> p = along_n(r, name, scene);
       if (p.empty()) continue;
       double lo = p[0].n, hi = p[0].n;
       for (const Measurement& m : p) lo = std::min(lo, m.n), hi = std::max(hi, m.n);
       for (double from = std::pow(10.0, std::floor(std::log10(lo))); from < hi; from *= 10) {
-        double slope = loglog_slope(p, from, from * 10);
-        if (std::isfinite(slope)) r.scaling.push_back({name, scene, from, from * 10, slope});
+        double slope = loglog_slope(p, from, from * 10, axis);
+        if (std::isfinite(slope))
+          r.scaling.push_back({name, scene, axis, from, from * 10, slope, 0});
+      }
+      for (double n : pixel_sweep_columns(r, scene)) {
+        std::vector<Measurement> column = along_pixels(r, name, scene, n);
+        double from = column[0].pixels, to = column[0].pixels;
+        for (const Measurement& m : column)
+          from = std::min(from, m.pixels), to = std::max(to, m.pixels);
+        double slope = loglog_slope(column, from, to, kPixelsAxis);
+        if (std::isfinite(slope))
+          r.scaling.push_back({name, scene, kPixelsAxis, from, to, slope, column[0].n});
       }
     }
 }
@@ -98,7 +161,7 @@ void scaling(StudyResult& r) {
 void unit_costs(StudyResult& r) {
   for (const std::string& name : r.renderers)
     for (const std::string& scene : r.scenes) {
-      std::vector<Measurement> p = points_of(r, name, scene);
+      std::vector<Measurement> p = along_n(r, name, scene);
       if (p.empty()) continue;
       const Measurement *lo = &p[0], *hi = &p[0];
       for (const Measurement& m : p) {
@@ -127,11 +190,13 @@ ModelForm model_form_of(const std::string& renderer) {
   return ModelForm::ZBuffer;
 }
 
-double loglog_slope(const std::vector<Measurement>& points, double from, double to) {
+double loglog_slope(const std::vector<Measurement>& points, double from, double to,
+                    const std::string& axis) {
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
   for (const Measurement& m : points) {
-    if (m.n < from * (1 - 1e-9) || m.n > to * (1 + 1e-9)) continue;
-    double x = std::log10(m.n), y = std::log10(typical_seconds(m));
+    const double v = axis == kPixelsAxis ? m.pixels : m.n;
+    if (v < from * (1 - 1e-9) || v > to * (1 + 1e-9)) continue;
+    double x = std::log10(v), y = std::log10(typical_seconds(m));
     n += 1, sx += x, sy += y, sxx += x * x, sxy += x * y;
   }
   double denominator = n * sxx - sx * sx;

@@ -10,9 +10,14 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// a's and b's points at the axis values both have, in increasing n.
+// The value of the swept axis at a point: its pixel count on the "pixels" axis, else its N.
+double axis_value(const Measurement& m, const std::string& axis) {
+  return axis == kPixelsAxis ? m.pixels : m.n;
+}
+
+// a's and b's points at the axis values both have, in increasing axis value.
 void matched(const std::vector<Measurement>& a, const std::vector<Measurement>& b,
-             std::vector<Measurement>& ma, std::vector<Measurement>& mb) {
+             const std::string& axis, std::vector<Measurement>& ma, std::vector<Measurement>& mb) {
   for (const Measurement& p : a)
     for (const Measurement& q : b)
       if (p.n == q.n && p.pixels == q.pixels) {
@@ -21,7 +26,8 @@ void matched(const std::vector<Measurement>& a, const std::vector<Measurement>& 
       }
   std::vector<size_t> idx(ma.size());
   for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
-  std::sort(idx.begin(), idx.end(), [&](size_t i, size_t j) { return ma[i].n < ma[j].n; });
+  std::sort(idx.begin(), idx.end(),
+            [&](size_t i, size_t j) { return axis_value(ma[i], axis) < axis_value(ma[j], axis); });
   std::vector<Measurement> sa, sb;
   for (size_t i : idx) {
     sa.push_back(ma[i]);
@@ -53,17 +59,63 @@ std::vector<double> log_ratios(const std::vector<double>& ta, const std::vector<
   return d;
 }
 
-// The replicates' positions of the crossing `c`: the nearest of each replicate's crossings of
-// the same direction, or ±inf when a replicate has none (one renderer faster everywhere).
-std::vector<double> replicate_positions(const std::vector<Measurement>& a,
-                                        const std::vector<Measurement>& b,
-                                        const std::vector<double>& log_n, const Crossing& c,
-                                        const BootstrapOptions& boot) {
+// Each replicate's log ratios d = log(t_a / t_b) at the matched points.
+std::vector<std::vector<double>> replicate_ratios(const std::vector<Measurement>& a,
+                                                  const std::vector<Measurement>& b,
+                                                  const BootstrapOptions& boot) {
   Rng rng(boot.seed);
-  std::vector<double> positions;
+  std::vector<std::vector<double>> out;
   for (int r = 0; r < boot.replicates; ++r) {
     std::vector<double> ta = resample_medians(a, rng), tb = resample_medians(b, rng);
-    std::vector<double> d = log_ratios(ta, tb);
+    out.push_back(log_ratios(ta, tb));
+  }
+  return out;
+}
+
+// Which renderer each point shows faster beyond its timing noise: −1 (a), +1 (b), or 0 when the
+// 95% interval of d over the replicates holds 0 (a tie).
+std::vector<int> significant_signs(const std::vector<std::vector<double>>& replicates,
+                                   size_t points) {
+  std::vector<int> signs(points, 0);
+  for (size_t i = 0; i < points; ++i) {
+    std::vector<double> di;
+    for (const auto& d : replicates) di.push_back(d[i]);
+    Interval ci = percentile_interval(di);
+    signs[i] = ci.high < 0 ? -1 : (ci.low > 0 ? +1 : 0);
+  }
+  return signs;
+}
+
+// The crossings of the measured curves that the noise cannot explain: one for every pair of
+// consecutive significant points of opposite signs, placed at the measured sign change between
+// them (the geometric middle of the first and last when ties between them change sign more
+// than once).
+std::vector<Crossing> significant_crossings(const std::vector<double>& log_n,
+                                            const std::vector<double>& d,
+                                            const std::vector<int>& signs) {
+  std::vector<Crossing> out;
+  size_t last = signs.size();  // the previous significant point
+  for (size_t j = 0; j < signs.size(); ++j) {
+    if (signs[j] == 0) continue;
+    if (last != signs.size() && signs[j] != signs[last]) {
+      std::vector<double> sub_n(log_n.begin() + long(last), log_n.begin() + long(j) + 1);
+      std::vector<double> sub_d(d.begin() + long(last), d.begin() + long(j) + 1);
+      std::vector<Crossing> raw = crossings(sub_n, sub_d);
+      double x = raw.empty() ? 0.5 * (log_n[last] + log_n[j])
+                             : 0.5 * (raw.front().log_n + raw.back().log_n);
+      out.push_back({x, signs[last] < 0});
+    }
+    last = j;
+  }
+  return out;
+}
+
+// The replicates' positions of the crossing `c`: the nearest of each replicate's crossings of
+// the same direction, or ±inf when a replicate has none (one renderer faster everywhere).
+std::vector<double> replicate_positions(const std::vector<std::vector<double>>& replicates,
+                                        const std::vector<double>& log_n, const Crossing& c) {
+  std::vector<double> positions;
+  for (const std::vector<double>& d : replicates) {
     double best = kInf, best_distance = kInf;
     for (const Crossing& x : crossings(log_n, d))
       if (x.a_faster_below == c.a_faster_below && std::fabs(x.log_n - c.log_n) < best_distance) {
@@ -80,17 +132,23 @@ std::vector<double> replicate_positions(const std::vector<Measurement>& a,
   return positions;
 }
 
-Dominance dominance(const std::vector<Measurement>& a, const std::vector<Measurement>& b,
-                    const std::vector<double>& d) {
+// The renderer faster wherever the difference is beyond the noise, and its smallest lead
+// there; nullopt when no point is.
+std::optional<Dominance> dominance(const std::vector<Measurement>& a,
+                                   const std::vector<Measurement>& b, const std::vector<double>& d,
+                                   const std::vector<int>& signs, const std::string& axis) {
+  size_t first = 0;
+  while (first < signs.size() && signs[first] == 0) ++first;
+  if (first == signs.size()) return std::nullopt;
   Dominance dom;
-  bool a_faster = d.front() < 0;
+  bool a_faster = signs[first] < 0;
   dom.faster = a_faster ? a[0].renderer : b[0].renderer;
   dom.slower = a_faster ? b[0].renderer : a[0].renderer;
   dom.min_ratio = kInf;
   for (size_t i = 0; i < d.size(); ++i)
-    if (std::exp(std::fabs(d[i])) < dom.min_ratio) {
+    if (signs[i] != 0 && std::exp(std::fabs(d[i])) < dom.min_ratio) {
       dom.min_ratio = std::exp(std::fabs(d[i]));
-      dom.at = a[i].n;
+      dom.at = axis_value(a[i], axis);
     }
   return dom;
 }
@@ -102,36 +160,47 @@ CurveComparison compare_curves(const std::vector<Measurement>& a_in,
                                const BootstrapOptions& boot) {
   CurveComparison out;
   std::vector<Measurement> a, b;
-  matched(a_in, b_in, a, b);
+  matched(a_in, b_in, axis, a, b);
   if (a.empty()) return out;
+  const bool pixels_axis = axis == kPixelsAxis;
+  const double low = axis_value(a.front(), axis), high = axis_value(a.back(), axis);
   std::vector<double> log_n, ta, tb;
   for (size_t i = 0; i < a.size(); ++i) {
-    log_n.push_back(std::log(a[i].n));
+    log_n.push_back(std::log(axis_value(a[i], axis)));
     ta.push_back(typical_seconds(a[i]));
     tb.push_back(typical_seconds(b[i]));
   }
   std::vector<double> d = log_ratios(ta, tb);
-  for (const Crossing& c : crossings(log_n, d)) {
+  std::vector<std::vector<double>> replicates = replicate_ratios(a, b, boot);
+  std::vector<int> signs = significant_signs(replicates, a.size());
+  for (const Crossing& c : significant_crossings(log_n, d, signs)) {
     Crossover x;
     x.a = a[0].renderer;
     x.b = b[0].renderer;
     x.scene = a[0].scene;
     x.axis = axis;
     x.value = std::exp(c.log_n);
-    x.ci95 = percentile_interval(replicate_positions(a, b, log_n, c, boot));
-    x.pixels = a[0].pixels;
+    x.ci95 = percentile_interval(replicate_positions(replicates, log_n, c));
+    x.pixels = pixels_axis ? 0 : a[0].pixels;
+    x.n = pixels_axis ? a[0].n : 0;
     x.a_faster_below = c.a_faster_below;
-    x.range_low = a.front().n;
-    x.range_high = a.back().n;
+    x.range_low = low;
+    x.range_high = high;
     out.crossovers.push_back(x);
   }
   if (out.crossovers.empty()) {
-    Dominance dom = dominance(a, b, d);
+    std::optional<Dominance> found = dominance(a, b, d, signs, axis);
+    if (!found) {
+      out.tie = true;
+      return out;
+    }
+    Dominance dom = *found;
     dom.scene = a[0].scene;
     dom.axis = axis;
-    dom.pixels = a[0].pixels;
-    dom.range_low = a.front().n;
-    dom.range_high = a.back().n;
+    dom.pixels = pixels_axis ? 0 : a[0].pixels;
+    dom.n = pixels_axis ? a[0].n : 0;
+    dom.range_low = low;
+    dom.range_high = high;
     out.dominance = dom;
   }
   return out;
@@ -144,7 +213,7 @@ std::optional<double> extrapolated_crossing(const ModelFit& fa, const ModelFit& 
   // The models' log ratio; a folded b·P is part of a, so it is evaluated at the study's P.
   auto d = [&](double log_n) {
     double n = std::exp(log_n);
-    double ta = predict(fa.form, ca, pixels, n), tb = predict(fb.form, cb, pixels, n);
+    double ta = predict(fa.model, ca, pixels, n), tb = predict(fb.model, cb, pixels, n);
     return ta > 0 && tb > 0 ? std::log(ta / tb) : std::numeric_limits<double>::quiet_NaN();
   };
   // Search outward from each end in steps of a quarter decade, then bisect the bracket.

@@ -4,12 +4,16 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
+#include <set>
 
 #include "rvr/study/fit_quality.h"
 #include "rvr/study/least_squares.h"
 
 namespace rvr::study {
 namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // Every point's pixel count when they all share one, else 0.
 double shared_pixels(const std::vector<Measurement>& points) {
@@ -21,7 +25,8 @@ double shared_pixels(const std::vector<Measurement>& points) {
 
 // Each coefficient's 95% interval over the bootstrap replicates (replicates whose fit fails,
 // which terms that are independent in the data do not, are skipped).
-std::vector<Interval> bootstrap_intervals(ModelForm form, const std::vector<Measurement>& points,
+std::vector<Interval> bootstrap_intervals(const CostModel& model,
+                                          const std::vector<Measurement>& points,
                                           const std::vector<bool>& use,
                                           const BootstrapOptions& boot) {
   Rng rng(boot.seed);
@@ -30,7 +35,7 @@ std::vector<Interval> bootstrap_intervals(ModelForm form, const std::vector<Meas
   std::vector<std::vector<double>> draws(use.size());
   for (int r = 0; r < boot.replicates; ++r) {
     Expected<std::vector<double>> c =
-        fit_coefficients(form, points, resample_medians(points, rng), use, measured);
+        fit_coefficients(model, points, resample_medians(points, rng), use, measured);
     if (!c) continue;
     for (size_t j = 0; j < use.size(); ++j) draws[j].push_back((*c)[j]);
   }
@@ -53,13 +58,14 @@ std::string verdict(const ModelFit& f, const FitThresholds& limits) {
 
 }  // namespace
 
-std::vector<bool> identifiable_terms(ModelForm form, const std::vector<Measurement>& points) {
-  std::vector<bool> use(coefficient_names(form).size(), true);
+std::vector<bool> identifiable_terms(const CostModel& model,
+                                     const std::vector<Measurement>& points) {
+  std::vector<bool> use(coefficient_names(model).size(), true);
   if (shared_pixels(points) > 0) use[kPixelCoefficient] = false;
   return use;
 }
 
-Expected<std::vector<double>> fit_coefficients(ModelForm form,
+Expected<std::vector<double>> fit_coefficients(const CostModel& model,
                                                const std::vector<Measurement>& points,
                                                const std::vector<double>& medians,
                                                const std::vector<bool>& use,
@@ -67,26 +73,27 @@ Expected<std::vector<double>> fit_coefficients(ModelForm form,
   std::vector<std::vector<double>> x;
   std::vector<double> w;
   for (size_t i = 0; i < points.size(); ++i) {
-    x.push_back(features(form, points[i].pixels, points[i].n));
+    x.push_back(features(model, points[i].pixels, points[i].n));
     double s = scale.empty() ? medians[i] : scale[i];
     w.push_back(1.0 / (s * s));
   }
   return weighted_least_squares(x, medians, w, use);
 }
 
-ModelFit fit_model(ModelForm form, const std::vector<Measurement>& points,
+ModelFit fit_model(const CostModel& model, const std::vector<Measurement>& points,
                    const BootstrapOptions& boot, const FitThresholds& limits) {
   ModelFit f;
-  f.form = form;
-  f.formula = formula(form);
+  f.model = model;
+  f.formula = formula(model);
+  f.selection = model.extended() ? "as asked" : "the textbook form";
   f.points = points.size();
   f.fixed_pixels = shared_pixels(points);
-  std::vector<bool> use = identifiable_terms(form, points);
+  std::vector<bool> use = identifiable_terms(model, points);
   std::vector<double> medians;
   for (const Measurement& p : points) medians.push_back(typical_seconds(p));
   size_t used = 0;
   for (bool u : use) used += u;
-  std::vector<std::string> names = coefficient_names(form);
+  std::vector<std::string> names = coefficient_names(model);
   f.coefficients.resize(names.size());
   for (size_t j = 0; j < names.size(); ++j) {
     f.coefficients[j].name = names[j];
@@ -97,20 +104,20 @@ ModelFit fit_model(ModelForm form, const std::vector<Measurement>& points,
                             points.size(), used, used + 2);
     return f;
   }
-  Expected<std::vector<double>> c = fit_coefficients(form, points, medians, use);
+  Expected<std::vector<double>> c = fit_coefficients(model, points, medians, use);
   if (!c) {
     f.verdict = "does not fit: " + c.error().message;
     return f;
   }
-  std::vector<Interval> ci = bootstrap_intervals(form, points, use, boot);
+  std::vector<Interval> ci = bootstrap_intervals(model, points, use, boot);
   for (size_t j = 0; j < use.size(); ++j) {
     f.coefficients[j].value = (*c)[j];
     f.coefficients[j].ci95 = ci[j];
   }
-  FitQuality q = fit_quality(form, points, medians, *c, use);
+  FitQuality q = fit_quality(model, points, medians, *c, use);
   f.r2 = q.r2;
   f.max_rel_residual = q.max_rel_residual;
-  f.loo_rel_error = q.loo_rel_error;
+  f.loo_rel_error = q.loo_median_rel_error;
   f.verdict = verdict(f, limits);
   f.fits = f.verdict == "fits";
   return f;
@@ -123,7 +130,46 @@ std::vector<double> coefficient_values(const ModelFit& fit) {
 }
 
 double predict_seconds(const ModelFit& fit, double pixels, double n) {
-  return predict(fit.form, coefficient_values(fit), pixels, n);
+  return predict(fit.model, coefficient_values(fit), pixels, n);
+}
+
+std::vector<CostModel> candidate_models(ModelForm form, const std::vector<Measurement>& points) {
+  std::set<double> distinct;
+  for (const Measurement& p : points) distinct.insert(p.n);
+  std::vector<double> ns(distinct.begin(), distinct.end());
+  std::vector<CostModel> out = {CostModel(form), CostModel(form, true, 0)};
+  for (size_t i = 2; i + 2 < ns.size(); ++i) out.push_back(CostModel(form, false, ns[i]));
+  for (size_t i = 2; i + 2 < ns.size(); ++i) out.push_back(CostModel(form, true, ns[i]));
+  return out;
+}
+
+ModelFit fit_chosen_model(ModelForm form, const std::vector<Measurement>& points,
+                          const BootstrapOptions& boot, const FitThresholds& limits) {
+  std::vector<double> medians;
+  for (const Measurement& p : points) medians.push_back(typical_seconds(p));
+  const size_t enough = coefficient_names(CostModel(form, true, 1)).size() + 2;
+  auto extensions = [](const CostModel& m) { return int(m.edges) + int(m.knee > 0); };
+  // The best candidate of each tier (number of extensions), by mean leave-one-out error.
+  std::vector<std::pair<CostModel, double>> best(3, {CostModel(form), kInfinity});
+  for (const CostModel& m : candidate_models(form, points)) {
+    if (m.extended() && points.size() < enough) continue;
+    double loo =
+        leave_one_out(m, points, medians, identifiable_terms(m, points)).loo_mean_rel_error;
+    auto& tier = best[size_t(extensions(m))];
+    if (loo < tier.second) tier = {m, loo};
+  }
+  size_t chosen = 0;
+  for (size_t t = 1; t < best.size(); ++t)
+    if (best[t].second < (1 - limits.min_extension_gain) * best[chosen].second) chosen = t;
+  ModelFit f = fit_model(best[chosen].first, points, boot, limits);
+  f.selection = chosen == 0 ? "the textbook form: no extension lowered the mean leave-one-out "
+                              "error by " +
+                                  fmt::format("{:.0f}%", 100 * limits.min_extension_gain)
+                            : fmt::format(
+                                  "extended: mean leave-one-out error {:.1f}% against {:.1f}% "
+                                  "for the textbook form",
+                                  100 * best[chosen].second, 100 * best[0].second);
+  return f;
 }
 
 }  // namespace rvr::study

@@ -26,10 +26,12 @@ double weighted_r2(const std::vector<double>& t, const std::vector<double>& mode
   return total > 0 ? 1 - residual / total : (residual == 0 ? 1.0 : 0.0);
 }
 
-// Each point predicted by the model fitted to all the others.
-double leave_one_out(ModelForm form, const std::vector<Measurement>& points,
-                     const std::vector<double>& medians, const std::vector<bool>& use) {
-  double sum = 0;
+}  // namespace
+
+FitQuality leave_one_out(const CostModel& model, const std::vector<Measurement>& points,
+                         const std::vector<double>& medians, const std::vector<bool>& use) {
+  FitQuality q;
+  std::vector<double> errors;
   for (size_t i = 0; i < points.size(); ++i) {
     std::vector<Measurement> rest;
     std::vector<double> rest_medians;
@@ -38,27 +40,32 @@ double leave_one_out(ModelForm form, const std::vector<Measurement>& points,
         rest.push_back(points[j]);
         rest_medians.push_back(medians[j]);
       }
-    Expected<std::vector<double>> c = fit_coefficients(form, rest, rest_medians, use);
-    if (!c) return std::numeric_limits<double>::infinity();
-    double e = (medians[i] - predict(form, *c, points[i].pixels, points[i].n)) / medians[i];
-    sum += e * e;
+    Expected<std::vector<double>> c = fit_coefficients(model, rest, rest_medians, use);
+    if (!c) {
+      q.loo_median_rel_error = q.loo_mean_rel_error = std::numeric_limits<double>::infinity();
+      return q;
+    }
+    errors.push_back(std::fabs(medians[i] - predict(model, *c, points[i].pixels, points[i].n)) /
+                     medians[i]);
   }
-  return std::sqrt(sum / double(points.size()));
+  double sum = 0;
+  for (double e : errors) sum += e;
+  q.loo_mean_rel_error = errors.empty() ? 0 : sum / double(errors.size());
+  q.loo_median_rel_error = median(errors);
+  return q;
 }
 
-}  // namespace
-
-FitQuality fit_quality(ModelForm form, const std::vector<Measurement>& points,
+FitQuality fit_quality(const CostModel& cost_model, const std::vector<Measurement>& points,
                        const std::vector<double>& medians, const std::vector<double>& coefficients,
                        const std::vector<bool>& use) {
-  FitQuality q;
+  FitQuality q = leave_one_out(cost_model, points, medians, use);
   std::vector<double> model;
-  for (const Measurement& p : points) model.push_back(predict(form, coefficients, p.pixels, p.n));
+  for (const Measurement& p : points)
+    model.push_back(predict(cost_model, coefficients, p.pixels, p.n));
   q.r2 = weighted_r2(medians, model);
   for (size_t i = 0; i < points.size(); ++i)
     q.max_rel_residual =
         std::max(q.max_rel_residual, std::fabs(medians[i] - model[i]) / medians[i]);
-  q.loo_rel_error = leave_one_out(form, points, medians, use);
   return q;
 }
 

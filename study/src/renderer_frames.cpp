@@ -5,13 +5,14 @@
 
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/study/grid_of_copies.h"
 
 namespace rvr::study {
 namespace {
 
 // Triangles the z-buffers draw for a mesh-only scene; the family's N for any other.
-double axis_value_of(const Scene& scene, const std::string& family, size_t n) {
-  if (family == "occluders") return double(n);
+double axis_value_of(const Scene& scene, const Family& family, size_t n) {
+  if (family.axis != "triangles") return double(n);
   double triangles = 0;
   for (const Object& o : scene.objects) triangles += double(o.mesh.triangles.size());
   return triangles;
@@ -51,14 +52,30 @@ class RendererFrames : public FrameSource {
   std::vector<std::unique_ptr<PreparedRenderer>> prepared_;
 };
 
+// builtin:<family>:<n>, or n copies of the family's file, at width × width·3/4.
+Expected<Scene> family_scene(const Family& family, size_t n, int width) {
+  if (family.source.empty()) {
+    Expected<Scene> scene = make_builtin_scene(family.name + ":" + std::to_string(n));
+    if (!scene) return scene.error();
+    scene->image.width = width;
+    scene->image.height = width * 3 / 4;
+    return scene;
+  }
+  SceneOverrides size;
+  size.width = width;
+  size.height = width * 3 / 4;
+  Expected<Scene> base = load_scene(family.source, size);
+  if (!base) return base.error();
+  return grid_of_copies(*base, n);
+}
+
 }  // namespace
 
 PrepareFrames renderer_frames(const StudyRequest& request) {
-  return [request](const std::string& family, size_t n) -> Expected<std::unique_ptr<FrameSource>> {
-    Expected<Scene> scene = make_builtin_scene(family + ":" + std::to_string(n));
+  return [request](const Family& family, size_t n,
+                   int width) -> Expected<std::unique_ptr<FrameSource>> {
+    Expected<Scene> scene = family_scene(family, n, width);
     if (!scene) return scene.error();
-    scene->image.width = request.width;
-    scene->image.height = request.width * 3 / 4;
     double axis = axis_value_of(*scene, family, n);
     auto frames =
         std::make_unique<RendererFrames>(std::make_unique<Scene>(std::move(*scene)), axis);

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <set>
+#include <tuple>
 
 #include "rvr/renderers/registry.h"
 #include "rvr/study/bootstrap.h"
@@ -16,9 +17,10 @@
 namespace rvr::study {
 namespace {
 
-// Of the budget share of a scene, what the log-spaced sweep may use; the rest is for the
-// points added near crossovers.
-constexpr double kBaseShare = 0.8;
+// Of the budget share of a scene, where the log-spaced sweep of N must end, and the sweep of
+// the pixel count; the rest is for the points added near crossovers.
+constexpr double kBaseShare = 0.6;
+constexpr double kPixelShare = 0.8;
 constexpr int kRefinementRounds = 3;
 
 Status validate(const StudyRequest& r) {
@@ -58,9 +60,15 @@ class Sweep {
   Status run_scene(const Family& family, double share_end);
 
  private:
-  Status measure(const Family& family, size_t n, double deadline);
+  // Measures (n, width) unless it was measured, or it would end past `limit` as predicted from
+  // the points measured at the full width: false then.
+  Expected<bool> try_point(const Family& family, size_t n, int width, double limit,
+                           double share_end);
+  Status measure(const Family& family, size_t n, int width, double deadline);
   void time_rounds(const Family& family, size_t n, FrameSource& frames, double deadline,
                    std::vector<Measurement>& points, Status& status);
+  Status sweep_n(const Family& family, double limit, double share_end);
+  Status sweep_pixels(const Family& family, double limit, double share_end);
   std::vector<size_t> crossover_midpoints(const Family& family) const;
   void progress(const std::string& what) const {
     if (hooks_.on_progress) hooks_.on_progress(what);
@@ -71,7 +79,8 @@ class Sweep {
   StudyResult& result_;
   Rng rng_;
   double start_ = 0;
-  std::set<std::pair<std::string, size_t>> measured_;
+  std::set<std::tuple<std::string, size_t, int>> measured_;  // family, n, width
+  CostPredictor cost_;  // of the current family's points at the full width
 };
 
 // Times `request.repetitions` rounds; in each, every renderer once, in a fresh random order.
@@ -98,10 +107,10 @@ void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, dou
   }
 }
 
-// Measures builtin:<family>:<n> with every renderer; the points join the result.
-Status Sweep::measure(const Family& family, size_t n, double deadline) {
-  progress(fmt::format("{} N={}: preparing", family.name, n));
-  Expected<std::unique_ptr<FrameSource>> frames = hooks_.prepare(family.name, n);
+// Measures builtin:<family>:<n> at `width` with every renderer; the points join the result.
+Status Sweep::measure(const Family& family, size_t n, int width, double deadline) {
+  progress(fmt::format("{} N={} {}×{}: preparing", family.name, n, width, width * 3 / 4));
+  Expected<std::unique_ptr<FrameSource>> frames = hooks_.prepare(family, n, width);
   if (!frames) return frames.error();
   std::vector<Measurement> points;
   for (const std::string& name : request_.renderers) {
@@ -111,8 +120,8 @@ Status Sweep::measure(const Family& family, size_t n, double deadline) {
     m.scene_n = double(n);
     m.n = (*frames)->axis_value();
     m.pixels = (*frames)->pixels();
-    m.width = request_.width;
-    m.height = request_.width * 3 / 4;
+    m.width = width;
+    m.height = width * 3 / 4;
     points.push_back(m);
   }
   Status status = ok_status();
@@ -120,7 +129,7 @@ Status Sweep::measure(const Family& family, size_t n, double deadline) {
   if (!status) return status;
   if (cancelled()) return ok_status();  // the point is incomplete: dropped
   for (Measurement& m : points) result_.points.push_back(std::move(m));
-  measured_.insert({family.name, n});
+  measured_.insert({family.name, n, width});
   return ok_status();
 }
 
@@ -129,7 +138,8 @@ Status Sweep::measure(const Family& family, size_t n, double deadline) {
 std::vector<size_t> Sweep::crossover_midpoints(const Family& family) const {
   std::map<size_t, std::map<std::string, double>> t;  // n -> renderer -> median
   for (const Measurement& m : result_.points)
-    if (m.scene == family.name) t[size_t(m.scene_n)][m.renderer] = typical_seconds(m);
+    if (m.scene == family.name && m.width == request_.width)
+      t[size_t(m.scene_n)][m.renderer] = typical_seconds(m);
   std::set<size_t> mids;
   for (size_t i = 0; i < request_.renderers.size(); ++i)
     for (size_t j = i + 1; j < request_.renderers.size(); ++j) {
@@ -146,22 +156,22 @@ std::vector<size_t> Sweep::crossover_midpoints(const Family& family) const {
   return {mids.begin(), mids.end()};
 }
 
-// The log-spaced sweep up to kBaseShare of the scene's share, then points near crossovers.
-Status Sweep::run_scene(const Family& family, double share_end) {
-  const double share_start = elapsed();
-  const double base_end = share_start + kBaseShare * (share_end - share_start);
-  CostPredictor cost;
-  auto try_point = [&](size_t n, double limit) -> Expected<bool> {
-    if (measured_.count({family.name, n})) return false;
-    if (!cost.empty() && elapsed() + cost.predict(n) > limit) return false;
-    double before = elapsed();
-    if (Status s = measure(family, n, share_end); !s) return s.error();
-    cost.add(n, elapsed() - before);
-    return true;
-  };
+Expected<bool> Sweep::try_point(const Family& family, size_t n, int width, double limit,
+                                double share_end) {
+  if (measured_.count({family.name, n, width})) return false;
+  // A narrower frame costs no more than the full-width one the prediction is made from.
+  if (!cost_.empty() && elapsed() + cost_.predict(n) > limit) return false;
+  double before = elapsed();
+  if (Status s = measure(family, n, width, share_end); !s) return s.error();
+  if (width == request_.width) cost_.add(n, elapsed() - before);
+  return true;
+}
+
+// The log-spaced sweep of N at the full width, stopped where a point would end past `limit`.
+Status Sweep::sweep_n(const Family& family, double limit, double share_end) {
   for (size_t n : log_spaced(family.low, family.high, family.points)) {
     if (cancelled()) return ok_status();
-    Expected<bool> done = try_point(n, base_end);
+    Expected<bool> done = try_point(family, n, request_.width, limit, share_end);
     if (!done) return done.error();
     if (!*done) {
       result_.notes.push_back(
@@ -170,10 +180,45 @@ Status Sweep::run_scene(const Family& family, double share_end) {
       break;
     }
   }
-  for (int round = 0; round < kRefinementRounds; ++round)
-    for (size_t mid : crossover_midpoints(family))
+  return ok_status();
+}
+
+// The pixel count swept at the smallest, the middle and the largest N measured, so that the
+// per-pixel terms can be told from the constant ones.
+Status Sweep::sweep_pixels(const Family& family, double limit, double share_end) {
+  std::vector<size_t> measured;
+  for (const auto& [name, n, width] : measured_)
+    if (name == family.name && width == request_.width) measured.push_back(n);
+  std::sort(measured.begin(), measured.end());
+  for (size_t n : pixel_sweep_ns(measured))
+    for (int width : pixel_sweep_widths(request_.width)) {
       if (cancelled()) return ok_status();
-      else if (Expected<bool> done = try_point(mid, share_end); !done) return done.error();
+      Expected<bool> done = try_point(family, n, width, limit, share_end);
+      if (!done) return done.error();
+      if (!*done && !measured_.count({family.name, n, width})) {
+        result_.notes.push_back(fmt::format(
+            "{}: the pixel sweep stopped at N={}, {} wide (it would have overrun the budget)",
+            family.name, n, width));
+        return ok_status();
+      }
+    }
+  return ok_status();
+}
+
+// The sweep of N up to kBaseShare of the scene's share, of the pixel count up to kPixelShare,
+// then points near crossovers.
+Status Sweep::run_scene(const Family& family, double share_end) {
+  const double share_start = elapsed();
+  const double length = share_end - share_start;
+  cost_ = CostPredictor();
+  if (Status s = sweep_n(family, share_start + kBaseShare * length, share_end); !s) return s;
+  if (Status s = sweep_pixels(family, share_start + kPixelShare * length, share_end); !s) return s;
+  for (int round = 0; round < kRefinementRounds; ++round)
+    for (size_t mid : crossover_midpoints(family)) {
+      if (cancelled()) return ok_status();
+      Expected<bool> done = try_point(family, mid, request_.width, share_end, share_end);
+      if (!done) return done.error();
+    }
   return ok_status();
 }
 
@@ -202,8 +247,9 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   }
   if (sweep.cancelled()) {
     result.interrupted = true;
-    result.notes.push_back("the study was interrupted: it is concluded from the points measured "
-                           "before the interruption");
+    result.notes.push_back(
+        "the study was interrupted: it is concluded from the points measured "
+        "before the interruption");
   }
   result.elapsed_seconds = sweep.elapsed();
   BootstrapOptions boot{request.bootstrap_replicates, request.seed};

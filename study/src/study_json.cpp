@@ -24,6 +24,7 @@ json fit_json(const ModelFit& f) {
                             {"ci95", c.identifiable ? interval(c.ci95) : json(nullptr)},
                             {"identifiable", c.identifiable}};
   return {{"formula", f.formula},
+          {"selection", f.selection},
           {"coefficients", coefficients},
           {"r2", number(f.r2)},
           {"max_rel_residual", number(f.max_rel_residual)},
@@ -41,7 +42,7 @@ json renderers_json(const StudyResult& r) {
     for (const auto& [scene, f] : m.fits) fits[scene] = fit_json(f);
     out[m.name] = {{"loop_order", m.loop_order},
                    {"model", to_string(m.form)},
-                   {"formula", formula(m.form)},
+                   {"formula", formula(CostModel(m.form))},
                    {"fits", fits}};
   }
   return out;
@@ -80,6 +81,8 @@ void conclusions_json(const StudyResult& r, json& doc) {
   for (const ScalingExponent& s : r.scaling)
     scaling.push_back({{"renderer", s.renderer},
                        {"scene", s.scene},
+                       {"axis", s.axis},
+                       {"n", s.n},
                        {"from", s.from},
                        {"to", s.to},
                        {"exponent", number(s.exponent)}});

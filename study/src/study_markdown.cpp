@@ -20,50 +20,12 @@ std::string interval_text(const Crossover& c) {
   return fmt::format("(95%: {} – {})", lo, hi);
 }
 
-std::string crossover_sentence(const StudyResult& r, const Crossover& c) {
-  const std::string& below = c.a_faster_below ? c.a : c.b;
-  const std::string& above = c.a_faster_below ? c.b : c.a;
-  std::string where = fmt::format("at {}×{} on {}", r.width, r.height, c.scene);
-  if (!c.measured)
-    return fmt::format(
-        "- {}, the fitted models put the crossover of {} and {} at {} {}, outside the swept "
-        "range {} (extrapolated, not measured): {} is faster below it, {} above.\n",
-        where, c.a, c.b, format_number(c.value), c.axis,
-        range_text(c.range_low, c.range_high, c.axis), below, above);
-  return fmt::format("- {}, {} is faster than {} below {} {} {}; {} is faster above.\n", where,
-                     below, above, format_number(c.value), c.axis, interval_text(c), above);
-}
-
-std::string dominance_sentence(const StudyResult& r, const Dominance& d) {
-  return fmt::format(
-      "- at {}×{} on {}, {} is faster than {} over the whole swept range {}, by at least {:.2f}× "
-      "(at {} {}).\n",
-      r.width, r.height, d.scene, d.faster, d.slower, range_text(d.range_low, d.range_high, d.axis),
-      d.min_ratio, format_number(d.at), d.axis);
-}
-
-std::string coefficient_text(const Coefficient& c) {
-  if (!c.identifiable) return "";
-  bool seconds = c.name == "a";
-  double f = seconds ? 1e3 : 1e9;
-  return fmt::format("{} = {} {} (95%: {} – {})", c.name, format_number(c.value * f),
-                     seconds ? "ms" : "ns", format_number(c.ci95.low * f),
-                     format_number(c.ci95.high * f));
-}
-
-std::string model_sentence(const RendererModels& m, const std::string& scene, const ModelFit& f) {
-  if (!f.fits)
-    return fmt::format("- {} on {}: the model {} {}; no conclusion is drawn from it.\n", m.name,
-                       scene, formula(m.form), f.verdict);
-  std::string terms;
-  for (const Coefficient& c : f.coefficients)
-    if (c.identifiable) terms += (terms.empty() ? "" : ", ") + coefficient_text(c);
-  std::string folded = f.fixed_pixels > 0 ? " (one image size: a includes b·P)" : "";
-  return fmt::format(
-      "- {} on {}: {} with {}{}; R² {:.3f}, largest residual {:.0f}%, leave-one-out error "
-      "{:.0f}%.\n",
-      m.name, scene, formula(m.form), terms, folded, f.r2, 100 * f.max_rel_residual,
-      100 * f.loo_rel_error);
+// "at 1024×768 on tessphere", or on the pixels axis "on tessphere with 1.0×10^6 triangles".
+std::string where_text(const StudyResult& r, const std::string& scene, const std::string& axis,
+                       double n) {
+  if (axis == kPixelsAxis)
+    return fmt::format("on {} with {} {}", scene, format_number(n), r.axes.at(scene));
+  return fmt::format("at {}×{} on {}", r.width, r.height, scene);
 }
 
 std::string header(const StudyResult& r) {
@@ -85,8 +47,13 @@ std::string header(const StudyResult& r) {
 std::string scaling_section(const StudyResult& r) {
   std::string text = "\n## Scaling (log-log slope per decade)\n\n";
   for (const ScalingExponent& s : r.scaling)
-    text += fmt::format("- {} on {}: time grows as N^{:.2f} from {} to {}.\n", s.renderer, s.scene,
-                        s.exponent, format_number(s.from), format_number(s.to));
+    text +=
+        s.axis == kPixelsAxis
+            ? fmt::format("- {} on {} with {} {}: time grows as P^{:.2f} from {} to {} pixels.\n",
+                          s.renderer, s.scene, format_number(s.n), r.axes.at(s.scene), s.exponent,
+                          format_number(s.from), format_number(s.to))
+            : fmt::format("- {} on {}: time grows as N^{:.2f} from {} to {}.\n", s.renderer,
+                          s.scene, s.exponent, format_number(s.from), format_number(s.to));
   text += "\n## Cost per triangle and per ray\n\n";
   for (const UnitCost& c : r.costs)
     text += fmt::format("- {} on {} at {} {}: {} ms a frame, {} ns per triangle, {} ns per ray.\n",
@@ -97,6 +64,51 @@ std::string scaling_section(const StudyResult& r) {
 }
 
 }  // namespace
+
+std::string crossover_sentence(const StudyResult& r, const Crossover& c) {
+  const std::string& below = c.a_faster_below ? c.a : c.b;
+  const std::string& above = c.a_faster_below ? c.b : c.a;
+  std::string where = where_text(r, c.scene, c.axis, c.n);
+  if (!c.measured)
+    return fmt::format(
+        "{}, the fitted models put the crossover of {} and {} at {} {}, outside the swept "
+        "range {} (extrapolated, not measured): {} is faster below it, {} above.",
+        where, c.a, c.b, format_number(c.value), c.axis,
+        range_text(c.range_low, c.range_high, c.axis), below, above);
+  return fmt::format("{}, {} is faster than {} below {} {} {}; {} is faster above.", where, below,
+                     above, format_number(c.value), c.axis, interval_text(c), above);
+}
+
+std::string dominance_sentence(const StudyResult& r, const Dominance& d) {
+  return fmt::format(
+      "{}, {} is faster than {} over the whole swept range {}, by at least {:.2f}× (at {} {}).",
+      where_text(r, d.scene, d.axis, d.n), d.faster, d.slower,
+      range_text(d.range_low, d.range_high, d.axis), d.min_ratio, format_number(d.at), d.axis);
+}
+
+std::string coefficient_text(const Coefficient& c) {
+  if (!c.identifiable) return "";
+  bool seconds = c.name == "a";
+  double f = seconds ? 1e3 : 1e9;
+  return fmt::format("{} = {} {} (95%: {} – {})", c.name, format_number(c.value * f),
+                     seconds ? "ms" : "ns", format_number(c.ci95.low * f),
+                     format_number(c.ci95.high * f));
+}
+
+std::string model_sentence(const RendererModels& m, const std::string& scene, const ModelFit& f) {
+  if (!f.fits)
+    return fmt::format("{} on {}: the model {} {}; no conclusion is drawn from it.", m.name, scene,
+                       f.formula, f.verdict);
+  std::string terms;
+  for (const Coefficient& c : f.coefficients)
+    if (c.identifiable) terms += (terms.empty() ? "" : ", ") + coefficient_text(c);
+  std::string folded = f.fixed_pixels > 0 ? " (one image size: a includes b·P)" : "";
+  return fmt::format(
+      "{} on {}: {} with {}{}; R² {:.3f}, largest residual {:.0f}%, leave-one-out error "
+      "{:.0f}% (median); {}.",
+      m.name, scene, f.formula, terms, folded, f.r2, 100 * f.max_rel_residual,
+      100 * f.loo_rel_error, f.selection);
+}
 
 std::string format_number(double v) {
   if (!std::isfinite(v)) return std::isnan(v) ? "n/a" : (v > 0 ? "∞" : "−∞");
@@ -112,12 +124,12 @@ std::string format_number(double v) {
 std::string study_markdown(const StudyResult& r) {
   std::string text = header(r);
   text += "\n## Crossovers\n\n";
-  for (const Crossover& c : r.crossovers) text += crossover_sentence(r, c);
-  for (const Dominance& d : r.dominance) text += dominance_sentence(r, d);
+  for (const Crossover& c : r.crossovers) text += "- " + crossover_sentence(r, c) + "\n";
+  for (const Dominance& d : r.dominance) text += "- " + dominance_sentence(r, d) + "\n";
   if (r.crossovers.empty() && r.dominance.empty()) text += "No pair of loop orders was measured.\n";
   text += "\n## Cost models\n\n";
   for (const RendererModels& m : r.models)
-    for (const auto& [scene, f] : m.fits) text += model_sentence(m, scene, f);
+    for (const auto& [scene, f] : m.fits) text += "- " + model_sentence(m, scene, f) + "\n";
   text += scaling_section(r);
   return text;
 }

@@ -3,17 +3,42 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+
+#include "rvr/shared/scene_loader.h"
 
 namespace rvr::study {
 
+namespace {
+
+// A scene or model file as a family: copies of it, as many as hold kFileFamilyTriangles.
+Expected<Family> file_family(const std::string& path) {
+  Expected<Scene> scene = load_scene(path);
+  if (!scene) return scene.error();
+  double per_copy = 0;
+  for (const Object& o : scene->objects)
+    if (o.type == ObjectType::Triangles)
+      per_copy += double(o.mesh.triangle_count());
+    else if (o.type == ObjectType::Sphere)
+      per_copy += 1;
+  if (per_copy == 0)
+    return bad_input(path + ": objects: no mesh or sphere to copy for the study's sweep");
+  size_t high = size_t(std::clamp(std::floor(kFileFamilyTriangles / per_copy), 4.0, 1024.0));
+  return Family{std::filesystem::path(path).filename().string(), "triangles", 1, high, 9, path};
+}
+
+}  // namespace
+
 Expected<Family> find_family(const std::string& name) {
-  std::string bare = name.rfind("builtin:", 0) == 0 ? name.substr(8) : name;
-  if (bare == "tessphere") return Family{"tessphere", "triangles", 100, 1000000, 13};
-  if (bare == "soup") return Family{"soup", "triangles", 100, 1000000, 13};
-  if (bare == "occluders") return Family{"occluders", "depth", 1, 256, 9};
+  const bool builtin = name.rfind("builtin:", 0) == 0;
+  std::string bare = builtin ? name.substr(8) : name;
+  if (bare == "tessphere") return Family{"tessphere", "triangles", 100, 1000000, 13, ""};
+  if (bare == "soup") return Family{"soup", "triangles", 100, 1000000, 13, ""};
+  if (bare == "occluders") return Family{"occluders", "depth", 1, 256, 9, ""};
+  if (!builtin && std::filesystem::exists(name)) return file_family(name);
   return bad_input(name +
                    ": not a scene family the study sweeps (builtin:tessphere, builtin:soup, "
-                   "builtin:occluders; the study chooses N)");
+                   "builtin:occluders, or a scene or model file; the study chooses N)");
 }
 
 std::vector<size_t> log_spaced(size_t low, size_t high, int count) {
@@ -23,6 +48,28 @@ std::vector<size_t> log_spaced(size_t low, size_t high, int count) {
     size_t v = size_t(std::llround(double(low) * std::pow(double(high) / double(low), f)));
     if (out.empty() || v != out.back()) out.push_back(v);
   }
+  return out;
+}
+
+std::vector<int> pixel_sweep_widths(int width) {
+  std::vector<int> out;
+  for (int k = 4; k >= 1; --k) {
+    int w = 4 * int(std::lround(double(width) * std::pow(2.0, -0.5 * k) / 4));
+    w = std::max(w, 16);
+    if (w < width && (out.empty() || w != out.back())) out.push_back(w);
+  }
+  return out;
+}
+
+std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured) {
+  if (measured.empty()) return {};
+  const double middle = std::sqrt(double(measured.front()) * double(measured.back()));  // in log N
+  size_t nearest = measured.front();
+  for (size_t n : measured)
+    if (std::fabs(std::log(double(n) / middle)) < std::fabs(std::log(double(nearest) / middle)))
+      nearest = n;
+  std::vector<size_t> out = {measured.front(), nearest, measured.back()};
+  out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
 

@@ -14,9 +14,10 @@ namespace rvr::study {
 // The model form of a renderer in the table, by its loop order.
 ModelForm model_form_of(const std::string& renderer);
 
-// The least-squares slope of log t against log n over the points with n in [from, to]; NaN
-// with fewer than two distinct n.
-double loglog_slope(const std::vector<Measurement>& points, double from, double to);
+// The least-squares slope of log t against log x over the points with x in [from, to], x their
+// N, or their pixel count when `axis` is "pixels"; NaN with fewer than two distinct x.
+double loglog_slope(const std::vector<Measurement>& points, double from, double to,
+                    const std::string& axis = "triangles");
 
 // Fills result.models, crossovers, dominance, scaling and costs from result.points.
 void conclude(StudyResult& result, const BootstrapOptions& boot);

@@ -12,13 +12,16 @@
 
 namespace rvr::study {
 
+// The name of the pixel-count axis; the others are the families' N ("triangles", "depth").
+inline constexpr const char* kPixelsAxis = "pixels";
+
 struct Crossover {
   std::string a, b, scene, axis;
   double value = 0;  // the axis value where t_a = t_b
   // 95% interval; −inf / +inf when over 2.5% of the replicates put it below / above the range.
   Interval ci95;
-  double pixels = 0;  // the pixel count held fixed (axis "triangles" or "depth")
-  double n = 0;       // the axis value held fixed when the axis is "pixels"
+  double pixels = 0;                     // the pixel count held fixed (axis "triangles" or "depth")
+  double n = 0;                          // the axis value held fixed when the axis is "pixels"
   bool a_faster_below = true;            // a is the faster one below `value`
   bool measured = true;                  // false: the fitted models', outside the swept range
   double range_low = 0, range_high = 0;  // the swept axis range
@@ -35,15 +38,20 @@ struct Dominance {
 };
 
 struct CurveComparison {
-  std::vector<Crossover> crossovers;   // one per sign change of log(t_a / t_b), along the axis
+  // One per change of which renderer is faster beyond the timing noise, along the axis.
+  std::vector<Crossover> crossovers;
   std::optional<Dominance> dominance;  // when there is none
+  bool tie = false;                    // neither: no point shows a difference beyond the noise
 };
 
-// Compares a's and b's medians at the axis values both measured (points matched by n; a and b
-// each one renderer's points of one scene at one pixel count). A crossing lies between two
-// neighbouring points where log(t_a / t_b) changes sign, placed by linear interpolation of
-// log(t_a / t_b) in log n. Each bootstrap replicate resamples every point's repetitions and
-// takes the crossing nearest the measured one.
+// Compares a's and b's medians at the axis values both measured (points matched by n and pixel
+// count; a and b each one renderer's points of one scene along one axis: at one pixel count
+// along N, or at one N along "pixels"). Only changes the timing noise cannot explain count: a
+// point shows a renderer faster when the 95% interval of log(t_a / t_b) over the bootstrap
+// replicates excludes 0, and a crossing lies between two such points of opposite signs, where
+// log(t_a / t_b) changes sign, placed by linear interpolation of it in the log of the axis.
+// Each bootstrap replicate resamples every point's repetitions and takes the crossing nearest
+// the measured one.
 CurveComparison compare_curves(const std::vector<Measurement>& a, const std::vector<Measurement>& b,
                                const std::string& axis, const BootstrapOptions& boot);
 

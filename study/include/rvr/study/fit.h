@@ -24,16 +24,19 @@ struct Coefficient {
 struct FitThresholds {
   double min_r2 = 0.9;
   double max_rel_residual = 0.25;
-  double max_loo_rel_error = 0.25;
+  double max_loo_rel_error = 0.20;
+  // An extension is taken only when it lowers the mean leave-one-out error by this fraction.
+  double min_extension_gain = 0.20;
 };
 
 struct ModelFit {
-  ModelForm form = ModelForm::ZBuffer;
-  std::string formula;  // the model fitted, with any extension the data demanded
+  CostModel model;
+  std::string formula;    // the model fitted, with any extension the data demanded
+  std::string selection;  // why this model and not the textbook form or another extension
   std::vector<Coefficient> coefficients;
   double r2 = 0;                // weighted (1/t²) coefficient of determination
   double max_rel_residual = 0;  // largest |t − model| / t over the points
-  double loo_rel_error = 0;     // root mean square of each point's error when left out
+  double loo_rel_error = 0;     // median over the points of their error when left out
   size_t points = 0;
   bool fits = false;
   std::string verdict;      // "fits", or why the model does not
@@ -41,12 +44,13 @@ struct ModelFit {
 };
 
 // Which coefficients can be fitted to these points: all but b when P never varies.
-std::vector<bool> identifiable_terms(ModelForm form, const std::vector<Measurement>& points);
+std::vector<bool> identifiable_terms(const CostModel& model,
+                                     const std::vector<Measurement>& points);
 
 // The coefficients fitted to `medians` (one per point), each weighted by 1/scale², so that
 // the fit minimizes relative error; `scale` is the medians themselves when empty (a bootstrap
 // replicate passes the measured medians: the weights are the design, not a resampled value).
-Expected<std::vector<double>> fit_coefficients(ModelForm form,
+Expected<std::vector<double>> fit_coefficients(const CostModel& model,
                                                const std::vector<Measurement>& points,
                                                const std::vector<double>& medians,
                                                const std::vector<bool>& use,
@@ -55,8 +59,18 @@ Expected<std::vector<double>> fit_coefficients(ModelForm form,
 // The model fitted to the points' medians, its intervals from `boot` replicates of the
 // bootstrap over repetitions, its quality and verdict against `limits`. Too few points, or
 // terms that cannot be told apart, give fits = false with the reason, not an error.
-ModelFit fit_model(ModelForm form, const std::vector<Measurement>& points,
+ModelFit fit_model(const CostModel& model, const std::vector<Measurement>& points,
                    const BootstrapOptions& boot, const FitThresholds& limits = {});
+
+// The models a form may be extended to for these points: the textbook form, + edges, + a cache
+// knee at each measured N with at least two points on either side, + both.
+std::vector<CostModel> candidate_models(ModelForm form, const std::vector<Measurement>& points);
+
+// The textbook form unless the data demand an extension: each more complex tier (one
+// extension, then both) is taken when its best candidate lowers the mean leave-one-out error
+// by limits.min_extension_gain; then fitted as fit_model does, `selection` saying why.
+ModelFit fit_chosen_model(ModelForm form, const std::vector<Measurement>& points,
+                          const BootstrapOptions& boot, const FitThresholds& limits = {});
 
 // The coefficients as fitted (b, when folded into a, as 0): for predict().
 std::vector<double> coefficient_values(const ModelFit& fit);

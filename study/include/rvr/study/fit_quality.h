@@ -11,10 +11,17 @@ namespace rvr::study {
 struct FitQuality {
   double r2 = 0;                // 1 − Σ w·r² / Σ w·(t − t̄_w)², w = 1/t²
   double max_rel_residual = 0;  // max |t − model| / t
-  double loo_rel_error = 0;  // RMS of |t_i − model without i (at i)| / t_i; inf if a refit fails
+  // Each point predicted by the model fitted to all the others: |t_i − model without i| / t_i,
+  // its median and mean over the points (inf when a refit fails).
+  double loo_median_rel_error = 0;
+  double loo_mean_rel_error = 0;
 };
 
-FitQuality fit_quality(ModelForm form, const std::vector<Measurement>& points,
+// The leave-one-out errors alone (what choosing among models needs).
+FitQuality leave_one_out(const CostModel& model, const std::vector<Measurement>& points,
+                         const std::vector<double>& medians, const std::vector<bool>& use);
+
+FitQuality fit_quality(const CostModel& model, const std::vector<Measurement>& points,
                        const std::vector<double>& medians, const std::vector<double>& coefficients,
                        const std::vector<bool>& use);
 

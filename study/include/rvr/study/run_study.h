@@ -1,6 +1,7 @@
-// Running a study: for each scene family, a log-spaced sweep of N within a share of the time
-// budget, each point's frames timed with the renderers' repetitions interleaved in random
-// order, points added near every crossover while the budget allows, then the conclusions.
+// Running a study: for each scene family, within a share of the time budget, a log-spaced
+// sweep of N at the full width, a sweep of the pixel count at three of those N, and points added
+// near every crossover; each point's frames timed with the renderers' repetitions interleaved in
+// random order; then the conclusions.
 #pragma once
 
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/study/study.h"
+#include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 
@@ -37,9 +39,10 @@ class FrameSource {
   virtual Expected<double> time_frame(size_t index) = 0;
 };
 
-// Makes the FrameSource of builtin:<family>:<n>.
-using PrepareFrames =
-    std::function<Expected<std::unique_ptr<FrameSource>>(const std::string& family, size_t n)>;
+// Makes the FrameSource of builtin:<family>:<n> (or n copies of the family's file) at
+// `width` × width·3/4 pixels.
+using PrepareFrames = std::function<Expected<std::unique_ptr<FrameSource>>(const Family& family,
+                                                                           size_t n, int width)>;
 
 struct StudyHooks {
   PrepareFrames prepare;

@@ -28,11 +28,14 @@ struct RendererModels {
   std::map<std::string, ModelFit> fits;  // by scene
 };
 
-// The log-log slope of time against the axis over one decade of it.
+// The log-log slope of time against an axis over one decade of it (the family's N at the full
+// width), or over the whole pixel sweep at one N.
 struct ScalingExponent {
   std::string renderer, scene;
+  std::string axis;  // the family's ("triangles", "depth") or "pixels"
   double from = 0, to = 0;
   double exponent = 0;
+  double n = 0;  // the N held fixed on the pixels axis; 0 on the others
 };
 
 // Time per triangle and per primary ray at one measured point.

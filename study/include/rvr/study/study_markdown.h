@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "rvr/study/crossover.h"
+#include "rvr/study/fit.h"
 #include "rvr/study/study.h"
 
 namespace rvr::study {
@@ -11,5 +13,15 @@ namespace rvr::study {
 std::string format_number(double v);
 
 std::string study_markdown(const StudyResult& result);
+
+// The sentences study.md lists, one each without the list marker or line end, for study.html to
+// say the same: where two renderers cross, which one wins over the whole range, each model.
+std::string crossover_sentence(const StudyResult& r, const Crossover& c);
+std::string dominance_sentence(const StudyResult& r, const Dominance& d);
+std::string model_sentence(const RendererModels& m, const std::string& scene, const ModelFit& f);
+
+// "a = 1.2 ms (95%: 0.9 – 1.5)" (ns for the per-pixel, per-triangle and per-ray terms); empty
+// for a coefficient that is not identifiable.
+std::string coefficient_text(const Coefficient& c);
 
 }  // namespace rvr::study

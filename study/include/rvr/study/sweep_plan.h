@@ -11,17 +11,32 @@
 namespace rvr::study {
 
 struct Family {
-  std::string name;          // "tessphere"
+  std::string name;          // "tessphere", or a file's name: "bunny.obj"
   std::string axis;          // "triangles", or "depth" for occluders (quads one behind another)
-  size_t low = 0, high = 0;  // the N of builtin:name:N swept
+  size_t low = 0, high = 0;  // the N of builtin:name:N swept, or the number of copies of a file
   int points = 0;            // log-spaced between them
+  std::string source;        // a scene or model file, grown by grid_of_copies; "" for built-ins
 };
 
-// "builtin:tessphere" (or "tessphere"); a BadInput error naming the families for any other.
+// The most triangles a file's grid of copies is grown to.
+constexpr double kFileFamilyTriangles = 2e6;
+
+// "builtin:tessphere" (or "tessphere"), or the path of a scene or model file: 1 … K copies of
+// it with K such that they hold about kFileFamilyTriangles (4 … 1024). A BadInput error naming
+// the families for any other built-in, and the loader's error for a file that does not load.
 Expected<Family> find_family(const std::string& name);
 
 // `count` values from low to high, evenly spaced in log, rounded, without repeats.
 std::vector<size_t> log_spaced(size_t low, size_t high, int count);
+
+// The narrower widths of the pixel sweep under `width`: width·2^(−k/2) for k = 1 … 4 (so the
+// pixel count falls by 16× in steps of 2×), rounded to multiples of 4, at least 16, in
+// increasing order, without repeats.
+std::vector<int> pixel_sweep_widths(int width);
+
+// The N at which the pixel sweep is taken, of those measured at the full width (in increasing
+// order): the smallest, the one nearest their geometric middle, and the largest.
+std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured);
 
 // The rounded geometric mean of two neighbours: the point that halves a bracket in log; 0 when
 // they are too close to hold one.
