@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <vector>
 
 #include "rvr/shared/compare.h"
@@ -225,4 +226,76 @@ TEST(Coverage, AgreementOverCoveredPixels) {
   EXPECT_DOUBLE_EQ(v.covered_fraction, 64.0 / 256.0);
   EXPECT_DOUBLE_EQ(v.covered_agreement, 63.0 / 64.0);
   EXPECT_DOUBLE_EQ(v.id_agreement, 255.0 / 256.0);
+}
+
+namespace {
+
+// A dense mesh over the 8x8 pixels 4..11: cells one pixel wide and two tall, each cut by the
+// diagonal from its top-left corner to its bottom-right one (pixel coordinates, y down), which
+// passes 0.5 / sqrt(5) = 0.224 pixel from both pixel centres of the cell; the cell sides lie on
+// pixel boundaries, 0.5 pixel from the centres. So every pixel has another triangle as a
+// neighbour (the other pixel of its cell, the cells beside it) and no centre lies within the
+// edge tolerance of an edge. Cell k = 8 r + c (column c = x - 4, row r = (y - 4) / 2): triangle
+// 2k holds the cell's top pixel, 2k + 1 its bottom one.
+Object dense_mesh(float z) {
+  Object o;
+  o.type = ObjectType::Triangles;
+  // Pixel position (px, py) at view depth z: X = z (px / 8 - 1), Y = z (1 - py / 8).
+  auto at = [z](int px, int py) {
+    return glm::vec3(z * (float(px) / 8.0f - 1.0f), z * (1.0f - float(py) / 8.0f), -z);
+  };
+  for (int r = 0; r < 4; ++r)
+    for (int c = 0; c < 8; ++c) {
+      const int x0 = 4 + c, y0 = 4 + 2 * r;
+      const uint32_t v = uint32_t(o.mesh.positions.size());
+      o.mesh.positions.push_back(at(x0, y0));          // v: top left
+      o.mesh.positions.push_back(at(x0 + 1, y0));      // v + 1: top right
+      o.mesh.positions.push_back(at(x0 + 1, y0 + 2));  // v + 2: bottom right
+      o.mesh.positions.push_back(at(x0, y0 + 2));      // v + 3: bottom left
+      o.mesh.triangles.push_back({v, v + 1, v + 2});   // above the diagonal: the top pixel
+      o.mesh.triangles.push_back({v, v + 2, v + 3});   // below it: the bottom pixel
+    }
+  return o;
+}
+
+uint32_t dense_triangle_at(int x, int y) {
+  return 2u * uint32_t(8 * ((y - 4) / 2) + (x - 4)) + uint32_t((y - 4) % 2);
+}
+
+// Object 0 (the dense mesh at depth 10) in a, a 24-bit z-buffer; b, a float tracer, shows
+// object 1 (the same mesh delta behind it) on the pixels with x + y even, as z-fighting does.
+MismatchCounts dense_z_fight(double delta) {
+  const float z0 = 10.0f, z1 = float(10.0 + delta);
+  const Scene scene = scene_of({dense_mesh(z0), dense_mesh(z1)});
+  FrameBuffers a = background(), b = background();
+  for (int y = 4; y < 12; ++y)
+    for (int x = 4; x < 12; ++x) {
+      put(a, x, y, 0, dense_triangle_at(x, y), z0);
+      if ((x + y) % 2 == 0)
+        put(b, x, y, 1, dense_triangle_at(x, y), z1);
+      else
+        put(b, x, y, 0, dense_triangle_at(x, y), z0);
+    }
+  MismatchContext context;
+  context.scene = &scene;
+  context.store_a = DepthStore::Window24;
+  context.store_b = DepthStore::ViewFloat;
+  return compare_buffers(a, b, context).visibility.classes;
+}
+
+}  // namespace
+
+// Z-fighting on a dense mesh: every mismatched pixel neighbours another primitive, so "a
+// neighbour has another id" would call all 32 edge ties; no pixel centre lies near an edge, so
+// none is: half the d24 step apart they are depth_precision, twice it occlusion.
+TEST(MismatchClasses, ZFightingOnADenseMeshIsNotAnEdgeTie) {
+  const double step = d24_resolution(10.0);
+  const MismatchCounts tie = dense_z_fight(0.5 * step);
+  EXPECT_EQ(tie.edge, 0u);
+  EXPECT_EQ(tie.depth_precision, 32u);
+  EXPECT_EQ(tie.total(), 32u);
+  const MismatchCounts error = dense_z_fight(2.0 * step);
+  EXPECT_EQ(error.edge, 0u);
+  EXPECT_EQ(error.occlusion, 32u);
+  EXPECT_EQ(error.total(), 32u);
 }

@@ -55,8 +55,8 @@ double float_spacing(double w) {
 
 // GL's perspective projection with depth range [0, 1] maps view depth z (n <= z <= f) to window
 // depth
-//   w(z) = f (z - n) / ((f - n) z)        (near at 0; reversed Z: 1 - w(z) = n (f - z) / ((f - n)
-//   z))
+//   w(z) = f (z - n) / ((f - n) z)            (near at 0)
+//   1 - w(z) = n (f - z) / ((f - n) z)        (reversed Z: near at 1)
 // whose slope is |dw/dz| = f n / ((f - n) z^2) either way. Two surfaces fall into one stored
 // value, and the depth test cannot order them, when their window depths differ by less than
 // the store's step s(w); in view depth that is

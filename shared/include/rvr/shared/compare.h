@@ -17,13 +17,6 @@ struct VisibilityMetrics {
   size_t pixels = 0;
   double id_agreement = 1.0;  // fraction of pixels with the same object AND primitive id
   size_t mismatched_pixels = 0;
-  // Mismatched pixels none of whose 8 neighbours lies on an object or primitive boundary in
-  // either id image (docs/cli.md): a silhouette or shared edge may fall either way by a pixel,
-  // nothing else may. A lone wrong pixel is excused (it draws a boundary around itself); a
-  // wrong region counts its interior.
-  // metrics.json and the report show the mismatch classes instead: on a dense mesh nearly
-  // every pixel neighbours a primitive boundary, so this count excuses z-fighting as edges.
-  size_t mismatched_off_edge = 0;
   // Pixels that show a hit in a, in b, in either; covered_fraction = covered_pixels / pixels.
   size_t covered_a = 0, covered_b = 0, covered_pixels = 0;
   double covered_fraction = 0.0;

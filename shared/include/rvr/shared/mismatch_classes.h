@@ -49,6 +49,7 @@ struct MismatchCounts {
   size_t occlusion = 0;
   size_t coverage = 0;
   size_t total() const { return edge + depth_precision + occlusion + coverage; }
+  size_t not_edge() const { return depth_precision + occlusion + coverage; }
   size_t of(MismatchClass c) const;
 };
 
