@@ -25,11 +25,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-try:
-    import jsonschema
-except ImportError:
-    print("check_scene_schema: python3-jsonschema is missing (make deps installs it)")
-    sys.exit(1)
+from schema_check import load_validator, schema_errors
 
 FAILURES = []
 
@@ -37,11 +33,6 @@ FAILURES = []
 def failure(message):
     FAILURES.append(message)
     print("FAIL: " + message)
-
-
-def schema_errors(validator, doc):
-    return [f"{'/'.join(str(p) for p in e.absolute_path) or '(top)'}: {e.message}"
-            for e in validator.iter_errors(doc)]
 
 
 def run(cmd, timeout=120):
@@ -229,16 +220,11 @@ def main():
     work = Path(args.work_dir or tempfile.mkdtemp(prefix="rvr-scene-schema-"))
     work.mkdir(parents=True, exist_ok=True)
 
-    schema = json.loads(schema_path.read_text())
-    Validator = jsonschema.Draft202012Validator
-    if schema.get("$schema") != "https://json-schema.org/draft/2020-12/schema":
-        failure("schema: $schema is not draft 2020-12")
-    try:
-        Validator.check_schema(schema)
-    except jsonschema.exceptions.SchemaError as e:
-        failure(f"schema: not a valid draft 2020-12 schema: {e.message}")
+    validator, problems = load_validator(schema_path)
+    for problem in problems:
+        failure(problem)
+    if validator is None:
         return 1
-    validator = Validator(schema)
 
     # 2. Scene files in the repository.
     count = 0

@@ -26,11 +26,7 @@ import tempfile
 import time
 from pathlib import Path
 
-try:
-    import jsonschema
-except ImportError:
-    print("FAIL: python3-jsonschema is missing (make deps)")
-    sys.exit(1)
+from schema_check import load_validator, schema_errors
 
 FAILURES = []
 
@@ -46,9 +42,8 @@ def run(cmd, timeout=100):
 
 def validate(validator, path):
     doc = json.loads(path.read_text())
-    for e in validator.iter_errors(doc):
-        where = "/".join(str(p) for p in e.absolute_path) or "(top)"
-        failure(f"{path}: schema: {where}: {e.message}")
+    for err in schema_errors(validator, doc):
+        failure(f"{path}: schema: {err}")
     return doc
 
 
@@ -149,17 +144,15 @@ def main():
     work = Path(args.work_dir or tempfile.mkdtemp(prefix="rvr-study-schema-"))
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
-    schema = json.loads((source / "docs/rvr-study-1.schema.json").read_text())
-    Validator = jsonschema.Draft202012Validator
-    try:
-        Validator.check_schema(schema)
-    except jsonschema.exceptions.SchemaError as e:
-        failure(f"schema: not a valid draft 2020-12 schema: {e.message}")
+    validator, problems = load_validator(source / "docs/rvr-study-1.schema.json")
+    for problem in problems:
+        failure(problem)
+    if validator is None:
         return 1
     check_refused(args.rvr, work)
-    check_study(args.rvr, Validator(schema), work)
-    check_merge(args.rvr, Validator(schema), work)
-    check_interrupted(args.rvr, Validator(schema), work)
+    check_study(args.rvr, validator, work)
+    check_merge(args.rvr, validator, work)
+    check_interrupted(args.rvr, validator, work)
     if FAILURES:
         print(f"{len(FAILURES)} failure(s)")
         return 1

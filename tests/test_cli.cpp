@@ -209,6 +209,82 @@ TEST_F(Cli, AgreementThresholdGivesExit1OnlyWhenCrossed) {
   EXPECT_EQ(itself.status, 0) << itself.err;
 }
 
+// Nothing visible is not agreement: a unit sphere 4 to 6 in front of the eye with the near plane
+// at 10 leaves every pixel background in both renders, which agree on every pixel (id agreement
+// 1). The comparison says so: covered fraction 0, a warning in metrics.json and report.html, and
+// --fail-below-agreement fails whatever F.
+TEST_F(Cli, NothingVisibleWarnsAndFailsTheAgreementThreshold) {
+  for (const char* camera : {R"("near": 10, "far": 100)", R"("near": 0.1, "far": 100)"}) {
+    SCOPED_TRACE(camera);
+    // The second camera looks away from the sphere, which lies behind it.
+    const std::string target =
+        std::string(camera).find("0.1") != std::string::npos ? "[0, 0, 10]" : "[0, 0, 0]";
+    fs::path scene = write(
+        "empty.json",
+        R"({"camera": {"eye": [0, 0, 5], "target": )" + target + R"(, "up": [0, 1, 0], )" + camera +
+            R"(}, "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}]})");
+    const std::string cmp =
+        "compare " + scene.string() + " -r softraster,raytrace --width 32 --height 24 -o ";
+    RunResult plain = run(cmp + (dir_ / "plain").string());
+    EXPECT_EQ(plain.status, 0) << plain.err;
+    EXPECT_NE(plain.err.find("nothing visible"), std::string::npos) << plain.err;
+    nlohmann::json m = nlohmann::json::parse(slurp(dir_ / "plain" / "metrics.json"));
+    EXPECT_EQ(m["format"], "rvr-metrics/2");
+    EXPECT_EQ(m["visibility"]["id_agreement"].get<double>(), 1.0);
+    EXPECT_EQ(m["visibility"]["covered_fraction"].get<double>(), 0.0);
+    EXPECT_EQ(m["visibility"]["covered_agreement"].get<double>(), 0.0);
+    ASSERT_EQ(m["warnings"].size(), 2u);  // one per renderer
+    for (const auto& w : m["warnings"])
+      EXPECT_NE(w.get<std::string>().find("nothing visible"), std::string::npos) << w;
+    EXPECT_NE(slurp(dir_ / "plain" / "report.html").find("nothing visible"), std::string::npos);
+    RunResult gated = run(cmp + (dir_ / "gated").string() + " --fail-below-agreement 0");
+    EXPECT_EQ(gated.status, 1) << gated.err;
+    EXPECT_NE(gated.err.find("nothing visible"), std::string::npos) << gated.err;
+    fs::remove_all(dir_ / "plain");
+    fs::remove_all(dir_ / "gated");
+  }
+}
+
+// Every pair of three renderers is compared, the first pair also at the top level; --fail-on
+// fails on the chosen classes only. A z-buffer skips builtin:csg's csg objects, which the tracers
+// draw in front of the floor and wall: softraster shows those farther surfaces there, occlusion
+// mismatches and no coverage ones (something lies behind every csg pixel); raytrace against
+// itself has none.
+TEST_F(Cli, EveryPairIsComparedAndFailOnChoosesClasses) {
+  const std::string csg = "compare builtin:csg --width 64 --height 48 ";
+  fs::path out = dir_ / "three";
+  RunResult r = run(csg + "-r softraster,raytrace,raytrace -o " + out.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  nlohmann::json m = nlohmann::json::parse(slurp(out / "metrics.json"));
+  ASSERT_EQ(m["pairs"].size(), 3u);
+  EXPECT_EQ(m["pairs"][0]["compared"], nlohmann::json({"softraster", "raytrace"}));
+  EXPECT_EQ(m["pairs"][1]["compared"], nlohmann::json({"softraster", "raytrace-2"}));
+  EXPECT_EQ(m["pairs"][2]["compared"], nlohmann::json({"raytrace", "raytrace-2"}));
+  EXPECT_EQ(m["pairs"][0]["visibility"], m["visibility"]);
+  EXPECT_EQ(m["pairs"][2]["visibility"]["id_agreement"].get<double>(), 1.0);
+  EXPECT_GT(m["visibility"]["mismatch_classes"]["occlusion"].get<int>(), 0);
+  EXPECT_EQ(m["visibility"]["mismatch_classes"]["coverage"].get<int>(), 0);
+  for (const auto& pair : m["pairs"])
+    for (const auto& [kind, file] : pair["files"].items())
+      EXPECT_TRUE(fs::exists(out / file.get<std::string>())) << file;
+  EXPECT_NE(r.out.find("raytrace vs raytrace-2"), std::string::npos) << r.out;
+
+  RunResult occlusion = run(csg + "-r softraster,raytrace --fail-on occlusion,coverage -o " +
+                            (dir_ / "occlusion").string());
+  EXPECT_EQ(occlusion.status, 1) << occlusion.err;
+  EXPECT_NE(occlusion.err.find("occlusion mismatches"), std::string::npos) << occlusion.err;
+  RunResult coverage =
+      run(csg + "-r softraster,raytrace --fail-on coverage -o " + (dir_ / "coverage").string());
+  EXPECT_EQ(coverage.status, 0) << coverage.err;
+  RunResult same = run(csg +
+                       "-r raytrace,raytrace --fail-on edge,depth_precision,occlusion,"
+                       "coverage -o " +
+                       (dir_ / "same").string());
+  EXPECT_EQ(same.status, 0) << same.err;
+  RunResult bad = run(csg + "--fail-on visibility -o " + (dir_ / "bad").string());
+  EXPECT_EQ(bad.status, 2) << bad.err;
+}
+
 TEST_F(Cli, DiffReportsAndFailsAboveThreshold) {
   fs::path a = dir_ / "a.png", b = dir_ / "b.png", c = dir_ / "c.png";
   ASSERT_EQ(run("render builtin:cornell -r raytrace --mode local " + std::string(kSmall) + " -o " +

@@ -260,7 +260,7 @@ TEST_P(Conformance, AgreesWithTheOtherLoopOrder) {
 
   EXPECT_GE(m.visibility.id_agreement, kMinAgreement)
       << m.visibility.mismatched_pixels << " mismatched pixels";
-  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
+  EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
   EXPECT_LE(m.depth.max_rel_error, kMaxDepthRelError) << worst_depth(a.buffers, b.buffers);
   EXPECT_EQ(m.depth.outliers_elsewhere, 0u) << worst_depth(a.buffers, b.buffers);
   EXPECT_GE(m.color.psnr_db, kMinPsnr);

@@ -61,7 +61,7 @@ TEST_P(HybridFullMode, IsTheTracersImageButOnEdges) {
 
   EXPECT_GE(m.visibility.id_agreement, kMinAgreement)
       << m.visibility.mismatched_pixels << " mismatched pixels";
-  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
+  EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
   EXPECT_GE(m.color.psnr_db, kMinPsnr);
   // Where the primary hits are the same, everything after them is the tracer's own code on the
   // same rays: the same bytes, not merely close ones.

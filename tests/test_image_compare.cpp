@@ -329,7 +329,7 @@ TEST(Compare, IdenticalBuffersAgreeCompletely) {
   EXPECT_EQ(m.visibility.pixels, 32u * 24u);
   EXPECT_EQ(m.visibility.id_agreement, 1.0);
   EXPECT_EQ(m.visibility.mismatched_pixels, 0u);
-  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
+  EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
   EXPECT_EQ(m.depth.max_rel_error, 0.0);
   EXPECT_EQ(m.depth.mean_rel_error, 0.0);
   EXPECT_EQ(m.color.rmse, 0.0);
@@ -343,8 +343,9 @@ TEST(Compare, LoneMismatchIsExcusedButAWrongRegionCountsItsInterior) {
   b.primitive_id[b.index(4, 4)] = 3;  // same object, another primitive: still a mismatch
   auto m = compare_buffers(a, b);
   EXPECT_EQ(m.visibility.mismatched_pixels, 1u);
-  // docs/cli.md: its neighbours lie on the boundary it draws in b, so it is not off the edges.
-  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
+  // Without a scene the edge class is the id-boundary rule (MismatchContext): its neighbours lie
+  // on the boundary it draws in b, so it is an edge.
+  EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
   EXPECT_DOUBLE_EQ(m.visibility.id_agreement, 80.0 / 81.0);
   // A 5x5 wrong region: only its centre has no boundary pixel among its 8 neighbours.
   FrameBuffers c = flat(9, 9);
@@ -352,9 +353,9 @@ TEST(Compare, LoneMismatchIsExcusedButAWrongRegionCountsItsInterior) {
     for (int x = 2; x <= 6; ++x) c.object_id[c.index(x, y)] = 5;
   auto m2 = compare_buffers(a, c);
   EXPECT_EQ(m2.visibility.mismatched_pixels, 25u);
-  EXPECT_EQ(m2.visibility.mismatched_off_edge, 1u);
+  EXPECT_EQ(m2.visibility.classes.not_edge(), 1u);
   // Either way round.
-  EXPECT_EQ(compare_buffers(c, a).visibility.mismatched_off_edge, 1u);
+  EXPECT_EQ(compare_buffers(c, a).visibility.classes.not_edge(), 1u);
 }
 
 TEST(Compare, MismatchNextToABoundaryIsOnEdge) {
@@ -364,20 +365,20 @@ TEST(Compare, MismatchNextToABoundaryIsOnEdge) {
   b.object_id[b.index(4, 2)] = 1;
   auto m = compare_buffers(a, b);
   EXPECT_EQ(m.visibility.mismatched_pixels, 1u);
-  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
+  EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
   // Diagonally next to the boundary (its 3x3 touches it) also counts as on the edge.
   FrameBuffers c = a;
   c.object_id[c.index(3, 2)] = 7;
   auto m2 = compare_buffers(a, c);
   EXPECT_EQ(m2.visibility.mismatched_pixels, 1u);
-  EXPECT_EQ(m2.visibility.mismatched_off_edge, 0u);
+  EXPECT_EQ(m2.visibility.classes.not_edge(), 0u);
   // A wrong region well inside the left half counts its interior.
   FrameBuffers d = two_halves(14, 9);
   FrameBuffers e = d;
   for (int y = 1; y <= 7; ++y)
     for (int x = 0; x <= 4; ++x) e.object_id[e.index(x, y)] = 7;
   // Rows 3..5 of columns 0..2 have no boundary (x = 4/5, y = 0/1 and 7/8) among neighbours.
-  EXPECT_EQ(compare_buffers(d, e).visibility.mismatched_off_edge, 9u);
+  EXPECT_EQ(compare_buffers(d, e).visibility.classes.not_edge(), 9u);
 }
 
 TEST(Compare, SilhouetteShiftedByOnePixelIsAllOnEdge) {
@@ -398,8 +399,8 @@ TEST(Compare, SilhouetteShiftedByOnePixelIsAllOnEdge) {
     }
   auto m = compare_buffers(a, b);
   EXPECT_EQ(m.visibility.mismatched_pixels, 4u);
-  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
-  EXPECT_EQ(compare_buffers(b, a).visibility.mismatched_off_edge, 0u);
+  EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
+  EXPECT_EQ(compare_buffers(b, a).visibility.classes.not_edge(), 0u);
 }
 
 TEST(Compare, BackgroundPrimitiveIdIsIgnored) {
@@ -501,7 +502,8 @@ TEST(Compare, DepthPercentilesAndOutliersByCause) {
     EXPECT_EQ(o.y, expected_y[k]) << k;
     EXPECT_EQ(o.object, 0u);
     EXPECT_EQ(o.depth_a, 4.0f);
-    EXPECT_EQ(o.cause, o.x == 1 ? DepthOutlierCause::Silhouette : DepthOutlierCause::Elsewhere) << k;
+    EXPECT_EQ(o.cause, o.x == 1 ? DepthOutlierCause::Silhouette : DepthOutlierCause::Elsewhere)
+        << k;
   }
   // Nothing compared (all background): every statistic is 0.
   FrameBuffers empty;

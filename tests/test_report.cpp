@@ -53,7 +53,16 @@ ReportInput sample_input(const std::string& out_dir) {
                    12.5,
                    {{"kernel", "avx2"}}};
   in.renderers = {a, b};
-  in.metrics.visibility = {48, 47.0 / 48.0, 1, 0};
+  in.metrics.visibility.pixels = 48;
+  in.metrics.visibility.id_agreement = 47.0 / 48.0;
+  in.metrics.visibility.mismatched_pixels = 1;
+  in.metrics.visibility.covered_a = 40;
+  in.metrics.visibility.covered_b = 39;
+  in.metrics.visibility.covered_pixels = 41;
+  in.metrics.visibility.covered_fraction = 41.0 / 48.0;
+  in.metrics.visibility.covered_agreement = 40.0 / 41.0;
+  in.metrics.visibility.classes = {5, 6, 7, 8};
+  in.warnings = {"raytrace: nearly all <background>"};
   in.metrics.depth.max_rel_error = 0.0004;
   in.metrics.depth.mean_rel_error = 0.00001;
   in.metrics.depth.p99_rel_error = 0.00007;
@@ -82,7 +91,7 @@ class ReportDir : public ::testing::Test {
     img.channels = 3;
     img.pixels.assign(8 * 6 * 3, 0.5f);
     for (const char* name : {"raster.png", "raytrace.png", "raytrace.cost.png", "diff.png",
-                             "id_mismatch.png", "depth_diff.png"})
+                             "id_mismatch.png", "depth_diff.png", "mismatch_classes.png"})
       ASSERT_TRUE(write_image((dir_ / name).string(), img).ok());
   }
   void TearDown() override {
@@ -132,7 +141,24 @@ TEST(MetricsJson, HasEveryRequiredField) {
   EXPECT_EQ(number("visibility", "pixels"), 48.0);
   EXPECT_DOUBLE_EQ(number("visibility", "id_agreement"), 47.0 / 48.0);
   EXPECT_EQ(number("visibility", "mismatched_pixels"), 1.0);
-  EXPECT_EQ(number("visibility", "mismatched_off_edge"), 0.0);
+  EXPECT_FALSE(doc["visibility"].contains("mismatched_off_edge"));  // replaced by the classes
+  EXPECT_EQ(number("visibility", "covered_a"), 40.0);
+  EXPECT_EQ(number("visibility", "covered_b"), 39.0);
+  EXPECT_EQ(number("visibility", "covered_pixels"), 41.0);
+  EXPECT_DOUBLE_EQ(number("visibility", "covered_fraction"), 41.0 / 48.0);
+  EXPECT_DOUBLE_EQ(number("visibility", "covered_agreement"), 40.0 / 41.0);
+  const auto& classes = doc["visibility"]["mismatch_classes"];
+  EXPECT_EQ(classes["edge"], 5);
+  EXPECT_EQ(classes["depth_precision"], 6);
+  EXPECT_EQ(classes["occlusion"], 7);
+  EXPECT_EQ(classes["coverage"], 8);
+  EXPECT_EQ(doc["format"], "rvr-metrics/2");
+  EXPECT_EQ(doc["warnings"], nlohmann::json({"raytrace: nearly all <background>"}));
+  // One pair, at the top level and as pairs[0].
+  ASSERT_EQ(doc["pairs"].size(), 1u);
+  EXPECT_EQ(doc["pairs"][0]["compared"], nlohmann::json({"raster", "raytrace"}));
+  EXPECT_EQ(doc["pairs"][0]["visibility"], doc["visibility"]);
+  EXPECT_EQ(doc["pairs"][0]["files"]["mismatch_classes"], "mismatch_classes.png");
   EXPECT_DOUBLE_EQ(number("depth", "max_rel_error"), 0.0004);
   EXPECT_DOUBLE_EQ(number("depth", "mean_rel_error"), 0.00001);
   EXPECT_DOUBLE_EQ(number("depth", "p99_rel_error"), 0.00007);
@@ -205,8 +231,8 @@ TEST_F(ReportDir, HtmlIsSelfContained) {
   const std::string& h = html.value();
   EXPECT_EQ(h.rfind("<!DOCTYPE html>", 0), 0u);
   // Both renders (side by side and in the flip view), diff.png, id_mismatch.png,
-  // depth_diff.png and the cost picture of the renderer that has one.
-  EXPECT_EQ(count_of(h, "data:image/png;base64,"), 8u);
+  // depth_diff.png, mismatch_classes.png and the cost picture of the renderer that has one.
+  EXPECT_EQ(count_of(h, "data:image/png;base64,"), 9u);
   EXPECT_NE(h.find("raytrace.cost.png</b>: BVH nodes visited + primitive tests per pixel; mean "
                    "12.5, yellow-white &ge; 31"),
             std::string::npos);
@@ -220,8 +246,10 @@ TEST_F(ReportDir, HtmlIsSelfContained) {
   EXPECT_NE(h.find("csg objects skipped: &lt;1&gt; &amp; &quot;more&quot;"), std::string::npos);
   EXPECT_EQ(h.find("<1>"), std::string::npos);
   for (const char* word :
-       {"id_agreement", "mismatched_off_edge", "max_rel_error", "psnr_db", "ssim", "time.render",
-        "time.build", "diff.png", "id_mismatch.png", "depth_diff.png"})
+       {"id_agreement", "covered_fraction", "mismatch_classes.occlusion", "max_rel_error",
+        "psnr_db", "ssim", "time.render", "time.build", "diff.png", "id_mismatch.png",
+        "depth_diff.png", "mismatch_classes.png", "raytrace: nearly all &lt;background&gt;",
+        "depth_precision: both hit"})
     EXPECT_NE(h.find(word), std::string::npos) << word;
   EXPECT_NE(h.find("</html>"), std::string::npos);
 }

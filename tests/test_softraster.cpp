@@ -119,7 +119,7 @@ TEST(SoftRasterizer, NearPlaneClippingHasNoArtefacts) {
   ASSERT_TRUE(traced.ok());
   ComparisonMetrics m = compare_buffers(fb, traced->buffers);
   EXPECT_GE(m.visibility.id_agreement, 0.99);
-  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
+  EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
   EXPECT_LE(m.depth.max_rel_error, 1e-3);
 }
 
@@ -152,7 +152,7 @@ TEST(SoftRasterizer, AgreesWithTheGlRasterizerOnIds) {
   ASSERT_TRUE(hard.ok()) << hard.error().message;
   ComparisonMetrics m = compare_buffers(soft.buffers, hard->buffers);
   EXPECT_GE(m.visibility.id_agreement, 0.999) << m.visibility.mismatched_pixels;
-  EXPECT_EQ(m.visibility.mismatched_off_edge, 0u);
+  EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
 }
 
 // Cost is every fragment generated, hidden or not: the depth complexity. Each quad rendered

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
@@ -13,7 +14,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
@@ -26,11 +29,76 @@
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/isa.h"
 #include "rvr/shared/limits.h"
+#include "rvr/shared/mismatch_classes.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/scene_writer.h"
 #include "terminal_progress.h"
 
 namespace rvr::cli {
+namespace {
+
+// The renderers' names as metrics.json keys them: a name used again gets "-2", "-3", ...
+std::vector<std::string> renderer_keys(const std::vector<std::string>& names) {
+  std::vector<std::string> keys;
+  for (const std::string& name : names) {
+    std::string key = name;
+    for (int k = 2; std::find(keys.begin(), keys.end(), key) != keys.end(); ++k)
+      key = name + "-" + std::to_string(k);
+    keys.push_back(key);
+  }
+  return keys;
+}
+
+// The summary of one pair on stdout.
+void print_pair(const ReportPair& p, const std::string& name_a, const std::string& name_b) {
+  const ComparisonMetrics& m = p.metrics;
+  const VisibilityMetrics& v = m.visibility;
+  std::printf("  %s vs %s:\n", name_a.c_str(), name_b.c_str());
+  std::printf("  id agreement      %.5f  (%zu of %zu pixels differ)\n", v.id_agreement,
+              v.mismatched_pixels, v.pixels);
+  std::printf("  covered           %.5f of the pixels (%zu), agreement over them %.5f\n",
+              v.covered_fraction, v.covered_pixels, v.covered_agreement);
+  std::printf("  mismatch classes  edge %zu  depth_precision %zu  occlusion %zu  coverage %zu\n",
+              v.classes.edge, v.classes.depth_precision, v.classes.occlusion, v.classes.coverage);
+  std::printf("  depth rel error   max %.3g  mean %.3g  p99 %.3g  p99.9 %.3g\n",
+              m.depth.max_rel_error, m.depth.mean_rel_error, m.depth.p99_rel_error,
+              m.depth.p999_rel_error);
+  if (m.depth.outliers)
+    std::printf("  depth outliers    %zu above %g: %zu at silhouettes, %zu elsewhere\n",
+                m.depth.outliers, kDepthOutlierThreshold, m.depth.outliers_at_silhouettes,
+                m.depth.outliers_elsewhere);
+  std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
+              m.color.psnr_db, m.color.max_abs, m.color.ssim);
+}
+
+// The exit status the thresholds give: 1 when a pair's id agreement is below
+// --fail-below-agreement or it has nothing visible, or a pair has a mismatch of a --fail-on class.
+int verdict(const CompareArgs& a, const std::vector<ReportPair>& pairs,
+            const std::vector<std::string>& keys) {
+  int status = 0;
+  for (const ReportPair& p : pairs) {
+    const VisibilityMetrics& v = p.metrics.visibility;
+    const std::string pair = keys[p.a] + " vs " + keys[p.b];
+    if (a.fail_below_agreement && v.covered_pixels == 0) {
+      std::fprintf(stderr, "%s: nothing visible in either image: no agreement to measure\n",
+                   pair.c_str());
+      status = 1;
+    } else if (a.fail_below_agreement && v.id_agreement < *a.fail_below_agreement) {
+      std::fprintf(stderr, "%s: id agreement %.5f is below %.5f\n", pair.c_str(), v.id_agreement,
+                   *a.fail_below_agreement);
+      status = 1;
+    }
+    for (const std::string& name : a.fail_on) {
+      const std::optional<MismatchClass> c = parse_mismatch_class(name);  // checked by CLI11
+      if (!c || v.classes.of(*c) == 0) continue;
+      std::fprintf(stderr, "%s: %zu %s mismatches\n", pair.c_str(), v.classes.of(*c), name.c_str());
+      status = 1;
+    }
+  }
+  return status;
+}
+
+}  // namespace
 
 int run_compare(const CompareArgs& a, const std::string& command_line) {
   if (a.renderers.size() < 2)
@@ -59,9 +127,9 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   report.mode = to_string(options.mode);
   report.command_line = command_line;
   report.out_dir = a.out_dir;
-  report.metrics = result.metrics;
   report.heat_map_scale = compare.heat_map_scale;
   report.depth_diff_scale = compare.depth_diff_scale;
+  report.warnings = result.warnings;
   for (const ComparedRenderer& c : result.renderers) {
     ReportRenderer r;
     r.name = c.name;
@@ -70,6 +138,7 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
     r.warnings = c.output.warnings;
     r.stats = c.output.stats;
     r.info = c.output.info;
+    r.depth_format = to_string(depth_store_of(c.name, c.output));
     r.stats["time.load"] = load_seconds;
     if (c.has_cost) {
       r.cost_file = r.name + ".cost.png";
@@ -78,6 +147,17 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
     }
     report.renderers.push_back(r);
   }
+  const std::vector<std::string> keys = renderer_keys(a.renderers);
+  for (size_t k = 0; k < result.pairs.size(); ++k) {
+    const ComparedPair& p = result.pairs[k];
+    ReportPair rp;
+    rp.a = p.a;
+    rp.b = p.b;
+    rp.metrics = p.metrics;
+    rp.suffix = k == 0 ? "" : "." + keys[p.a] + "_vs_" + keys[p.b];
+    report.pairs.push_back(rp);
+  }
+  report.metrics = report.pairs.front().metrics;
 
   for (size_t i = 0; i < result.renderers.size(); ++i) {
     check(write_image(a.out_dir + "/" + report.renderers[i].image_file, result.renderers[i].image));
@@ -85,45 +165,35 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
       check(write_image(a.out_dir + "/" + report.renderers[i].cost_file,
                         result.renderers[i].cost_image, false));
   }
-  check(write_image(a.out_dir + "/diff.png", result.diff, false));
-  check(write_image(a.out_dir + "/id_mismatch.png", result.id_mismatch, false));
-  check(write_image(a.out_dir + "/depth_diff.png", result.depth_diff, false));
+  for (size_t k = 0; k < result.pairs.size(); ++k) {
+    const ComparedPair& p = result.pairs[k];
+    const ReportPair& rp = report.pairs[k];
+    check(write_image(a.out_dir + "/" + rp.file("diff"), p.diff, false));
+    check(write_image(a.out_dir + "/" + rp.file("id_mismatch"), p.id_mismatch, false));
+    check(write_image(a.out_dir + "/" + rp.file("depth_diff"), p.depth_diff, false));
+    check(write_image(a.out_dir + "/" + rp.file("mismatch_classes"), p.mismatch_classes, false));
+  }
   check(write_text_file(a.out_dir + "/metrics.json", metrics_json(report)));
   check(write_text_file(a.out_dir + "/report.html", take(report_html(report))));
 
   progress.stop();  // before the warnings and the table
-  const ComparisonMetrics& m = report.metrics;
   for (const std::string& w : scene.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   for (const ReportRenderer& r : report.renderers)
     for (const std::string& w : r.warnings)
       std::fprintf(stderr, "warning: %s: %s\n", r.name.c_str(), w.c_str());
+  for (const std::string& w : report.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   std::printf("%s  %dx%d  mode %s\n", scene.source.c_str(), scene.image.width, scene.image.height,
               report.mode.c_str());
   for (const ReportRenderer& r : report.renderers)
-    std::printf("  %-12s %9.3f s\n", r.name.c_str(), r.seconds);
-  std::printf("  %s vs %s:\n", a.renderers[0].c_str(), a.renderers[1].c_str());
-  std::printf("  id agreement      %.5f  (%zu of %zu pixels differ, %zu off edges)\n",
-              m.visibility.id_agreement, m.visibility.mismatched_pixels, m.visibility.pixels,
-              m.visibility.mismatched_off_edge);
-  std::printf("  depth rel error   max %.3g  mean %.3g  p99 %.3g  p99.9 %.3g\n",
-              m.depth.max_rel_error, m.depth.mean_rel_error, m.depth.p99_rel_error,
-              m.depth.p999_rel_error);
-  if (m.depth.outliers)
-    std::printf("  depth outliers    %zu above %g: %zu at silhouettes, %zu elsewhere\n",
-                m.depth.outliers, kDepthOutlierThreshold, m.depth.outliers_at_silhouettes,
-                m.depth.outliers_elsewhere);
-  std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
-              m.color.psnr_db, m.color.max_abs, m.color.ssim);
-  std::printf(
-      "  wrote %s/{%s.png,%s.png,diff.png,depth_diff.png,id_mismatch.png,metrics.json,"
-      "report.html}\n",
-      a.out_dir.c_str(), a.renderers[0].c_str(), a.renderers[1].c_str());
-  if (a.fail_below_agreement && m.visibility.id_agreement < *a.fail_below_agreement) {
-    std::fprintf(stderr, "id agreement %.5f is below %.5f\n", m.visibility.id_agreement,
-                 *a.fail_below_agreement);
-    return 1;
-  }
-  return 0;
+    std::printf("  %-12s %9.3f s  depth %s\n", r.name.c_str(), r.seconds, r.depth_format.c_str());
+  for (const ReportPair& p : report.pairs) print_pair(p, keys[p.a], keys[p.b]);
+  std::printf("  wrote %s/{", a.out_dir.c_str());
+  for (const ReportRenderer& r : report.renderers) std::printf("%s,", r.image_file.c_str());
+  for (const ReportPair& p : report.pairs)
+    std::printf("%s,%s,%s,%s,", p.file("diff").c_str(), p.file("depth_diff").c_str(),
+                p.file("id_mismatch").c_str(), p.file("mismatch_classes").c_str());
+  std::printf("metrics.json,report.html}\n");
+  return verdict(a, report.pairs, keys);
 }
 
 }  // namespace rvr::cli

@@ -71,6 +71,7 @@ struct CompareArgs {
   std::vector<std::string> renderers{"raster", "raytrace"};
   std::string out_dir = "rvr-out";
   std::optional<double> fail_below_agreement;
+  std::vector<std::string> fail_on;  // mismatch classes: edge, depth_precision, ...
 };
 
 int run_compare(const CompareArgs& a, const std::string& command_line);

@@ -75,13 +75,19 @@ int run(int argc, char** argv) {
   compare_cmd
       ->add_option(
           "-r,--renderers", compare.renderers,
-          "renderers, first two compared (default raster,raytrace): " + renderer_name_list())
+          "renderers, every pair compared (default raster,raytrace): " + renderer_name_list())
       ->delimiter(',');
   compare_cmd->add_option("-o,--output", compare.out_dir, "output folder (default rvr-out)");
   compare_cmd
       ->add_option("--fail-below-agreement", compare.fail_below_agreement,
-                   "exit 1 when the id agreement is below F")
+                   "exit 1 when a pair's id agreement is below F, or nothing is visible")
       ->check(CLI::Range(0.0, 1.0));
+  compare_cmd
+      ->add_option("--fail-on", compare.fail_on,
+                   "exit 1 when a pair has a mismatch of one of these classes: "
+                   "edge,depth_precision,occlusion,coverage")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"edge", "depth_precision", "occlusion", "coverage"}));
 
   DiffArgs diff;
   CLI::App* diff_cmd = app.add_subcommand("diff", "compare two image files, like idiff");

@@ -1,7 +1,6 @@
 // metrics.json of `rvr compare`.
 //
-// metrics.json holds the fields docs/cli.md lists: the required ones plus a few extras ("command",
-// "heat_map_scale", "depth_diff_scale", "compared", "files", and "image" per renderer). JSON
+// metrics.json holds the fields docs/cli.md lists and docs/rvr-metrics-2.schema.json checks. JSON
 // has no infinity or NaN: an infinite PSNR (identical colour) is written as 999.0, any other
 // non-finite number as null.
 #include <algorithm>
@@ -23,6 +22,7 @@
 
 #include "report.h"
 #include "report_text.h"
+#include "rvr/shared/mismatch_classes.h"
 
 namespace rvr {
 namespace {
@@ -32,6 +32,9 @@ using namespace report;
 using ordered_json = nlohmann::ordered_json;
 
 constexpr double kPsnrIdentical = 999.0;  // stands for +inf in metrics.json
+// The document's shape (docs/rvr-metrics-2.schema.json). 2: pairs[], warnings, covered pixels
+// and mismatch classes in place of mismatched_off_edge.
+constexpr const char* kMetricsFormat = "rvr-metrics/2";
 
 ordered_json number(double v) {
   return std::isfinite(v) ? ordered_json(v) : ordered_json(nullptr);
@@ -47,18 +50,77 @@ ordered_json psnr_number(double v) {
   return number(v);
 }
 
+// The metrics of one pair: visibility (with the mismatch classes), depth and colour.
+ordered_json pair_metrics(const ComparisonMetrics& m) {
+  const auto& v = m.visibility;
+  ordered_json doc;
+  doc["visibility"] = {{"pixels", v.pixels},
+                       {"id_agreement", number(v.id_agreement)},
+                       {"mismatched_pixels", v.mismatched_pixels},
+                       {"covered_pixels", v.covered_pixels},
+                       {"covered_fraction", number(v.covered_fraction)},
+                       {"covered_agreement", number(v.covered_agreement)},
+                       {"covered_a", v.covered_a},
+                       {"covered_b", v.covered_b},
+                       {"mismatch_classes",
+                        {{"edge", v.classes.edge},
+                         {"depth_precision", v.classes.depth_precision},
+                         {"occlusion", v.classes.occlusion},
+                         {"coverage", v.classes.coverage}}}};
+  const auto& d = m.depth;
+  ordered_json outliers = ordered_json::array();
+  for (const DepthOutlier& o : d.worst_outliers)
+    outliers.push_back({{"x", o.x},
+                        {"y", o.y},
+                        {"object", o.object},
+                        {"rel_error", number(o.rel_error)},
+                        {"depth_a", float_number(o.depth_a)},
+                        {"depth_b", float_number(o.depth_b)},
+                        {"cause", to_string(o.cause)}});
+  doc["depth"] = {{"max_rel_error", number(d.max_rel_error)},
+                  {"mean_rel_error", number(d.mean_rel_error)},
+                  {"p99_rel_error", number(d.p99_rel_error)},
+                  {"p999_rel_error", number(d.p999_rel_error)},
+                  {"outlier_threshold", kDepthOutlierThreshold},
+                  {"outliers", d.outliers},
+                  {"outliers_at_silhouettes", d.outliers_at_silhouettes},
+                  {"outliers_elsewhere", d.outliers_elsewhere},
+                  {"outlier_pixels", outliers}};
+  const auto& c = m.color;
+  doc["color"] = {{"rmse", number(c.rmse)},
+                  {"psnr_db", psnr_number(c.psnr_db)},
+                  {"max_abs", number(c.max_abs)},
+                  {"ssim", number(c.ssim)}};
+  return doc;
+}
+
+ordered_json pair_files(const ReportPair& p) {
+  return {{"diff", p.file("diff")},
+          {"depth_diff", p.file("depth_diff")},
+          {"id_mismatch", p.file("id_mismatch")},
+          {"mismatch_classes", p.file("mismatch_classes")}};
+}
+
 }  // namespace
+
+std::vector<ReportPair> report_pairs(const ReportInput& input) {
+  if (!input.pairs.empty()) return input.pairs;
+  ReportPair only;
+  only.metrics = input.metrics;
+  return {only};
+}
 
 std::string metrics_json(const ReportInput& input) {
   try {
     ordered_json doc;
+    doc["format"] = kMetricsFormat;
     doc["scene"] = input.scene;
     doc["width"] = input.width;
     doc["height"] = input.height;
     doc["mode"] = input.mode;
 
     ordered_json renderers = ordered_json::object();
-    ordered_json compared = ordered_json::array();
+    std::vector<std::string> keys;  // the renderers' keys, in order
     for (const auto& r : input.renderers) {
       std::string key = r.name;
       for (int k = 2; renderers.contains(key); ++k) key = r.name + "-" + std::to_string(k);
@@ -68,43 +130,34 @@ std::string metrics_json(const ReportInput& input) {
                         {"warnings", r.warnings},
                         {"stats", stats},
                         {"info", r.info},
+                        {"depth_format", r.depth_format},
                         {"image", r.image_file}};
       if (!r.cost_file.empty())
         renderers[key]["cost"] = {
             {"image", r.cost_file}, {"mean", number(r.cost_mean)}, {"scale", number(r.cost_scale)}};
-      if (compared.size() < 2) compared.push_back(key);
+      keys.push_back(key);
     }
     doc["renderers"] = renderers;
+    doc["warnings"] = input.warnings;
 
-    const auto& v = input.metrics.visibility;
-    doc["visibility"] = {{"pixels", v.pixels},
-                         {"id_agreement", number(v.id_agreement)},
-                         {"mismatched_pixels", v.mismatched_pixels},
-                         {"mismatched_off_edge", v.mismatched_off_edge}};
-    const auto& d = input.metrics.depth;
-    ordered_json outliers = ordered_json::array();
-    for (const DepthOutlier& o : d.worst_outliers)
-      outliers.push_back({{"x", o.x},
-                          {"y", o.y},
-                          {"object", o.object},
-                          {"rel_error", number(o.rel_error)},
-                          {"depth_a", float_number(o.depth_a)},
-                          {"depth_b", float_number(o.depth_b)},
-                          {"cause", to_string(o.cause)}});
-    doc["depth"] = {{"max_rel_error", number(d.max_rel_error)},
-                    {"mean_rel_error", number(d.mean_rel_error)},
-                    {"p99_rel_error", number(d.p99_rel_error)},
-                    {"p999_rel_error", number(d.p999_rel_error)},
-                    {"outlier_threshold", kDepthOutlierThreshold},
-                    {"outliers", d.outliers},
-                    {"outliers_at_silhouettes", d.outliers_at_silhouettes},
-                    {"outliers_elsewhere", d.outliers_elsewhere},
-                    {"outlier_pixels", outliers}};
-    const auto& c = input.metrics.color;
-    doc["color"] = {{"rmse", number(c.rmse)},
-                    {"psnr_db", psnr_number(c.psnr_db)},
-                    {"max_abs", number(c.max_abs)},
-                    {"ssim", number(c.ssim)}};
+    // The first pair at the top level, as a single-pair document has it; then every pair.
+    const std::vector<ReportPair> pairs = report_pairs(input);
+    auto key_of = [&](size_t i) { return i < keys.size() ? keys[i] : std::string(); };
+    const ordered_json first = pair_metrics(pairs.front().metrics);
+    for (const auto& [k, v] : first.items()) doc[k] = v;
+    ordered_json compared = ordered_json::array();
+    for (size_t i : {pairs.front().a, pairs.front().b})
+      if (i < keys.size()) compared.push_back(keys[i]);
+    ordered_json all = ordered_json::array();
+    for (const ReportPair& p : pairs) {
+      ordered_json entry = {{"compared", {key_of(p.a), key_of(p.b)}}};
+      const ordered_json metrics = pair_metrics(p.metrics);
+      for (const auto& [k, v] : metrics.items()) entry[k] = v;
+      entry["files"] = pair_files(p);
+      all.push_back(entry);
+    }
+    doc["pairs"] = all;
+    doc["edge_tolerance_px"] = kEdgeTolerancePixels;
 
     // Extras.
     doc["compared"] = compared;
@@ -113,10 +166,8 @@ std::string metrics_json(const ReportInput& input) {
     doc["depth_diff_scale"] = {{"low", float_number(input.depth_diff_scale.low)},
                                {"high", float_number(input.depth_diff_scale.high)},
                                {"map", "log10"}};
-    doc["files"] = {{"diff", "diff.png"},
-                    {"depth_diff", "depth_diff.png"},
-                    {"id_mismatch", "id_mismatch.png"},
-                    {"report", "report.html"}};
+    doc["files"] = pair_files(pairs.front());
+    doc["files"]["report"] = "report.html";
     // Invalid UTF-8 in a path or command line must not make dump() throw.
     return doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   } catch (const std::exception& e) {

@@ -21,20 +21,38 @@ struct ReportRenderer {
   std::string cost_file;
   double cost_scale = 0.0, cost_mean = 0.0;
   std::map<std::string, std::string> info;  // e.g. accel: bvh, kernel: avx2
+  std::string depth_format = "float";       // how its visibility test stores depth (to_string)
+};
+
+// Two renderers compared: indices into ReportInput::renderers, a before b.
+struct ReportPair {
+  size_t a = 0, b = 1;
+  ComparisonMetrics metrics;
+  // Appended to the stems of the pair's pictures: "" for the first pair (diff.png, ...),
+  // ".A_vs_B" for the others (diff.A_vs_B.png, ...).
+  std::string suffix;
+  std::string file(const std::string& stem) const { return stem + suffix + ".png"; }
 };
 
 struct ReportInput {
   std::string scene;  // "builtin:cornell" or the file path
   int width = 0, height = 0;
   std::string mode;                       // "local"
-  std::vector<ReportRenderer> renderers;  // the first two are the compared pair
-  ComparisonMetrics metrics;
-  float heat_map_scale = 0.1f;      // colour difference at the top of diff.png's colour map
-  DepthDiffScale depth_diff_scale;  // relative depth difference at the ends of depth_diff.png
+  std::vector<ReportRenderer> renderers;  // the first two are the first pair
+  ComparisonMetrics metrics;              // of the first pair
+  // Every pair compared, the first first; empty: one pair, the first two renderers, `metrics`.
+  std::vector<ReportPair> pairs;
+  std::vector<std::string> warnings;  // about the comparison, e.g. an image with nothing visible
+  float heat_map_scale = 0.1f;        // colour difference at the top of diff.png's colour map
+  DepthDiffScale depth_diff_scale;    // relative depth difference at the ends of depth_diff.png
   std::string command_line;
-  // Holds the images named here plus diff.png, depth_diff.png and id_mismatch.png.
+  // Holds the images named here plus each pair's diff, depth_diff, id_mismatch and
+  // mismatch_classes pictures.
   std::string out_dir;
 };
+
+// input.pairs, or the one pair its `metrics` describe when it lists none.
+std::vector<ReportPair> report_pairs(const ReportInput& input);
 
 // The metrics.json document (docs/cli.md), as text.
 std::string metrics_json(const ReportInput& input);

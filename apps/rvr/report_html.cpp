@@ -25,6 +25,7 @@
 #include "report_css.h"
 #include "report_script.h"
 #include "report_text.h"
+#include "rvr/shared/mismatch_classes.h"
 #include "timing_chart.h"
 
 namespace rvr {
@@ -74,7 +75,8 @@ std::string outlier_table(const DepthMetrics& depth, const std::string& name_a,
        "z-buffer's sub-pixel vertex snapping (1/256 pixel) can follow, so a pixel centre a hair "
        "outside one facet may be drawn on it while the tracer hits its neighbour. Anywhere else "
        "the renderers disagree, unless spheres are analytic: then the z-buffer draws a polygon "
-       "inside the sphere (--spheres mesh compares like with like). They are ringed on depth_diff.png (orange: outline, red: "
+       "inside the sphere (--spheres mesh compares like with like). They are ringed on "
+       "depth_diff.png (orange: outline, red: "
        "elsewhere).</p>\n";
   if (depth.worst_outliers.empty()) return h.str();
   h << "<div class=\"scroll\"><table><thead><tr><th>x</th><th>y</th><th>object</th><th>depth "
@@ -93,15 +95,78 @@ std::string outlier_table(const DepthMetrics& depth, const std::string& name_a,
   return h.str();
 }
 
+// The legend of mismatch_classes.png: a swatch and what each class means.
+std::string class_legend() {
+  static const char* const kMeaning[] = {
+      "",
+      "edge: the pixel centre lies within the edge tolerance of an edge of a hit primitive (a "
+      "rule tie)",
+      "depth_precision: both hit, the two surfaces within the depth buffers' resolution of each "
+      "other (z-fighting)",
+      "occlusion: both hit, one surface farther than the other by more than that (a visibility "
+      "error)",
+      "coverage: a surface in one image only, away from its edges"};
+  std::ostringstream h;
+  for (size_t c = 1; c < kMismatchClassColours.size(); ++c)
+    h << "<br><span class=\"nowrap\">" << swatch(kMismatchClassColours[c].data()) << kMeaning[c]
+      << "</span>";
+  return h.str();
+}
+
+// The classes of one pair as "edge 3, depth_precision 0, occlusion 0, coverage 1".
+std::string class_counts(const MismatchCounts& n) {
+  return "edge " + std::to_string(n.edge) + ", depth_precision " +
+         std::to_string(n.depth_precision) + ", occlusion " + std::to_string(n.occlusion) +
+         ", coverage " + std::to_string(n.coverage);
+}
+
+// The pairs after the first: a table of their figures and each one's class picture.
+std::string other_pairs(const std::vector<ReportPair>& pairs, const std::vector<std::string>& names,
+                        const std::vector<std::string>& class_uris) {
+  if (pairs.size() < 2) return "";
+  std::ostringstream h;
+  h << "<h2>Every pair</h2>\n<div class=\"scroll\"><table><thead><tr><th>pair</th>"
+       "<th>id agreement</th><th>covered</th><th>agreement over covered</th><th>edge</th>"
+       "<th>depth_precision</th><th>occlusion</th><th>coverage</th><th>PSNR</th></tr></thead>"
+       "<tbody>\n";
+  for (const ReportPair& p : pairs) {
+    const auto& v = p.metrics.visibility;
+    const double psnr = p.metrics.color.psnr_db;
+    h << "<tr><td><b>" << escape_html(names[p.a]) << "</b> vs <b>" << escape_html(names[p.b])
+      << "</b></td><td class=\"num\">" << fmt("%.5f", v.id_agreement) << "</td><td class=\"num\">"
+      << fmt("%.4f", v.covered_fraction) << "</td><td class=\"num\">"
+      << fmt("%.5f", v.covered_agreement) << "</td><td class=\"num\">" << v.classes.edge
+      << "</td><td class=\"num\">" << v.classes.depth_precision << "</td><td class=\"num"
+      << (v.classes.occlusion ? " bad" : "") << "\">" << v.classes.occlusion
+      << "</td><td class=\"num" << (v.classes.coverage ? " bad" : "") << "\">" << v.classes.coverage
+      << "</td><td class=\"num\">"
+      << (std::isinf(psnr) && psnr > 0 ? std::string("&infin;") : fmt("%.2f dB", psnr))
+      << "</td></tr>\n";
+  }
+  h << "</tbody></table></div>\n<div class=\"grid\">\n";
+  for (size_t k = 1; k < pairs.size(); ++k)
+    h << "<figure><img src=\"" << class_uris[k] << "\" alt=\"mismatch classes\"><figcaption><b>"
+      << escape_html(pairs[k].file("mismatch_classes"))
+      << "</b>: " << escape_html(names[pairs[k].a]) << " vs " << escape_html(names[pairs[k].b])
+      << ": " << class_counts(pairs[k].metrics.visibility.classes) << ".</figcaption></figure>\n";
+  h << "</div>\n";
+  return h.str();
+}
+
 }  // namespace
 
 Expected<std::string> report_html(const ReportInput& input) {
   try {
-    const auto& vis = input.metrics.visibility;
-    const auto& dep = input.metrics.depth;
-    const auto& col = input.metrics.color;
-    const std::string name_a = input.renderers.size() > 0 ? input.renderers[0].name : "A";
-    const std::string name_b = input.renderers.size() > 1 ? input.renderers[1].name : "B";
+    const std::vector<ReportPair> pairs = report_pairs(input);
+    const auto& vis = pairs.front().metrics.visibility;
+    const auto& dep = pairs.front().metrics.depth;
+    const auto& col = pairs.front().metrics.color;
+    std::vector<std::string> names;
+    for (const auto& r : input.renderers) names.push_back(r.name);
+    for (const ReportPair& p : pairs)
+      while (names.size() <= std::max(p.a, p.b)) names.push_back(names.empty() ? "A" : "B");
+    const std::string name_a = names[pairs.front().a];
+    const std::string name_b = names[pairs.front().b];
 
     // Every image first, so a missing file fails before any HTML is built.
     std::vector<std::string> render_uris;
@@ -120,12 +185,19 @@ Expected<std::string> report_html(const ReportInput& input) {
       if (!uri) return uri.error();
       cost_uris.push_back(std::move(uri.value()));
     }
-    auto diff_uri = data_uri(input.out_dir, "diff.png");
+    const ReportPair& first = pairs.front();
+    auto diff_uri = data_uri(input.out_dir, first.file("diff"));
     if (!diff_uri) return diff_uri.error();
-    auto mismatch_uri = data_uri(input.out_dir, "id_mismatch.png");
+    auto mismatch_uri = data_uri(input.out_dir, first.file("id_mismatch"));
     if (!mismatch_uri) return mismatch_uri.error();
-    auto depth_uri = data_uri(input.out_dir, "depth_diff.png");
+    auto depth_uri = data_uri(input.out_dir, first.file("depth_diff"));
     if (!depth_uri) return depth_uri.error();
+    std::vector<std::string> class_uris;
+    for (const ReportPair& p : pairs) {
+      auto uri = data_uri(input.out_dir, p.file("mismatch_classes"));
+      if (!uri) return uri.error();
+      class_uris.push_back(std::move(uri.value()));
+    }
 
     std::ostringstream h;
     const std::string title = "rvr compare: " + name_a + " vs " + name_b + " on " + input.scene;
@@ -144,8 +216,12 @@ Expected<std::string> report_html(const ReportInput& input) {
 
     // Verdict badges.
     h << "<div class=\"badges\">"
-      << "<span class=\"badge " << (vis.mismatched_off_edge == 0 ? "good" : "bad") << "\">"
-      << "mismatched off edges: " << vis.mismatched_off_edge << "</span>"
+      << "<span class=\"badge "
+      << (vis.classes.occlusion + vis.classes.coverage == 0 ? "good" : "bad") << "\">"
+      << "visibility errors (occlusion + coverage): "
+      << vis.classes.occlusion + vis.classes.coverage << "</span>"
+      << "<span class=\"badge " << (vis.covered_pixels == 0 ? "bad" : "neutral") << "\">covered "
+      << fmt("%.2f", vis.covered_fraction * 100.0) << "%</span>"
       << "<span class=\"badge neutral\">id agreement " << fmt("%.4f", vis.id_agreement * 100.0)
       << "%</span>"
       << "<span class=\"badge neutral\">PSNR "
@@ -154,10 +230,11 @@ Expected<std::string> report_html(const ReportInput& input) {
       << "</span><span class=\"badge neutral\">SSIM " << fmt("%.5f", col.ssim) << "</span></div>\n";
 
     // Warnings, prominently.
-    size_t warning_count = 0;
+    size_t warning_count = input.warnings.size();
     for (const auto& r : input.renderers) warning_count += r.warnings.size();
     if (warning_count > 0) {
       h << "<div class=\"warn\"><h2>&#9888; Warnings (" << warning_count << ")</h2><ul>\n";
+      for (const auto& w : input.warnings) h << "<li>" << escape_html(w) << "</li>\n";
       for (const auto& r : input.renderers)
         for (const auto& w : r.warnings)
           h << "<li><b>" << escape_html(r.name) << "</b>: " << escape_html(w) << "</li>\n";
@@ -209,6 +286,13 @@ Expected<std::string> report_html(const ReportInput& input) {
                       {0.5, fmt("%g", input.heat_map_scale / 2)},
                       {1.0, "&ge; " + fmt("%g", input.heat_map_scale)}})
       << "</figcaption></figure>\n"
+      << "<figure><img src=\"" << class_uris.front()
+      << "\" alt=\"mismatch classes\"><figcaption><b>"
+      << escape_html(first.file("mismatch_classes"))
+      << "</b>: each pixel whose (object, primitive) id differs, coloured by why, over a dimmed "
+         "grey version of "
+      << escape_html(name_a) << " (the reference of the edge test):" << class_legend()
+      << "</figcaption></figure>\n"
       << "<figure><img src=\"" << mismatch_uri.value()
       << "\" alt=\"object id mismatches\"><figcaption><b>id_mismatch.png</b>: pixels whose "
          "object id differs, in red, over a grey version of "
@@ -253,10 +337,26 @@ Expected<std::string> report_html(const ReportInput& input) {
          "Fraction of pixels where both renders see the same object and the same primitive."},
         {"visibility", "mismatched_pixels", std::to_string(vis.mismatched_pixels),
          "Pixels whose (object, primitive) id differs."},
-        {"visibility", "mismatched_off_edge", std::to_string(vis.mismatched_off_edge),
-         "Mismatches with no id boundary within one pixel in both renders: not a silhouette or "
-         "edge tie, so a real disagreement. Should be 0.",
-         vis.mismatched_off_edge != 0},
+        {"visibility", "covered_fraction", fmt("%.6f", vis.covered_fraction),
+         "Fraction of pixels where either render shows a surface.", vis.covered_pixels == 0},
+        {"visibility", "covered_agreement", fmt("%.6f", vis.covered_agreement),
+         "Fraction of those covered pixels whose ids agree; 0 when nothing is visible.",
+         vis.covered_pixels == 0},
+        {"visibility", "mismatch_classes.edge", std::to_string(vis.classes.edge),
+         "Mismatches whose pixel centre lies within " + short_number(kEdgeTolerancePixels) +
+             " pixel of an edge of a hit primitive: a tie the fill rules may break either way."},
+        {"visibility", "mismatch_classes.depth_precision",
+         std::to_string(vis.classes.depth_precision),
+         "Both hit, and the two surfaces lie within the depth buffers' resolution of each other "
+         "at that depth: z-fighting, decided by the depth format, not by the loop order."},
+        {"visibility", "mismatch_classes.occlusion", std::to_string(vis.classes.occlusion),
+         "Both hit, one surface farther than the other by more than that: a visibility error. "
+         "Should be 0.",
+         vis.classes.occlusion != 0},
+        {"visibility", "mismatch_classes.coverage", std::to_string(vis.classes.coverage),
+         "A surface in one render, background in the other, away from the surface's edges. "
+         "Should be 0.",
+         vis.classes.coverage != 0},
         {"depth", "max_rel_error", fmt("%.3g", dep.max_rel_error),
          "Largest |d<sub>A</sub> &minus; d<sub>B</sub>| / max(d<sub>A</sub>, d<sub>B</sub>) of "
          "view-axis depth over pixels where the ids agree (background excluded)."},
@@ -293,6 +393,7 @@ Expected<std::string> report_html(const ReportInput& input) {
         << (row.flagged ? " bad" : "") << "\">" << row.value << "</td><td class=\"why\">" << row.why
         << "</td></tr>\n";
     h << "</tbody></table>\n" << outlier_table(dep, name_a, name_b);
+    h << other_pairs(pairs, names, class_uris);
 
     // Timings: seconds and every "time.*" stat, one row per renderer.
     std::set<std::string> time_keys;

@@ -2,11 +2,68 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include "rvr/shared/mismatch_classes.h"
 #include "rvr/shared/timer.h"
 
 namespace rvr {
+
+DepthStore depth_store_of(const std::string& name, const RenderOutput& output) {
+  auto stated = output.info.find("depth_format");
+  if (stated != output.info.end())
+    if (std::optional<DepthStore> store = parse_depth_store(stated->second)) return *store;
+  if (name == "raster" || name == "hybrid") return DepthStore::Window32F;
+  return DepthStore::ViewFloat;
+}
+
+namespace {
+
+// A warning for a renderer whose image is all, or nearly all, background; empty otherwise.
+std::string background_warning(const ComparedRenderer& r) {
+  const FrameBuffers& fb = r.output.buffers;
+  size_t covered = 0;
+  for (uint32_t id : fb.object_id) covered += id != kNoId;
+  const size_t n = fb.pixel_count();
+  if (covered == 0)
+    return r.name +
+           ": nothing visible: every pixel is background, so agreement with it says "
+           "nothing about visibility (is the model between the camera's near and far "
+           "planes, and in front of it?)";
+  if (double(covered) >= kNearlyAllBackground * double(n)) return "";
+  return r.name + ": nearly all background: " + std::to_string(covered) + " of " +
+         std::to_string(n) +
+         " pixels show a surface, so agreement is mostly agreement on "
+         "background";
+}
+
+ComparedPair compare_pair(const Scene& scene, const CompareResult& result, size_t ia, size_t ib,
+                          const CompareOptions& compare) {
+  const ComparedRenderer& ra = result.renderers[ia];
+  const ComparedRenderer& rb = result.renderers[ib];
+  const FrameBuffers& a = ra.output.buffers;
+  const FrameBuffers& b = rb.output.buffers;
+  MismatchContext context;
+  context.scene = &scene;
+  context.store_a = depth_store_of(ra.name, ra.output);
+  context.store_b = depth_store_of(rb.name, rb.output);
+  ComparedPair p;
+  p.a = ia;
+  p.b = ib;
+  p.metrics = compare_buffers(a, b, context);
+  p.diff = diff_heat_map(ra.image, rb.image, compare.heat_map_scale);
+  p.id_mismatch = id_mismatch_image(a, b);
+  p.depth_diff = depth_diff_image(a, b, compare.depth_diff_scale);
+  p.mismatch_classes = mismatch_class_image(a, classify_mismatches(a, b, context));
+  return p;
+}
+
+}  // namespace
 
 Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<std::string>& names,
                                           const RenderOptions& options,
@@ -38,9 +95,6 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
   }
 
   phase("", "compare");
-  const FrameBuffers& a = result.renderers[0].output.buffers;
-  const FrameBuffers& b = result.renderers[1].output.buffers;
-  result.metrics = compare_buffers(a, b);
   for (ComparedRenderer& r : result.renderers) {
     const FrameBuffers& fb = r.output.buffers;
     r.image = color_image(fb);
@@ -54,10 +108,11 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
       r.cost_mean = total / double(std::max<size_t>(1, fb.pixel_count()));
     }
   }
-  result.diff =
-      diff_heat_map(result.renderers[0].image, result.renderers[1].image, compare.heat_map_scale);
-  result.id_mismatch = id_mismatch_image(a, b);
-  result.depth_diff = depth_diff_image(a, b, compare.depth_diff_scale);
+  for (size_t i = 0; i < result.renderers.size(); ++i)
+    for (size_t j = i + 1; j < result.renderers.size(); ++j)
+      result.pairs.push_back(compare_pair(scene, result, i, j, compare));
+  for (const ComparedRenderer& r : result.renderers)
+    if (std::string w = background_warning(r); !w.empty()) result.warnings.push_back(std::move(w));
   return result;
 }
 

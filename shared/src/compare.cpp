@@ -38,22 +38,6 @@ bool ids_sized(const FrameBuffers& fb) {
          fb.primitive_id.size() == fb.pixel_count();
 }
 
-// Marks every pixel whose 3x3 neighbourhood (itself included) holds a marked pixel of `mask`.
-std::vector<bool> dilate3x3(const std::vector<bool>& mask, int w, int h) {
-  std::vector<bool> rows(mask.size(), false), out(mask.size(), false);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      size_t i = size_t(y) * w + x;
-      rows[i] = mask[i] || (x > 0 && mask[i - 1]) || (x + 1 < w && mask[i + 1]);
-    }
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      size_t i = size_t(y) * w + x;
-      out[i] = rows[i] || (y > 0 && rows[i - w]) || (y + 1 < h && rows[i + w]);
-    }
-  return out;
-}
-
 // |da - db| / max(|da|, |db|) of a pixel both renders hit; unequal infinite or NaN depth on a
 // hit is as wrong as a depth can be (1).
 double relative_depth_error(double da, double db) {
@@ -160,6 +144,26 @@ bool on_outline(const FrameBuffers& a, const FrameBuffers& b, int x, int y) {
 
 }  // namespace
 
+namespace {
+
+// The covered pixels (a hit in either image) and the agreement over them.
+VisibilityMetrics with_coverage(VisibilityMetrics v, const FrameBuffers& a, const FrameBuffers& b) {
+  for (size_t i = 0; i < a.pixel_count(); ++i) {
+    const bool hit_a = a.object_id[i] != kNoId, hit_b = b.object_id[i] != kNoId;
+    v.covered_a += hit_a;
+    v.covered_b += hit_b;
+    v.covered_pixels += hit_a || hit_b;
+  }
+  v.covered_fraction = v.pixels ? double(v.covered_pixels) / double(v.pixels) : 0.0;
+  // Every mismatch is covered: background against background is never one.
+  v.covered_agreement =
+      v.covered_pixels ? double(v.covered_pixels - v.mismatched_pixels) / double(v.covered_pixels)
+                       : 0.0;
+  return v;
+}
+
+}  // namespace
+
 const char* to_string(DepthOutlierCause cause) {
   return cause == DepthOutlierCause::Silhouette ? "silhouette" : "elsewhere";
 }
@@ -220,7 +224,8 @@ std::vector<bool> id_boundaries(const FrameBuffers& fb) {
   return edge;
 }
 
-ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) {
+ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b,
+                                  const MismatchContext& context) {
   ComparisonMetrics m;
   const size_t n = a.pixel_count();
   m.visibility.pixels = n;
@@ -231,7 +236,7 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) 
     // The caller broke the contract; report total disagreement rather than reading out of range.
     m.visibility.id_agreement = 0.0;
     m.visibility.mismatched_pixels = n;
-    m.visibility.mismatched_off_edge = n;
+    m.visibility.classes.coverage = n;
     m.depth.max_rel_error = m.depth.mean_rel_error = 1.0;
     m.depth.p99_rel_error = m.depth.p999_rel_error = 1.0;
     m.color = ColorMetrics{1.0, 0.0, 1.0, 0.0};
@@ -243,26 +248,14 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b) 
   }
   const int w = a.width, h = a.height;
 
-  // Visibility, as docs/cli.md defines it: a mismatch is off the edges when none of its 8
-  // neighbours lies on an object or primitive boundary in either id image. (A boundary pixel
-  // always has a 4-neighbour that is one too, so dilating the union of both boundary masks
-  // over the 3x3 neighbourhood, the pixel itself included, is the same test.) A lone wrong
-  // pixel draws a boundary around itself and so is excused like an edge tie; what is counted
-  // is a mismatch with a clean ring around it: a region of wrong pixels, eroded by two.
-  std::vector<bool> boundary = id_boundaries(a);
-  const std::vector<bool> boundary_b = id_boundaries(b);
-  for (size_t i = 0; i < boundary.size(); ++i) boundary[i] = boundary[i] || boundary_b[i];
-  const std::vector<bool> near_edge = dilate3x3(boundary, w, h);
-  size_t mismatched = 0, off_edge = 0;
-  for (size_t i = 0; i < n; ++i) {
-    if (id_key(a, i) != id_key(b, i)) {
-      ++mismatched;
-      if (!near_edge[i]) ++off_edge;
-    }
-  }
+  // Visibility: pixels whose (object, primitive) ids differ, each in one class
+  // (mismatch_classes.h).
+  size_t mismatched = 0;
+  for (size_t i = 0; i < n; ++i) mismatched += id_key(a, i) != id_key(b, i);
   m.visibility.mismatched_pixels = mismatched;
-  m.visibility.mismatched_off_edge = off_edge;
   m.visibility.id_agreement = double(n - mismatched) / double(n);
+  m.visibility = with_coverage(m.visibility, a, b);
+  m.visibility.classes = count_classes(classify_mismatches(a, b, context));
   m.depth = depth_metrics(a, b);
 
   // Colour, linear values, peak 1.

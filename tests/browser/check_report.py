@@ -65,8 +65,10 @@ def check_report(args, work):
     metrics = json.loads((out_dir / "metrics.json").read_text())
     renderers = list(metrics["renderers"])
     with_cost = sum(1 for r in metrics["renderers"].values() if "cost" in r)
-    # Every render, the two in the flip view, diff, id_mismatch, depth_diff, each cost picture.
-    expected_images = len(renderers) + 2 + 3 + with_cost
+    pairs = metrics.get("pairs", [])
+    # Every render, the two in the flip view, diff, id_mismatch, depth_diff, each cost picture,
+    # and the mismatch-class picture of every pair (the first pair's among the differences).
+    expected_images = len(renderers) + 2 + 3 + with_cost + max(len(pairs), 1)
 
     problems, probe = check_page(args.chromium, out_dir / "report.html", args.screenshot, work,
                                  args.timeout, PAGE_PROBE)
@@ -75,7 +77,7 @@ def check_report(args, work):
         problems.append(f"{len(images)} images on the page, expected at least {expected_images}")
     alts = {i["alt"] for i in images}
     for alt in ("colour difference heat map", "object id mismatches",
-                "relative depth difference"):
+                "relative depth difference", "mismatch classes"):
         if alt not in alts:
             problems.append(f"no image with alt '{alt}'")
     if not probe["chart"]:
@@ -100,7 +102,11 @@ def check_report(args, work):
                 problems.append(f"the timing chart's bar for {name} lacks phase {key}")
         if row["width"] <= 0:
             problems.append(f"the timing chart's bar for {name} is not drawn")
-    expected_text = [metrics["command"], "Work per pixel", "Timings", "mismatched_off_edge"]
+    # The mismatch classes in the legend, and the table of the pairs after the first.
+    expected_text = [metrics["command"], "Work per pixel", "Timings", "depth_precision",
+                     "occlusion", "coverage"]
+    if len(pairs) > 1:
+        expected_text.append("Every pair")
     # The warnings box appears when some renderer warned (e.g. embree: no cost AOV), not always.
     if any(r.get("warnings") for r in metrics["renderers"].values()):
         expected_text.append("Warnings")

@@ -1,5 +1,5 @@
-// `rvr compare` without the files and the printing: every renderer renders the scene, the first
-// two are compared pixel by pixel, and the pictures of the comparison are made.
+// `rvr compare` without the files and the printing: every renderer renders the scene, every pair
+// is compared pixel by pixel, and the pictures of the comparison are made.
 #pragma once
 
 #include <functional>
@@ -35,13 +35,35 @@ struct CompareOptions {
   std::function<void(const std::string& label, const std::string& phase)> on_phase;
 };
 
+// Two of the renderers compared, a before b in the order asked for; a is the reference of the
+// mismatch classes.
+struct ComparedPair {
+  size_t a = 0, b = 1;  // indices into CompareResult::renderers
+  ComparisonMetrics metrics;
+  Image diff;              // colour difference heat map
+  Image id_mismatch;       // id mismatches over grey
+  Image depth_diff;        // relative depth difference
+  Image mismatch_classes;  // mismatched pixels coloured by class over grey
+};
+
+// A renderer whose image shows a surface in fewer than this fraction of its pixels is warned
+// about: agreement with it is mostly agreement on background. 1e-3 is about a 15x15 pixel
+// patch at 480x480, too small for the agreement figures to say much about visibility.
+inline constexpr double kNearlyAllBackground = 1e-3;
+
 struct CompareResult {
   std::vector<ComparedRenderer> renderers;  // in the order asked for
-  ComparisonMetrics metrics;                // of the first two
-  Image diff;                               // colour difference heat map of the first two
-  Image id_mismatch;                        // their id mismatches over grey
-  Image depth_diff;                         // their relative depth difference
+  // Every pair (i, j), i < j: (0, 1), (0, 2), ..., (1, 2), ...; the first is the pair the
+  // single-pair outputs (metrics.json's top level, diff.png) are about.
+  std::vector<ComparedPair> pairs;
+  // What makes the figures say less than they seem to, e.g. "raster: nothing visible: ...".
+  std::vector<std::string> warnings;
 };
+
+// How the named renderer's visibility test stores depth: what its output states in
+// info["depth_format"] (d24, d32f, d32f_reversed, float), else the GL z-buffers' (raster,
+// hybrid) GL_DEPTH_COMPONENT32F, else float view depth (the tracers; softraster orders doubles).
+DepthStore depth_store_of(const std::string& name, const RenderOutput& output);
 
 // At least two names, all in the table (a BadInput error otherwise, before any rendering).
 // Stops at the first renderer that fails.

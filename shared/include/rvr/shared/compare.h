@@ -10,6 +10,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/mismatch_classes.h"
 
 namespace rvr {
 
@@ -17,11 +18,13 @@ struct VisibilityMetrics {
   size_t pixels = 0;
   double id_agreement = 1.0;  // fraction of pixels with the same object AND primitive id
   size_t mismatched_pixels = 0;
-  // Mismatched pixels none of whose 8 neighbours lies on an object or primitive boundary in
-  // either id image (docs/cli.md): a silhouette or shared edge may fall either way by a pixel,
-  // nothing else may. A lone wrong pixel is excused (it draws a boundary around itself); a
-  // wrong region counts its interior.
-  size_t mismatched_off_edge = 0;
+  // Pixels that show a hit in a, in b, in either; covered_fraction = covered_pixels / pixels.
+  size_t covered_a = 0, covered_b = 0, covered_pixels = 0;
+  double covered_fraction = 0.0;
+  // The fraction of covered pixels whose ids agree; 0 when nothing is covered: agreement on
+  // background alone says nothing about visibility.
+  double covered_agreement = 0.0;
+  MismatchCounts classes;  // every mismatched pixel in one class (mismatch_classes.h)
 };
 
 // Why a pixel's depths differ by more than kDepthOutlierThreshold (docs/cli.md).
@@ -76,8 +79,10 @@ struct ComparisonMetrics {
   ColorMetrics color;
 };
 
-// Both buffers must have the same size.
-ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b);
+// Both buffers must have the same size. The context gives the mismatch classes their geometry
+// and depth resolutions; without it they use the id-boundary rule (see MismatchContext).
+ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b,
+                                  const MismatchContext& context = {});
 
 // A pixel whose (object, primitive) id differs from one of its 4 neighbours.
 std::vector<bool> id_boundaries(const FrameBuffers& fb);

@@ -1,0 +1,151 @@
+#!/usr/bin/python3
+"""Checks docs/rvr-metrics-2.schema.json against the metrics.json that `rvr compare` writes.
+
+1. The schema is a valid draft 2020-12 schema.
+2. A real three-renderer compare (builtin:cornell, raster,raytrace,softraster, 64x48) exits 0
+   and writes metrics.json that the schema accepts: format rvr-metrics/2, one renderer entry
+   per renderer with its depth format, the pairs (0,1), (0,2), (1,2) in that order with the
+   first repeating the top level, and every file it names present.
+3. A compare where nothing is visible (the near plane beyond the only object) writes a
+   metrics.json with a warning per renderer that the schema also accepts.
+4. Documents the schema must refuse, each a copy of the real one with one thing wrong: the
+   dropped mismatched_off_edge count back in `visibility`, a mismatch class missing, no pairs,
+   an unknown depth format, a negative count.
+
+Usage: check_metrics_schema.py --rvr build/bin/rvr --source-dir . [--work-dir DIR]
+Exits 1 with one line per failure.
+"""
+
+import argparse
+import copy
+import json
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+from schema_check import load_validator, schema_errors
+
+FAILURES = []
+RENDERERS = ["raster", "raytrace", "softraster"]
+
+
+def failure(message):
+    FAILURES.append(message)
+    print("FAIL: " + message)
+
+
+def compare(rvr, scene, renderers, out):
+    r = subprocess.run([rvr, "compare", scene, "-r", ",".join(renderers), "--width", "64",
+                        "--height", "48", "-o", str(out)],
+                       capture_output=True, text=True, timeout=100)
+    if r.returncode != 0:
+        failure(f"rvr compare {scene}: exit {r.returncode}: {r.stderr.strip()}")
+        return None
+    return json.loads((out / "metrics.json").read_text())
+
+
+def accepted(validator, doc, label):
+    for err in schema_errors(validator, doc):
+        failure(f"{label}: the schema refuses rvr's own metrics.json: {err}")
+
+
+def check_three(rvr, validator, work):
+    out = work / "three"
+    doc = compare(rvr, "builtin:cornell", RENDERERS, out)
+    if doc is None:
+        return None
+    accepted(validator, doc, "three renderers")
+    if doc.get("format") != "rvr-metrics/2":
+        failure(f"format {doc.get('format')!r}, want 'rvr-metrics/2'")
+    if list(doc.get("renderers", {})) != RENDERERS:
+        failure(f"renderers {list(doc.get('renderers', {}))}, want {RENDERERS}")
+    want = [[RENDERERS[0], RENDERERS[1]], [RENDERERS[0], RENDERERS[2]],
+            [RENDERERS[1], RENDERERS[2]]]
+    pairs = doc.get("pairs", [])
+    if [p.get("compared") for p in pairs] != want:
+        failure(f"pairs compare {[p.get('compared') for p in pairs]}, want {want}")
+    elif any(pairs[0][k] != doc[k] for k in ("compared", "visibility", "depth", "color")):
+        failure("pairs[0] does not repeat the top level")
+    named = [doc["files"][k] for k in doc.get("files", {})]
+    named += [f for p in pairs for f in p.get("files", {}).values()]
+    named += [r["image"] for r in doc.get("renderers", {}).values()]
+    for name in named:
+        if not (out / name).is_file():
+            failure(f"metrics.json names {name}, which was not written")
+    print(f"three renderers: {len(pairs)} pairs, {len(named)} files named, "
+          f"classes of the first pair {doc['visibility']['mismatch_classes']}")
+    return doc
+
+
+def check_nothing_visible(rvr, validator, work):
+    scene = work / "empty.json"
+    scene.write_text(json.dumps({
+        "camera": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "near": 10,
+                   "far": 100},
+        "objects": [{"type": "sphere", "center": [0, 0, 0], "radius": 1}]}))
+    doc = compare(rvr, str(scene), ["softraster", "raytrace"], work / "empty")
+    if doc is None:
+        return
+    accepted(validator, doc, "nothing visible")
+    if len(doc.get("warnings", [])) != 2:
+        failure(f"nothing visible: want a warning per renderer, got {doc.get('warnings')}")
+    if doc["visibility"]["covered_pixels"] != 0:
+        failure(f"nothing visible: covered_pixels {doc['visibility']['covered_pixels']}")
+
+
+def check_refused(validator, doc):
+    def off_edge(d):
+        d["visibility"]["mismatched_off_edge"] = 0
+
+    def no_class(d):
+        del d["pairs"][1]["visibility"]["mismatch_classes"]["depth_precision"]
+
+    def no_pairs(d):
+        d["pairs"] = []
+
+    def depth_format(d):
+        d["renderers"]["raster"]["depth_format"] = "d16"
+
+    def negative(d):
+        d["visibility"]["mismatch_classes"]["occlusion"] = -1
+
+    for what, mutate in [("mismatched_off_edge in visibility", off_edge),
+                         ("a mismatch class missing in a pair", no_class),
+                         ("no pairs", no_pairs), ("depth format d16", depth_format),
+                         ("a negative class count", negative)]:
+        bad = copy.deepcopy(doc)
+        mutate(bad)
+        if not schema_errors(validator, bad):
+            failure(f"the schema accepts a metrics.json with {what}")
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--rvr", required=True)
+    ap.add_argument("--source-dir", required=True)
+    ap.add_argument("--work-dir", help="default: a temporary folder")
+    args = ap.parse_args()
+    source = Path(args.source_dir).resolve()
+    work = Path(args.work_dir or tempfile.mkdtemp(prefix="rvr-metrics-schema-"))
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    validator, problems = load_validator(source / "docs/rvr-metrics-2.schema.json")
+    for problem in problems:
+        failure(problem)
+    if validator is None:
+        return 1
+    doc = check_three(args.rvr, validator, work)
+    check_nothing_visible(args.rvr, validator, work)
+    if doc is not None:
+        check_refused(validator, doc)
+    if FAILURES:
+        print(f"{len(FAILURES)} failure(s)")
+        return 1
+    print("PASS")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
