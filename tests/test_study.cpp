@@ -466,7 +466,7 @@ TEST(StudyRun, PointsMeasuredWhileTheMachineWasBusyAreMeasuredAgain) {
       if (note.find(words) != std::string::npos) return true;
     return false;
   };
-  EXPECT_TRUE(noted("were measured again"));
+  EXPECT_TRUE(noted("measured again"));
   EXPECT_EQ(still_busy, noted("left out of the fits"));
   ASSERT_FALSE(r->crossovers.empty()) << study_markdown(*r);
   EXPECT_LT(std::fabs(std::log10(r->crossovers[0].value / true_crossing())), 0.1);

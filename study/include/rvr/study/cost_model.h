@@ -7,8 +7,9 @@
 //   edges  + e·√(P·N): N triangles sharing a fixed part of the screen have edges of total length
 //          ∝ N·√(P/N) = √(P·N) pixels; work per edge pixel or per tile an edge crosses (the
 //          z-buffer's partly covered blocks, the tracer's packets split at silhouettes)
-//   cache  + f·max(0, N − k) (z-buffer, hybrid) or f·P·max(0, log2(N/k)) (tracer): a change
-//          of slope at N = k, where the working set leaves a cache
+//   knee   + f·max(0, N − k) (z-buffer, hybrid) or f·P·max(0, log2(N/k)) (tracer): a change
+//          of slope at N = k: where the working set leaves a cache (steeper), or where triangles
+//          become smaller than the rasterizer's blocks (flatter)
 #pragma once
 
 #include <string>
@@ -21,7 +22,7 @@ enum class ModelForm { ZBuffer, Tracer, Hybrid };
 struct CostModel {
   ModelForm form = ModelForm::ZBuffer;
   bool edges = false;  // the e·√(P·N) term
-  double knee = 0;     // > 0: the cache term, its change of slope at N = knee
+  double knee = 0;     // > 0: the knee term, its change of slope at N = knee
 
   CostModel() = default;
   CostModel(ModelForm f) : form(f) {}  // NOLINT: the textbook form, implicitly

@@ -62,7 +62,7 @@ Expected<std::vector<double>> fit_coefficients(const CostModel& model,
 ModelFit fit_model(const CostModel& model, const std::vector<Measurement>& points,
                    const BootstrapOptions& boot, const FitThresholds& limits = {});
 
-// The models a form may be extended to for these points: the textbook form, + edges, + a cache
+// The models a form may be extended to for these points: the textbook form, + edges, + a
 // knee at each measured N with at least two points on either side, + both.
 std::vector<CostModel> candidate_models(ModelForm form, const std::vector<Measurement>& points);
 
