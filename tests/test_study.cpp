@@ -384,22 +384,38 @@ class SimulatedFrames : public FrameSource {
   double busy_from_, busy_to_;
 };
 
+// A study of softraster and raytrace on tessphere whose frames are SimulatedFrames on a
+// simulated clock (busy between busy_from and busy_to).
+struct SimulatedStudy {
+  double clock = 0;
+  Rng rng;
+  StudyRequest request;
+  StudyHooks hooks;
+
+  SimulatedStudy(uint64_t seed, double budget, int replicates, double busy_from = 0,
+                 double busy_to = 0)
+      : rng(seed) {
+    request.scenes = {"builtin:tessphere"};
+    request.renderers = {"softraster", "raytrace"};
+    request.budget_seconds = budget;
+    request.bootstrap_replicates = replicates;
+    hooks.now = [this] { return clock; };
+    hooks.prepare = [this, busy_from, busy_to](
+                        const Family&, size_t n,
+                        int width) -> Expected<std::unique_ptr<FrameSource>> {
+      return std::unique_ptr<FrameSource>(
+          new SimulatedFrames(double(n), width, clock, rng, busy_from, busy_to));
+    };
+  }
+  SimulatedStudy(const SimulatedStudy&) = delete;  // the hooks point at this one
+};
+
 }  // namespace
 
 TEST(StudyRun, SweepsWithinTheBudgetAndRefinesNearTheCrossover) {
-  double clock = 0;
-  Rng rng(4);
-  StudyRequest request;
-  request.scenes = {"builtin:tessphere"};
-  request.renderers = {"softraster", "raytrace"};
-  request.budget_seconds = 30;
-  request.bootstrap_replicates = 200;
-  StudyHooks hooks;
-  hooks.now = [&] { return clock; };
-  hooks.prepare = [&](const Family&, size_t n,
-                      int width) -> Expected<std::unique_ptr<FrameSource>> {
-    return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, clock, rng));
-  };
+  SimulatedStudy study(4, 30, 200);
+  StudyRequest& request = study.request;
+  StudyHooks& hooks = study.hooks;
   Expected<StudyResult> r = run_study(request, hooks);
   ASSERT_TRUE(r.ok()) << r.error().message;
   EXPECT_LE(r->elapsed_seconds, request.budget_seconds * 1.1);
@@ -438,19 +454,9 @@ TEST(StudyRun, SweepsWithinTheBudgetAndRefinesNearTheCrossover) {
 // measured then are found by their reference frames and measured again as the budget allows;
 // every point left in the fits is on its curve, and those still busy are said to be.
 TEST(StudyRun, PointsMeasuredWhileTheMachineWasBusyAreMeasuredAgain) {
-  double clock = 0;
-  Rng rng(6);
-  StudyRequest request;
-  request.scenes = {"builtin:tessphere"};
-  request.renderers = {"softraster", "raytrace"};
-  request.budget_seconds = 30;
-  request.bootstrap_replicates = 200;
-  StudyHooks hooks;
-  hooks.now = [&] { return clock; };
-  hooks.prepare = [&](const Family&, size_t n,
-                      int width) -> Expected<std::unique_ptr<FrameSource>> {
-    return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, clock, rng, 4, 7));
-  };
+  SimulatedStudy study(6, 30, 200, 4, 7);
+  StudyRequest& request = study.request;
+  StudyHooks& hooks = study.hooks;
   Expected<StudyResult> r = run_study(request, hooks);
   ASSERT_TRUE(r.ok()) << r.error().message;
   bool still_busy = false;
@@ -968,19 +974,10 @@ TEST(StudyMerge, DifferentKernelsAreNotPooled) {
 // point exactly once between them and nothing else (no points near crossovers); merged, they
 // hold the plan.
 TEST(StudyRun, ShardsMeasureEveryPlannedPointOnce) {
-  double clock = 0;
-  Rng rng(9);
-  StudyRequest request;
+  SimulatedStudy study(9, 1e5, 50);
+  StudyRequest& request = study.request;
+  StudyHooks& hooks = study.hooks;
   request.scenes = {"builtin:tessphere", "builtin:occluders"};
-  request.renderers = {"softraster", "raytrace"};
-  request.budget_seconds = 1e5;
-  request.bootstrap_replicates = 50;
-  StudyHooks hooks;
-  hooks.now = [&] { return clock; };
-  hooks.prepare = [&](const Family&, size_t n,
-                      int width) -> Expected<std::unique_ptr<FrameSource>> {
-    return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, clock, rng));
-  };
   using Key = std::tuple<std::string, double, int>;  // family, N, width
   std::map<Key, int> planned;
   for (const char* family : {"tessphere", "occluders"})

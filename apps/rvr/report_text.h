@@ -3,9 +3,11 @@
 
 #include <string>
 
+#include "rvr/shared/html_escape.h"
+
 namespace rvr::report {
 
-std::string escape_html(const std::string& s);
+using ::rvr::escape_html;  // rvr/shared/html_escape.h
 // printf of one number, with n/a and infinity spelt out for HTML.
 std::string fmt(const char* format, double v);
 std::string fmt_seconds(double s);

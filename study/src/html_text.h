@@ -4,10 +4,11 @@
 
 #include <string>
 
+#include "rvr/shared/html_escape.h"
+
 namespace rvr::study {
 
-// `s` with & < > " ' replaced by their character references: safe in text and attributes.
-std::string escape_html(const std::string& s);
+using ::rvr::escape_html;
 
 // escape_html(s) with every "10^k" written as 10<sup>k</sup> (for HTML text).
 std::string html_with_powers(const std::string& s);
