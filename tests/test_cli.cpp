@@ -923,3 +923,99 @@ TEST_F(Cli, StudyShardAndMergeRefuseBadInput) {
     EXPECT_FALSE(fs::exists(dir_ / "out")) << c.args;
   }
 }
+
+// Issue 26, item 6: the messages a user reads.
+
+// A renderer's warning is printed "warning: RENDERER: what", the renderer named once, and
+// reaches metrics.json and report.html with the same text.
+TEST_F(Cli, WarningsNameTheirRendererOnce) {
+  const std::string spp_note =
+      "2 samples per pixel requested; multisampling is not implemented, rendered 1";
+  RunResult r = run("render builtin:glass -r softraster --mode full --spp 2 " +
+                    std::string(kSmall) + " -o " + (dir_ / "g.png").string() + " --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: softraster: " + spp_note + "\n"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("warning: softraster: transparency not rendered\n"), std::string::npos)
+      << r.err;
+  EXPECT_EQ(r.err.find("softraster: softraster"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("by softraster"), std::string::npos) << r.err;
+
+  // The hybrid's tracer takes every sample: softraster's single-sample note is not its own.
+  RunResult hybrid = run("render builtin:spheres -r hybrid_soft --mode local --spp 2 " +
+                         std::string(kSmall) + " -o " + (dir_ / "h.png").string() + " --quiet");
+  ASSERT_EQ(hybrid.status, 0) << hybrid.err;
+  EXPECT_EQ(hybrid.err.find("multisampling"), std::string::npos) << hybrid.err;
+
+  fs::path out = dir_ / "cmp";
+  RunResult c = run("compare builtin:spheres -r softraster,raytrace --mode local --spp 2 " +
+                    std::string(kSmall) + " -o " + out.string() + " --quiet");
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_NE(c.err.find("warning: softraster: " + spp_note + "\n"), std::string::npos) << c.err;
+  EXPECT_EQ(c.err.find("softraster: softraster"), std::string::npos) << c.err;
+  nlohmann::json metrics = nlohmann::json::parse(slurp(out / "metrics.json"));
+  const auto soft_warnings =
+      metrics["renderers"]["softraster"]["warnings"].get<std::vector<std::string>>();
+  EXPECT_EQ(soft_warnings, std::vector<std::string>{spp_note});
+  EXPECT_NE(slurp(out / "report.html").find("<b>softraster</b>: " + spp_note), std::string::npos);
+}
+
+// Outputs are written to a temporary beside them and renamed into place; an error names the
+// path the user gave, never the temporary.
+TEST_F(Cli, OutputErrorNamesTheUsersPathNotTheTemporary) {
+  const std::string out = (dir_ / "t.xyz").string();
+  RunResult r = run("render builtin:spheres -r raytrace --mode local " + std::string(kSmall) +
+                    " -o " + out + " --quiet");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.err.rfind("error: cannot write '" + out + "': ", 0), 0u) << r.err;
+  EXPECT_EQ(r.err.find(".tmp-"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_TRUE(outputs({}).empty());
+}
+
+// --export of a file that is not there says so; a bare word is still a built-in scene.
+TEST_F(Cli, ExportOfAMissingFileSaysTheFileIsMissing) {
+  RunResult r = run("scenes --export missing.obj");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "error: missing.obj: no such file\n");
+  const std::string in_folder = (dir_ / "models" / "engine.glb").string();
+  r = run("scenes --export " + in_folder);
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "error: " + in_folder + ": no such file\n");
+  r = run("scenes --export nope");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "error: builtin:nope: no such built-in scene (see 'rvr scenes')\n");
+  r = run("scenes --export tessphere:2.5");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err.rfind("error: builtin:tessphere:2.5: N must be an integer in 1..", 0), 0u)
+      << r.err;
+  EXPECT_EQ(run("scenes --export spheres").status, 0);  // a bare name: the built-in scene
+  EXPECT_TRUE(outputs({}).empty());
+}
+
+// An unknown command or option names the nearest known one, in one error line, exit 2.
+TEST_F(Cli, UnknownCommandOrOptionSuggestsTheNearest) {
+  const std::map<std::string, std::string> expected = {
+      {"rendr", "error: unknown command 'rendr': did you mean 'render'?\n"},
+      {"compare --renderer x",
+       "error: compare: unknown option '--renderer': did you mean '--renderers'?\n"},
+      {"compare --renderer=raster,raytrace",
+       "error: compare: unknown option '--renderer': did you mean '--renderers'?\n"},
+      // The typo leaves -r missing too: the typo is what is reported.
+      {"render --rendrer raytrace",
+       "error: render: unknown option '--rendrer': did you mean '--renderer'?\n"},
+      {"diff a.png b.png --failpercnt 5",
+       "error: diff: unknown option '--failpercnt': did you mean '--failpercent'?\n"},
+      {"frobnicate",
+       "error: unknown command 'frobnicate' (commands: render, compare, diff, scenes, info, "
+       "study)\n"},
+      {"render -r raytrace --zzzzzz",
+       "error: render: unknown option '--zzzzzz' (see 'rvr render --help')\n"},
+      {"info extra", "error: info: unexpected argument 'extra'\n"},
+  };
+  for (const auto& [args, message] : expected) {
+    RunResult r = run(args);
+    EXPECT_EQ(r.status, 2) << args;
+    EXPECT_EQ(r.err, message) << args;
+  }
+  EXPECT_TRUE(outputs({}).empty());
+}

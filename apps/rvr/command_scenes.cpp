@@ -38,10 +38,19 @@ namespace {
 // the format: they go to PLY files next to -o FILE.
 int export_scene(const ScenesArgs& a) {
   std::string name = a.export_name;
-  if (name.rfind("builtin:", 0) == 0) name = name.substr(8);
+  const bool builtin_prefix = name.rfind("builtin:", 0) == 0;
+  if (builtin_prefix) name = name.substr(8);
+  // A name that is no regular file is a built-in scene unless it reads as a path: a folder in
+  // it, or a dot in its name (a file extension; built-in names and their ":N" have none). A
+  // path that names nothing is reported as missing, not as an unknown built-in scene.
+  const bool reads_as_path = name.find('/') != std::string::npos ||
+                             name.substr(0, name.find(':')).find('.') != std::string::npos;
   std::error_code ec;
-  bool is_file = a.export_name.rfind("builtin:", 0) != 0 &&
-                 std::filesystem::is_regular_file(a.export_name, ec);
+  const bool is_file =
+      !builtin_prefix && (std::filesystem::is_regular_file(a.export_name, ec) ||
+                          (reads_as_path && std::filesystem::exists(a.export_name, ec)));
+  if (!builtin_prefix && !is_file && reads_as_path)
+    fail(bad_input(a.export_name + ": no such file"));
   if (is_file) refuse_overwriting_inputs({a.export_name}, {a.out});
   Scene scene = is_file ? take(load_scene(a.export_name)) : take(make_builtin_scene(name));
   if (is_file) name = std::filesystem::path(a.export_name).stem().string();

@@ -1,6 +1,7 @@
 // rvr: render one scene two ways and tell the truth about the difference. This program only
 // parses, calls the libraries and writes; errors come back as values and are printed here.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -13,7 +14,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
@@ -28,6 +31,7 @@
 #include "rvr/shared/limits.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/scene_writer.h"
+#include "suggest.h"
 #include "terminal_progress.h"
 
 namespace {
@@ -52,6 +56,52 @@ std::string join_args(int argc, char** argv) {
     s += (i ? " " : "") + (quote ? "'" + arg + "'" : arg);
   }
   return s;
+}
+
+// The names of `cmd`'s options as they are typed ("--long", "-s").
+std::vector<std::string> option_names(const CLI::App& cmd) {
+  std::vector<std::string> names;
+  for (const CLI::Option* o : cmd.get_options()) {
+    for (const std::string& n : o->get_lnames()) names.push_back("--" + n);
+    for (const std::string& n : o->get_snames()) names.push_back("-" + n);
+  }
+  return names;
+}
+
+// The names of `cmd`'s subcommands, in the order they were added.
+std::vector<std::string> subcommand_names(const CLI::App& cmd) {
+  std::vector<std::string> names;
+  for (const CLI::App* sub : cmd.get_subcommands([](const CLI::App*) { return true; }))
+    names.push_back(sub->get_name());
+  return names;
+}
+
+// The first word that `cmd` or a subcommand chosen under it did not take, as an error line
+// naming the nearest known option or subcommand; "" when every word was taken. CLI11 parses
+// on past an unknown word (and may then fail on a consequence of it, e.g. a required option
+// the typo was meant to be), so this is the error to show first.
+std::string unknown_word_message(const CLI::App& cmd, const std::string& where) {
+  const std::vector<std::string> left = cmd.remaining();
+  if (!left.empty()) {
+    std::string word = left.front();
+    const bool is_option = word.size() > 1 && word[0] == '-';
+    if (is_option) word = word.substr(0, word.find('='));  // "--name=value": the name
+    const std::vector<std::string> known = is_option ? option_names(cmd) : subcommand_names(cmd);
+    if (!is_option && known.empty()) return fmt::format("{}unexpected argument '{}'", where, word);
+    std::string message =
+        fmt::format("{}unknown {} '{}'", where, is_option ? "option" : "command", word);
+    if (std::string near = nearest(word, known); !near.empty())
+      return message + fmt::format(": did you mean '{}'?", near);
+    if (is_option)
+      return message +
+             fmt::format(" (see 'rvr {}--help')", where.empty() ? "" : cmd.get_name() + " ");
+    return message + fmt::format(" (commands: {})", fmt::join(known, ", "));
+  }
+  for (const CLI::App* sub : cmd.get_subcommands()) {
+    std::string message = unknown_word_message(*sub, sub->get_name() + ": ");
+    if (!message.empty()) return message;
+  }
+  return "";
 }
 
 int run(int argc, char** argv) {
@@ -135,7 +185,8 @@ int run(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    const std::string unknown = unknown_word_message(app, "");
+    std::fprintf(stderr, "error: %s\n", unknown.empty() ? e.what() : unknown.c_str());
     return 2;
   }
   if (render_cmd->parsed()) return run_render(render);

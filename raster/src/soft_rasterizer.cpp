@@ -302,17 +302,17 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   out.stats["memory.raster_bytes"] = double(target.bytes() + drawn.peak_chunk_bytes);
   out.info["hiz"] = options.hiz ? "on" : "off";
 
+  // The warnings do not name the renderer: whoever prints them says whose they are.
   if (!skipped_csg.empty()) out.warnings.push_back(skipped_csg_warning(skipped_csg));
   if (options.mode == RenderMode::Full) {
-    if (mirror) out.warnings.push_back("mirror reflection not rendered by softraster");
-    if (transparency) out.warnings.push_back("transparency not rendered by softraster");
+    if (mirror) out.warnings.push_back("mirror reflection not rendered");
+    if (transparency) out.warnings.push_back("transparency not rendered");
     if (scene.camera.aperture_radius > 0.0f)
-      out.warnings.push_back("depth of field (aperture) not rendered by softraster: pinhole");
+      out.warnings.push_back("depth of field (aperture) not rendered: pinhole");
   }
   if (scene.image.samples_per_pixel > 1)
     out.warnings.push_back(
-        fmt::format("softraster: {} samples per pixel requested; multisampling is not "
-                    "implemented, rendered 1",
+        fmt::format("{} samples per pixel requested; multisampling is not implemented, rendered 1",
                     scene.image.samples_per_pixel));
   return out;
 }

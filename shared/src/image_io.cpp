@@ -22,6 +22,7 @@
 #include <span>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "image_codec_loader.h"
@@ -63,6 +64,21 @@ Error write_error(const std::string& path, const std::string& reason) {
   return bad_input("cannot write '" + path + "': " + reason);
 }
 
+// `reason` with the temporary file's name replaced by the name the caller gave, since the
+// temporary is how the file is written, not what was asked for: first the whole temporary path,
+// then its bare file name (messages that quote only that).
+std::string naming_the_target(std::string reason, const fs::path& temp, const fs::path& target) {
+  const std::pair<std::string, std::string> replacements[] = {
+      {temp.string(), target.string()}, {temp.filename().string(), target.filename().string()}};
+  for (const auto& [from, to] : replacements) {
+    if (from.empty()) continue;
+    for (size_t at = reason.find(from); at != std::string::npos;
+         at = reason.find(from, at + to.size()))
+      reason.replace(at, from.size(), to);
+  }
+  return reason;
+}
+
 // Creates the parent folder of `path` when missing.
 bool make_parent(const fs::path& path, std::string& reason) {
   fs::path parent = path.parent_path();
@@ -92,19 +108,20 @@ struct UnfinishedOutput {
   ~UnfinishedOutput() { g_unfinished.store(false); }
 };
 
+// Errors name `path`, never the temporary.
 template <class F>
 Status write_atomically(const std::string& path, F&& write_temp) {
+  fs::path target(path), temp;
   try {
     if (path.empty()) return write_error(path, "empty file name");
-    fs::path target(path);
     std::string reason;
     if (!make_parent(target, reason)) return write_error(path, reason);
-    fs::path temp = temp_path_for(target);
+    temp = temp_path_for(target);
     UnfinishedOutput unfinished(temp.string());
     std::error_code ec;
     if (!write_temp(temp, reason)) {
       fs::remove(temp, ec);
-      return write_error(path, reason);
+      return write_error(path, naming_the_target(reason, temp, target));
     }
     fs::rename(temp, target, ec);
     if (ec) {
@@ -114,7 +131,7 @@ Status write_atomically(const std::string& path, F&& write_temp) {
     }
     return ok_status();
   } catch (const std::exception& e) {
-    return write_error(path, e.what());
+    return write_error(path, naming_the_target(e.what(), temp, target));
   }
 }
 

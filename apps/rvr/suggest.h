@@ -1,0 +1,20 @@
+// "Did you mean" for the command line: the known name nearest to what was typed, by edit
+// distance. Private to apps/rvr.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace rvr::cli {
+
+// Levenshtein distance: the fewest single-character insertions, deletions and substitutions
+// that turn `a` into `b`.
+size_t edit_distance(const std::string& a, const std::string& b);
+
+// The candidate nearest to `typed`, or "" when none is near enough to be a likely typo: within
+// one edit per three characters of `typed` (at least one, at most three), leading dashes not
+// counted, and never a candidate that shares nothing with it. Ties go to the earlier candidate.
+std::string nearest(const std::string& typed, const std::vector<std::string>& candidates);
+
+}  // namespace rvr::cli
