@@ -1,13 +1,15 @@
 // Every input the fuzzers (tests/fuzz, `make fuzz`) ever broke the loader with, and the seed
-// corpora, replayed in the normal test run: the loader must return a scene or a well-formed
-// error (bad input, one line, naming the file), never crash or hang. fuzz_common.h aborts on
-// a malformed error, which fails the test binary.
+// corpora, replayed in the normal test run: each must give its expected outcome, a scene or a
+// bad-input error saying what is wrong (one line, naming the file), never a crash or hang.
+// fuzz_common.h aborts on a malformed error, which fails the test binary.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -41,36 +43,132 @@ const fs::path& dir() {
   return d;
 }
 
-// Replays every file of tests/fuzz/SUB and returns how many there were.
-size_t replay(const std::string& sub, bool mesh) {
-  size_t count = 0;
+// What loading an input must give: success (`error` empty), or a bad-input error whose message
+// contains `error` (after the file name that every message starts with).
+struct Expect {
+  const char* file;
+  const char* error;
+};
+
+// Inputs that once crashed, hung or exhausted the loader: each is now refused, for its reason.
+const std::vector<Expect> kSceneRegressions = {
+    {"nesting_past_the_stack.json", ":1:592: JSON syntax: nesting deeper than 512"},
+};
+
+// The scene seeds: valid scenes load; the rest are refused, each for the fault it was made with.
+const std::vector<Expect> kSceneSeeds = {
+    {"bad_camera.json", "camera.up: must not be parallel to target - eye"},
+    {"bad_image.json", "image.width: must be an integer in 1..16384, got number 0"},
+    {"bad_utf8.json", ":1:24: JSON syntax: invalid string: ill-formed UTF-8 byte"},
+    {"blob.json", ""},
+    {"deep.json", ":1:513: JSON syntax: nesting deeper than 512"},
+    {"deep_csg.json", "top level: unknown key 'a'"},
+    {"deep_csg_object.json", "csg tree nested deeper than 64 levels"},
+    {"duplicate_key.json", "camera: duplicate key"},
+    {"empty.json", ":1:1: JSON syntax: unexpected end of input (the file is empty)"},
+    {"full.json", ""},
+    {"gallery.json", ""},
+    {"mesh_is_dir.json", "objects[0].file: cannot read 'models': Is a directory"},
+    {"minimal.json", ""},
+    {"missing_mesh.json", "objects[0].file: cannot read 'models/missing.obj': No such file"},
+    {"negative_radius.json", "objects[0].radius: must be > 0, got -1"},
+    {"overflow.json", "camera.eye[2]: must be a finite number, got 1e999 (overflows)"},
+    {"spaces.json", ":2:3: JSON syntax: unexpected end of input (the file is empty)"},
+    {"torus.json", ""},
+    {"trailing_comma.json", ":1:47: JSON syntax: expected a quoted key, got '}' (trailing comma?)"},
+    {"truncated_blob.json", ":17:63: JSON syntax: unexpected end of input (expected a value)"},
+    {"truncated_gallery.json",
+     ":19:47: JSON syntax: unexpected end of input (expected ',' or '}')"},
+    {"truncated_torus.json", ":15:13: JSON syntax: unexpected end of input (expected ':')"},
+    {"typo.json", "unknown key 'objcts' (did you mean 'objects'?)"},
+};
+
+// Mesh inputs that once crashed, hung, leaked or exhausted the loader (or Assimp under it).
+// A crash inside Assimp is caught by the child process that imports and becomes the file's error.
+const std::vector<Expect> kMeshRegressions = {
+    {"dae_float_array_without_count_segv",
+     "cannot read 'mesh.dae': the importer crashed (signal 11"},
+    {"dae_triangle_count_past_the_file_oom",
+     "cannot read 'mesh.dae': the file declares more data than it holds"},
+    {"off_faces_without_indices",
+     "cannot read 'mesh.off': Validation failed: aiMesh::mFaces[0].mIndices is nullptr"},
+    {"off_vertex_count_past_the_file_oom",
+     "cannot read 'mesh.off': the file declares more data than it holds"},
+    {"ply_ascii_vertex_count_past_the_file_oom",
+     "cannot read 'mesh.ply': the file declares more data than it holds"},
+    {"ply_bad_header_segv", "cannot read 'mesh.ply': PLY header has no end_header line"},
+    {"ply_bad_vertex_assimp_leak", "cannot read 'mesh.ply': Cannot parse string \"(0?\""},
+    {"ply_face_index_out_of_range_aborts", "'mesh.ply': face 0 of mesh 0 has no vertices"},
+    {"ply_header_without_end_hangs", "cannot read 'mesh.ply': PLY header has no end_header line"},
+};
+
+// The mesh seeds: one valid file per importer loads; the faulty ones are refused.
+const std::vector<Expect> kMeshSeeds = {
+    {"crystal.3ds", ""},
+    {"empty.obj", "cannot read 'mesh.obj': OBJ-file is too small."},
+    {"nan.obj", "'mesh.obj': vertex 0 of mesh 0 has a non-finite coordinate"},
+    {"neg_index.obj", "cannot read 'mesh.obj': OBJ: vertex index out of range"},
+    {"quad.obj", ""},
+    {"tri.dae", ""},
+    {"tri.glb", ""},
+    {"tri.gltf", ""},
+    {"tri.obj", ""},
+    {"tri.off", ""},
+    {"tri.ply", ""},
+    {"tri.stl", ""},
+    {"tri_binary.ply", ""},
+    {"tri_binary.stl", ""},
+    {"tri_smooth.obj", ""},
+    {"tri_smooth.ply", ""},
+};
+
+// Replays every file of tests/fuzz/SUB against its expected outcome in `table`; a file without
+// an entry, or an entry without a file, fails (a new regression input needs its outcome).
+void replay(const std::string& sub, bool mesh, const std::vector<Expect>& table) {
+  std::set<std::string> seen;
   for (const fs::path& p : files_in(sub)) {
-    SCOPED_TRACE(p.string());
+    const std::string name = p.filename().string();
+    SCOPED_TRACE(sub + "/" + name);
+    seen.insert(name);
     std::vector<uint8_t> bytes = read_bytes(p);
+    // load_*() abort on a malformed error (not bad input, not one line, no file name first).
     rvr::Expected<rvr::Scene> s =
         mesh ? rvr::fuzz::load_mesh_bytes(dir(), bytes.data(), bytes.size())
              : rvr::fuzz::load_scene_text(dir(), bytes.data(), bytes.size());
-    // load_*() abort on a malformed error (not bad input, not one line, no file name first).
-    if (!s.ok()) {
-      EXPECT_EQ(s.error().kind, rvr::ErrorKind::BadInput);
+    const std::string got = s.ok() ? "" : s.error().message;
+    std::printf("%s/%s: %s\n", sub.c_str(), name.c_str(), s.ok() ? "loads" : got.c_str());
+    auto it =
+        std::find_if(table.begin(), table.end(), [&](const Expect& e) { return name == e.file; });
+    if (it == table.end()) {
+      ADD_FAILURE() << "no expected outcome for " << name
+                    << " (it gives: " << (s.ok() ? "a scene" : got) << ")";
+      continue;
     }
-    ++count;
+    if (std::string(it->error).empty()) {
+      EXPECT_TRUE(s.ok()) << got;
+    } else {
+      ASSERT_FALSE(s.ok()) << "loads; expected an error containing \"" << it->error << "\"";
+      EXPECT_EQ(s.error().kind, rvr::ErrorKind::BadInput);
+      EXPECT_NE(got.find(it->error), std::string::npos)
+          << "expected \"" << it->error << "\" in: " << got;
+    }
   }
-  return count;
+  for (const Expect& e : table)
+    EXPECT_TRUE(seen.count(e.file)) << sub << "/" << e.file << " is missing";
 }
 
 }  // namespace
 
-// Each harness replays at least one regression input and one seed: an empty or missing folder
-// fails here instead of replaying nothing.
-TEST(FuzzRegressions, SceneInputsLoadOrFailCleanly) {
-  EXPECT_GE(replay("regressions/scene", false), 1u);
-  EXPECT_GE(replay("corpus/scene", false), 1u);
+// Each harness replays its regression inputs and its seeds, each against its expected outcome;
+// an empty or missing folder fails (its table's files are missing).
+TEST(FuzzRegressions, SceneInputsGiveTheirExpectedOutcome) {
+  replay("regressions/scene", false, kSceneRegressions);
+  replay("corpus/scene", false, kSceneSeeds);
 }
 
-TEST(FuzzRegressions, MeshInputsLoadOrFailCleanly) {
-  EXPECT_GE(replay("regressions/mesh", true), 1u);
-  EXPECT_GE(replay("corpus/mesh", true), 1u);
+TEST(FuzzRegressions, MeshInputsGiveTheirExpectedOutcome) {
+  replay("regressions/mesh", true, kMeshRegressions);
+  replay("corpus/mesh", true, kMeshSeeds);
 }
 
 // Every folder of regressions/ and corpus/ is a harness's: one named otherwise (a typo, a
@@ -83,21 +181,5 @@ TEST(FuzzRegressions, EveryFolderBelongsToAHarness) {
       const std::string name = e.path().filename().string();
       EXPECT_TRUE(e.is_directory() && (name == "scene" || name == "mesh")) << e.path();
     }
-  }
-}
-
-TEST(FuzzRegressions, ValidSeedsLoad) {
-  for (const char* name : {"full.json", "minimal.json", "gallery.json"}) {
-    std::vector<uint8_t> bytes =
-        read_bytes(fs::path(RVR_SOURCE_DIR) / "tests/fuzz/corpus/scene" / name);
-    rvr::Expected<rvr::Scene> s = rvr::fuzz::load_scene_text(dir(), bytes.data(), bytes.size());
-    EXPECT_TRUE(s.ok()) << name << ": " << (s.ok() ? "" : s.error().message);
-  }
-  for (const char* name : {"tri.obj", "tri.ply", "tri_binary.ply", "tri.gltf", "crystal.3ds",
-                           "tri.stl", "tri.off", "tri.glb"}) {
-    std::vector<uint8_t> bytes =
-        read_bytes(fs::path(RVR_SOURCE_DIR) / "tests/fuzz/corpus/mesh" / name);
-    rvr::Expected<rvr::Scene> s = rvr::fuzz::load_mesh_bytes(dir(), bytes.data(), bytes.size());
-    EXPECT_TRUE(s.ok()) << name << ": " << (s.ok() ? "" : s.error().message);
   }
 }

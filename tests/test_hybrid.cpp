@@ -14,9 +14,14 @@ using namespace rvr;
 namespace {
 
 // The contract, as the conformance suite's: ids may differ only where an edge falls
-// either way by a pixel; colour to 40 dB (a pixel whose id differs shades another surface).
+// either way by a pixel. Colour: the hybrid's image is the tracer's but for the few pixels whose
+// primary hit differs, which shade another surface. At 128x96 the worst scene measured is
+// cornell, 2 such pixels giving 52.3 dB (spheres 60.0, dof and glass 67, the rest identical);
+// each further such pixel adds its squared error, a third one taking cornell to 50.6 dB. 50 dB
+// allows that and no more: a whole-image shading error of 0.3% (1/255 off everywhere: 48 dB)
+// fails.
 constexpr double kMinAgreement = 0.999;
-constexpr double kMinPsnr = 40.0;
+constexpr double kMinPsnr = 50.0;
 
 // Every built-in scene at its default size parameter, shrunk to keep the suite fast.
 std::vector<std::string> scene_names() {

@@ -65,6 +65,7 @@ Classified classify_renders(const Scene& s, const FrameBuffers& full, const Fram
 
 struct Agreement {
   size_t compared = 0, agree = 0, shadowed = 0;
+  size_t disagree() const { return compared - agree; }
   double percent() const { return compared ? 100.0 * double(agree) / double(compared) : 0.0; }
 };
 
@@ -108,7 +109,16 @@ Classification classify_renderer(Renderer& r, const Scene& s) {
   return c;
 }
 
-TEST(ShadowAgreement, ShadowMapsVsShadowRaysOnCornellAgreeOnAtLeast98Percent) {
+// GL's 1024-texel shadow cubes against the tracer's shadow rays: they classify a pixel
+// differently only on a shadow's edge, where the map's texels (each covering a light-space
+// solid angle, and so a patch of floor or wall wider than a pixel there) put the edge up to a
+// texel away from where the rays find it. Measured at 640x480: 99.76% of 202,408 pixels agree
+// (about 490 differ). The count is the shadow edges' length in pixels times the texel's
+// footprint, fixed by the scene and map size, and varies only with how a driver rounds the
+// map's rasterization: kMinGlVsRaysPercent lets it grow by a quarter (to about 610 pixels).
+constexpr double kMinGlVsRaysPercent = 99.7;
+
+TEST(ShadowAgreement, ShadowMapsVsShadowRaysOnCornellAgreeOnShadowEdgesOnly) {
   Scene s = cornell_for_shadows();
   GlRasterizer raster;
   RayTracer tracer;
@@ -116,18 +126,23 @@ TEST(ShadowAgreement, ShadowMapsVsShadowRaysOnCornellAgreeOnAtLeast98Percent) {
   Classification rays = classify_renderer(tracer, s);
   Agreement a = agreement(gl.full, gl.classes, rays.full, rays.classes);
   std::printf(
-      "shadow agreement on builtin:cornell %dx%d: %.2f%% of %zu pixels (%zu not fully "
-      "lit by the tracer)\n",
-      gl.full.width, gl.full.height, a.percent(), a.compared, a.shadowed);
+      "shadow agreement on builtin:cornell %dx%d: %.3f%% of %zu pixels, %zu differ (%zu not "
+      "fully lit by the tracer)\n",
+      gl.full.width, gl.full.height, a.percent(), a.compared, a.disagree(), a.shadowed);
   EXPECT_GT(a.compared, gl.full.pixel_count() / 2);
   EXPECT_GT(a.shadowed, a.compared / 50);  // the test means something: there are shadows
-  EXPECT_GE(a.percent(), 98.0);
+  EXPECT_GE(a.percent(), kMinGlVsRaysPercent) << a.disagree() << " pixels differ";
 }
 
-// softraster's shadow cubes, drawn by its own z-buffer, against GL's (the same maps, bias and
-// lookup: >= 99.5% of pixels classify alike; what differs is rounding on shadow edges, where
-// the two z-buffers' maps differ by a texel) and against the tracer's shadow rays (at least as
-// well as GL's maps agree with them, less 0.2 points of such edge pixels). Also with PCF.
+// softraster's shadow cubes, drawn by its own z-buffer, against GL's: the same maps (size,
+// faces, bias, lookup), so a pixel classifies differently only where a map texel's depth test
+// comes out the other way in the two z-buffers: a texel centre on a map triangle's edge (a rule
+// tie) or a depth within rounding of the biased receiver's. Measured at 640x480: 1 pixel of
+// 202,408 differs (not traced to its texel); kMaxSoftVsGlDisagree allows one more such tie.
+// Against the tracer's shadow rays softraster's maps then agree as GL's do, give or take the
+// pixels where the two maps differ (measured: 483 differ against GL's 482).
+constexpr size_t kMaxSoftVsGlDisagree = 2;
+
 TEST(ShadowAgreement, SoftrasterShadowMapsAgreeWithGlAndWithShadowRays) {
   Scene s = cornell_for_shadows();
   GlRasterizer raster;
@@ -140,14 +155,23 @@ TEST(ShadowAgreement, SoftrasterShadowMapsAgreeWithGlAndWithShadowRays) {
   Agreement with_rays = agreement(ours.full, ours.classes, rays.full, rays.classes);
   Agreement gl_rays = agreement(gl.full, gl.classes, rays.full, rays.classes);
   std::printf(
-      "softraster shadow maps vs GL's: %.3f%% of %zu pixels; vs shadow rays: %.3f%% "
-      "(GL's vs shadow rays: %.3f%%)\n",
-      with_gl.percent(), with_gl.compared, with_rays.percent(), gl_rays.percent());
+      "softraster shadow maps vs GL's: %.3f%% of %zu pixels, %zu differ; vs shadow rays: %.3f%% "
+      "(%zu differ; GL's vs shadow rays: %.3f%%, %zu differ)\n",
+      with_gl.percent(), with_gl.compared, with_gl.disagree(), with_rays.percent(),
+      with_rays.disagree(), gl_rays.percent(), gl_rays.disagree());
   EXPECT_GT(with_gl.compared, ours.full.pixel_count() / 2);
   EXPECT_GT(with_gl.shadowed, with_gl.compared / 50);
-  EXPECT_GE(with_gl.percent(), 99.5);
-  EXPECT_GE(with_rays.percent(), gl_rays.percent() - 0.2);
+  EXPECT_LE(with_gl.disagree(), kMaxSoftVsGlDisagree);
+  EXPECT_LE(with_rays.disagree(), gl_rays.disagree() + with_gl.disagree());
+  EXPECT_GE(with_rays.disagree() + with_gl.disagree(), gl_rays.disagree());
 }
+
+// With 3x3 PCF a pixel's lit fraction is a count of nine texel tests; one test coming out the
+// other way in the two z-buffers (as above) moves it across a class boundary only from 9/9 to
+// 8/9 (lit to partial, 0.9) or 0/9 to 1/9 (shadowed to partial, 0.1), so differing pixels are
+// such ties, nine times as many chances per texel as without PCF. Measured: 4 of 202,408;
+// kMaxPcfDisagree allows twice that.
+constexpr size_t kMaxPcfDisagree = 8;
 
 TEST(ShadowAgreement, SoftrasterPcfAgreesWithGlPcf) {
   Scene s = cornell_for_shadows();
@@ -170,8 +194,9 @@ TEST(ShadowAgreement, SoftrasterPcfAgreesWithGlPcf) {
   Classification gl = classify_with(raster);
   Classification ours = classify_with(soft);
   Agreement a = agreement(ours.full, ours.classes, gl.full, gl.classes);
-  std::printf("softraster PCF vs GL PCF: %.3f%% of %zu pixels\n", a.percent(), a.compared);
-  EXPECT_GE(a.percent(), 99.5);
+  std::printf("softraster PCF vs GL PCF: %.3f%% of %zu pixels, %zu differ\n", a.percent(),
+              a.compared, a.disagree());
+  EXPECT_LE(a.disagree(), kMaxPcfDisagree);
 }
 
 // Where each renderer puts the edges of hard shadows, against the closed form. builtin:spheres
