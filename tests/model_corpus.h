@@ -370,6 +370,97 @@ inline std::string dae_cube(const DaeExtras& e) {
 )";
 }
 
+// The facet normal an ASCII STL file states for cube triangle t (cube_triangles()), by
+// facet_normal_kind(t): 'k' outward but tilted (0.25 added on the axis after the normal's own:
+// agrees with the winding, and differs from the geometric normal so that keeping it shows),
+// 'r' that tilted normal reversed (contradicts the winding; reversing it again is not the
+// geometric normal), 'z' zero (contradicts it too).
+inline char facet_normal_kind(size_t t) {
+  return t < 3 ? 'r' : t < 5 ? 'z' : 'k';
+}
+inline std::array<float, 3> cube_outward_normal(const std::array<int, 3>& t) {
+  auto a = cube_vertex(t[0]), b = cube_vertex(t[1]), c = cube_vertex(t[2]);
+  std::array<float, 3> e1{b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+      e2{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  return {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+          e1[0] * e2[1] - e1[1] * e2[0]};  // unit length: the cube's edges are 1 and square
+}
+inline std::array<float, 3> stated_facet_normal(size_t t) {
+  const std::array<float, 3> n = cube_outward_normal(cube_triangles()[t]);
+  std::array<float, 3> tilted = n;
+  for (int k = 0; k < 3; ++k) {
+    if (n[k] != 0.0f) {
+      tilted[(k + 1) % 3] += 0.25f;
+      break;
+    }
+  }
+  switch (facet_normal_kind(t)) {
+    case 'r':
+      return {-tilted[0], -tilted[1], -tilted[2]};
+    case 'z':
+      return {0.0f, 0.0f, 0.0f};
+    default:
+      return tilted;
+  }
+}
+// An ASCII STL of the cube with those facet normals, and (when `degenerate_facet`) a 13th
+// facet of zero area (its three vertices on one line).
+inline std::string ascii_stl_cube_with_stated_normals(bool degenerate_facet) {
+  std::string s = "solid stated\n";
+  auto tris = cube_triangles();
+  for (size_t t = 0; t < tris.size(); ++t) {
+    auto n = stated_facet_normal(t);
+    s += "  facet normal " + num(n[0]) + " " + num(n[1]) + " " + num(n[2]) + "\n    outer loop\n";
+    for (int i : tris[t]) {
+      auto p = cube_vertex(i);
+      s += "      vertex " + num(p[0]) + " " + num(p[1]) + " " + num(p[2]) + "\n";
+    }
+    s += "    endloop\n  endfacet\n";
+  }
+  if (degenerate_facet) {
+    s += "  facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 0.5 0 0\n"
+         "      vertex 1 0 0\n    endloop\n  endfacet\n";
+  }
+  return s + "endsolid stated\n";
+}
+
+// Collada 1.4 with a camera and no geometry (`light`: a point light too); Assimp's Collada
+// reader puts a placeholder skeleton mesh around the nodes of such a file.
+inline std::string dae_camera_only(bool light) {
+  std::string lights =
+      light ? R"(<library_lights><light id="lamp" name="lamp"><technique_common><point>
+    <color>1 1 1</color></point></technique_common></light></library_lights>)"
+            : "";
+  std::string lamp_node =
+      light ? R"(<node id="lamp-node" name="lamp-node"><translate>3 4 5</translate>
+      <instance_light url="#lamp"/></node>)"
+            : "";
+  return R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><up_axis>Y_UP</up_axis></asset>
+  <library_cameras><camera id="cam" name="cam"><optics><technique_common><perspective>
+    <yfov>40</yfov><aspect_ratio>1.5</aspect_ratio><znear>0.1</znear><zfar>100</zfar>
+  </perspective></technique_common></optics></camera></library_cameras>
+  )" + lights +
+         R"(
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="cam-node" name="cam-node"><translate>0.5 0.5 5</translate>
+      <instance_camera url="#cam"/></node>
+    )" + lamp_node +
+         R"(
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+}
+
+// glTF 2 with one perspective camera on one node and no meshes.
+inline std::string gltf_camera_only() {
+  return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+  "nodes": [{"camera": 0, "translation": [0.5, 0.5, 5]}],
+  "cameras": [{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1, "zfar": 100}}]})";
+}
+
 }  // namespace corpus
 
 }  // namespace rvr::test

@@ -17,7 +17,11 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
+#include <string>
 #include <thread>
+#include <vector>
+
+#include "model_corpus.h"
 
 namespace fs = std::filesystem;
 
@@ -311,6 +315,69 @@ TEST_F(Cli, NothingVisibleWarnsAndFailsTheAgreementThreshold) {
     EXPECT_NE(gated.err.find("nothing visible"), std::string::npos) << gated.err;
     fs::remove_all(dir_ / "plain");
     fs::remove_all(dir_ / "gated");
+  }
+}
+
+// Every scene loader warning reaches metrics.json (`warnings`), report.html and render --stats
+// beside the renderers', and stderr once: an STL whose facet normals contradict the winding,
+// with a zero-area facet (tests/model_corpus.h), and an OBJ whose material names a colour
+// texture (not sampled).
+TEST_F(Cli, LoaderWarningsReachMetricsReportAndStats) {
+  fs::path stl = write("stated.stl", rvr::test::corpus::ascii_stl_cube_with_stated_normals(true));
+  fs::path obj = write("tex.obj", rvr::test::corpus::obj_cube("mtllib tex.mtl\n", "paint"));
+  write("tex.mtl", "newmtl paint\nKd 0.8 0.5 0.2\nmap_Kd wood.png\n");
+  struct Case {
+    fs::path file;
+    std::vector<std::string> warnings;  // each starts with the file's path
+  };
+  for (const Case& c : {Case{stl,
+                             {": 5 facets have normals that contradict the winding",
+                              ": dropped 1 degenerate triangle"}},
+                        Case{obj, {": 1 mesh has colour textures, which are not sampled"}}}) {
+    SCOPED_TRACE(c.file.string());
+    fs::path out = dir_ / "cmp", stats = dir_ / "stats.json";
+    RunResult cmp = run("compare " + c.file.string() +
+                        " -r softraster,raytrace --width 32 --height 24 -o " + out.string());
+    ASSERT_EQ(cmp.status, 0) << cmp.err;
+    RunResult render = run("render " + c.file.string() + " -r raytrace --width 32 --height 24 -o " +
+                           (dir_ / "r.png").string() + " --stats " + stats.string());
+    ASSERT_EQ(render.status, 0) << render.err;
+    nlohmann::json metrics = nlohmann::json::parse(slurp(out / "metrics.json"));
+    nlohmann::json stat = nlohmann::json::parse(slurp(stats));
+    std::string html = slurp(out / "report.html");
+    for (const std::string& tail : c.warnings) {
+      const std::string w = c.file.string() + tail;
+      auto listed = [&](const nlohmann::json& list) {
+        return std::count_if(list.begin(), list.end(), [&](const nlohmann::json& x) {
+          return x.get<std::string>().rfind(w, 0) == 0;
+        });
+      };
+      EXPECT_EQ(listed(metrics["warnings"]), 1) << metrics["warnings"];
+      EXPECT_EQ(listed(stat["warnings"]), 1) << stat["warnings"];
+      EXPECT_NE(html.find("<li>" + w), std::string::npos) << w;
+      for (const std::string* err : {&cmp.err, &render.err}) {
+        size_t first = err->find("warning: " + w);
+        EXPECT_NE(first, std::string::npos) << *err;
+        EXPECT_EQ(err->find("warning: " + w, first + 1), std::string::npos) << *err;
+      }
+    }
+    fs::remove_all(out);
+  }
+}
+
+// A model file whose only mesh is Assimp's placeholder for a file with a camera alone: bad
+// input, one error line saying what the file holds, nothing written.
+TEST_F(Cli, ModelWithOnlyACameraIsExit2NoTriangles) {
+  fs::path dae = write("camera.dae", rvr::test::corpus::dae_camera_only(false));
+  for (const char* command : {"render", "compare"}) {
+    SCOPED_TRACE(command);
+    RunResult r = run(std::string(command) + " " + dae.string() + " -r raytrace" +
+                      (command[0] == 'c' ? ",softraster " : " ") + kSmall + " -o " +
+                      (dir_ / (command[0] == 'r' ? "out.png" : "cmp")).string());
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_EQ(r.err, "error: " + dae.string() +
+                         ": objects: no triangles (the file holds only 1 camera)\n");
+    EXPECT_TRUE(outputs({"camera.dae"}).empty());
   }
 }
 

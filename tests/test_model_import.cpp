@@ -477,4 +477,99 @@ TEST_F(ModelFiles, ModelContentIsRecognisedWhateverTheExtension) {
   EXPECT_EQ(s->triangle_count(), 12u);
 }
 
+// STL facet normals against the winding: facets 0-2 state a tilted outward normal reversed, 3-4 a
+// zero normal, the rest an outward normal tilted by 0.25 (corpus::stated_facet_normal). Assimp
+// hands every stated normal on as it is (the oracle, checked first); rvr shades the five that
+// contradict the winding with their geometric normal (e1 x e2 of the file's vertices, the
+// cube's outward normal) and keeps the seven that agree, normalised; the warning counts both
+// kinds. A zero-area facet is dropped, with its own warning.
+TEST_F(ModelFiles, StlFacetNormalsThatContradictTheWindingAreReplaced) {
+  std::string p = write("stated.stl", corpus::ascii_stl_cube_with_stated_normals(true));
+  const auto tris = corpus::cube_triangles();
+  {
+    Assimp::Importer importer;
+    const aiScene* ai = importer.ReadFile(p, 0);
+    ASSERT_TRUE(ai && ai->mNumMeshes == 1 && ai->mMeshes[0]->mNormals);
+    ASSERT_EQ(ai->mMeshes[0]->mNumFaces, tris.size() + 1);
+    for (size_t t = 0; t < tris.size(); ++t) {
+      auto want = corpus::stated_facet_normal(t);
+      const aiVector3D& got = ai->mMeshes[0]->mNormals[ai->mMeshes[0]->mFaces[t].mIndices[0]];
+      expect_near3({got.x, got.y, got.z}, {want[0], want[1], want[2]}, 0.0f);
+    }
+  }
+  rvr::Expected<rvr::Scene> loaded = rvr::load_scene(p);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  const rvr::Scene& s = *loaded;
+  ASSERT_EQ(s.objects.size(), 1u);
+  const rvr::TriangleMesh& mesh = s.objects[0].mesh;
+  ASSERT_EQ(mesh.triangles.size(), tris.size());
+  // Each loaded triangle is the cube triangle with the same corners, in the same order.
+  size_t matched = 0;
+  for (const glm::uvec3& lt : mesh.triangles) {
+    for (size_t t = 0; t < tris.size(); ++t) {
+      bool same = true;
+      for (int k = 0; k < 3; ++k) {
+        auto c = corpus::cube_vertex(tris[t][k]);
+        same = same && mesh.positions[lt[k]] == glm::vec3(c[0], c[1], c[2]);
+      }
+      if (!same) continue;
+      ++matched;
+      SCOPED_TRACE("facet " + std::to_string(t));
+      auto out = corpus::cube_outward_normal(tris[t]);
+      auto stated = corpus::stated_facet_normal(t);
+      glm::vec3 want = corpus::facet_normal_kind(t) == 'k'
+                           ? glm::normalize(glm::vec3(stated[0], stated[1], stated[2]))
+                           : glm::vec3(out[0], out[1], out[2]);
+      for (int k = 0; k < 3; ++k) expect_near3(mesh.normals[lt[k]], want, 1e-6f);
+    }
+  }
+  EXPECT_EQ(matched, tris.size());
+  std::string all;
+  for (const std::string& w : s.warnings) all += w + "\n";
+  EXPECT_NE(all.find(p + ": 5 facets have normals that contradict the winding (3 pointing "
+                         "against it, 2 zero or non-finite)"),
+            std::string::npos)
+      << all;
+  EXPECT_NE(all.find(p + ": dropped 1 degenerate triangle"), std::string::npos) << all;
+}
+
+// A file with a camera (and a light) and no geometry: Assimp's Collada reader makes a
+// placeholder skeleton mesh of its nodes and flags the scene incomplete (the oracle: Assimp on
+// its own returns triangles); its glTF reader makes no mesh. Either is refused as bad input
+// saying what the file holds, as a model file and as a mesh object of a scene file.
+TEST_F(ModelFiles, FileWithOnlyCamerasOrLightsHasNoTriangles) {
+  struct Case {
+    std::string name, text, holds;
+    bool placeholder;
+  };
+  for (const Case& c :
+       {Case{"camera.dae", corpus::dae_camera_only(false), "1 camera", true},
+        Case{"lit.dae", corpus::dae_camera_only(true), "1 camera and 1 light", true},
+        Case{"camera.gltf", corpus::gltf_camera_only(), "1 camera", false}}) {
+    SCOPED_TRACE(c.name);
+    std::string p = write(c.name, c.text);
+    {
+      Assimp::Importer importer;
+      const aiScene* ai = importer.ReadFile(p, aiProcess_Triangulate);
+      ASSERT_TRUE(ai) << importer.GetErrorString();
+      EXPECT_TRUE(ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE);
+      EXPECT_EQ(assimp_triangles(p) > 0, c.placeholder);
+    }
+    auto r = rvr::load_scene(p);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().kind, rvr::ErrorKind::BadInput);
+    EXPECT_EQ(r.error().message,
+              p + ": objects: no triangles (the file holds only " + c.holds + ")");
+    for (const char* material : {"", R"(, "material": "from_file")"}) {
+      auto o = rvr::parse_scene(R"({"camera":{"eye":[3,3,3],"target":[0,0,0],"up":[0,1,0]},)"
+                                R"("objects":[{"type":"mesh","file":")" +
+                                    c.name + "\"" + material + "}]}",
+                                "t.json", dir_.string());
+      ASSERT_FALSE(o.ok()) << material;
+      EXPECT_EQ(o.error().message, "t.json: objects[0].file: '" + c.name +
+                                       "': no triangles (the file holds only " + c.holds + ")");
+    }
+  }
+}
+
 }  // namespace

@@ -129,7 +129,9 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   report.out_dir = a.out_dir;
   report.heat_map_scale = compare.heat_map_scale;
   report.depth_diff_scale = compare.depth_diff_scale;
-  report.warnings = result.warnings;
+  // The scene loader's warnings (each names the file), then the comparison's.
+  report.warnings = scene.warnings;
+  report.warnings.insert(report.warnings.end(), result.warnings.begin(), result.warnings.end());
   for (const ComparedRenderer& c : result.renderers) {
     ReportRenderer r;
     r.name = c.name;
@@ -181,7 +183,7 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   for (const ReportRenderer& r : report.renderers)
     for (const std::string& w : r.warnings)
       std::fprintf(stderr, "warning: %s: %s\n", r.name.c_str(), w.c_str());
-  for (const std::string& w : report.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+  for (const std::string& w : result.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
   std::printf("%s  %dx%d  mode %s\n", scene.source.c_str(), scene.image.width, scene.image.height,
               report.mode.c_str());
   for (const ReportRenderer& r : report.renderers)

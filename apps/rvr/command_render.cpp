@@ -12,7 +12,9 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
@@ -88,7 +90,10 @@ int run_render(const RenderArgs& a) {
     for (const auto& [k, v] : out.stats) counters[k] = finite_or_null(v);
     j["stats"] = counters;
     j["info"] = out.info;
-    j["warnings"] = out.warnings;
+    // The scene loader's warnings (each names the file), then the renderer's.
+    std::vector<std::string> warnings = scene.warnings;
+    warnings.insert(warnings.end(), out.warnings.begin(), out.warnings.end());
+    j["warnings"] = warnings;
     j["peak_memory_bytes"] = peak_memory_bytes();
     // The scene's own vertex and index data, to read peak memory against.
     double scene_bytes = 0;

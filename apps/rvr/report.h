@@ -42,9 +42,11 @@ struct ReportInput {
   ComparisonMetrics metrics;              // of the first pair
   // Every pair compared, the first first; empty: one pair, the first two renderers, `metrics`.
   std::vector<ReportPair> pairs;
-  std::vector<std::string> warnings;  // about the comparison, e.g. an image with nothing visible
-  float heat_map_scale = 0.1f;        // colour difference at the top of diff.png's colour map
-  DepthDiffScale depth_diff_scale;    // relative depth difference at the ends of depth_diff.png
+  // The scene loader's (e.g. dropped degenerate triangles), then the comparison's (e.g. an
+  // image with nothing visible); each renderer's own are in `renderers`.
+  std::vector<std::string> warnings;
+  float heat_map_scale = 0.1f;      // colour difference at the top of diff.png's colour map
+  DepthDiffScale depth_diff_scale;  // relative depth difference at the ends of depth_diff.png
   std::string command_line;
   // Holds the images named here plus each pair's diff, depth_diff, id_mismatch and
   // mismatch_classes pictures.

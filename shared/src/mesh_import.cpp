@@ -19,9 +19,11 @@
 #include <cstring>
 #include <filesystem>
 #include <functional>
+#include <glm/glm.hpp>
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "allocation_budget.h"
@@ -367,6 +369,89 @@ void append_mesh(TriangleMesh& mesh, const aiScene* ai, unsigned m, bool normals
   }
 }
 
+// Whether the meshes of a freshly read scene are a placeholder an Assimp reader made rather
+// than the file's geometry: Assimp's SkeletonMeshBuilder puts one mesh of small pyramids around
+// the nodes of a file with no meshes (Collada, ASE, BVH, CSM, LWS, MD5, SMD: cameras, lights or
+// a skeleton alone). Its readers then flag the scene AI_SCENE_FLAGS_INCOMPLETE (all but BVH),
+// and the mesh has bones and takes the material the builder adds, "SkeletonMaterial", where the
+// file has none.
+bool placeholder_meshes(const aiScene* raw) {
+  if (raw->mNumMeshes == 0) return false;
+  if (raw->mFlags & AI_SCENE_FLAGS_INCOMPLETE) return true;
+  const aiMesh* am = raw->mMeshes[0];
+  if (raw->mNumMeshes != 1 || am->mNumBones == 0 || am->mMaterialIndex >= raw->mNumMaterials)
+    return false;
+  aiString name;
+  return raw->mMaterials[am->mMaterialIndex]->Get(AI_MATKEY_NAME, name) == AI_SUCCESS &&
+         std::strcmp(name.C_Str(), "SkeletonMaterial") == 0;
+}
+
+// What a freshly read scene holds besides meshes, e.g. {"1 camera", "2 lights"} (read before
+// post-processing, which may drop animations).
+std::vector<std::string> other_contents(const aiScene* raw) {
+  std::vector<std::string> items;
+  auto count = [&](size_t n, const char* one, const char* many) {
+    if (n > 0) items.push_back(fmt::format("{} {}", n, n == 1 ? one : many));
+  };
+  count(raw->mNumCameras, "camera", "cameras");
+  count(raw->mNumLights, "light", "lights");
+  count(raw->mNumAnimations, "animation", "animations");
+  return items;
+}
+
+// Refuses a file with no triangles of its own: "no triangles (the file holds only ...)", with
+// what it holds instead (`contents`, and its point and line primitives), on `path` for a mesh
+// object of a scene file, on "objects" for a model file given as the scene.
+[[noreturn]] void fail_no_triangles(std::vector<std::string> contents, size_t point_line_primitives,
+                                    const std::string& file, const std::string& path) {
+  if (point_line_primitives > 0) {
+    contents.push_back(fmt::format("{} point/line primitive{}", point_line_primitives,
+                                   point_line_primitives == 1 ? "" : "s"));
+  }
+  std::string holds = contents.empty() ? "empty nodes" : contents[0];
+  for (size_t i = 1; i < contents.size(); ++i)
+    holds += (i + 1 == contents.size() ? " and " : ", ") + contents[i];
+  std::string what = "no triangles (the file holds only " + holds + ")";
+  if (path.empty()) fail("objects", what);
+  fail(path, quote_json(file) + ": " + what);
+}
+
+// Facet normals of an STL file that contradict the facet's winding: the normal points to the
+// side the vertices turn clockwise on (normal . (e1 x e2) < 0, e1 and e2 the edges from the
+// first vertex), or is zero or non-finite. Such facets are shaded with their geometric normal
+// (the winding's, which the STL format defines as pointing out), counted in `opposite` and
+// `zero`. Assimp's STL reader gives each corner of a facet the facet's normal as written;
+// degenerate facets are left alone (finish_mesh drops them).
+void replace_contradicting_facet_normals(TriangleMesh& mesh, size_t* opposite, size_t* zero) {
+  if (mesh.normals.size() != mesh.positions.size()) return;
+  std::vector<uint32_t> uses(mesh.positions.size(), 0);
+  for (const glm::uvec3& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) ++uses[t[k]];
+  for (glm::uvec3& t : mesh.triangles) {
+    const glm::vec3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
+    if (degenerate(a, b, c)) continue;
+    const glm::vec3 n = mesh.normals[t.x];
+    const glm::dvec3 g = glm::cross(glm::dvec3(b) - glm::dvec3(a), glm::dvec3(c) - glm::dvec3(a));
+    if (finite(n) && glm::length(n) > 0.0f) {
+      if (glm::dot(glm::dvec3(n), g) >= 0.0) continue;
+      ++*opposite;
+    } else {
+      ++*zero;
+    }
+    const glm::vec3 geometric(glm::normalize(g));
+    for (int k = 0; k < 3; ++k) {
+      if (uses[t[k]] > 1) {  // shared with another facet: this facet gets a vertex of its own
+        --uses[t[k]];
+        mesh.positions.push_back(mesh.positions[t[k]]);
+        mesh.normals.push_back(geometric);
+        t[k] = uint32_t(mesh.positions.size() - 1);
+      } else {
+        mesh.normals[t[k]] = geometric;
+      }
+    }
+  }
+}
+
 // Merges vertices whose position and normal are the same bits, renumbering the triangles;
 // first occurrences keep their order. Stands in for aiProcess_JoinIdenticalVertices on model
 // files: Assimp's OBJ reader makes one vertex per face corner, and Assimp's join (which also
@@ -555,16 +640,19 @@ void read_lights(const aiScene* ai, ImportedModel& model) {
 TriangleMesh import_mesh_here(const fs::path& full, const std::string& file,
                               const std::string& path, bool smooth, size_t* skipped_primitives) {
   Assimp::Importer importer;
-  read_checked(importer, full, file, path);
+  const aiScene* raw = read_checked(importer, full, file, path);
+  const bool placeholder = placeholder_meshes(raw);
+  const std::vector<std::string> contents = other_contents(raw);
   unsigned flags =
       aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
   if (smooth) flags |= aiProcess_GenSmoothNormals;  // ignored where the file has normals
   const aiScene* ai = post_process(importer, flags, file, path);
   TriangleMesh mesh;
   for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
+    if (placeholder) continue;
     append_mesh(mesh, ai, m, smooth, file, path, skipped_primitives);
   }
-  if (mesh.triangles.empty()) fail(path, quote_json(file) + " contains no triangles");
+  if (mesh.triangles.empty()) fail_no_triangles(contents, *skipped_primitives, file, path);
   return mesh;
 }
 
@@ -573,6 +661,8 @@ ImportedModel import_model_here(const fs::path& full, const std::string& file,
   Assimp::Importer importer;
   ImportedModel model;
   const aiScene* raw = read_checked(importer, full, file, path);
+  const bool placeholder = placeholder_meshes(raw);
+  const std::vector<std::string> contents = other_contents(raw);
   // Cameras and lights hang off nodes, whose transforms PreTransformVertices removes: read
   // them first.
   std::string ext = full.extension().string();
@@ -590,19 +680,28 @@ ImportedModel import_model_here(const fs::path& full, const std::string& file,
                                    aiProcess_Triangulate | aiProcess_PreTransformVertices |
                                        (vertex_colours ? aiProcess_JoinIdenticalVertices : 0u),
                                    file, path);
-  size_t textured = 0;
-  for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
+  size_t textured = 0, opposite_normals = 0, zero_normals = 0;
+  const bool stl = ext == ".stl";
+  for (unsigned m = 0; m < ai->mNumMeshes && !placeholder; ++m) {
     const aiMesh* am = ai->mMeshes[m];
     ModelPart part;
     part.name = am->mName.length > 0 ? am->mName.C_Str() : fmt::format("mesh{}", m);
     append_mesh(part.mesh, ai, m, am->mNormals != nullptr, file, path, &model.skipped_primitives);
     if (part.mesh.triangles.empty()) continue;
+    if (stl) replace_contradicting_facet_normals(part.mesh, &opposite_normals, &zero_normals);
     weld_identical_vertices(part.mesh);
     part.material = part_material(ai, am, &part.textured);
     textured += part.textured;
     model.parts.push_back(std::move(part));
   }
-  if (model.parts.empty()) fail(path, quote_json(file) + " contains no triangles");
+  if (model.parts.empty()) fail_no_triangles(contents, model.skipped_primitives, file, path);
+  if (opposite_normals + zero_normals > 0) {
+    size_t n = opposite_normals + zero_normals;
+    model.warnings.push_back(fmt::format(
+        "{} facet{} normals that contradict the winding ({} pointing against it, {} zero or "
+        "non-finite): shaded with the facets' geometric normals",
+        n, n == 1 ? " has" : "s have", opposite_normals, zero_normals));
+  }
   if (textured > 0) {
     model.warnings.push_back(fmt::format(
         "{} mesh{} colour textures, which are not sampled: rendered with the base colour factor",

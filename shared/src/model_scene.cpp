@@ -133,7 +133,7 @@ Expected<Scene> load_model_scene(const std::string& path, const SceneOverrides& 
   try {
     return scene_load::build_model_scene(path, overrides);
   } catch (const scene_load::LoadError& e) {
-    return bad_input(path + ": " + e.what);
+    return bad_input(path + ": " + (e.path.empty() ? "" : e.path + ": ") + e.what);
   } catch (const std::bad_alloc&) {
     return internal_error(path + ": out of memory while loading the model");
   } catch (const std::exception& e) {
