@@ -270,6 +270,31 @@ TEST(StudyModelChoice, AChangeOfSlopeIsFoundAtItsKnee) {
         << ", " << f.coefficients[j].ci95.high << "]";
 }
 
+// Along depth complexity D (occluders), a z-buffer shades and tests P·D fragments: the textbook
+// form there has d·P·D, recovered within its interval from data that have it.
+TEST(StudyModelChoice, DepthComplexityAddsTheFragmentTerm) {
+  const std::vector<double> truth = {1e-3, 8e-9, 20e-6, 3e-9};  // a, b, c, d
+  CostFn cost = [&](double p, double d) {
+    return truth[0] + truth[1] * p + truth[2] * d + truth[3] * p * d;
+  };
+  Rng rng(29);
+  std::vector<Measurement> points;
+  for (double p : {256.0 * 192, 512.0 * 384, kP})
+    for (size_t d : log_spaced(1, 256, 9))
+      points.push_back(synthetic("r", cost, p, double(d), 5, 0.03, rng));
+  CostModel textbook(ModelForm::ZBuffer);
+  textbook.depth = true;
+  ModelFit f = fit_chosen_model(textbook, points, {1000, 1});
+  ASSERT_TRUE(f.fits) << f.verdict;
+  EXPECT_NE(f.formula.find("d·P·D"), std::string::npos) << f.formula;
+  ASSERT_EQ(f.coefficients.size(), 4u) << f.formula;
+  EXPECT_EQ(f.coefficients[3].name, "d");
+  for (size_t j = 0; j < truth.size(); ++j)
+    EXPECT_TRUE(covers(f.coefficients[j], truth[j]))
+        << f.coefficients[j].name << " = " << truth[j] << " not in [" << f.coefficients[j].ci95.low
+        << ", " << f.coefficients[j].ci95.high << "]";
+}
+
 namespace {
 
 // softraster's and raytrace's costs crossing at a known N, on one curve each.

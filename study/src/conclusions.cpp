@@ -54,6 +54,14 @@ std::vector<double> pixel_sweep_columns(const StudyResult& r, const std::string&
   return out;
 }
 
+// The textbook form of a loop order for a family's axis: with the fragments' P·D term where the
+// axis is depth complexity.
+CostModel textbook_model(ModelForm form, const std::string& axis) {
+  CostModel m(form);
+  m.depth = axis == "depth";
+  return m;
+}
+
 LoopOrder order_of(const std::string& renderer) {
   Expected<RendererChoice> c = find_renderer_choice(renderer);
   return c ? c->info->order : LoopOrder::TriangleMajor;
@@ -66,7 +74,8 @@ void fit_models(StudyResult& r, const BootstrapOptions& boot) {
     m.loop_order = short_name(order_of(name));
     m.form = model_form_of(name);
     for (const std::string& scene : r.scenes)
-      m.fits[scene] = fit_chosen_model(m.form, points_of(r, name, scene), boot);
+      m.fits[scene] =
+          fit_chosen_model(textbook_model(m.form, r.axes[scene]), points_of(r, name, scene), boot);
     r.models.push_back(m);
   }
 }

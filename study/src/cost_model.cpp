@@ -37,6 +37,8 @@ const char* to_string(ModelForm form) {
 
 std::string formula(const CostModel& model) {
   std::string text = textbook_formula(model.form);
+  if (model.depth && model.form == ModelForm::ZBuffer) text += " + d·P·D";
+  if (model.depth && model.form == ModelForm::Hybrid) text += " + g·P·D";
   if (model.edges) text += " + e·√(P·N)";
   if (model.knee > 0) {
     std::string knee = format_number(model.knee);
@@ -49,6 +51,8 @@ std::string formula(const CostModel& model) {
 std::vector<std::string> coefficient_names(const CostModel& model) {
   std::vector<std::string> names = {"a", "b", "c"};
   if (model.form == ModelForm::Hybrid) names.push_back("d");
+  if (model.depth && model.form != ModelForm::Tracer)
+    names.push_back(model.form == ModelForm::ZBuffer ? "d" : "g");
   if (model.edges) names.push_back("e");
   if (model.knee > 0) names.push_back("f");
   return names;
@@ -68,6 +72,7 @@ std::vector<double> features(const CostModel& model, double pixels, double n) {
       x = {1.0, pixels, n, pixels * tree_levels};
       break;
   }
+  if (model.depth && model.form != ModelForm::Tracer) x.push_back(pixels * n);
   if (model.edges) x.push_back(std::sqrt(pixels * n));
   if (model.knee > 0) {
     x.push_back(model.form == ModelForm::Tracer

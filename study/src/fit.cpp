@@ -133,25 +133,35 @@ double predict_seconds(const ModelFit& fit, double pixels, double n) {
   return predict(fit.model, coefficient_values(fit), pixels, n);
 }
 
-std::vector<CostModel> candidate_models(ModelForm form, const std::vector<Measurement>& points) {
+std::vector<CostModel> candidate_models(const CostModel& textbook,
+                                        const std::vector<Measurement>& points) {
   std::set<double> distinct;
   for (const Measurement& p : points) distinct.insert(p.n);
   std::vector<double> ns(distinct.begin(), distinct.end());
-  std::vector<CostModel> out = {CostModel(form), CostModel(form, true, 0)};
-  for (size_t i = 2; i + 2 < ns.size(); ++i) out.push_back(CostModel(form, false, ns[i]));
-  for (size_t i = 2; i + 2 < ns.size(); ++i) out.push_back(CostModel(form, true, ns[i]));
+  auto with = [&](bool edges, double knee) {
+    CostModel m = textbook;
+    m.edges = edges;
+    m.knee = knee;
+    return m;
+  };
+  std::vector<CostModel> out = {with(false, 0), with(true, 0)};
+  for (size_t i = 2; i + 2 < ns.size(); ++i) out.push_back(with(false, ns[i]));
+  for (size_t i = 2; i + 2 < ns.size(); ++i) out.push_back(with(true, ns[i]));
   return out;
 }
 
-ModelFit fit_chosen_model(ModelForm form, const std::vector<Measurement>& points,
+ModelFit fit_chosen_model(const CostModel& textbook, const std::vector<Measurement>& points,
                           const BootstrapOptions& boot, const FitThresholds& limits) {
   std::vector<double> medians;
   for (const Measurement& p : points) medians.push_back(typical_seconds(p));
-  const size_t enough = coefficient_names(CostModel(form, true, 1)).size() + 2;
+  CostModel widest = textbook;
+  widest.edges = true;
+  widest.knee = 1;
+  const size_t enough = coefficient_names(widest).size() + 2;
   auto extensions = [](const CostModel& m) { return int(m.edges) + int(m.knee > 0); };
   // The best candidate of each tier (number of extensions), by mean leave-one-out error.
-  std::vector<std::pair<CostModel, double>> best(3, {CostModel(form), kInfinity});
-  for (const CostModel& m : candidate_models(form, points)) {
+  std::vector<std::pair<CostModel, double>> best(3, {textbook, kInfinity});
+  for (const CostModel& m : candidate_models(textbook, points)) {
     if (m.extended() && points.size() < enough) continue;
     double loo =
         leave_one_out(m, points, medians, identifiable_terms(m, points)).loo_mean_rel_error;

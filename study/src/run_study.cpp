@@ -312,11 +312,10 @@ Status Sweep::measure_busy_points_again(const Family& family, double share_end) 
     ++again;
   }
   if (again > 0)
-    result_.notes.push_back(
-        fmt::format("{}: {} {} measured while the machine was busy with something else {} "
-                    "measured again",
-                    family.name, again, again == 1 ? "point" : "points",
-                    again == 1 ? "was" : "were"));
+    result_.notes.push_back(fmt::format(
+        "{}: {} {} measured while the machine was busy with something else {} "
+        "measured again",
+        family.name, again, again == 1 ? "point" : "points", again == 1 ? "was" : "were"));
   size_t still = 0;
   double worst = 0;
   for (const Measurement& m : result_.points)

@@ -2,7 +2,9 @@
 //   z-buffer  t = a + b·P + c·N            (setup, per pixel, per triangle)
 //   tracer    t = a + P·(b + c·log2 N)     (setup, per ray, per ray and level of the tree)
 //   hybrid    t = a + b·P + c·N + d·P·log2 N   (the sum of both; the two per-pixel terms are one)
-// P is the pixel count (primary rays), N the swept axis (triangles). Two extensions, added only
+// P is the pixel count (primary rays), N the swept axis (triangles). Where N is depth complexity
+// D (the occluders family), the z-buffers' fragments add d·P·D (g·P·D for the hybrid, whose d
+// is taken). Two extensions, added only
 // where the data demand them (fit.h chooses by leave-one-out error):
 //   edges  + e·√(P·N): N triangles sharing a fixed part of the screen have edges of total length
 //          ∝ N·√(P/N) = √(P·N) pixels; work per edge pixel or per tile an edge crosses (the
@@ -23,6 +25,7 @@ struct CostModel {
   ModelForm form = ModelForm::ZBuffer;
   bool edges = false;  // the e·√(P·N) term
   double knee = 0;     // > 0: the knee term, its change of slope at N = knee
+  bool depth = false;  // N is depth complexity: the z-buffers' d·P·D (g for the hybrid)
 
   CostModel() = default;
   CostModel(ModelForm f) : form(f) {}  // NOLINT: the textbook form, implicitly

@@ -64,12 +64,13 @@ ModelFit fit_model(const CostModel& model, const std::vector<Measurement>& point
 
 // The models a form may be extended to for these points: the textbook form, + edges, + a
 // knee at each measured N with at least two points on either side, + both.
-std::vector<CostModel> candidate_models(ModelForm form, const std::vector<Measurement>& points);
+std::vector<CostModel> candidate_models(const CostModel& textbook,
+                                        const std::vector<Measurement>& points);
 
 // The textbook form unless the data demand an extension: each more complex tier (one
 // extension, then both) is taken when its best candidate lowers the mean leave-one-out error
 // by limits.min_extension_gain; then fitted as fit_model does, `selection` saying why.
-ModelFit fit_chosen_model(ModelForm form, const std::vector<Measurement>& points,
+ModelFit fit_chosen_model(const CostModel& textbook, const std::vector<Measurement>& points,
                           const BootstrapOptions& boot, const FitThresholds& limits = {});
 
 // The coefficients as fitted (b, when folded into a, as 0): for predict().
