@@ -109,14 +109,14 @@ void add_extrapolated(StudyResult& r, const Dominance& d) {
   r.crossovers.push_back(c);
 }
 
-// Every pair of renderers of different loop orders, along N at the full width and along the
-// pixel count at each N of the pixel sweep.
+// Every pair the study compares, along N at the full width and along the pixel count at each N
+// of the pixel sweep.
 void compare_pairs(StudyResult& r, const BootstrapOptions& boot) {
   for (const std::string& scene : r.scenes)
     for (size_t i = 0; i < r.renderers.size(); ++i)
       for (size_t j = i + 1; j < r.renderers.size(); ++j) {
         const std::string &a = r.renderers[i], &b = r.renderers[j];
-        if (order_of(a) == order_of(b)) continue;
+        if (!compared_pair(a, b)) continue;
         CurveComparison c =
             compare_curves(along_n(r, a, scene), along_n(r, b, scene), r.axes[scene], boot);
         for (const Crossover& x : c.crossovers) r.crossovers.push_back(x);
@@ -187,6 +187,15 @@ void unit_costs(StudyResult& r) {
 }
 
 }  // namespace
+
+// Whether the study compares two renderers: of different loop orders, or one renderer and its
+// variant (softraster and softraster_nohiz: what hierarchical z saves; raytrace and
+// raytrace_bvh2).
+bool compared_pair(const std::string& a, const std::string& b) {
+  Expected<RendererChoice> ca = find_renderer_choice(a), cb = find_renderer_choice(b);
+  if (!ca || !cb) return false;
+  return ca->info->order != cb->info->order || ca->info == cb->info;
+}
 
 ModelForm model_form_of(const std::string& renderer) {
   switch (order_of(renderer)) {

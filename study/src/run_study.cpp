@@ -222,7 +222,7 @@ std::vector<size_t> Sweep::crossover_midpoints(const Family& family) const {
   for (size_t i = 0; i < request_.renderers.size(); ++i)
     for (size_t j = i + 1; j < request_.renderers.size(); ++j) {
       const std::string &a = request_.renderers[i], &b = request_.renderers[j];
-      if (find_renderer_choice(a)->info->order == find_renderer_choice(b)->info->order) continue;
+      if (!compared_pair(a, b)) continue;
       for (auto it = t.begin(); it != t.end() && std::next(it) != t.end(); ++it) {
         auto next = std::next(it);
         bool before = it->second.at(a) < it->second.at(b);

@@ -11,6 +11,10 @@
 
 namespace rvr::study {
 
+// Whether the study compares two renderers: of different loop orders, or one renderer and its
+// variant (softraster and softraster_nohiz: what hierarchical z saves).
+bool compared_pair(const std::string& a, const std::string& b);
+
 // The model form of a renderer in the table, by its loop order.
 ModelForm model_form_of(const std::string& renderer);
 
