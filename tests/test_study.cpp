@@ -857,6 +857,54 @@ TEST(StudyJsonRead, RoundTripsEveryFieldConcludeNeeds) {
   EXPECT_FALSE(read_back(r).shard.has_value());
 }
 
+// The hybrid's z-buffer/trace split: the medians of each phase's repetitions at the smallest and
+// largest N at full width, kept through study.json and read back.
+TEST(StudyConclusions, TheHybridsSplitIsTheMedianOfEachPhase) {
+  StudyResult r;
+  r.scenes = {"tessphere"};
+  r.renderers = {"softraster", "hybrid_soft"};
+  r.axes["tessphere"] = "triangles";
+  r.width = 1024;
+  r.height = 768;
+  r.repetitions = 5;
+  r.bootstrap_replicates = 50;
+  r.mode = "local";
+  r.budget_seconds = 10;
+  r.seed = 1;
+  for (double n : {100.0, 10000.0, 1000000.0})
+    for (const std::string& name : r.renderers) {
+      Measurement m;
+      m.renderer = name;
+      m.scene = "tessphere";
+      m.scene_n = m.n = n;
+      m.width = 1024;
+      m.height = 768;
+      m.pixels = kP;
+      m.seconds = {5e-3, 6e-3, 7e-3, 8e-3, 9e-3};
+      m.order = {0, 1, 0, 1, 0};
+      if (name == "hybrid_soft") {
+        m.phases["zbuffer"] = {1e-3, 3e-3, 2e-3, 5e-3, 4e-3};  // median 3 ms
+        m.phases["trace"] = {2e-3, 1e-3, 3e-3, 1e-3, 6e-3};    // median 2 ms
+      }
+      r.points.push_back(m);
+    }
+  conclude(r, {50, 1});
+  ASSERT_EQ(r.splits.size(), 2u);
+  EXPECT_EQ(r.splits[0].renderer, "hybrid_soft");
+  EXPECT_EQ(r.splits[0].n, 100.0);
+  EXPECT_EQ(r.splits[1].n, 1000000.0);
+  EXPECT_DOUBLE_EQ(r.splits[0].zbuffer_seconds, 3e-3);
+  EXPECT_DOUBLE_EQ(r.splits[0].trace_seconds, 2e-3);
+  EXPECT_DOUBLE_EQ(r.splits[0].zbuffer_share, 0.6);
+  Expected<StudyResult> back = read_study_json(study_json(r), "split.json");
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  StudyResult again = *back;
+  conclude(again, {50, 1});
+  ASSERT_EQ(again.splits.size(), 2u);
+  EXPECT_DOUBLE_EQ(again.splits[1].zbuffer_share, 0.6);
+  EXPECT_NE(study_markdown(r).find("(60% z-buffer)"), std::string::npos) << study_markdown(r);
+}
+
 TEST(StudyJsonRead, RefusesMalformedInputNamingFileAndPath) {
   StudyResult r = synthetic_study(32);
   conclude(r, {50, 1});

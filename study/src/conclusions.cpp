@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -227,11 +228,35 @@ bool is_conclusion_note(const std::string& note) {
   return note.find(kTieWords) != std::string::npos;
 }
 
+namespace {
+
+// The hybrids' z-buffer/trace split at the smallest and largest N at full width.
+void phase_splits(StudyResult& r) {
+  for (const std::string& name : r.renderers)
+    for (const std::string& scene : r.scenes) {
+      std::vector<Measurement> p = along_n(r, name, scene);
+      std::erase_if(p, [](const Measurement& m) {
+        return !m.phases.count("zbuffer") || !m.phases.count("trace");
+      });
+      if (p.empty()) continue;
+      auto by_n = [](const Measurement& x, const Measurement& y) { return x.n < y.n; };
+      for (const Measurement* m : {&*std::min_element(p.begin(), p.end(), by_n),
+                                   &*std::max_element(p.begin(), p.end(), by_n)}) {
+        const double z = median(m->phases.at("zbuffer")), t = median(m->phases.at("trace"));
+        r.splits.push_back({name, scene, m->n, m->pixels, z, t, z + t > 0 ? z / (z + t) : 0});
+        if (p.size() == 1) break;
+      }
+    }
+}
+
+}  // namespace
+
 void conclude(StudyResult& result, const BootstrapOptions& boot) {
   fit_models(result, boot);
   compare_pairs(result, boot);
   scaling(result);
   unit_costs(result);
+  phase_splits(result);
 }
 
 }  // namespace rvr::study

@@ -43,13 +43,20 @@ class RendererFrames : public FrameSource {
     Expected<RenderOutput> out = prepared_[index]->render();
     auto end = std::chrono::steady_clock::now();
     if (!out) return out.error();
+    last_phases_.clear();
+    for (const auto& [stat, phase] :
+         {std::pair{"time.zbuffer", "zbuffer"}, {"time.trace", "trace"}})
+      if (auto it = out->stats.find(stat); it != out->stats.end()) last_phases_[phase] = it->second;
     return std::chrono::duration<double>(end - start).count();
   }
+
+  std::map<std::string, double> last_phases() const override { return last_phases_; }
 
  private:
   std::unique_ptr<Scene> scene_;  // before prepared_: they hold references to it
   double axis_;
   std::vector<std::unique_ptr<PreparedRenderer>> prepared_;
+  std::map<std::string, double> last_phases_;
 };
 
 // builtin:<family>:<n>, or n copies of the family's file, at width × width·3/4.

@@ -174,6 +174,8 @@ void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, dou
       }
       points[order[k]].seconds.push_back(*t);
       points[order[k]].order.push_back(int(k));
+      for (const auto& [phase, seconds] : frames.last_phases())
+        points[order[k]].phases[phase].push_back(seconds);
     }
     if (Expected<double> t = time_reference(); !t) status = t.error();
   }

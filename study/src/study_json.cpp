@@ -108,9 +108,29 @@ void conclusions_json(const StudyResult& r, json& doc) {
                       {"ratio", number(c.ratio)},
                       {"holds", c.holds}});
   doc["checks"] = checks;
+  json splits = json::array();
+  for (const PhaseSplit& s : r.splits)
+    splits.push_back({{"renderer", s.renderer},
+                      {"scene", s.scene},
+                      {"n", s.n},
+                      {"pixels", s.pixels},
+                      {"zbuffer_seconds", number(s.zbuffer_seconds)},
+                      {"trace_seconds", number(s.trace_seconds)},
+                      {"zbuffer_share", number(s.zbuffer_share)}});
+  doc["splits"] = splits;
   doc["dominance"] = dominance;
   doc["scaling"] = scaling;
   doc["costs"] = costs;
+}
+
+json phases_json(const Measurement& m) {
+  json out = json::object();
+  for (const auto& [phase, seconds] : m.phases) {
+    json values = json::array();
+    for (double s : seconds) values.push_back(number(s));
+    out[phase] = values;
+  }
+  return out;
 }
 
 json points_json(const StudyResult& r) {
@@ -131,6 +151,7 @@ json points_json(const StudyResult& r) {
                    {"hd_median", number(typical_seconds(m))},
                    {"relative_mad", number(relative_mad(m))},
                    {"reference_ratio", number(m.reference_ratio)},
+                   {"phases", phases_json(m)},
                    {"busy", m.busy}});
   }
   return out;

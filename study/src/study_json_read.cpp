@@ -127,10 +127,11 @@ const std::vector<std::string> kTopKeys = {
     "elapsed_seconds", "repetitions", "seed",       "bootstrap_replicates",
     "machine",         "renderers",   "crossovers", "dominance",
     "scaling",         "costs",       "checks",     "notes",
-    "interrupted",     "shard",       "points"};
+    "interrupted",     "shard",       "points",     "splits"};
 const std::vector<std::string> kPointKeys = {
-    "renderer", "scene", "scene_n", "n",         "width",        "height",          "pixels",
-    "seconds",  "order", "median",  "hd_median", "relative_mad", "reference_ratio", "busy"};
+    "renderer",  "scene",        "scene_n",         "n",     "width",
+    "height",    "pixels",       "seconds",         "order", "median",
+    "hd_median", "relative_mad", "reference_ratio", "busy",  "phases"};
 
 // A family is a built-in (its axis fixed) or a file grown by copies (axis "triangles").
 void read_scenes(const Fields& top, StudyResult& r) {
@@ -222,6 +223,7 @@ void check_conclusions(const Fields& top) {
   // Prediction checks tested the crossovers of the study as it was: not carried to one
   // concluded again. Studies written before them have none.
   if (top.has("checks")) top.array("checks");
+  if (top.has("splits")) top.array("splits");
 }
 
 std::vector<double> seconds_of(const json& values, const std::string& path) {
@@ -258,6 +260,14 @@ Measurement read_point(const json& v, const std::string& path, const StudyResult
   // Studies written before the reference frame have neither: measured as if quiet.
   if (p.has("reference_ratio")) m.reference_ratio = p.number_or_nan("reference_ratio");
   if (p.has("busy")) m.busy = p.boolean("busy");
+  if (p.has("phases"))
+    for (const auto& item : p.object("phases").items()) {
+      const std::string where = p.path("phases") + "." + item.key();
+      m.phases[item.key()] = seconds_of(item.value(), where);
+      if (m.phases[item.key()].size() != m.seconds.size())
+        fail(where, fmt::format("must have one entry per repetition ({}), got {}", m.seconds.size(),
+                                m.phases[item.key()].size()));
+    }
   return m;
 }
 

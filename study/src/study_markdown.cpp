@@ -145,6 +145,15 @@ std::string study_markdown(const StudyResult& r) {
         "and three times its value:\n\n";
     for (const PredictionCheck& c : r.checks) text += "- " + check_sentence(c) + "\n";
   }
+  if (!r.splits.empty()) {
+    text += "\n## The hybrids' split\n\n";
+    for (const PhaseSplit& s : r.splits)
+      text += fmt::format(
+          "- {} on {} at {} {}: z-buffer pass {} ms, the tracer's part {} ms ({:.0f}% z-buffer).\n",
+          s.renderer, s.scene, format_number(s.n), r.axes.at(s.scene),
+          format_number(1e3 * s.zbuffer_seconds), format_number(1e3 * s.trace_seconds),
+          100 * s.zbuffer_share);
+  }
   text += "\n## Cost models\n\n";
   for (const RendererModels& m : r.models)
     for (const auto& [scene, f] : m.fits) text += "- " + model_sentence(m, scene, f) + "\n";

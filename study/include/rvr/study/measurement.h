@@ -1,6 +1,7 @@
 // One measured point of a study: a renderer's frame of one scene size, timed several times.
 #pragma once
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,9 @@ struct Measurement {
   // family so far: how much busier the machine was than at its quietest (run_study.h).
   double reference_ratio = 0;
   bool busy = false;  // reference_ratio over kBusyRatio: left out of fits and crossovers
+  // Per repetition, the seconds of each phase the renderer reports: the hybrids' "zbuffer" and
+  // "trace" passes (RenderOutput::stats time.zbuffer, time.trace); empty for the others.
+  std::map<std::string, std::vector<double>> phases;
 };
 
 // A point whose reference frame ran this much slower than its quickest was measured on a

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -52,6 +53,8 @@ class FrameSource {
   virtual double pixels() const = 0;
   // The wall time of one frame of renderer `index` (in the request's order).
   virtual Expected<double> time_frame(size_t index) = 0;
+  // The phases of the last frame timed, in seconds ("zbuffer", "trace" for the hybrids).
+  virtual std::map<std::string, double> last_phases() const { return {}; }
 };
 
 // Makes the FrameSource of builtin:<family>:<n> (or n copies of the family's file) at

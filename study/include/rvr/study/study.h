@@ -59,6 +59,14 @@ struct PredictionCheck {
   bool holds = false;
 };
 
+// A hybrid's frame split into its z-buffer pass and its tracer's part, at one point.
+struct PhaseSplit {
+  std::string renderer, scene;
+  double n = 0, pixels = 0;
+  double zbuffer_seconds = 0, trace_seconds = 0;  // medians over the repetitions
+  double zbuffer_share = 0;                       // zbuffer / (zbuffer + trace)
+};
+
 struct StudyResult {
   std::vector<std::string> scenes;          // families: "tessphere"
   std::vector<std::string> renderers;       // in the order asked for
@@ -77,6 +85,7 @@ struct StudyResult {
   std::vector<Dominance> dominance;
   std::vector<ScalingExponent> scaling;
   std::vector<UnitCost> costs;
+  std::vector<PhaseSplit> splits;  // the hybrids', at the smallest and largest N at full width
   std::vector<PredictionCheck> checks;
   std::vector<std::string> notes;  // what the budget cut short, and the like
   bool interrupted = false;        // the sweep was stopped (Ctrl-C) before its end
