@@ -1,5 +1,6 @@
 // A model file as a scene: the file's meshes, materials, first camera and point lights, with
-// a framing camera and default lights where it has none (docs/scene-format.md).
+// a framing camera and default lights where it has none or where asked, turned so that its up
+// is +y, and an automatic exposure (docs/scene-format.md).
 #include <fmt/format.h>
 
 #include <algorithm>

@@ -55,9 +55,12 @@ Expected<Scene> load_scene(const std::string& spec, const SceneOverrides& overri
 bool is_model_file_name(const std::string& path);
 
 // A model file as a scene (docs/scene-format.md, "Model files as scenes"): one object per
-// mesh with the file's own material; the file's first camera, else one framing the model from
-// default_view_from() (overrides.view_from replaces either); the file's point lights, else a
-// key light near the camera and ambient.
+// mesh with the file's own material, turned so that its up axis (overrides.up) is +y; the
+// file's first camera (not an FBX exporter's viewport camera, nor one that sees none of the
+// model), else one framing the model from default_view_from() (overrides.view_from replaces
+// either, overrides.camera = Auto always frames); the file's point lights, else (or with
+// overrides.lights = Auto) a key light near the camera and ambient; the automatic exposure
+// unless overrides.exposure is set.
 Expected<Scene> load_model_scene(const std::string& path, const SceneOverrides& overrides = {});
 
 struct BuiltinSceneInfo {
