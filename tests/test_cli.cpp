@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "model_corpus.h"
+#include "rvr/shared/image_io.h"
 
 namespace fs = std::filesystem;
 
@@ -167,6 +168,51 @@ TEST_F(Cli, BadUsageIsExit2) {
   EXPECT_EQ(run("").status, 2);
   EXPECT_EQ(run("render " + (dir_ / "missing.json").string() + " -r raytrace").status, 2);
   EXPECT_TRUE(outputs({}).empty());
+}
+
+// The model-file options: --up, --camera, --lights and --exposure reach the scene (the
+// exported scene shows them), and bad values are exit 2 with one error line.
+TEST_F(Cli, ModelUpCameraLightsAndExposureOptions) {
+  fs::path obj = write("zup.obj", "v 0 0 0\nv 1 0 0\nv 0 1 2\nf 1 2 3\n");
+  RunResult r =
+      run("render " + obj.string() + " -r raytrace " + kSmall +
+          " --up z --camera auto --lights auto --exposure 1 -o " + (dir_ / "z.png").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(dir_ / "z.png"));
+  // Exported, a model file's automatic exposure is kept in the scene (a white triangle under
+  // the default key light: below 0).
+  write("white.mtl", "newmtl white\nKd 1 1 1\n");
+  fs::path white =
+      write("white.obj", "mtllib white.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl white\nf 1 2 3\n");
+  r = run("scenes --export " + white.string() + " -o " + (dir_ / "white.json").string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(slurp(dir_ / "white.json").find("\"exposure\": -"), std::string::npos);
+  // --exposure reaches the renderer: the linear EXR at --exposure 1 is exactly twice the one
+  // at 0, pixel by pixel; --up z turns the model (another image from --up y).
+  auto exr = [&](const std::string& args, const char* name) {
+    RunResult rr = run("render " + obj.string() + " -r raytrace " + kSmall + " --mode local " +
+                       args + " -o " + (dir_ / name).string());
+    EXPECT_EQ(rr.status, 0) << rr.err;
+    return rvr::read_image((dir_ / name).string()).value();
+  };
+  rvr::Image e0 = exr("--exposure 0", "e0.exr"), e1 = exr("--exposure 1", "e1.exr");
+  ASSERT_EQ(e0.pixels.size(), e1.pixels.size());
+  float brightest = 0.0f;
+  for (size_t i = 0; i < e0.pixels.size(); ++i) {
+    ASSERT_EQ(e1.pixels[i], 2.0f * e0.pixels[i]) << i;
+    brightest = std::max(brightest, e0.pixels[i]);
+  }
+  EXPECT_GT(brightest, 0.0f);
+  EXPECT_NE(exr("--up y", "y.exr").pixels, exr("--up z", "z.exr").pixels);
+  for (const char* bad :
+       {"--up w", "--camera fancy", "--lights none", "--exposure 65", "--exposure nan"}) {
+    SCOPED_TRACE(bad);
+    r = run("render " + obj.string() + " -r raytrace " + bad + " -o " + (dir_ / "b.png").string());
+    EXPECT_EQ(r.status, 2);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_EQ(r.err.rfind("error: ", 0), 0u) << r.err;
+    EXPECT_FALSE(fs::exists(dir_ / "b.png"));
+  }
 }
 
 TEST_F(Cli, SoftpipeIsRefusedWithExit3) {
@@ -633,6 +679,8 @@ std::vector<CliBadInput> cli_bad_inputs() {
       {"unknown top-level key", with_camera(R"("objets": [])"),
        "bad.json: top level: unknown key 'objets'"},
       {"wrong format", with_camera(R"("format": "rvr-scene/9")"), "bad.json: format:"},
+      {"exposure out of range", with_camera(R"("image": {"exposure": 65})"),
+       "bad.json: image.exposure: must be between -64 and 64 stops"},
       {"missing camera", R"({"objects": []})", "bad.json: camera: is required"},
       {"short eye", R"({"camera": {"eye": [0, 0], "target": [0, 0, 0], "up": [0, 1, 0]}})",
        "bad.json: camera.eye:"},

@@ -16,8 +16,10 @@
 #include <string>
 
 #include "model_corpus.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/camera_framing.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/scene_loader.h"
 
 namespace fs = std::filesystem;
@@ -259,7 +261,7 @@ TEST_F(ModelFiles, TexturedMeshUsesItsFactorAndWarns) {
                kTextTolerance);
   bool warned = false;
   for (const std::string& w : s.warnings) warned |= w.find("not sampled") != std::string::npos;
-  EXPECT_TRUE(warned);
+  EXPECT_TRUE(warned) << (s.warnings.empty() ? "no warnings" : s.warnings.front());
 }
 
 TEST_F(ModelFiles, ThreeDsMaterialColour) {
@@ -286,6 +288,227 @@ TEST_F(ModelFiles, ColladaCameraLightAndColour) {
   // as rvr's inverse-square light, colour x distance^2.
   glm::vec3 d = glm::vec3(e.light_at[0], e.light_at[1], e.light_at[2]) - glm::vec3(0.5f);
   EXPECT_NEAR(s.lights[0].intensity.x, glm::dot(d, d), 1e-3f);
+}
+
+// A Collada file in centimetres (<unit meter="0.01">) with a camera: Assimp scales the
+// positions to metres through the root node; near and far, distances along the camera's view
+// direction, scale with them. The camera 500 cm in front of a 100 cm cube with znear 10 cm
+// and zfar 10000 cm: eye at 5 m, near 0.1 m, far 100 m (near at 10 m was beyond the cube, an
+// image of background only).
+TEST_F(ModelFiles, ColladaInCentimetresScalesTheCamerasNearAndFar) {
+  std::string positions, indices;
+  for (int v = 0; v < 8; ++v) {
+    auto p = corpus::cube_vertex(v);
+    positions += std::to_string(100 * p[0]) + " " + std::to_string(100 * p[1]) + " " +
+                 std::to_string(100 * p[2]) + " ";
+  }
+  for (const auto& q : corpus::cube_quads())
+    for (int i : q) indices += std::to_string(i) + " ";
+  std::string dae = R"(<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit meter="0.01" name="centimeter"/><up_axis>Y_UP</up_axis></asset>
+  <library_cameras><camera id="cam" name="cam"><optics><technique_common><perspective>
+    <yfov>40</yfov><aspect_ratio>1.5</aspect_ratio><znear>10</znear><zfar>10000</zfar>
+  </perspective></technique_common></optics></camera></library_cameras>
+  <library_geometries><geometry id="cube-mesh" name="cube"><mesh>
+    <source id="cube-pos"><float_array id="cube-pos-array" count="24">)" +
+                    positions + R"(</float_array>
+      <technique_common><accessor source="#cube-pos-array" count="8" stride="3">
+        <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+      </accessor></technique_common></source>
+    <vertices id="cube-verts"><input semantic="POSITION" source="#cube-pos"/></vertices>
+    <polylist count="6"><input semantic="VERTEX" source="#cube-verts" offset="0"/>
+      <vcount>4 4 4 4 4 4</vcount><p>)" +
+                    indices + R"(</p></polylist>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="scene">
+    <node id="cube-node" name="cube"><instance_geometry url="#cube-mesh"/></node>
+    <node id="cam-node" name="cam-node"><translate>50 50 500</translate><instance_camera url="#cam"/></node>
+  </visual_scene></library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>
+)";
+  std::string p = write("cm.dae", dae);
+  expect_loads_like_assimp(p, 12);
+  rvr::Scene s = rvr::load_scene(p).value();
+  expect_near3(s.camera.eye, {0.5f, 0.5f, 5.0f}, 1e-5f);
+  expect_near3(glm::normalize(s.camera.target - s.camera.eye), {0, 0, -1}, 1e-5f);
+  EXPECT_NEAR(s.camera.near, 0.1f, 1e-6f);
+  EXPECT_NEAR(s.camera.far, 100.0f, 1e-3f);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+  // --camera auto: the framing camera instead, from the default direction.
+  rvr::SceneOverrides o;
+  o.camera = rvr::FromFile::Auto;
+  rvr::Scene framed = rvr::load_scene(p, o).value();
+  expect_near3(framed.camera.target, glm::vec3(0.5f), 1e-5f);
+  expect_near3(glm::normalize(framed.camera.eye - framed.camera.target), rvr::default_view_from(),
+               1e-5f);
+}
+
+// The file's lights replaced by the default key light and ambient with --lights auto, and its
+// camera by the framing one with --camera auto; each on its own.
+TEST_F(ModelFiles, CameraAndLightsAutoReplaceTheFilesOwn) {
+  corpus::DaeExtras e;
+  std::string p = write("cube.dae", corpus::dae_cube(e));
+  rvr::SceneOverrides o;
+  o.lights = rvr::FromFile::Auto;
+  rvr::Scene s = rvr::load_scene(p, o).value();
+  expect_near3(s.camera.eye, {e.camera_at[0], e.camera_at[1], e.camera_at[2]}, kTextTolerance);
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_EQ(s.ambient, glm::vec3(0.15f));
+  // The default key light gives an irradiance of 1 at the centre: intensity = distance^2.
+  glm::vec3 d = s.lights[0].position - glm::vec3(0.5f);
+  EXPECT_NEAR(s.lights[0].intensity.x, glm::dot(d, d), 1e-3f);
+  EXPECT_GT(
+      glm::length(s.lights[0].position - glm::vec3(e.light_at[0], e.light_at[1], e.light_at[2])),
+      0.1f);
+  o = {};
+  o.camera = rvr::FromFile::Auto;
+  rvr::Scene c = rvr::load_scene(p, o).value();
+  expect_near3(glm::normalize(c.camera.eye - c.camera.target), rvr::default_view_from(), 1e-5f);
+  expect_near3(c.lights.at(0).position, {e.light_at[0], e.light_at[1], e.light_at[2]},
+               kTextTolerance);
+}
+
+// --up z: a Z-up OBJ turned so that its +z is +y, by the quarter turn about x that takes
+// (x, y, z) to (x, z, -y). The triangle standing 2 high along z stands 2 high along y.
+TEST_F(ModelFiles, UpZTurnsTheModelSoItsZIsUp) {
+  std::string p = write("zup.obj", "v 0 0 0\nv 1 0 0\nv 0 1 2\nf 1 2 3\n");
+  rvr::Scene as_read = rvr::load_scene(p).value();
+  ASSERT_EQ(as_read.objects.size(), 1u);
+  expect_near3(as_read.objects[0].mesh.positions.at(2), {0, 1, 2}, 0.0f);
+  rvr::SceneOverrides o;
+  o.up = rvr::UpAxis::Z;
+  rvr::Scene s = rvr::load_scene(p, o).value();
+  const std::vector<glm::vec3>& v = s.objects.at(0).mesh.positions;
+  ASSERT_EQ(v.size(), 3u);
+  expect_near3(v[0], {0, 0, 0}, 0.0f);
+  expect_near3(v[1], {1, 0, 0}, 0.0f);
+  expect_near3(v[2], {0, 2, -1}, 1e-6f);
+  // Framed after turning: the camera's up is still +y and it looks at the turned model.
+  EXPECT_EQ(s.camera.up, glm::vec3(0, 1, 0));
+  expect_near3(s.camera.target, {0.5f, 1.0f, -0.5f}, 1e-6f);
+  o.up = rvr::UpAxis::Y;  // as read
+  expect_near3(rvr::load_scene(p, o)->objects.at(0).mesh.positions.at(2), {0, 1, 2}, 0.0f);
+}
+
+// An ASCII FBX 7.4 saying it is Z-up (GlobalSettings UpAxis 2, UpAxisSign 1), with the
+// viewport camera "Producer Perspective" of FBX 6 exporters as a model of its own, and a
+// camera the user placed, "shot", at (-5, 0.5, 1) looking along its node's +x (Assimp's FBX
+// camera convention). Assimp reads both cameras and the axes into the scene's metadata
+// without applying them. rvr takes "shot", not the viewport camera, and turns the model
+// (x, y, z) -> (x, z, -y): the triangle's (0, 1, 2) to (0, 2, -1), the eye to (-5, 1, -0.5).
+TEST_F(ModelFiles, FbxUpAxisFromItsMetadataAndItsViewportCameraSkipped) {
+  std::string p = write("cam.fbx", R"FBX(; FBX 7.4.0 project file
+FBXHeaderExtension:  {
+	FBXHeaderVersion: 1003
+	FBXVersion: 7400
+	Creator: "rvr test"
+}
+GlobalSettings:  {
+	Version: 1000
+	Properties70:  {
+		P: "UpAxis", "int", "Integer", "",2
+		P: "UpAxisSign", "int", "Integer", "",1
+		P: "FrontAxis", "int", "Integer", "",1
+		P: "FrontAxisSign", "int", "Integer", "",-1
+		P: "CoordAxis", "int", "Integer", "",0
+		P: "CoordAxisSign", "int", "Integer", "",1
+		P: "UnitScaleFactor", "double", "Number", "",1
+		P: "DefaultCamera", "KString", "", "", "Producer Perspective"
+	}
+}
+Objects:  {
+	Geometry: 1000, "Geometry::tri", "Mesh" {
+		Vertices: *9 {
+			a: 0,0,0,1,0,0,0,1,2
+		}
+		PolygonVertexIndex: *3 {
+			a: 0,1,-3
+		}
+		GeometryVersion: 124
+	}
+	Model: 2000, "Model::tri", "Mesh" {
+		Version: 232
+	}
+	NodeAttribute: 3000, "NodeAttribute::Producer Perspective", "Camera" {
+		TypeFlags: "Camera"
+	}
+	Model: 4000, "Model::Producer Perspective", "Camera" {
+		Version: 232
+		Properties70:  {
+			P: "Lcl Translation", "Lcl Translation", "", "A",-10,0.5,1
+		}
+	}
+	NodeAttribute: 5000, "NodeAttribute::shot", "Camera" {
+		TypeFlags: "Camera"
+	}
+	Model: 6000, "Model::shot", "Camera" {
+		Version: 232
+		Properties70:  {
+			P: "Lcl Translation", "Lcl Translation", "", "A",-5,0.5,1
+		}
+	}
+}
+Connections:  {
+	C: "OO",2000,0
+	C: "OO",1000,2000
+	C: "OO",4000,0
+	C: "OO",3000,4000
+	C: "OO",6000,0
+	C: "OO",5000,6000
+}
+)FBX");
+  rvr::Scene s = rvr::load_scene(p).value();
+  const std::vector<glm::vec3>& v = s.objects.at(0).mesh.positions;
+  ASSERT_EQ(v.size(), 3u);
+  expect_near3(v[2], {0, 2, -1}, 1e-6f);
+  expect_near3(s.camera.eye, {-5, 1, -0.5f}, 1e-5f);
+  expect_near3(glm::normalize(s.camera.target - s.camera.eye), {1, 0, 0}, 1e-6f);
+  bool warned = false;
+  for (const std::string& w : s.warnings)
+    warned |= w.find("ignored the exporter's viewport camera 'Producer Perspective'") !=
+              std::string::npos;
+  EXPECT_TRUE(warned) << (s.warnings.empty() ? "no warnings" : s.warnings.front());
+  // --up y: the coordinates as Assimp reads them.
+  rvr::SceneOverrides o;
+  o.up = rvr::UpAxis::Y;
+  rvr::Scene as_read = rvr::load_scene(p, o).value();
+  expect_near3(as_read.objects.at(0).mesh.positions.at(2), {0, 1, 2}, 0.0f);
+  expect_near3(as_read.camera.eye, {-5, 0.5f, 1}, 1e-5f);
+}
+
+// The automatic exposure: a white cube (diffuse 1, from an MTL) under the default key light
+// clips most of its lit faces at exposure 0; the automatic exposure is below 0 and leaves
+// under 1 % of the cube's pixels above 1 in a render.
+TEST_F(ModelFiles, AutomaticExposureClipsUnderOnePercentOfTheModel) {
+  write("white.mtl", "newmtl white\nKd 1 1 1\nKs 0 0 0\n");
+  std::string p = write("white.obj", corpus::obj_cube("mtllib white.mtl\n", "white"));
+  rvr::Scene s = rvr::load_scene(p).value();
+  EXPECT_LT(s.image.exposure, 0.0f);
+  rvr::SceneOverrides o;
+  o.exposure = 0.0f;
+  EXPECT_EQ(rvr::load_scene(p, o)->image.exposure, 0.0f);
+  auto count = [](const rvr::Scene& scene, size_t* model) {
+    auto r = rvr::make_renderer("raytrace").value();
+    rvr::FrameBuffers b = r->render(scene, {}).value().buffers;
+    size_t clipped = 0;
+    *model = 0;
+    for (size_t i = 0; i < b.color.size(); ++i) {
+      if (b.object_id[i] == rvr::kNoId) continue;
+      ++*model;
+      clipped += b.color[i].r > 1.0f || b.color[i].g > 1.0f || b.color[i].b > 1.0f;
+    }
+    return clipped;
+  };
+  size_t model = 0;
+  rvr::Scene unexposed = s;
+  unexposed.image.exposure = 0.0f;
+  size_t before = count(unexposed, &model);
+  EXPECT_GT(before, model / 10) << "the test cube should clip without the exposure";
+  size_t after = count(s, &model);
+  EXPECT_GT(model, 1000u);
+  EXPECT_LT(after, model / 100);
 }
 
 // A model without a camera: the default three-quarter view from above (35 degrees round from

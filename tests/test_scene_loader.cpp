@@ -8,10 +8,14 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/glm.hpp>
 #include <string>
 #include <vector>
 
+#include "rvr/renderers/prepared_renderer.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/scene_writer.h"
 
 namespace fs = std::filesystem;
 using rvr::Expected;
@@ -783,6 +787,83 @@ TEST(ExampleScenes, AllLoadCleanly) {
     EXPECT_TRUE(has_plane) << entry.path();
   }
   EXPECT_GE(count, 3);
+}
+
+// image.exposure: read, range-checked, written back by the scene writer (rvr scenes --export)
+// only when it is not 0, and overridden by SceneOverrides::exposure (--exposure).
+TEST_F(SceneLoader, ExposureIsReadCheckedAndWrittenBack) {
+  Expected<Scene> s = rvr::parse_scene(scene(R"("image": {"exposure": -1.5})"), "e.json", ".");
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  EXPECT_EQ(s->image.exposure, -1.5f);
+  Expected<rvr::SceneDocument> doc = rvr::write_scene(*s, "e");
+  ASSERT_TRUE(doc.ok());
+  EXPECT_NE(doc->json.find("\"exposure\": -1.5"), std::string::npos) << doc->json;
+  Expected<Scene> back = rvr::parse_scene(doc->json, "back.json", ".");
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_EQ(back->image.exposure, -1.5f);
+  // The default, 0, is not written (documents written before the key stay as they were).
+  Expected<Scene> plain = rvr::parse_scene(scene(R"("objects": [])"), "p.json", ".");
+  EXPECT_EQ(plain->image.exposure, 0.0f);
+  EXPECT_EQ(rvr::write_scene(*plain, "p")->json.find("exposure"), std::string::npos);
+  Expected<Scene> bad = rvr::parse_scene(scene(R"("image": {"exposure": 64.5})"), "b.json", ".");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().message,
+            "b.json: image.exposure: must be between -64 and 64 stops, got 64.5");
+  fs::path file = dir_ / "e.json";
+  write_file(file, scene(R"("image": {"exposure": 3})"));
+  rvr::SceneOverrides o;
+  o.exposure = 1.0f;
+  EXPECT_EQ(rvr::load_scene(file.string(), o)->image.exposure, 1.0f);
+  o.exposure = -65.0f;
+  EXPECT_FALSE(rvr::load_scene(file.string(), o).ok());
+}
+
+// A known diffuse square under a known light: diffuse 0.4, a point light of intensity 4 at
+// distance 2 straight above the centre, no ambient, so the centre's colour is
+// 0.4 x 4 / 2^2 = 0.4 at exposure 0 and exactly 2 x 0.4 = 0.8 (below clipping) at exposure 1,
+// in every renderer of the table and through the prepared renderers alike; exactly a quarter
+// of it at exposure -2.
+TEST_F(SceneLoader, ExposureDoublesTheColourInEveryRenderer) {
+  const std::string text = R"({"image": {"width": 33, "height": 33},
+    "camera": {"eye": [0, 0, 3], "target": [0, 0, 0], "up": [0, 1, 0]},
+    "materials": {"paint": {"diffuse": [0.4, 0.4, 0.4]}},
+    "lights": [{"type": "point", "position": [0, 0, 2], "intensity": [4, 4, 4]}],
+    "objects": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 0, 1], "half_size": 1,
+                 "material": "paint"}]})";
+  Scene dark = rvr::parse_scene(text, "quad.json", ".").value();
+  Scene bright = dark, dim = dark;
+  bright.image.exposure = 1.0f;
+  dim.image.exposure = -2.0f;  // 2^-2: a quarter
+  const size_t centre = 16 * 33 + 16;
+  for (const rvr::RendererChoice& choice : rvr::renderer_choices()) {
+    SCOPED_TRACE(choice.name);
+    rvr::RenderOptions options;
+    options.mode = rvr::RenderMode::Local;
+    auto prepared_dark = rvr::prepare_renderer(choice, dark, {}, options);
+    auto prepared_bright = rvr::prepare_renderer(choice, bright, {}, options);
+    ASSERT_TRUE(prepared_dark.ok() && prepared_bright.ok());
+    auto renderer = choice.info->create({});
+    ASSERT_TRUE(renderer.ok());
+    for (int prepared = 0; prepared < 2; ++prepared) {
+      Expected<rvr::RenderOutput> a =
+          prepared ? prepared_dark.value()->render() : renderer.value()->render(dark, options);
+      Expected<rvr::RenderOutput> b =
+          prepared ? prepared_bright.value()->render() : renderer.value()->render(bright, options);
+      ASSERT_TRUE(a.ok() && b.ok());
+      glm::vec3 c0 = a->buffers.color[centre], c1 = b->buffers.color[centre];
+      EXPECT_NEAR(c0.g, 0.4f, 1e-4f);
+      EXPECT_EQ(c1, 2.0f * c0);  // a power of two: exact
+      EXPECT_LT(c1.g, 1.0f);
+      // Every pixel, background included, is the same transform of the one at exposure 0.
+      for (size_t i = 0; i < a->buffers.color.size(); ++i) {
+        ASSERT_EQ(b->buffers.color[i], 2.0f * a->buffers.color[i]) << i;
+      }
+    }
+    Expected<rvr::RenderOutput> d = renderer.value()->render(dim, options);
+    ASSERT_TRUE(d.ok());
+    Expected<rvr::RenderOutput> a = renderer.value()->render(dark, options);
+    EXPECT_EQ(d->buffers.color[centre], 0.25f * a->buffers.color[centre]);
+  }
 }
 
 }  // namespace

@@ -45,6 +45,22 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--camera-from", o.camera_from,
                  "X,Y,Z: look at the scene's (or model's) bounding sphere from this direction, "
                  "framing it (replaces the scene's camera)");
+  cmd.add_option("--exposure", o.exposure,
+                 "EV: multiply every renderer's linear colour by 2^EV after shading (replaces the "
+                 "scene's, or a model file's automatic exposure)")
+      ->check(CLI::Range(-kMaxExposure, kMaxExposure));
+  cmd.add_option("--up", o.up,
+                 "model files: the up axis of the file's coordinates, turned to +y: auto (the "
+                 "file's metadata; +y where it has none) | y | z")
+      ->check(CLI::IsMember({"auto", "y", "z"}));
+  cmd.add_option("--camera", o.camera,
+                 "model files: file (the file's own camera where it has one) | auto (the "
+                 "framing camera)")
+      ->check(CLI::IsMember({"file", "auto"}));
+  cmd.add_option("--lights", o.lights,
+                 "model files: file (the file's own lights where it has them) | auto (the "
+                 "default key light and ambient)")
+      ->check(CLI::IsMember({"file", "auto"}));
   cmd.add_option("--spp", o.spp, "samples per pixel (overrides the scene)")
       ->check(CLI::Range(1, 65536));
   cmd.add_option("--threads", o.threads, "worker threads, 0 = every core")
@@ -159,6 +175,10 @@ Scene load(const CommonOptions& o, const RenderOptions& options, double& load_se
   overrides.height = o.height;
   if (!o.image.empty()) std::tie(overrides.width, overrides.height) = parse_image_size(o.image);
   if (!o.camera_from.empty()) overrides.view_from = parse_direction(o.camera_from);
+  overrides.exposure = o.exposure;
+  overrides.up = o.up == "z" ? UpAxis::Z : o.up == "y" ? UpAxis::Y : UpAxis::Auto;
+  overrides.camera = o.camera == "auto" ? FromFile::Auto : FromFile::File;
+  overrides.lights = o.lights == "auto" ? FromFile::Auto : FromFile::File;
   auto start = Clock::now();
   Scene scene = take(load_scene(o.scene, overrides));
   if (o.spp) scene.image.samples_per_pixel = *o.spp;

@@ -26,8 +26,12 @@ struct CommonOptions {
   std::string scene = "builtin:cornell";
   std::string mode;
   std::optional<int> width, height, spp;
-  std::string image;        // --image WxH
-  std::string camera_from;  // --camera-from X,Y,Z
+  std::string image;              // --image WxH
+  std::string camera_from;        // --camera-from X,Y,Z
+  std::optional<float> exposure;  // --exposure EV
+  std::string up = "auto";        // --up auto | y | z (model files)
+  std::string camera = "file";    // --camera file | auto (model files)
+  std::string lights = "file";    // --lights file | auto (model files)
   int threads = 0;
   std::string accel = "bvh";
   std::string spheres = "analytic";

@@ -8,6 +8,7 @@
 
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/renderers/prepared_renderer.h"
+#include "rvr/shared/framebuffers.h"
 
 namespace rvr {
 
@@ -22,7 +23,12 @@ class PreparedOverGeometry : public PreparedRenderer {
         loop_(std::forward<LoopArgs>(loop_args)...),
         geometry_(scene, options.spheres, options.sphere_segments, accel, options.triangle_test,
                   options.isa) {}
-  Expected<RenderOutput> render() override { return loop_.render(scene_, options_, geometry_); }
+  // The frame, then the scene's exposure (as for every renderer of the registry).
+  Expected<RenderOutput> render() override {
+    Expected<RenderOutput> out = loop_.render(scene_, options_, geometry_);
+    if (out.ok()) apply_exposure(out->buffers, scene_.image.exposure);
+    return out;
+  }
 
   // `accel` answers the queries (the options' for raytrace and the hybrids, Embree for embree);
   // the chapter's triangle test runs on the binary tree, as RayTracer::render does it, since

@@ -3,20 +3,38 @@
 // rvr info), the conformance, progress and NaN tests and the benchmarks all pick it up from here.
 #include "rvr/renderers/registry.h"
 
+#include <memory>
+
 #include "prepared_hybrid.h"
 #include "prepared_tracer.h"
 #include "rvr/hybrid/hybrid_renderer.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/framebuffers.h"
 
 namespace rvr {
 
 namespace {
 
+// Renderer R with the scene's exposure applied to its colour after it has rendered
+// (apply_exposure): the one place every renderer of the table gets it, so that it is the
+// same transform in all of them (the prepared tracer and hybrids apply it in
+// PreparedOverGeometry::render).
+template <class R>
+class Exposed : public R {
+ public:
+  using R::R;
+  Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options) override {
+    Expected<RenderOutput> out = R::render(scene, options);
+    if (out.ok()) apply_exposure(out->buffers, scene.image.exposure);
+    return out;
+  }
+};
+
 template <class R, class... Args>
 Expected<std::unique_ptr<Renderer>> make(Args... args) {
-  return std::unique_ptr<Renderer>(std::make_unique<R>(args...));
+  return std::unique_ptr<Renderer>(std::make_unique<Exposed<R>>(args...));
 }
 
 std::string joined(const std::vector<std::string>& names) {

@@ -3,6 +3,7 @@
 
 #include <assimp/DefaultIOSystem.h>
 #include <assimp/material.h>
+#include <assimp/metadata.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
@@ -569,11 +570,44 @@ glm::vec3 to_glm(const aiVector3D& v) {
   return {v.x, v.y, v.z};
 }
 
-// The first camera, in world space; empty when the file has none or it is unusable.
-// `gltf`: Assimp's glTF reader stores yfov x aspect as the horizontal angle.
-void read_camera(const aiScene* ai, bool gltf, ImportedModel& model) {
-  if (ai->mNumCameras == 0 || !ai->mCameras || !ai->mCameras[0]) return;
-  const aiCamera& cam = *ai->mCameras[0];
+// Whether an FBX camera is an exporter's viewport camera rather than one the user placed.
+// Assimp's FBX reader (5.2, FBXConverter::ConvertNodes) converts only cameras attached to
+// models in the node hierarchy, so FBX 7's viewport cameras, which only GlobalSettings'
+// DefaultCamera names, never arrive. What can arrive: the FBX 6 "Producer Perspective",
+// "Producer Top", ... cameras and the "Camera Switcher", which exporters write as models of
+// their own; and a camera whose node Assimp did not keep, which an FBX camera needs (Assimp
+// puts it at its node's origin looking along +x), so without it every such camera would sit
+// at the world's origin. Both are refused; a camera the user placed is kept wherever it is.
+bool fbx_viewport_camera(const aiScene* ai, const aiCamera& cam) {
+  const std::string name = cam.mName.C_Str();
+  return name.rfind("Producer ", 0) == 0 || name == "Camera Switcher" ||
+         find_node(ai, cam.mName) == nullptr;
+}
+
+// The first camera the file's author placed, in world space; empty when the file has none or
+// it is unusable. `gltf`: Assimp's glTF reader stores yfov x aspect as the horizontal angle.
+// `fbx`: an exporter's viewport cameras are skipped (fbx_viewport_camera).
+void read_camera(const aiScene* ai, bool gltf, bool fbx, ImportedModel& model) {
+  if (ai->mNumCameras == 0 || !ai->mCameras) return;
+  const aiCamera* first = nullptr;
+  std::vector<std::string> viewport;
+  for (unsigned i = 0; i < ai->mNumCameras && !first; ++i) {
+    const aiCamera* cam = ai->mCameras[i];
+    if (!cam) continue;
+    if (fbx && fbx_viewport_camera(ai, *cam)) {
+      viewport.push_back(quote_json(cam->mName.C_Str()));
+      continue;
+    }
+    first = cam;
+  }
+  if (!viewport.empty()) {
+    std::string names;
+    for (const std::string& n : viewport) names += (names.empty() ? "" : ", ") + n;
+    model.warnings.push_back(fmt::format("ignored the exporter's viewport camera{} {}",
+                                         viewport.size() == 1 ? "" : "s", names));
+  }
+  if (!first) return;
+  const aiCamera& cam = *first;
   aiMatrix4x4 t = world_transform(find_node(ai, cam.mName));
   aiMatrix3x3 turn(t);
   // A glTF camera sits at its node's origin (the format has no other place for it); Assimp's
@@ -601,10 +635,14 @@ void read_camera(const aiScene* ai, bool gltf, ImportedModel& model) {
   float fov_y = gltf ? cam.mHorizontalFOV / aspect
                      : 2.0f * std::atan(std::tan(0.5f * cam.mHorizontalFOV) / aspect);
   if (std::isfinite(fov_y) && fov_y > 1e-3f && fov_y < 3.1f) c.fov_y_deg = glm::degrees(fov_y);
-  if (std::isfinite(cam.mClipPlaneNear) && cam.mClipPlaneNear > 0.0f &&
-      std::isfinite(cam.mClipPlaneFar) && cam.mClipPlaneFar > cam.mClipPlaneNear) {
-    c.near = cam.mClipPlaneNear;
-    c.far = cam.mClipPlaneFar;
+  // Near and far are distances along the view direction in the camera's own units: they
+  // scale as that direction does from the camera to world space (e.g. Collada's <unit>,
+  // which Assimp puts in the root node's transform, as it does the positions).
+  float scale = glm::length(forward) / glm::length(to_glm(cam.mLookAt));
+  float near = cam.mClipPlaneNear * scale, far = cam.mClipPlaneFar * scale;
+  if (std::isfinite(near) && near > 0.0f && std::isfinite(far) && far > near) {
+    c.near = near;
+    c.far = far;
   }
   c.focus_distance = 1.0f;
   model.camera = c;
@@ -635,6 +673,19 @@ void read_lights(const aiScene* ai, ImportedModel& model) {
         "ignored {} light{} that {} not point or spot lights (directional, area, ambient)", skipped,
         skipped == 1 ? "" : "s", skipped == 1 ? "is" : "are"));
   }
+}
+
+// The up direction the file's metadata gives (Assimp's scene metadata: UpAxis 0/1/2 for
+// x/y/z and UpAxisSign +-1, which its FBX reader stores and does not apply); +y when it gives
+// none or something else.
+glm::vec3 metadata_up(const aiScene* ai) {
+  int32_t axis = 1, sign = 1;
+  if (!ai->mMetaData || !ai->mMetaData->Get("UpAxis", axis)) return {0.0f, 1.0f, 0.0f};
+  if (!ai->mMetaData->Get("UpAxisSign", sign)) sign = 1;
+  if (axis < 0 || axis > 2 || (sign != 1 && sign != -1)) return {0.0f, 1.0f, 0.0f};
+  glm::vec3 up(0.0f);
+  up[axis] = float(sign);
+  return up;
 }
 
 TriangleMesh import_mesh_here(const fs::path& full, const std::string& file,
@@ -668,8 +719,10 @@ ImportedModel import_model_here(const fs::path& full, const std::string& file,
   std::string ext = full.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  read_camera(raw, ext == ".gltf" || ext == ".glb", model);
+  read_camera(raw, ext == ".gltf" || ext == ".glb", ext == ".fbx", model);
   read_lights(raw, model);
+  // Only FBX: Assimp (5.2) reports the axes of FBX alone, and applies Collada's itself.
+  if (ext == ".fbx") model.up = metadata_up(raw);
   // The file's normals where it has them (smooth shading); flat faces where it has none.
   // Vertices are joined afterwards by weld_identical_vertices, except where a mesh has vertex
   // colours, whose mean (part_material) is taken over Assimp's joined vertices.

@@ -31,6 +31,10 @@ struct ImportedModel {
   std::vector<ModelPart> parts;
   std::optional<Camera> camera;
   float camera_aspect = 0.0f;  // width / height, 0 when the file does not say
+  // The up direction of the file's coordinates as Assimp gives them, from the file's metadata
+  // (FBX's UpAxis and UpAxisSign); +y where the file says nothing or Assimp has turned it
+  // already (Collada's <up_axis>, 3DS).
+  glm::vec3 up{0.0f, 1.0f, 0.0f};
   std::vector<Light> lights;
   // Lights whose intensity does not fall off with distance (no quadratic or linear
   // attenuation, e.g. Collada's default): their index in `lights`.

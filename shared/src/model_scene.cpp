@@ -1,5 +1,6 @@
 // A model file as a scene: the file's meshes, materials, first camera and point lights, with
-// a framing camera and default lights where it has none (docs/scene-format.md).
+// a framing camera and default lights where it has none or where asked, turned so that its up
+// is +y, and an automatic exposure (docs/scene-format.md).
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -8,6 +9,9 @@
 #include <filesystem>
 #include <new>
 #include <set>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "mesh_import.h"
 #include "mesh_repair.h"
@@ -41,6 +45,85 @@ void add_default_lights(Scene& scene, const BoundingSphere& bounds) {
   scene.ambient = glm::vec3(kDefaultAmbient);
 }
 
+// The rotation that turns `up` (a unit axis, +-x, +-y or +-z) to +y by the smallest angle
+// (90 degrees about an axis in the horizontal plane, or 180 about x for -y).
+glm::mat3 turn_up_to_y(const glm::vec3& up) {
+  const glm::vec3 y(0.0f, 1.0f, 0.0f);
+  float c = glm::dot(up, y);
+  if (c > 0.5f) return glm::mat3(1.0f);
+  if (c < -0.5f) return glm::mat3(glm::vec3(1, 0, 0), glm::vec3(0, -1, 0), glm::vec3(0, 0, -1));
+  // up is horizontal: a quarter turn about k = up x y, which takes up to y and y to -up.
+  glm::vec3 k = glm::cross(up, y);
+  // Rodrigues at 90 degrees: R v = (k.v) k + k x v.
+  glm::mat3 r;
+  for (int i = 0; i < 3; ++i) {
+    glm::vec3 e(0.0f);
+    e[i] = 1.0f;
+    r[i] = glm::dot(k, e) * k + glm::cross(k, e);
+  }
+  return r;
+}
+
+// Turns the whole model (meshes, camera, lights) by `r` about the origin.
+void turn_model(ImportedModel& model, const glm::mat3& r) {
+  for (ModelPart& part : model.parts) {
+    for (glm::vec3& p : part.mesh.positions) p = r * p;
+    for (glm::vec3& n : part.mesh.normals) n = r * n;
+  }
+  if (model.camera) {
+    model.camera->eye = r * model.camera->eye;
+    model.camera->target = r * model.camera->target;
+    model.camera->up = r * model.camera->up;
+  }
+  for (Light& l : model.lights) l.position = r * l.position;
+}
+
+// Whether any of the sphere lies inside the camera's view volume (between near and far and
+// inside the four side planes).
+bool camera_sees(const Camera& c, float aspect, const BoundingSphere& b) {
+  glm::vec3 f = glm::normalize(c.target - c.eye);
+  glm::vec3 x = glm::normalize(glm::cross(f, c.up));
+  glm::vec3 y = glm::cross(x, f);
+  glm::vec3 d = b.centre - c.eye;
+  float px = glm::dot(d, x), py = glm::dot(d, y), pz = glm::dot(d, f);
+  if (pz + b.radius < c.near || pz - b.radius > c.far) return false;
+  float half_y = 0.5f * glm::radians(c.fov_y_deg);
+  float half_x = std::atan(std::tan(half_y) * aspect);
+  // Signed distances to the side planes through the eye, positive outside.
+  for (auto [p, half] : {std::pair{px, half_x}, std::pair{py, half_y}}) {
+    if (std::fabs(p) * std::cos(half) - pz * std::sin(half) > b.radius) return false;
+  }
+  return true;
+}
+
+// The automatic exposure of a model file: the brightest a diffuse surface of the model can
+// be, per channel, is emission + diffuse * (ambient + E), E bounding the irradiance of the
+// lights anywhere in the bounding sphere: sum of I / (distance from the light to the sphere)^2,
+// that distance taken as at least half the radius (a light inside the sphere). The exposure
+// brings that to 1 when it is above (EV = -log2 of it), and is 0 otherwise: diffuse shading
+// then never clips, and only specular highlights can. From the scene alone, so every renderer
+// gets the same value.
+float automatic_exposure(const Scene& scene, const BoundingSphere& bounds) {
+  glm::vec3 irradiance(0.0f);
+  for (const Light& l : scene.lights) {
+    glm::vec3 at =
+        l.type == LightType::Point ? l.position : l.corner + 0.5f * (l.edge_u + l.edge_v);
+    float gap = std::max(glm::length(at - bounds.centre) - bounds.radius, 0.5f * bounds.radius);
+    irradiance += l.intensity / (gap * gap);
+  }
+  float peak = 0.0f;
+  std::vector<bool> used(scene.materials.size(), false);
+  for (const Object& o : scene.objects) used[o.material] = true;
+  for (size_t m = 0; m < scene.materials.size(); ++m) {
+    if (!used[m]) continue;
+    const Material& mat = scene.materials[m];
+    glm::vec3 brightest = mat.emission + mat.diffuse * (scene.ambient + irradiance);
+    peak = std::max({peak, brightest.r, brightest.g, brightest.b});
+  }
+  if (!(peak > 1.0f) || !std::isfinite(peak)) return 0.0f;
+  return std::max(-std::log2(peak), -kMaxExposure);
+}
+
 std::string unique_name(const std::string& wanted, std::set<std::string>& taken) {
   std::string name = wanted.empty() ? "material" : wanted;
   for (int i = 2; taken.count(name) || name == "default"; ++i) {
@@ -53,6 +136,11 @@ std::string unique_name(const std::string& wanted, std::set<std::string>& taken)
 Scene build_model_scene(const std::string& path, const SceneOverrides& overrides) {
   const std::optional<glm::vec3>& view_from = overrides.view_from;
   ImportedModel model = import_model(path, "", "");
+  // Up: the file's (auto) or the one asked for, turned to +y before anything is framed.
+  glm::vec3 up = overrides.up == UpAxis::Auto ? model.up
+                 : overrides.up == UpAxis::Z  ? glm::vec3(0.0f, 0.0f, 1.0f)
+                                              : glm::vec3(0.0f, 1.0f, 0.0f);
+  if (up != glm::vec3(0.0f, 1.0f, 0.0f)) turn_model(model, turn_up_to_y(up));
   Scene scene;
   scene.source = path;
   scene.materials.push_back(default_material());
@@ -74,7 +162,21 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
   }
   if (scene.objects.empty()) fail("", "all triangles are degenerate (zero area)");
   BoundingSphere bounds = scene_bounds(scene);
-  bool own_camera = model.camera && !view_from;
+  if (model.camera && !view_from && overrides.camera == FromFile::File) {
+    // A file camera that sees none of the model (e.g. an exporter's camera left where it
+    // was) gives an image of background only: framed instead, with a warning.
+    float aspect = model.camera_aspect > 0.0f
+                       ? model.camera_aspect
+                       : float(overrides.width.value_or(scene.image.width)) /
+                             float(overrides.height.value_or(scene.image.height));
+    if (!camera_sees(*model.camera, aspect, bounds)) {
+      model.warnings.push_back(
+          "the file's camera sees none of the model; framing the model "
+          "instead");
+      model.camera.reset();
+    }
+  }
+  bool own_camera = model.camera && !view_from && overrides.camera == FromFile::File;
   if (own_camera && model.camera_aspect > 0.0f) {  // the image takes the camera's shape
     scene.image.width = overrides.width.value_or(scene.image.width);
     scene.image.height =
@@ -87,7 +189,7 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
   } else {
     frame_camera(scene, bounds, view_from ? *view_from : default_view_from());
   }
-  if (model.lights.empty()) {
+  if (model.lights.empty() || overrides.lights == FromFile::Auto) {
     add_default_lights(scene, bounds);
   } else {
     scene.lights = model.lights;
@@ -100,6 +202,7 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
     }
     scene.ambient = glm::vec3(0.05f);
   }
+  scene.image.exposure = overrides.exposure.value_or(automatic_exposure(scene, bounds));
   scene.warnings = model.warnings;
   if (model.skipped_primitives > 0) {
     scene.warnings.push_back(

@@ -143,6 +143,7 @@ std::string encode(const ImportedModel& model) {
   w.pod(uint8_t(model.camera.has_value()));
   if (model.camera) w.pod(*model.camera);
   w.pod(model.camera_aspect);
+  w.pod(model.up);
   w.array(model.lights);
   std::vector<uint64_t> unattenuated(model.unattenuated_lights.begin(),
                                      model.unattenuated_lights.end());
@@ -167,6 +168,7 @@ ImportedModel decode_model(const std::string& bytes) {
   }
   if (r.pod<uint8_t>()) model.camera = r.pod<Camera>();
   model.camera_aspect = r.pod<float>();
+  model.up = r.pod<glm::vec3>();
   model.lights = r.array<Light>();
   for (uint64_t i : r.array<uint64_t>()) model.unattenuated_lights.push_back(size_t(i));
   model.skipped_primitives = size_t(r.pod<uint64_t>());

@@ -87,7 +87,7 @@ class Reader {
   void read_image(const json& v) {
     const std::string path = "image";
     check_object(v, path);
-    check_keys(v, path, {"width", "height", "background", "samples_per_pixel"});
+    check_keys(v, path, {"width", "height", "background", "samples_per_pixel", "exposure"});
     ImageSettings& im = scene_.image;
     if (const json* w = find(v, "width")) im.width = integer(*w, "image.width", 1, kMaxImageSize);
     if (const json* h = find(v, "height")) {
@@ -97,6 +97,13 @@ class Reader {
     if (const json* s = find(v, "samples_per_pixel")) {
       im.samples_per_pixel = integer(*s, "image.samples_per_pixel", 1, kMaxSamplesPerPixel,
                                      " (capped at " + std::to_string(kMaxSamplesPerPixel) + ")");
+    }
+    if (const json* e = find(v, "exposure")) {
+      im.exposure = real(*e, "image.exposure");
+      if (!(std::fabs(im.exposure) <= kMaxExposure)) {
+        fail("image.exposure",
+             fmt::format("must be between -{0} and {0} stops, got {1}", kMaxExposure, e->dump()));
+      }
     }
   }
 
@@ -662,6 +669,7 @@ void apply_overrides(Scene& scene, const SceneOverrides& overrides) {
   if (overrides.view_from && !scene.objects.empty()) {
     frame_camera(scene, scene_bounds(scene), *overrides.view_from);
   }
+  if (overrides.exposure) scene.image.exposure = *overrides.exposure;
 }
 
 }  // namespace
@@ -670,6 +678,10 @@ Expected<Scene> load_scene(const std::string& spec, const SceneOverrides& overri
   if (overrides.view_from && !(std::isfinite(glm::length(*overrides.view_from)) &&
                                glm::length(*overrides.view_from) > 0.0f)) {
     return bad_input(spec + ": the view direction must be finite and non-zero");
+  }
+  if (overrides.exposure && !(std::fabs(*overrides.exposure) <= kMaxExposure)) {
+    return bad_input(fmt::format("{}: the exposure must be between -{} and {} stops", spec,
+                                 kMaxExposure, kMaxExposure));
   }
   static const std::string kBuiltin = "builtin:";
   bool model = false;

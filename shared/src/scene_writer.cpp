@@ -185,6 +185,7 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix) {
                    {"height", im.height},
                    {"background", vec(im.background, "image.background")},
                    {"samples_per_pixel", im.samples_per_pixel}};
+  if (im.exposure != 0.0f) root["image"]["exposure"] = num(im.exposure, "image.exposure");
 
   const Camera& c = scene.camera;
   root["camera"] = {{"eye", vec(c.eye, "camera.eye")},

@@ -1,6 +1,7 @@
 // What every renderer produces: colour plus the AOVs, row-major with y = 0 the TOP row.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <limits>
@@ -101,6 +102,14 @@ inline void FrameBuffers::allocate(int w, int h) {
     v->clear();
     v->resize(n);
   }
+}
+
+// The one colour transform after shading, the same for every renderer: linear colour times
+// 2^ev (ImageSettings::exposure). Nothing changes at ev = 0.
+inline void apply_exposure(FrameBuffers& buffers, float ev) {
+  if (ev == 0.0f) return;
+  const float scale = std::exp2(ev);
+  for (glm::vec3& c : buffers.color) c *= scale;
 }
 
 }  // namespace rvr

@@ -49,6 +49,9 @@ struct ImageSettings {
   int height = 480;
   glm::vec3 background{0.0f};
   int samples_per_pixel = 1;
+  // Exposure in stops (EV): every renderer's linear colour is multiplied by 2^exposure after
+  // shading, before it is written or compared (apply_exposure in framebuffers.h).
+  float exposure = 0.0f;
 };
 
 struct Sphere {

@@ -21,11 +21,28 @@ Expected<Scene> parse_scene(const std::string& json_text, const std::string& sou
                             const std::string& base_dir);
 
 // What the command line may change in a scene as it is loaded.
+// The largest exposure, in stops either way (image.exposure, --exposure).
+constexpr float kMaxExposure = 64.0f;
+
+// Model files: which axis of the file's coordinates (as Assimp reads them) is up. Auto: FBX
+// from its UpAxis/UpAxisSign; every other format +y (Assimp has already turned Collada's
+// <up_axis> and 3DS's +z to +y; glTF is +y; OBJ, STL, PLY say nothing). Z: +z is up.
+enum class UpAxis { Auto, Y, Z };
+// Model files: the file's own camera or lights where it has them (File), or rvr's framing
+// camera and default key light whatever the file holds (Auto).
+enum class FromFile { File, Auto };
+
 struct SceneOverrides {
   std::optional<int> width, height;  // the image size (before the camera is framed)
   // Frame the scene from this direction (from the centre towards the eye; see
   // camera_framing.h), replacing the camera of the scene or model file.
   std::optional<glm::vec3> view_from;
+  // ImageSettings::exposure for any scene; unset: the scene file's, or for a model file the
+  // automatic exposure (docs/scene-format.md, "Model files as scenes").
+  std::optional<float> exposure;
+  UpAxis up = UpAxis::Auto;          // model files only
+  FromFile camera = FromFile::File;  // model files only
+  FromFile lights = FromFile::File;  // model files only
 };
 
 // "builtin:NAME" or a path: a scene file, or a model file in any format Assimp reads (see
@@ -38,9 +55,12 @@ Expected<Scene> load_scene(const std::string& spec, const SceneOverrides& overri
 bool is_model_file_name(const std::string& path);
 
 // A model file as a scene (docs/scene-format.md, "Model files as scenes"): one object per
-// mesh with the file's own material; the file's first camera, else one framing the model from
-// default_view_from() (overrides.view_from replaces either); the file's point lights, else a
-// key light near the camera and ambient.
+// mesh with the file's own material, turned so that its up axis (overrides.up) is +y; the
+// file's first camera (not an FBX exporter's viewport camera, nor one that sees none of the
+// model), else one framing the model from default_view_from() (overrides.view_from replaces
+// either, overrides.camera = Auto always frames); the file's point lights, else (or with
+// overrides.lights = Auto) a key light near the camera and ambient; the automatic exposure
+// unless overrides.exposure is set.
 Expected<Scene> load_model_scene(const std::string& path, const SceneOverrides& overrides = {});
 
 struct BuiltinSceneInfo {
