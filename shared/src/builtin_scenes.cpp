@@ -343,6 +343,46 @@ Scene glass() {
   return s;
 }
 
+// A checkerboard texture of squares x squares squares, each `texels` texels wide, in two
+// colours (linear RGB), built in memory.
+Texture checkerboard(int squares, int texels, glm::vec3 a, glm::vec3 b) {
+  TextureLevel level;
+  level.width = level.height = squares * texels;
+  level.texels.resize(size_t(level.width) * size_t(level.height));
+  for (int y = 0; y < level.height; ++y)
+    for (int x = 0; x < level.width; ++x)
+      level.texels[size_t(y) * size_t(level.width) + size_t(x)] =
+          ((x / texels + y / texels) % 2 == 0) ? a : b;
+  Texture t;
+  t.file = "checkerboard";
+  t.mips = std::make_shared<const MipChain>(build_mip_chain(std::move(level)));
+  return t;
+}
+
+// A checkerboard-textured floor seen at grazing angles (the texture repeats 32 times across
+// it: every mip level shows, up to the horizon) and a triangle whose corners are red, green
+// and blue (vertex colours), standing on it.
+Scene textured() {
+  Scene s = base_scene("textured");
+  s.textures.push_back(checkerboard(8, 16, {0.9f, 0.9f, 0.85f}, {0.1f, 0.15f, 0.4f}));
+  uint32_t floor = add_material(s, "checker", glm::vec3(1.0f));
+  s.materials[floor].texture = 0;
+  uint32_t white = add_material(s, "vertex colours", glm::vec3(1.0f));
+  const float h = 40.0f, repeats = 32.0f;
+  Object& f = add_object(s, "floor", ObjectType::Triangles, floor);
+  f.mesh.positions = {{-h, 0, h}, {h, 0, h}, {h, 0, -h}, {-h, 0, -h}};
+  f.mesh.uvs = {{0, 0}, {repeats, 0}, {repeats, repeats}, {0, repeats}};
+  f.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  Object& t = add_object(s, "triangle", ObjectType::Triangles, white);
+  t.mesh.positions = {{-1.2f, 0.0f, -1.0f}, {1.2f, 0.0f, -1.0f}, {0.0f, 1.8f, -1.0f}};
+  t.mesh.colours = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  t.mesh.triangles = {{0, 1, 2}};
+  look_at(s, {0.0f, 1.0f, 5.0f}, {0.0f, 0.6f, -2.0f}, 45.0f, 0.05f, 200.0f);
+  s.ambient = {0.1f, 0.1f, 0.1f};
+  add_point_light(s, {2.0f, 6.0f, 4.0f}, {60.0f, 60.0f, 60.0f});
+  return s;
+}
+
 }  // namespace
 
 std::vector<BuiltinSceneInfo> builtin_scenes() {
@@ -359,6 +399,9 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
       {"csg", "union, intersection, difference of spheres and a nested tree, on a floor"},
       {"dof", "spheres at several depths, thin lens focused on the middle one, 16 samples"},
       {"glass", "a glass slab and a glass sphere in front of coloured quads"},
+      {"textured",
+       "a checkerboard-textured floor to the horizon (every mip level) and a vertex-coloured "
+       "triangle"},
   };
 }
 
@@ -389,6 +432,7 @@ Expected<Scene> make_builtin_scene(const std::string& spec) {
   if (name == "csg") return has_count ? no_count() : Expected<Scene>(csg());
   if (name == "dof") return has_count ? no_count() : Expected<Scene>(dof());
   if (name == "glass") return has_count ? no_count() : Expected<Scene>(glass());
+  if (name == "textured") return has_count ? no_count() : Expected<Scene>(textured());
   return bad_input("builtin:" + spec + ": no such built-in scene (see 'rvr scenes')");
 }
 

@@ -56,6 +56,9 @@ struct FrameBuffers {
   PixelVector<uint32_t> primitive_id;  // triangle index in the object (0 for analytic)
   PixelVector<glm::vec3> normal;       // world-space shading normal facing the viewer, 0 on bg
   PixelVector<float> cost;             // work per pixel (nodes + tests, or fragments)
+  // The texture level of detail the renderer sampled at the visible surface, NaN where that is
+  // not textured; empty (reset and allocate empty it) unless the scene has a textured object.
+  PixelVector<float> lod;
 
   // Sizes every buffer and fills it with the background values.
   void reset(int w, int h, const glm::vec3& background);
@@ -84,6 +87,7 @@ inline void FrameBuffers::reset(int w, int h, const glm::vec3& background) {
   primitive_id.assign(n, kNoId);
   normal.assign(n, glm::vec3(0.0f));
   cost.assign(n, 0.0f);
+  lod.clear();
 }
 
 inline void FrameBuffers::allocate(int w, int h) {
@@ -102,6 +106,7 @@ inline void FrameBuffers::allocate(int w, int h) {
     v->clear();
     v->resize(n);
   }
+  lod.clear();
 }
 
 // The one colour transform after shading, the same for every renderer: linear colour times

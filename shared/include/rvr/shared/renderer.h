@@ -57,6 +57,9 @@ struct RenderOptions {
   // d32f_reversed when the GL offers ARB_clip_control, else d32f; softraster: view depth in
   // double precision, finer than any of the formats). The tracers ignore it.
   std::optional<DepthFormat> depth_format;
+  // Tracers: how a ray chooses a texture's level of detail (the z-buffers take theirs from
+  // screen-space derivatives; the hybrids' primary hits from their z-buffer's).
+  TextureLod texture_lod = TextureLod::Cones;
   // softraster: hierarchical z (each 8x8 block's farthest depth rejects triangles behind it).
   bool hiz = true;
   // Cost AOV: false: the caller does not read the cost AOV, which is then 0 everywhere (the

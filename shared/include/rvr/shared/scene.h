@@ -8,10 +8,30 @@
 #include <string>
 #include <vector>
 
+#include "rvr/shared/texture.h"
+
 namespace rvr {
+
+// A 2D affine map of texture coordinates, glTF's KHR_texture_transform, in glTF's texture space
+// (v down, s = (u, 1 - v) of a mesh's uv): s' = translate(offset) * R * scale(scale) * s with
+// R = [cos r, -sin r; sin r, cos r] (the extension's GLSL matrix, column-major), r = rotation in
+// radians. apply() takes and returns a mesh's uv (v up).
+struct UvTransform {
+  glm::vec2 offset{0.0f};
+  float rotation = 0.0f;
+  glm::vec2 scale{1.0f};
+
+  bool identity() const {
+    return offset == glm::vec2(0.0f) && rotation == 0.0f && scale == glm::vec2(1.0f);
+  }
+  glm::vec2 apply(glm::vec2 uv) const;
+};
 
 struct Material {
   std::string name;
+  // The base colour: diffuse times the texture (when `texture` >= 0 and the surface has texture
+  // coordinates) times the interpolated vertex colour (when the mesh has them); it scales the
+  // ambient and diffuse terms of the shading equation (docs/design.md).
   glm::vec3 diffuse{0.8f};
   glm::vec3 specular{0.0f};
   glm::vec3 emission{0.0f};
@@ -19,6 +39,8 @@ struct Material {
   float mirror = 0.0f;
   float transparency = 0.0f;
   float ior = 1.0f;
+  int32_t texture = -1;      // index into Scene::textures, or -1
+  UvTransform uv_transform;  // applied to the mesh's uvs before the texture is sampled
 };
 
 enum class LightType { Point, Area };
@@ -67,14 +89,20 @@ struct Plane {
 };
 
 // Triangles in world space. normals is empty (flat shading: geometric normal) or holds one
-// unit normal per position (smooth shading: interpolated).
+// unit normal per position (smooth shading: interpolated). uvs and colours are empty or hold
+// one value per position, interpolated like the normals: texture coordinates (OpenGL's
+// convention: v = 0 is the image's bottom row) and linear RGB vertex colours.
 struct TriangleMesh {
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
   std::vector<glm::uvec3> triangles;
+  std::vector<glm::vec2> uvs;
+  std::vector<glm::vec3> colours;
 
   size_t triangle_count() const { return triangles.size(); }
   bool smooth() const { return !normals.empty(); }
+  bool textured() const { return !uvs.empty(); }
+  bool coloured() const { return !colours.empty(); }
 };
 
 enum class CsgOp { Union, Intersection, Difference };
@@ -105,6 +133,7 @@ struct Scene {
   Camera camera;
   glm::vec3 ambient{0.0f};
   std::vector<Material> materials;  // index 0 is the built-in grey default
+  std::vector<Texture> textures;    // base-colour textures, referred to by Material::texture
   std::vector<Light> lights;
   std::vector<Object> objects;
   std::vector<std::string> warnings;  // e.g. dropped degenerate triangles
