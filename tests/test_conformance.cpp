@@ -9,13 +9,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/compare.h"
+#include "rvr/shared/mismatch_classes.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/tessellate.h"
 
 using namespace rvr;
 
@@ -59,7 +64,8 @@ std::vector<RendererCase> renderer_cases() {
 // a csg object has no z-buffer form, so rasterizers skip it (with a warning; tested in
 // test_raster) and there is nothing to agree on.
 const char* kScenes[] = {"cornell",   "spheres",         "occluders:16", "occluders_back:16",
-                         "soup:2000", "tessphere:20000", "dof",          "glass"};
+                         "soup:2000", "tessphere:20000", "dof",          "glass",
+                         "textured"};
 
 TEST(ConformanceScenes, CoverEveryBuiltinSceneButCsg) {
   std::set<std::string> listed;
@@ -401,5 +407,66 @@ TEST(AnalyticSpheres, MismatchesStayOnSilhouettesAndShrinkWithSegments) {
     EXPECT_EQ(far_from_silhouette, 0u) << segments << " segments, reach " << reach << " px";
     EXPECT_LT(mismatched, previous) << segments << " segments";
     previous = mismatched;
+  }
+}
+
+namespace {
+
+// The facet of `mesh` the ray through the centre of pixel (x, y) meets first, found in double
+// precision (Moller-Trumbore over every facet), or kNoId.
+uint32_t exact_facet(const Scene& scene, const TriangleMesh& mesh, int x, int y) {
+  const CameraFrame frame = make_camera_frame(scene.camera, scene.image.width, scene.image.height);
+  const glm::dvec3 eye(scene.camera.eye);
+  const glm::dvec3 d(camera_ray_direction(frame, float(x) + 0.5f, float(y) + 0.5f));
+  uint32_t best = kNoId;
+  double best_t = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const glm::uvec3 t = mesh.triangles[i];
+    const glm::dvec3 a(mesh.positions[t.x]), e1 = glm::dvec3(mesh.positions[t.y]) - a,
+                                             e2 = glm::dvec3(mesh.positions[t.z]) - a;
+    const glm::dvec3 p = glm::cross(d, e2);
+    const double det = glm::dot(e1, p);
+    if (det == 0.0) continue;
+    const glm::dvec3 s = eye - a, q = glm::cross(s, e1);
+    const double u = glm::dot(s, p) / det, v = glm::dot(d, q) / det, h = glm::dot(e2, q) / det;
+    if (u >= 0 && v >= 0 && u + v <= 1 && h > 0 && h < best_t) best = uint32_t(i), best_t = h;
+  }
+  return best;
+}
+
+}  // namespace
+
+// Tessellated spheres (--spheres mesh) are the same triangles for every renderer, so their
+// facets are named like a mesh's. At the two grazing pixels below the pixel centre lies inside a
+// sliver facet of about 0.006 px^2 on screen; GL snaps vertices to 1/256 pixel, the sliver
+// moves off the centre and its neighbour, whose edge passes within 1/256 pixel of the centre,
+// takes the pixel. With one primitive id per sphere that showed as a depth outlier of 1.5e-3
+// on "the same primitive"; with facet ids it is a named edge tie.
+TEST(TessellatedSpheres, GrazingFacetSwapsAreEdgeTiesNotDepthErrors) {
+  Expected<Scene> scene = make_builtin_scene("spheres");
+  ASSERT_TRUE(scene.ok());
+  const int segments = 64;  // the command line's default
+  RenderOutput gl = render_with("raster", *scene, SphereMode::Mesh, segments, GlBackend::OsMesa);
+  RenderOutput rt = render_with("raytrace", *scene, SphereMode::Mesh, segments);
+  MismatchContext context;
+  context.scene = &*scene;
+  context.store_a = DepthStore::Window32FReversed;
+  context.sphere_segments = segments;
+  ComparisonMetrics m = compare_buffers(gl.buffers, rt.buffers, context);
+  EXPECT_EQ(m.depth.outliers, 0u) << worst_depth(gl.buffers, rt.buffers);
+  EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
+  EXPECT_GT(m.visibility.classes.edge, 0u);  // facets now disagree on ties, as meshes do
+
+  const std::vector<MismatchClass> classes = classify_mismatches(gl.buffers, rt.buffers, context);
+  for (auto [x, y] : {std::pair{197, 259}, std::pair{442, 259}}) {
+    const size_t i = gl.buffers.index(x, y);
+    const uint32_t object = rt.buffers.object_id[i];
+    ASSERT_NE(object, kNoId);
+    ASSERT_EQ(scene->objects[object].type, ObjectType::Sphere);
+    const TriangleMesh facets = tessellate_sphere(scene->objects[object].sphere, segments);
+    EXPECT_EQ(rt.buffers.primitive_id[i], exact_facet(*scene, facets, x, y)) << x << "," << y;
+    EXPECT_EQ(gl.buffers.object_id[i], object);
+    EXPECT_NE(gl.buffers.primitive_id[i], rt.buffers.primitive_id[i]) << x << "," << y;
+    EXPECT_EQ(classes[i], MismatchClass::Edge) << x << "," << y;
   }
 }

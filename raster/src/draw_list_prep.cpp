@@ -21,6 +21,11 @@ TriangleMesh tessellate_shape(const Object& o, int sphere_segments) {
                                       : tessellate_plane(o.plane);
 }
 
+bool names_triangles(const Object& o, SphereMode spheres) {
+  return o.type == ObjectType::Triangles ||
+         (o.type == ObjectType::Sphere && spheres == SphereMode::Mesh);
+}
+
 std::string object_label(const Object& o, size_t index) {
   return o.name.empty() ? fmt::format("csg#{}", index) : o.name;
 }

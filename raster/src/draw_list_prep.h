@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rvr/shared/expected.h"
+#include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
 
 namespace rvr {
@@ -18,6 +19,12 @@ Expected<const Material*> object_material(const Scene& scene, const Object& o,
 
 // The triangles drawn for an analytic sphere or square.
 TriangleMesh tessellate_shape(const Object& o, int sphere_segments);
+
+// Whether the object's primitive ids are the indices of the triangles drawn: a mesh's, and a
+// sphere's tessellation when the tracers trace that same tessellation (SphereMode::Mesh), so
+// that the two loop orders name the same facet. Otherwise (an analytic sphere, a square) the
+// tracer sees one primitive and the z-buffers write 0.
+bool names_triangles(const Object& o, SphereMode spheres);
 
 // How the skipped-CSG warning names an object.
 std::string object_label(const Object& o, size_t index);

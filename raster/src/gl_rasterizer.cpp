@@ -606,6 +606,7 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
       case ObjectType::Plane:
         RVR_TRY(append_mesh(tessellate_shape(o, options.sphere_segments), o.name, vertices));
         d.smooth = o.type == ObjectType::Sphere;
+        d.use_primitive_id = names_triangles(o, options.spheres);
         break;
       case ObjectType::Csg:
         up.skipped_csg.push_back(object_label(o, i));

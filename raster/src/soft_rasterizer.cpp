@@ -88,6 +88,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
       case ObjectType::Plane:
         tessellated.push_back(tessellate_shape(o, options.sphere_segments));
         d.mesh = &tessellated.back();
+        d.use_primitive_id = names_triangles(o, options.spheres);
         break;
       case ObjectType::Csg:
         skipped_csg.push_back(object_label(o, i));

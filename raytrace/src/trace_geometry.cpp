@@ -89,16 +89,18 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
   object_first_triangle_.assign(n_objects, 0);
   object_analytic_.assign(n_objects, kNoPrimitive);
   object_names_triangles_.assign(n_objects, 0);
-  auto add_mesh = [&](uint32_t object, const TriangleMesh& mesh, bool report_triangle_ids) {
+  // Every triangle the tracer sees is named by its index in its mesh (a tessellated sphere's
+  // facets too, as the z-buffers name them under SphereMode::Mesh).
+  auto add_mesh = [&](uint32_t object, const TriangleMesh& mesh) {
     object_mesh_[object] = &mesh;
     object_first_triangle_[object] = uint32_t(triangles_.size());
-    object_names_triangles_[object] = report_triangle_ids ? 1 : 0;
+    object_names_triangles_[object] = 1;
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
       const glm::uvec3& t = mesh.triangles[i];
       triangles_.push_back(
           precompute_triangle(mesh.positions[t.x], mesh.positions[t.y], mesh.positions[t.z]));
       triangle_object_.push_back(object);
-      triangle_id_.push_back(report_triangle_ids ? uint32_t(i) : 0u);
+      triangle_id_.push_back(uint32_t(i));
       triangle_in_mesh_.push_back(uint32_t(i));
     }
   };
@@ -108,13 +110,13 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
     object_material_[id] = o.material;
     switch (o.type) {
       case ObjectType::Triangles:
-        add_mesh(id, o.mesh, true);
+        add_mesh(id, o.mesh);
         break;
       case ObjectType::Sphere:
         if (spheres == SphereMode::Mesh) {
           owned_meshes_.push_back(
               std::make_unique<TriangleMesh>(tessellate_sphere(o.sphere, sphere_segments)));
-          add_mesh(id, *owned_meshes_.back(), false);
+          add_mesh(id, *owned_meshes_.back());
         } else {
           object_analytic_[id] = uint32_t(analytic_.size());
           analytic_.push_back({Kind::Sphere, id, o.sphere, {}, {}, {}, nullptr, {}});

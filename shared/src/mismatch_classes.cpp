@@ -5,9 +5,12 @@
 #include <cmath>
 #include <glm/glm.hpp>
 #include <limits>
+#include <optional>
+#include <vector>
 
 #include "rvr/shared/camera.h"
 #include "rvr/shared/srgb.h"
+#include "rvr/shared/tessellate.h"
 
 namespace rvr {
 
@@ -240,22 +243,43 @@ bool on_own_outline(const FrameBuffers& fb, int x, int y) {
   return false;
 }
 
+// The triangles an object's primitive ids index: a mesh's own, a sphere's facets when the
+// renderers drew and traced its tessellation (tessellated once, on first use); null for an
+// object drawn as one primitive.
+class NamedTriangles {
+ public:
+  NamedTriangles(const Scene& scene, int sphere_segments)
+      : scene_(scene), sphere_segments_(sphere_segments), spheres_(scene.objects.size()) {}
+
+  const TriangleMesh* of(uint32_t object) {
+    const Object& o = scene_.objects[object];
+    if (o.type == ObjectType::Triangles) return &o.mesh;
+    if (o.type != ObjectType::Sphere || sphere_segments_ <= 0) return nullptr;
+    if (!spheres_[object]) spheres_[object] = tessellate_sphere(o.sphere, sphere_segments_);
+    return &*spheres_[object];
+  }
+
+ private:
+  const Scene& scene_;
+  int sphere_segments_;
+  std::vector<std::optional<TriangleMesh>> spheres_;
+};
+
 // Whether the hit `fb` shows at (x, y) is within the tolerance of an edge of its primitive: a
-// mesh triangle's projected edges, or the outline of an object drawn as one primitive.
-bool at_hit_edge(const FrameBuffers& fb, int x, int y, const Scene& scene, const PixelRays& rays,
-                 double tolerance) {
+// named triangle's projected edges, or the outline of an object drawn as one primitive.
+bool at_hit_edge(const FrameBuffers& fb, int x, int y, NamedTriangles& named, const Scene& scene,
+                 const PixelRays& rays, double tolerance) {
   const size_t i = fb.index(x, y);
   const uint32_t object = fb.object_id[i];
   if (object == kNoId) return false;
   if (object >= scene.objects.size()) return on_own_outline(fb, x, y);
-  const Object& o = scene.objects[object];
+  const TriangleMesh* mesh = named.of(object);
   const uint32_t prim = fb.primitive_id[i];
-  if (o.type != ObjectType::Triangles || prim >= o.mesh.triangles.size())
-    return on_own_outline(fb, x, y);
-  const glm::uvec3 t = o.mesh.triangles[prim];
-  const std::array<glm::dvec3, 3> v = {glm::dvec3(o.mesh.positions[t.x]),
-                                       glm::dvec3(o.mesh.positions[t.y]),
-                                       glm::dvec3(o.mesh.positions[t.z])};
+  if (!mesh || prim >= mesh->triangles.size()) return on_own_outline(fb, x, y);
+  const glm::uvec3 t = mesh->triangles[prim];
+  const std::array<glm::dvec3, 3> v = {glm::dvec3(mesh->positions[t.x]),
+                                       glm::dvec3(mesh->positions[t.y]),
+                                       glm::dvec3(mesh->positions[t.z])};
   return edge_distance_pixels(rays, v, x, y) <= tolerance;
 }
 
@@ -286,15 +310,17 @@ std::vector<MismatchClass> classify_mismatches(const FrameBuffers& a, const Fram
   const PixelRays rays(camera, std::max(a.width, 1), std::max(a.height, 1));
   std::vector<bool> near_boundary;
   if (!scene) near_boundary = near_any_boundary(a, b);
+  std::optional<NamedTriangles> named;
+  if (scene) named.emplace(*scene, context.sphere_segments);
 
   for (int y = 0; y < a.height; ++y)
     for (int x = 0; x < a.width; ++x) {
       const size_t i = a.index(x, y);
       if (id_key(a, i) == id_key(b, i)) continue;
-      const bool edge = scene
-                            ? at_hit_edge(a, x, y, *scene, rays, context.edge_tolerance_pixels) ||
-                                  at_hit_edge(b, x, y, *scene, rays, context.edge_tolerance_pixels)
-                            : bool(near_boundary[i]);
+      const double tolerance = context.edge_tolerance_pixels;
+      const bool edge = scene ? at_hit_edge(a, x, y, *named, *scene, rays, tolerance) ||
+                                    at_hit_edge(b, x, y, *named, *scene, rays, tolerance)
+                              : bool(near_boundary[i]);
       classes[i] = edge ? MismatchClass::Edge
                         : classify_off_edge(a.depth[i], b.depth[i], a.object_id[i] != kNoId,
                                             b.object_id[i] != kNoId, context, near, far);

@@ -174,7 +174,7 @@ class TraceGeometry {
   // Unified primitive index: [0, T) triangles, [T, T + A) analytic shapes.
   std::vector<TrianglePrecomputed> triangles_;
   std::vector<uint32_t> triangle_object_;
-  std::vector<uint32_t> triangle_id_;       // primitive id reported (0 for tessellated spheres)
+  std::vector<uint32_t> triangle_id_;       // primitive id reported: the index in its mesh
   std::vector<uint32_t> triangle_in_mesh_;  // index into the mesh's triangles (normals)
   std::vector<Analytic> analytic_;
   std::vector<const TriangleMesh*> object_mesh_;             // per object, or null
