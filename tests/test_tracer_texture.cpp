@@ -369,3 +369,104 @@ TEST(TracerTexture, EmbreeFindsTheSameSurfacesColoursAndLevels) {
     EXPECT_GT(textured, ours.buffers.pixel_count() / 4);
   }
 }
+
+// A textured wall z = -5 (uv = (x + 10, y) per unit) standing on a mirror floor y = 0, lit by an
+// ambient of 1 alone: below the horizon the camera sees the wall's reflection, whose colour is
+// the wall's texture sampled at the reflected ray's level of detail.
+Scene wall_over_mirror() {
+  Scene s = empty_scene(80, 60, {0.0f, 1.5f, 6.0f}, {0.0f, 0.5f, 0.0f}, 50.0f);
+  s.textures.push_back(checker_texture());
+  s.ambient = glm::vec3(1.0f);
+  Object wall;
+  wall.type = ObjectType::Triangles;
+  wall.material = add_material(s, glm::vec3(1.0f));
+  s.materials[wall.material].texture = 0;
+  wall.mesh.positions = {{-10, 0, -5}, {10, 0, -5}, {10, 10, -5}, {-10, 10, -5}};
+  wall.mesh.uvs = {{0, 0}, {20, 0}, {20, 10}, {0, 10}};
+  wall.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  s.objects.push_back(wall);
+  add_plane(s, {0.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 20.0f,
+            add_material(s, glm::vec3(0.0f), glm::vec3(0.0f), 1.0f));
+  return s;
+}
+
+// The reflected ray of pixel (x, y) off the mirror floor, worked out in double: it starts at
+// the floor point lifted by the tracer's ray_epsilon, along the unit mirrored direction R; its
+// footprint is the floor point's derivatives dO (Igehy's transfer onto y = 0) and R's
+// derivatives (those of normalize(mirror(D))); carried to the wall's plane z = -5 the same way.
+// The level of detail there by either method; nothing where the ray misses the wall.
+struct WallSample {
+  glm::dvec2 uv;
+  double lod_cones, lod_differentials;
+};
+
+std::optional<WallSample> exact_wall_sample(const ExactCamera& c, int x, int y) {
+  constexpr double kUv = 1.0, kWallZ = -5.0;
+  const glm::dvec3 D = c.direction(x, y);
+  if (!(D.y < 0.0)) return std::nullopt;
+  const double t1 = -c.eye.y / D.y;
+  const glm::dvec3 floor = c.eye + t1 * D;
+  if (!(floor.z > kWallZ + 0.5) || std::abs(floor.x) > 19.0 || floor.z > 19.0) return std::nullopt;
+  auto floor_derivative = [&](const glm::dvec3& dD) { return t1 * dD + (-t1 * dD.y / D.y) * D; };
+  const glm::dvec3 M(D.x, -D.y, D.z);  // mirror(D)
+  const double m = glm::length(M);
+  const glm::dvec3 R = M / m;
+  auto unit_derivative = [&](const glm::dvec3& dD) {
+    const glm::dvec3 dM(dD.x, -dD.y, dD.z);
+    return (dM - glm::dot(R, dM) * R) / m;
+  };
+  const double eps = 1e-4 * std::max({std::abs(floor.x), std::abs(floor.z), 1.0});
+  const glm::dvec3 O = floor + glm::dvec3(0.0, eps, 0.0);
+  if (!(R.z < 0.0)) return std::nullopt;
+  const double t2 = (kWallZ - O.z) / R.z;
+  const glm::dvec3 P = O + t2 * R;
+  if (std::abs(P.x) > 9.5 || P.y < 0.5 || P.y > 9.5) return std::nullopt;
+  auto wall_duv = [&](const glm::dvec3& dD) {
+    const glm::dvec3 dO = floor_derivative(dD), dR = unit_derivative(dD);
+    const glm::dvec3 moved = dO + t2 * dR;
+    const glm::dvec3 dP = moved - (moved.z / R.z) * R;
+    return glm::dvec2(dP.x * kUv, dP.y * kUv);
+  };
+  WallSample w;
+  w.uv = {(P.x + 10.0) * kUv, P.y * kUv};
+  const glm::dvec2 dx = wall_duv(c.d_dx()), dy = wall_duv(c.d_dy());
+  w.lod_differentials = std::log2(std::max(glm::length(dx), glm::length(dy)) * kTexels);
+  // The cone: primary spread, width grown over both legs; theta at the wall, whose normal is z.
+  const double spread = std::atan(2.0 * c.tan_half / c.height);
+  const double width = spread * (t1 * glm::length(D) + t2);
+  w.lod_cones =
+      0.5 * std::log2(double(kTexels) * kTexels * kUv * kUv) + std::log2(width / std::abs(R.z));
+  return w;
+}
+
+TEST(TracerTexture, ReflectedRaysCarryTheirFootprintToTheTexture) {
+  const Scene s = wall_over_mirror();
+  const ExactCamera c(s);
+  const MipChain& mips = *s.textures[0].mips;
+  for (TextureLod kind : {TextureLod::Cones, TextureLod::Differentials}) {
+    const RenderOutput out = trace(s, RenderMode::Full, kind);
+    int checked = 0;
+    double spread_of_levels[2] = {1e9, -1e9};
+    for (int y = 0; y < c.height; ++y)
+      for (int x = 0; x < c.width; ++x) {
+        const std::optional<WallSample> w = exact_wall_sample(c, x, y);
+        if (!w) continue;
+        const double lod = kind == TextureLod::Cones ? w->lod_cones : w->lod_differentials;
+        spread_of_levels[0] = std::min(spread_of_levels[0], lod);
+        spread_of_levels[1] = std::max(spread_of_levels[1], lod);
+        // The texture sampled at the exact uv and level: colours move by at most 0.8 per texel
+        // or per level, and the float uv and level stray by far less than 1e-3 of either.
+        const glm::vec3 want = sample_trilinear(mips, TextureWrap::Repeat, TextureWrap::Repeat,
+                                                glm::vec2(w->uv), float(lod));
+        const glm::vec3 got = out.buffers.color[out.buffers.index(x, y)];
+        for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], want[a], 1e-3) << x << "," << y;
+        ++checked;
+      }
+    EXPECT_GT(checked, 500);
+    std::printf("reflected levels %.3f .. %.3f\n", spread_of_levels[0], spread_of_levels[1]);
+    // The reflection is minified, across fractional levels: a wrong footprint shows as a wrong
+    // blend of two levels.
+    EXPECT_GT(spread_of_levels[0], 1.0);
+    EXPECT_GT(spread_of_levels[1] - spread_of_levels[0], 0.2);
+  }
+}
