@@ -13,6 +13,7 @@
 
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/surface_colour.h"
 #include "scene_builders.h"
 
 using namespace rvr;
@@ -469,4 +470,25 @@ TEST(TracerTexture, ReflectedRaysCarryTheirFootprintToTheTexture) {
     EXPECT_GT(spread_of_levels[0], 1.0);
     EXPECT_GT(spread_of_levels[1] - spread_of_levels[0], 0.2);
   }
+}
+
+TEST(TracerTexture, EveryMethodAndModeGivesFiniteColoursAndALevelExactlyWhereTextured) {
+  Expected<Scene> scene = make_builtin_scene("textured");
+  ASSERT_TRUE(scene.ok());
+  Scene s = *scene;
+  s.image.width = 80;
+  s.image.height = 60;
+  s.image.samples_per_pixel = 4;  // the jittered sample rays carry footprints too
+  const uint32_t floor = 0;       // builtin:textured's textured floor
+  ASSERT_TRUE(textured(s, s.objects[floor]));
+  for (TextureLod kind : {TextureLod::Cones, TextureLod::Differentials, TextureLod::None})
+    for (RenderMode mode : {RenderMode::Local, RenderMode::Full}) {
+      const RenderOutput out = trace(s, mode, kind);
+      ASSERT_EQ(out.buffers.lod.size(), out.buffers.pixel_count());
+      for (size_t i = 0; i < out.buffers.pixel_count(); ++i) {
+        const glm::vec3 c = out.buffers.color[i];
+        EXPECT_TRUE(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z)) << i;
+        EXPECT_EQ(std::isnan(out.buffers.lod[i]), out.buffers.object_id[i] != floor) << i;
+      }
+    }
 }
