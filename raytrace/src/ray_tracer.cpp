@@ -576,13 +576,14 @@ class FrameTracer {
     glm::vec3 colour = (1.0f - m.mirror - m.transparency) * local;
     if (depth >= options_.max_depth) return colour;
     glm::vec3 d = glm::normalize(ray.dir);
-    // The footprint where this ray meets s, for the rays that leave it.
-    HitFootprint here;
-    if (footprint) here = footprint_at_hit(*footprint, ray.dir, s.t, s.geometric_normal);
+    // The footprint where this ray meets s, for the rays that leave it (computed only for
+    // those, and only when rays carry footprints).
+    auto here = [&] { return footprint_at_hit(*footprint, ray.dir, s.t, s.geometric_normal); };
     if (m.mirror > 0.0f) {
       counters.reflection++;
       Ray r{above, glm::reflect(d, N), 0.0f, INFINITY};
-      const RayFootprint reflected = footprint ? reflected_footprint(here, N) : RayFootprint{};
+      RayFootprint reflected;
+      if (footprint) reflected = reflected_footprint(here(), N);
       colour += m.mirror * trace(r, depth + 1, counters, rng, footprint ? &reflected : nullptr);
     }
     if (m.transparency > 0.0f) {
@@ -597,11 +598,11 @@ class FrameTracer {
       if (k < 0.0f) {  // total internal reflection
         counters.reflection++;
         r = {above, glm::reflect(d, N), 0.0f, INFINITY};
-        if (footprint) leaving = reflected_footprint(here, N);
+        if (footprint) leaving = reflected_footprint(here(), N);
       } else {
         counters.refraction++;
         r = {below, eta * d + (eta * cos_i - std::sqrt(k)) * N, 0.0f, INFINITY};
-        if (footprint) leaving = refracted_footprint(here, d, N, eta);
+        if (footprint) leaving = refracted_footprint(here(), d, N, eta);
       }
       colour += m.transparency * trace(r, depth + 1, counters, rng, footprint ? &leaving : nullptr);
     }
