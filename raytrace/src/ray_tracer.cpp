@@ -516,7 +516,9 @@ class FrameTracer {
   }
 
   // The primary rays' footprint when the scene has a texture to sample, else null (no ray
-  // carries one).
+  // carries one). Every primary ray carries the pixel-centre ray's: a jittered sample's direction
+  // has the same derivatives along the pixel grid (it is linear in the image position); a lens
+  // sample's is the pinhole's, an approximation.
   const RayFootprint* textured_footprint() const {
     return textured_ ? &primary_footprint_ : nullptr;
   }
