@@ -1321,6 +1321,12 @@ TEST_F(Cli, UnknownCommandOrOptionSuggestsTheNearest) {
       {"render -r raytrace --zzzzzz",
        "error: render: unknown option '--zzzzzz' (see 'rvr render --help')\n"},
       {"info extra", "error: info: unexpected argument 'extra'\n"},
+      // A value out of a list: the list, and the nearest name.
+      {"render -r raytrace --texture-lod cone",
+       "error: --texture-lod: 'cone' is not one of cones, differentials, none: did you mean "
+       "'cones'?\n"},
+      {"render -r raytrace --texture-lod zzzz",
+       "error: --texture-lod: 'zzzz' is not one of cones, differentials, none\n"},
   };
   for (const auto& [args, message] : expected) {
     RunResult r = run(args);

@@ -16,6 +16,7 @@
 
 #include "cli_exit.h"
 #include "commands.h"
+#include "one_of.h"
 #include "report.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
@@ -77,6 +78,10 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--triangle-test", o.triangle_test,
                  "tracer ray-triangle test: mt (Moller-Trumbore) | chapter (plane, then edges)")
       ->check(CLI::IsMember({"mt", "chapter"}));
+  cmd.add_option("--texture-lod", o.texture_lod,
+                 "tracers' texture level of detail: cones (ray cones, default) | differentials "
+                 "(ray differentials) | none (level 0, bilinear)")
+      ->check(one_of({"cones", "differentials", "none"}));
   cmd.add_option("--max-depth", o.max_depth, "recursion limit for bounce rays")
       ->check(CLI::Range(0, 64));
   cmd.add_option("--seed", o.seed, "seed of the per-pixel random streams");
@@ -133,6 +138,9 @@ RenderOptions render_options(const CommonOptions& o, const std::string& default_
                                 : AccelKind::Bvh;
   r.triangle_test =
       o.triangle_test == "chapter" ? TriangleTest::Chapter : TriangleTest::MollerTrumbore;
+  r.texture_lod = o.texture_lod == "differentials" ? TextureLod::Differentials
+                  : o.texture_lod == "none"        ? TextureLod::None
+                                                   : TextureLod::Cones;
   r.shadow_map_size = o.shadow_map_size;
   r.shadow_bias = o.shadow_bias;
   r.shadow_pcf = o.shadow_pcf;

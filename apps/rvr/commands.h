@@ -37,6 +37,7 @@ struct CommonOptions {
   std::string spheres = "analytic";
   int sphere_segments = 64;
   std::string triangle_test = "mt";
+  std::string texture_lod = "cones";  // --texture-lod cones | differentials | none (tracers)
   int max_depth = 5;
   uint64_t seed = 0;
   std::string gl;  // empty: osmesa, falling back to egl when OSMesa is missing

@@ -8,12 +8,15 @@
 #include <tbb/task_arena.h>
 #include <tbb/version.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <optional>
 
+#include "ray_footprint.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/shared/camera.h"
@@ -21,6 +24,7 @@
 #include "rvr/shared/shade_batch.h"
 #include "rvr/shared/shade_kernel.h"
 #include "rvr/shared/shading.h"
+#include "rvr/shared/surface_colour.h"
 #include "rvr/shared/timer.h"
 #include "screen_bounds.h"
 #include "tile_output.h"
@@ -96,6 +100,9 @@ struct RayCounters {
   }
 };
 
+// The lod AOV where the visible surface is not textured.
+constexpr float kNoLod = std::numeric_limits<float>::quiet_NaN();
+
 // Offset for secondary ray origins: large enough to leave the surface at this position's
 // float precision, small enough not to skip thin geometry.
 float ray_epsilon(const glm::vec3& p) {
@@ -115,10 +122,19 @@ class FrameTracer {
         rays_(frame_, scene.camera.near, scene.camera.far),
         thin_lens_(options.mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f),
         kernels_(kernels),
-        light_arrays_(lights_) {
+        light_arrays_(lights_),
+        primary_footprint_(rvr::primary_footprint(frame_)) {
     materials_.reserve(scene.materials.size());
     for (const Material& m : scene.materials)
       materials_.push_back(shade_material(m, scene.ambient));
+    object_varies_.reserve(scene.objects.size());
+    object_textured_.reserve(scene.objects.size());
+    for (const Object& o : scene.objects) {
+      object_varies_.push_back(varies_in_colour(scene, o) ? 1 : 0);
+      object_textured_.push_back(textured(scene, o) ? 1 : 0);
+      varies_ = varies_ || object_varies_.back();
+      textured_ = textured_ || object_textured_.back();
+    }
   }
 
   // render_visible for the hybrid's accumulation-buffer passes: the pixel-centre pass keeps the
@@ -159,7 +175,7 @@ class FrameTracer {
           counters.fallback_missed += visible.object_id[i] != kNoId;
           if (!geometry_.closest(ray, hit, counters.traversal)) hit = HitRecord{};
         }
-        sum[i] += shade_hit(ray, hit, 0, counters, &rng);
+        sum[i] += shade_hit(ray, hit, 0, counters, &rng, textured_footprint());
       }
   }
 
@@ -179,7 +195,10 @@ class FrameTracer {
                             TileOutput& out, RayCounters& counters) const {
     if (shows_only_background(x0, y0, x1, y1, visible)) {
       for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) out.set_background(out.index(x, y), scene_.image.background);
+        for (int x = x0; x < x1; ++x) {
+          out.set_background(out.index(x, y), scene_.image.background);
+          if (textured_) out.lod[out.index(x, y)] = kNoLod;
+        }
       counters.background += uint64_t(x1 - x0) * uint64_t(y1 - y0);
       return;
     }
@@ -327,6 +346,7 @@ class FrameTracer {
         counters.traversal.primitive_tests += work[k].primitive_tests;
         const uint64_t work_before =
             counters.traversal.nodes_visited + counters.traversal.primitive_tests;
+        if (textured_) out.lod[i] = kNoLod;
         if (hit.primitive == kNoPrimitive) {
           out.set_background(i, scene_.image.background);
         } else if (mode == RenderMode::Visibility) {
@@ -337,17 +357,37 @@ class FrameTracer {
           out.object_id[i] = object;
           out.primitive_id[i] = primitive;
           out.normal[i] = glm::vec3(0.0f);
+          if (textured_ && object_textured_[object]) {
+            const glm::vec3 D(packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]);
+            out.lod[i] =
+                textured_hit_lod(scene_.objects[object], primitive, D, hit.t, primary_footprint_);
+          }
         } else if (mode == RenderMode::Local) {
           const int slot = batch.count++;
           batch_pixel[slot] = i;
           const uint32_t material = add_to_batch(batch, slot, packet, k, hit, out, i);
-          if (slot == 0) {
-            batch_material = material;
-          } else if (!mixed && material != batch_material) {
-            mixed = true;  // from now on each slot carries its material
-            for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
+          const uint32_t object = out.object_id[i];
+          if (varies_ && object_varies_[object]) {
+            // Its own material: the diffuse replaced by the base colour at the hit.
+            const glm::vec3 D(packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]);
+            const Material& m = scene_.materials[material];
+            const glm::vec3 base =
+                varying_base_colour(scene_.objects[object], out.primitive_id[i], hit.u, hit.v, D,
+                                    hit.t, &primary_footprint_, out.lod[i]);
+            if (!mixed) {
+              mixed = true;
+              for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
+            }
+            put_material(batch, slot, shade_material(with_diffuse(m, base), scene_.ambient));
+          } else {
+            if (slot == 0) {
+              batch_material = material;
+            } else if (!mixed && material != batch_material) {
+              mixed = true;  // from now on each slot carries its material
+              for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
+            }
+            if (mixed) put_material(batch, slot, materials_[material]);
           }
-          if (mixed) put_material(batch, slot, materials_[material]);
         } else {
           const Ray ray = PrimaryRays::ray_of(packet, k);
           const SurfaceHit s = geometry_.surface(ray, hit);
@@ -357,7 +397,8 @@ class FrameTracer {
           out.object_id[i] = s.object;
           out.primitive_id[i] = s.primitive;
           out.normal[i] = N;
-          out.color[i] = shade(ray, s, N, V, 0, counters, nullptr);
+          out.color[i] = shade(ray, s, N, V, 0, counters, nullptr, textured_footprint(),
+                               textured_ ? &out.lod[i] : nullptr);
         }
         if (supersampled) out.color[i] = supersample(x, y, counters);
         // Work for this pixel: its centre ray and every ray its shading traced.
@@ -433,7 +474,7 @@ class FrameTracer {
           sample_ray(x, y, image_sample(scene_.camera, options_.seed, k, spp, thin_lens_));
       PixelRng rng(options_.seed, x, y, k);
       counters.primary++;
-      sum += trace(ray, 0, counters, &rng);
+      sum += trace(ray, 0, counters, &rng, textured_footprint());
     }
     return sum / float(spp);
   }
@@ -457,27 +498,70 @@ class FrameTracer {
     return r;
   }
 
-  glm::vec3 trace(const Ray& ray, int depth, RayCounters& counters, PixelRng* rng) const {
+  glm::vec3 trace(const Ray& ray, int depth, RayCounters& counters, PixelRng* rng,
+                  const RayFootprint* footprint) const {
     HitRecord hit;
     if (!geometry_.closest(ray, hit, counters.traversal)) return scene_.image.background;
-    return shade_hit(ray, hit, depth, counters, rng);
+    return shade_hit(ray, hit, depth, counters, rng, footprint);
   }
 
   // The colour a ray brings back from its closest hit (primitive kNoPrimitive: it missed).
   glm::vec3 shade_hit(const Ray& ray, const HitRecord& hit, int depth, RayCounters& counters,
-                      PixelRng* rng) const {
+                      PixelRng* rng, const RayFootprint* footprint) const {
     if (hit.primitive == kNoPrimitive) return scene_.image.background;
     SurfaceHit s = geometry_.surface(ray, hit);
     glm::vec3 V = -glm::normalize(ray.dir);
     return shade(ray, s, face_viewer(s.shading_normal, s.geometric_normal, V), V, depth, counters,
-                 rng);
+                 rng, footprint, nullptr);
+  }
+
+  // The primary rays' footprint when the scene has a texture to sample, else null (no ray
+  // carries one). Every primary ray carries the pixel-centre ray's: a jittered sample's direction
+  // has the same derivatives along the pixel grid (it is linear in the image position); a lens
+  // sample's is the pinhole's, an approximation.
+  const RayFootprint* textured_footprint() const {
+    return textured_ ? &primary_footprint_ : nullptr;
+  }
+
+  // The texture's level of detail at a hit on `triangle` of textured object o, for a ray of
+  // direction D with `footprint`, hitting at t.
+  float textured_hit_lod(const Object& o, uint32_t triangle, const glm::vec3& D, float t,
+                         const RayFootprint& footprint) const {
+    const TriangleMesh& mesh = o.mesh;
+    const glm::uvec3 c = mesh.triangles[triangle];
+    const glm::vec3 N = glm::normalize(glm::cross(mesh.positions[c.y] - mesh.positions[c.x],
+                                                  mesh.positions[c.z] - mesh.positions[c.x]));
+    const Material& m = scene_.materials[o.material];
+    const MipChain& mips = *scene_.textures[size_t(m.texture)].mips;
+    return texture_lod_at_hit(options_.texture_lod, footprint_at_hit(footprint, D, t, N), D, N,
+                              mesh, m, triangle, mips.width(), mips.height());
+  }
+
+  // The base colour at barycentrics (u, v) of `triangle` of object o, whose colour varies
+  // (varies_in_colour), and in lod the texture's level of detail there (NaN: not textured).
+  glm::vec3 varying_base_colour(const Object& o, uint32_t triangle, float u, float v,
+                                const glm::vec3& D, float t, const RayFootprint* footprint,
+                                float& lod) const {
+    lod = kNoLod;
+    if (footprint && textured(scene_, o)) lod = textured_hit_lod(o, triangle, D, t, *footprint);
+    return base_colour(scene_, o, scene_.materials[o.material], triangle, u, v, lod);
   }
 
   // rng is the pixel's stream when it takes several samples (area lights are then jittered
-  // inside their strata), null for one sample at the pixel centre.
+  // inside their strata), null for one sample at the pixel centre. footprint: the ray's, when
+  // the scene has a texture; lod, when not null, receives the texture's level of detail at s.
   glm::vec3 shade(const Ray& ray, const SurfaceHit& s, const glm::vec3& N, const glm::vec3& V,
-                  int depth, RayCounters& counters, PixelRng* rng) const {
-    const Material& m = scene_.materials[s.material];
+                  int depth, RayCounters& counters, PixelRng* rng, const RayFootprint* footprint,
+                  float* lod) const {
+    std::optional<Material> coloured;  // the material with the base colour at s, where it varies
+    if (varies_ && object_varies_[s.object]) {
+      float hit_lod;
+      coloured.emplace(with_diffuse(scene_.materials[s.material],
+                                    varying_base_colour(scene_.objects[s.object], s.primitive, s.u,
+                                                        s.v, ray.dir, s.t, footprint, hit_lod)));
+      if (lod) *lod = hit_lod;
+    }
+    const Material& m = coloured ? *coloured : scene_.materials[s.material];
     if (options_.mode != RenderMode::Full) {
       return shade_local(m, s.position, N, V, scene_.ambient, lights_);
     }
@@ -494,10 +578,15 @@ class FrameTracer {
     glm::vec3 colour = (1.0f - m.mirror - m.transparency) * local;
     if (depth >= options_.max_depth) return colour;
     glm::vec3 d = glm::normalize(ray.dir);
+    // The footprint where this ray meets s, for the rays that leave it (computed only for
+    // those, and only when rays carry footprints).
+    auto here = [&] { return footprint_at_hit(*footprint, ray.dir, s.t, s.geometric_normal); };
     if (m.mirror > 0.0f) {
       counters.reflection++;
       Ray r{above, glm::reflect(d, N), 0.0f, INFINITY};
-      colour += m.mirror * trace(r, depth + 1, counters, rng);
+      RayFootprint reflected;
+      if (footprint) reflected = reflected_footprint(here(), N);
+      colour += m.mirror * trace(r, depth + 1, counters, rng, footprint ? &reflected : nullptr);
     }
     if (m.transparency > 0.0f) {
       glm::vec3 below = s.position - eps * N;
@@ -507,14 +596,17 @@ class FrameTracer {
       float cos_i = -glm::dot(d, N);
       float k = 1.0f - eta * eta * (1.0f - cos_i * cos_i);
       Ray r;
+      RayFootprint leaving;
       if (k < 0.0f) {  // total internal reflection
         counters.reflection++;
         r = {above, glm::reflect(d, N), 0.0f, INFINITY};
+        if (footprint) leaving = reflected_footprint(here(), N);
       } else {
         counters.refraction++;
         r = {below, eta * d + (eta * cos_i - std::sqrt(k)) * N, 0.0f, INFINITY};
+        if (footprint) leaving = refracted_footprint(here(), d, N, eta);
       }
-      colour += m.transparency * trace(r, depth + 1, counters, rng);
+      colour += m.transparency * trace(r, depth + 1, counters, rng, footprint ? &leaving : nullptr);
     }
     return colour;
   }
@@ -531,6 +623,11 @@ class FrameTracer {
   const uint8_t* approximated_mask_ = nullptr;
   std::vector<ShadeMaterial> materials_;  // scene_.materials as the kernels read them
   ShadeLightArrays light_arrays_;         // lights_ likewise
+  // Colour that varies over a surface (textures, vertex colours): per object, and whether any.
+  std::vector<uint8_t> object_varies_, object_textured_;
+  bool varies_ = false;
+  bool textured_ = false;  // a texture to sample: rays carry footprints, the lod AOV is written
+  RayFootprint primary_footprint_;
 };
 
 }  // namespace
@@ -679,6 +776,13 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   if (!isa) return isa.error();
   auto t_render = Clock::now();
   out.buffers.allocate(w, h);  // every pixel is written below, in parallel
+  if (std::any_of(scene.objects.begin(), scene.objects.end(),
+                  [&](const Object& o) { return textured(scene, o); })) {
+    out.buffers.lod.resize(out.buffers.pixel_count());
+    out.info["texture_lod"] = options.texture_lod == TextureLod::Cones           ? "cones"
+                              : options.texture_lod == TextureLod::Differentials ? "differentials"
+                                                                                 : "none";
+  }
   FrameTracer tracer(scene, options, geometry, shade_kernels(*isa));
   if (centre_only) tracer.keep_centre_colour();
   std::vector<uint8_t> approximated;

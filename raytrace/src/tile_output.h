@@ -43,6 +43,7 @@ class TileOutput {
     copy_rows(object_id, fb.object_id.data(), fb);
     copy_rows(primitive_id, fb.primitive_id.data(), fb);
     copy_rows(cost, fb.cost.data(), fb);
+    if (!fb.lod.empty()) copy_rows(lod, fb.lod.data(), fb);
   }
 
   glm::vec3 color[kMaxWidth * kMaxHeight];
@@ -51,6 +52,8 @@ class TileOutput {
   uint32_t object_id[kMaxWidth * kMaxHeight];
   uint32_t primitive_id[kMaxWidth * kMaxHeight];
   float cost[kMaxWidth * kMaxHeight];
+  // Written (and copied out) only when the frame buffers have a lod AOV (a textured scene).
+  float lod[kMaxWidth * kMaxHeight];
 
  private:
   template <class T>

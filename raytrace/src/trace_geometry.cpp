@@ -505,6 +505,8 @@ SurfaceHit TraceGeometry::surface(const Ray& ray, const HitRecord& hit) const {
     const TrianglePrecomputed& tri = triangles_[p];
     s.object = triangle_object_[p];
     s.primitive = triangle_id_[p];
+    s.u = hit.u;
+    s.v = hit.v;
     s.geometric_normal = glm::normalize(glm::cross(tri.e1, tri.e2));
     s.shading_normal = s.geometric_normal;
     const TriangleMesh* mesh = object_mesh_[s.object];

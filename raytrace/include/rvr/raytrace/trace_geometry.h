@@ -53,6 +53,7 @@ struct SurfaceHit {
   uint32_t object = kNoId;
   uint32_t primitive = kNoId;  // triangle index in the object; 0 for analytic shapes
   uint32_t material = 0;
+  float u = 0.0f, v = 0.0f;  // triangles: the hit's barycentrics (1 - u - v, u, v); else 0
 };
 
 // What surface() computes a triangle hit's surface from: the triangle's edges, its vertex
