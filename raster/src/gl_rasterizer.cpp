@@ -259,6 +259,7 @@ struct GlRasterizer::Impl {
   int width = 0, height = 0;
   GLuint scene_fbo = 0, cost_fbo = 0, depth_buffer = 0;
   GLenum depth_format = GL_DEPTH_COMPONENT32F;  // of depth_buffer and msaa_depth
+  GLint depth_bits = 0;                         // of depth_buffer, as the driver allocated it
   std::array<GLuint, kTargetCount> targets{};
   // Multisampled colour + depth (spp > 1), re-made when size or sample count change.
   GLuint msaa_fbo = 0, msaa_colour = 0, msaa_depth = 0;
@@ -411,6 +412,8 @@ Status GlRasterizer::Impl::resize(int w, int h, GLenum depth) {
   gl().BindRenderbuffer(GL_RENDERBUFFER, depth_buffer);
   gl().RenderbufferStorage(GL_RENDERBUFFER, depth, w, h);
   depth_format = depth;
+  // The driver may store more bits than the format asks for ("at least 24").
+  gl().GetRenderbufferParameteriv(GL_RENDERBUFFER, GL_RENDERBUFFER_DEPTH_SIZE, &depth_bits);
   RVR_GL_CHECK("allocating render targets");
 
   gl().GenFramebuffers(1, &scene_fbo);
@@ -837,6 +840,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
   use_depth_convention(false);
   RVR_GL_CHECK("scene pass");
   out.stats["time.render"] = seconds_since(t) - shadow_time;
+  out.stats["zbuffer.depth_bits"] = double(depth_bits);
   if (shadows.enabled) {
     out.stats["time.shadow_maps"] = shadow_time;
     out.stats["shadow_map.maps"] = double(samples.size());
