@@ -10,9 +10,11 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 #include <random>
+#include <string>
 
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/isa.h"
 #include "rvr/shared/scene_loader.h"
 #include "soft/fill_dispatch.h"
 #include "soft/triangle_setup.h"
@@ -380,3 +382,29 @@ INSTANTIATE_TEST_SUITE_P(EveryBuiltinScene, Kernels, ::testing::ValuesIn([] {
                          [](const ::testing::TestParamInfo<std::string>& info) {
                            return info.param;
                          });
+
+// RVR_ISA's decision on CPUs this machine may not be: every outcome, whatever runs the test
+// (the CLI test covers the message's path to the user only on a CPU without AVX-512).
+TEST(IsaSelection, ForcedKernelsTheCpuCannotRunAreBadInputNamingTheBest) {
+  auto up_to = [](Isa widest) { return [widest](Isa isa) { return int(isa) <= int(widest); }; };
+  for (Isa widest : kAllIsas) {
+    EXPECT_EQ(select_isa(nullptr, up_to(widest)).value(), widest);
+    EXPECT_EQ(select_isa("", up_to(widest)).value(), widest);
+    for (Isa forced : kAllIsas) {
+      Expected<Isa> got = select_isa(to_string(forced), up_to(widest));
+      if (int(forced) <= int(widest)) {
+        ASSERT_TRUE(got.ok()) << to_string(forced) << " on " << to_string(widest);
+        EXPECT_EQ(*got, forced);
+        continue;
+      }
+      ASSERT_FALSE(got.ok()) << to_string(forced) << " on " << to_string(widest);
+      EXPECT_EQ(got.error().kind, ErrorKind::BadInput);
+      EXPECT_EQ(got.error().message, std::string("RVR_ISA=") + to_string(forced) +
+                                         ": this CPU cannot run " + to_string(forced) +
+                                         " kernels (best available: " + to_string(widest) + ")");
+    }
+  }
+  Expected<Isa> unknown = select_isa("avx3", up_to(Isa::Avx512));
+  ASSERT_FALSE(unknown.ok());
+  EXPECT_EQ(unknown.error().message, "RVR_ISA=avx3: unknown (use sse, avx2 or avx512)");
+}

@@ -37,20 +37,31 @@ bool cpu_supports(Isa isa) {
   return false;
 }
 
-Isa best_supported_isa() {
-  if (cpu_supports(Isa::Avx512)) return Isa::Avx512;
-  if (cpu_supports(Isa::Avx2)) return Isa::Avx2;
+namespace {
+
+Isa best_of(const std::function<bool(Isa)>& supports) {
+  if (supports(Isa::Avx512)) return Isa::Avx512;
+  if (supports(Isa::Avx2)) return Isa::Avx2;
   return Isa::Sse;
 }
 
+}  // namespace
+
+Isa best_supported_isa() {
+  return best_of(cpu_supports);
+}
+
 Expected<Isa> selected_isa() {
-  const char* forced = std::getenv("RVR_ISA");
-  if (!forced || !*forced) return best_supported_isa();
+  return select_isa(std::getenv("RVR_ISA"), cpu_supports);
+}
+
+Expected<Isa> select_isa(const char* forced, const std::function<bool(Isa)>& supports) {
+  if (!forced || !*forced) return best_of(supports);
   for (Isa isa : kAllIsas) {
     if (std::strcmp(forced, to_string(isa)) != 0) continue;
-    if (!cpu_supports(isa))
+    if (!supports(isa))
       return bad_input(std::string("RVR_ISA=") + forced + ": this CPU cannot run " + forced +
-                       " kernels (best available: " + to_string(best_supported_isa()) + ")");
+                       " kernels (best available: " + to_string(best_of(supports)) + ")");
     return isa;
   }
   std::string names;  // "sse, avx2 or avx512"

@@ -3,6 +3,7 @@
 // wider instruction sets, and a kernel is never called on a CPU that lacks its instructions.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -24,6 +25,10 @@ Isa best_supported_isa();
 // The kernel set to use: RVR_ISA=sse|avx2|avx512 when set, otherwise the best the CPU offers.
 // A bad value, or an ISA this CPU cannot run, is a BadInput error naming RVR_ISA.
 Expected<Isa> selected_isa();
+
+// The decision selected_isa() makes, for a value of RVR_ISA (null or empty: unset) on a CPU that
+// runs what `supports` says (so that every outcome can be tested on any CPU).
+Expected<Isa> select_isa(const char* forced, const std::function<bool(Isa)>& supports);
 
 // The kernels a render runs: `requested` (RenderOptions::isa) when set, else selected_isa(); a
 // BadInput error when this CPU cannot run them.
