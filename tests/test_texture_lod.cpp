@@ -11,6 +11,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -242,6 +243,64 @@ TEST(TextureLod, GlMatchesTheClosedFormOfItsQuadsWithinItsLog2Approximation) {
   std::cout << "GL (" << out.info.at("lod") << "): against the exact level max " << e.max_abs
             << " mean " << e.mean_abs << "; against its quads max " << quad_max << " mean "
             << quad_sum / double(std::max<size_t>(quads, 1)) << " levels\n";
+}
+
+// A triangle leaning away from the camera, corners red, green and blue, lit by the ambient term
+// alone (ambient 1, white diffuse): every pixel's colour is the vertex colour interpolated
+// perspective-correctly, here the barycentrics of the ray-triangle intersection in double.
+TEST(VertexColours, BothZBuffersInterpolatePerspectiveCorrectly) {
+  Scene s;
+  s.image.width = 160;
+  s.image.height = 120;
+  s.camera.eye = {0.0f, 0.5f, 2.0f};
+  s.camera.target = {0.0f, 0.0f, -3.0f};
+  s.camera.fov_y_deg = 50.0f;
+  s.ambient = glm::vec3(1.0f);
+  s.materials.push_back(Material{});
+  Material white;
+  white.diffuse = glm::vec3(1.0f);
+  s.materials.push_back(white);
+  Object o;
+  o.type = ObjectType::Triangles;
+  o.material = 1;
+  o.mesh.positions = {{-2.0f, -1.0f, 0.5f}, {2.5f, -0.5f, -1.0f}, {0.0f, 2.0f, -12.0f}};
+  o.mesh.colours = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  o.mesh.triangles = {{0, 1, 2}};
+  s.objects.push_back(o);
+  const dvec3 p0(o.mesh.positions[0]), e1 = dvec3(o.mesh.positions[1]) - p0,
+                                       e2 = dvec3(o.mesh.positions[2]) - p0;
+  // Barycentrics (1 - b1 - b2, b1, b2) where the ray through (px, py) meets the triangle, all
+  // three above `margin` (away from its edges), else nothing.
+  auto barycentrics = [&](double px, double py, double margin) -> std::optional<dvec3> {
+    const oracle::Ray r = oracle::camera_ray(s.camera, s.image.width, s.image.height, px, py);
+    const dvec3 q = glm::cross(r.direction, e2);
+    const double det = glm::dot(e1, q);
+    const dvec3 t = r.origin - p0;
+    const double b1 = glm::dot(t, q) / det;
+    const double b2 = glm::dot(r.direction, glm::cross(t, e1)) / det;
+    const dvec3 b(1.0 - b1 - b2, b1, b2);
+    if (b.x < margin || b.y < margin || b.z < margin) return std::nullopt;
+    return b;
+  };
+  SoftRasterizer soft;
+  GlRasterizer gl(GlBackend::OsMesa);
+  for (Renderer* r : {static_cast<Renderer*>(&soft), static_cast<Renderer*>(&gl)}) {
+    const RenderOutput out = render(*r, s);
+    size_t checked = 0;
+    double worst = 0.0;
+    for (int y = 0; y < s.image.height; ++y)
+      for (int x = 0; x < s.image.width; ++x) {
+        const std::optional<dvec3> b = barycentrics(x + 0.5, y + 0.5, 0.02);
+        if (!b) continue;
+        ++checked;
+        const glm::vec3 got = out.buffers.color[out.buffers.index(x, y)];
+        for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(double(got[c]) - (*b)[c]));
+      }
+    EXPECT_GT(checked, 2000u) << r->name();
+    // Float barycentrics (relative 1e-6) times colours of 1.
+    EXPECT_LT(worst, 1e-4) << r->name();
+    EXPECT_TRUE(out.buffers.lod.empty()) << r->name();  // coloured, not textured
+  }
 }
 
 // Textures change colours only: builtin:textured in both z-buffers has the same ids at every

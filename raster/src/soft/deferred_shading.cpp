@@ -151,6 +151,7 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
       ShadeBatch batch;
+      PlanesCache planes;
       // Flat pixels leave their slots' vertex normals as they were: defined values, not read.
       std::fill(&batch.normal[0][0][0], &batch.normal[0][0][0] + 9 * kShadeBatch, 0.0f);
       size_t pixel[kShadeBatch];  // frame-buffer index of each slot
@@ -212,7 +213,7 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
               for (int k = 0; k < i; ++k) put_material(batch, k, objects[batch_object].material);
             }
             const glm::vec3 b(batch.bary[0][i], batch.bary[1][i], batch.bary[2][i]);
-            const SurfaceSample here = surfaces->at(id, *s.source, primitive, b, x - 1, y);
+            const SurfaceSample here = surfaces->at(id, *s.source, primitive, b, x - 1, y, planes);
             put_material(batch, i,
                          shade_material(with_diffuse(*s.source, here.base), settings.ambient));
             if (!fb.lod.empty()) fb.lod[o] = here.lod;
@@ -258,11 +259,12 @@ void write_visibility(const DrawList& list, const DepthTarget& target, const glm
         std::memset(static_cast<void*>(fb.normal.data() + row), 0,
                     size_t(w) * sizeof(glm::vec3));  // +0.0f is all zero bits
         if (fb.lod.empty()) continue;
+        PlanesCache planes;
         for (int x = 0; x < w; ++x) {
           const uint32_t id = fb.object_id[row + size_t(x)];
           if (id == kNoId || !list.objects[id].material) continue;
-          fb.lod[row + size_t(x)] =
-              surfaces->lod(id, *list.objects[id].material, fb.primitive_id[row + size_t(x)], x, y);
+          fb.lod[row + size_t(x)] = surfaces->lod(id, *list.objects[id].material,
+                                                  fb.primitive_id[row + size_t(x)], x, y, planes);
         }
       }
       if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));

@@ -73,31 +73,29 @@ SurfaceColours::SurfaceColours(const Scene& scene, const glm::dmat4& view_projec
 }
 
 float SurfaceColours::lod(uint32_t object, const Material& material, uint32_t primitive, int x,
-                          int y) const {
-  float lod = std::numeric_limits<float>::quiet_NaN();
-  if (textured_objects_[object]) {
+                          int y, PlanesCache& cache) const {
+  if (!textured_objects_[object]) return std::numeric_limits<float>::quiet_NaN();
+  if (cache.object != object || cache.primitive != primitive) {
     const TriangleMesh& mesh = scene_.objects[object].mesh;
     const glm::uvec3 t = mesh.triangles[primitive];
     const glm::vec3 p[3] = {mesh.positions[t.x], mesh.positions[t.y], mesh.positions[t.z]};
     const glm::vec2 uv[3] = {material.uv_transform.apply(mesh.uvs[t.x]),
                              material.uv_transform.apply(mesh.uvs[t.y]),
                              material.uv_transform.apply(mesh.uvs[t.z])};
-    const UvPlanes planes = uv_planes(view_projection_, width_, height_, p, uv);
-    const MipChain& mips = *scene_.textures[size_t(material.texture)].mips;
-    if (planes.valid) {
-      glm::dvec2 dx, dy;
-      uv_derivatives(planes, double(x) + 0.5, double(y) + 0.5, dx, dy);
-      lod = lod_from_derivatives(glm::vec2(dx), glm::vec2(dy), mips.width(), mips.height());
-    } else {
-      lod = std::numeric_limits<float>::infinity();  // edge-on: the coarsest level
-    }
+    cache.planes = uv_planes(view_projection_, width_, height_, p, uv);
+    cache.object = object;
+    cache.primitive = primitive;
   }
-  return lod;
+  if (!cache.planes.valid) return std::numeric_limits<float>::infinity();  // edge-on: coarsest
+  glm::dvec2 dx, dy;
+  uv_derivatives(cache.planes, double(x) + 0.5, double(y) + 0.5, dx, dy);
+  const MipChain& mips = *scene_.textures[size_t(material.texture)].mips;
+  return lod_from_derivatives(glm::vec2(dx), glm::vec2(dy), mips.width(), mips.height());
 }
 
 SurfaceSample SurfaceColours::at(uint32_t object, const Material& material, uint32_t primitive,
-                                 const glm::vec3& b, int x, int y) const {
-  const float level = lod(object, material, primitive, x, y);
+                                 const glm::vec3& b, int x, int y, PlanesCache& cache) const {
+  const float level = lod(object, material, primitive, x, y, cache);
   return {base_colour(scene_, scene_.objects[object], material, primitive, b.y, b.z, level), level};
 }
 

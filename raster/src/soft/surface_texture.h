@@ -37,6 +37,13 @@ UvPlanes uv_planes(const glm::dmat4& view_projection, int width, int height,
 void uv_derivatives(const UvPlanes& planes, double x, double y, glm::dvec2& duv_dx,
                     glm::dvec2& duv_dy);
 
+// The planes of the last triangle asked for, kept by each thread: consecutive pixels mostly show
+// the same triangle, whose planes are then not made again.
+struct PlanesCache {
+  uint32_t object = 0xFFFFFFFFu, primitive = 0xFFFFFFFFu;
+  UvPlanes planes;
+};
+
 // Which objects of the scene (indexed as scene.objects, which the draw list follows) vary in
 // colour, and their base colour per pixel.
 class SurfaceColours {
@@ -49,12 +56,13 @@ class SurfaceColours {
 
   // The level of detail of `object`'s triangle `primitive` at pixel (x, y): GL's formula on the
   // exact derivatives; NaN when the object is not textured.
-  float lod(uint32_t object, const Material& material, uint32_t primitive, int x, int y) const;
+  float lod(uint32_t object, const Material& material, uint32_t primitive, int x, int y,
+            PlanesCache& cache) const;
 
   // The base colour of `object`'s triangle `primitive` at pixel (x, y), whose perspective-correct
   // barycentrics are b, with `material` (the object's).
   SurfaceSample at(uint32_t object, const Material& material, uint32_t primitive,
-                   const glm::vec3& b, int x, int y) const;
+                   const glm::vec3& b, int x, int y, PlanesCache& cache) const;
 
  private:
   const Scene& scene_;
