@@ -245,6 +245,34 @@ TEST(TextureLod, GlMatchesTheClosedFormOfItsQuadsWithinItsLog2Approximation) {
             << quad_sum / double(std::max<size_t>(quads, 1)) << " levels\n";
 }
 
+// The hybrids' z-buffer pass: visibility mode with visibility_lod writes the very levels the
+// shading pass does (NaN where they are NaN), and without it no lod buffer at all.
+TEST(TextureLod, VisibilityModeWritesTheShadingPassesLodWhenAsked) {
+  const Scene s = grazing_plane(160, 120);
+  SoftRasterizer soft;
+  GlRasterizer gl(GlBackend::OsMesa);
+  for (Renderer* r : {static_cast<Renderer*>(&soft), static_cast<Renderer*>(&gl)}) {
+    const RenderOutput shaded = render(*r, s);
+    RenderOptions options;
+    options.mode = RenderMode::Visibility;
+    Expected<RenderOutput> plain = r->render(s, options);
+    ASSERT_TRUE(plain.ok());
+    EXPECT_TRUE(plain->buffers.lod.empty()) << r->name();
+    options.visibility_lod = true;
+    Expected<RenderOutput> ids = r->render(s, options);
+    ASSERT_TRUE(ids.ok());
+    ASSERT_EQ(ids->buffers.lod.size(), shaded.buffers.lod.size()) << r->name();
+    size_t differ = 0, textured = 0;
+    for (size_t i = 0; i < ids->buffers.lod.size(); ++i) {
+      const float a = ids->buffers.lod[i], b = shaded.buffers.lod[i];
+      textured += !std::isnan(a);
+      differ += !(a == b || (std::isnan(a) && std::isnan(b)));
+    }
+    EXPECT_EQ(differ, 0u) << r->name();
+    EXPECT_GT(textured, 5000u) << r->name();
+  }
+}
+
 // A triangle leaning away from the camera, corners red, green and blue, lit by the ambient term
 // alone (ambient 1, white diffuse): every pixel's colour is the vertex colour interpolated
 // perspective-correctly, here the barycentrics of the ray-triangle intersection in double.
