@@ -273,6 +273,29 @@ TEST(TextureLod, VisibilityModeWritesTheShadingPassesLodWhenAsked) {
   }
 }
 
+// A mesh whose texture coordinates or colours do not match its positions is bad input to both
+// z-buffers, not a read past the end.
+TEST(TextureLod, MismatchedUvsOrColoursAreBadInput) {
+  for (bool colours : {false, true}) {
+    Scene s = grazing_plane(32, 24);
+    if (colours)
+      s.objects[0].mesh.colours = {glm::vec3(1.0f)};
+    else
+      s.objects[0].mesh.uvs.pop_back();
+    SoftRasterizer soft;
+    GlRasterizer gl(GlBackend::OsMesa);
+    for (Renderer* r : {static_cast<Renderer*>(&soft), static_cast<Renderer*>(&gl)}) {
+      Expected<RenderOutput> out = r->render(s, RenderOptions{});
+      ASSERT_FALSE(out.ok()) << r->name();
+      EXPECT_EQ(out.error().kind, ErrorKind::BadInput);
+      EXPECT_NE(out.error().message.find(colours ? "1 vertex colours for 4 positions"
+                                                 : "3 texture coordinates for 4 positions"),
+                std::string::npos)
+          << out.error().message;
+    }
+  }
+}
+
 // A triangle leaning away from the camera, corners red, green and blue, lit by the ambient term
 // alone (ambient 1, white diffuse): every pixel's colour is the vertex colour interpolated
 // perspective-correctly, here the barycentrics of the ray-triangle intersection in double.

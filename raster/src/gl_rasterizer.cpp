@@ -153,6 +153,12 @@ Status append_mesh(const TriangleMesh& mesh, const std::string& name, std::vecto
   if (mesh.smooth() && mesh.normals.size() != n)
     return bad_input(
         fmt::format("object '{}': {} normals for {} positions", name, mesh.normals.size(), n));
+  if (mesh.textured() && mesh.uvs.size() != n)
+    return bad_input(fmt::format("object '{}': {} texture coordinates for {} positions", name,
+                                 mesh.uvs.size(), n));
+  if (mesh.coloured() && mesh.colours.size() != n)
+    return bad_input(fmt::format("object '{}': {} vertex colours for {} positions", name,
+                                 mesh.colours.size(), n));
   for (const glm::uvec3& t : mesh.triangles) {
     if (t.x >= n || t.y >= n || t.z >= n)
       return bad_input(

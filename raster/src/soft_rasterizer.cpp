@@ -100,6 +100,12 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     if (m.smooth() && m.normals.size() != m.positions.size())
       return bad_input(fmt::format("object '{}': {} normals for {} positions", o.name,
                                    m.normals.size(), m.positions.size()));
+    if (m.textured() && m.uvs.size() != m.positions.size())
+      return bad_input(fmt::format("object '{}': {} texture coordinates for {} positions", o.name,
+                                   m.uvs.size(), m.positions.size()));
+    if (m.coloured() && m.colours.size() != m.positions.size())
+      return bad_input(fmt::format("object '{}': {} vertex colours for {} positions", o.name,
+                                   m.colours.size(), m.positions.size()));
     for (const glm::uvec3& tri : m.triangles)
       if (std::max({tri.x, tri.y, tri.z}) >= m.positions.size())
         return bad_input(fmt::format("object '{}': triangle index out of range ({} positions)",
