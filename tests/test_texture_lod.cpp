@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <glm/glm.hpp>
 #include <iostream>
 #include <limits>
@@ -217,8 +218,11 @@ TEST(TextureLod, SoftrasterWritesNoLodWithoutTexturesAndNanOffTheTexture) {
 // per 2x2 quad, as differences of the uvs of the quad's neighbouring pixels, and approximates
 // log2. Against that model of a quad (computed here from the closed form's uvs) it agrees within
 // 0.1 levels: a piecewise-linear log2 (the mantissa taken as its own logarithm) is off by up to
-// 0.086 levels. Against the exact per-pixel level the mean stays within the 0.1 levels;
-// the largest differences are a quad's own change of level on the grazing rows.
+// 0.086 levels. Without the extension (ctest texture_lod_without_query_lod turns it off in Mesa)
+// the shader's own formula on dFdx/dFdy, with an exact log2, agrees with the quad model within
+// 0.01 levels (float differences of large uvs near the horizon). Against the exact per-pixel
+// level the mean stays within the 0.1 levels; the largest differences are a quad's own
+// change of level on the grazing rows.
 TEST(TextureLod, GlMatchesTheClosedFormOfItsQuadsWithinItsLog2Approximation) {
   const Scene s = grazing_plane(320, 240);
   GlRasterizer r(GlBackend::OsMesa);
@@ -239,7 +243,12 @@ TEST(TextureLod, GlMatchesTheClosedFormOfItsQuadsWithinItsLog2Approximation) {
       ++quads;
     }
   EXPECT_GT(quads, 20000u);
-  EXPECT_LT(quad_max, 0.1);
+  const bool driver_lod = out.info.at("lod").find("textureQueryLOD") != std::string::npos;
+  const char* overrides = std::getenv("MESA_EXTENSION_OVERRIDE");
+  if (overrides && std::string(overrides).find("-GL_ARB_texture_query_lod") != std::string::npos) {
+    EXPECT_FALSE(driver_lod);
+  }
+  EXPECT_LT(quad_max, driver_lod ? 0.1 : 0.01);
   std::cout << "GL (" << out.info.at("lod") << "): against the exact level max " << e.max_abs
             << " mean " << e.mean_abs << "; against its quads max " << quad_max << " mean "
             << quad_sum / double(std::max<size_t>(quads, 1)) << " levels\n";
