@@ -379,6 +379,11 @@ TEST(TextureLod, BuiltinTexturedSoftrasterAndGlSeeTheSameSurfaces) {
             << ", colour PSNR " << m.color.psnr_db << " dB\n";
   EXPECT_EQ(m.visibility.id_agreement, 1.0);
   EXPECT_GT(m.color.psnr_db, 30.0);
+  // The target for the two z-buffers' levels of detail: a mean within 0.1 levels.
+  std::cout << "lod |soft - gl| mean " << m.lod.mean_abs << " p99 " << m.lod.p99_abs << " over "
+            << m.lod.pixels << " pixels\n";
+  EXPECT_GT(m.lod.pixels, 30000u);
+  EXPECT_LT(m.lod.mean_abs, 0.1);
 }
 
 }  // namespace
