@@ -7,6 +7,10 @@
 //   BM_Effects/hybrid[_soft]/<effect>          the same frames with the hybrids
 //   BM_Trace/<accel>/<rays>/<scene>/<n>        one thread, rays only, no shading
 //   BM_Build/<accel>/<n>                       acceleration structure build
+//   BM_Texture/<renderer>/<lod>                builtin:textured at 640x480, local mode; lod is
+//     the z-buffers' own (zbuffer) or the tracers' --texture-lod (cones, differentials, none);
+//     counter texel_bytes/pixel: texel bytes one frame's trilinear filter reads per pixel,
+//     counted from its lod AOV (8 texels of 12 bytes where two levels blend, 4 where one does)
 //   BM_Threads/<renderer>/<threads>            tessphere:100000 at 1024x768 on 1 or 2 threads
 // Scenes and acceleration structures are built outside the timed loops (FrameRenderer).
 // Counters of every frame benchmark: rays/s, triangles/s, pixels/s; from the renderer's phase
@@ -21,6 +25,7 @@
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -29,6 +34,8 @@
 #include <optional>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/ray_tracer.h"
@@ -150,6 +157,44 @@ void time_frames(benchmark::State& state, const std::string& renderer_name, cons
     state.counters["hiz_blocks_rejected"] = it->second;
   if (auto it = out.stats.find("fragments.generated"); it != out.stats.end())
     state.counters["fragments"] = it->second;
+}
+
+// Texel bytes the sampler reads, per pixel of the frame, from the levels of detail it sampled
+// at: LINEAR_MIPMAP_LINEAR reads 4 RGB32F texels of each level it blends, one level where the
+// clamped lod is a whole number (at or below level 0, at or above the last level).
+double texel_bytes_per_pixel(const FrameBuffers& fb, float max_lod) {
+  if (fb.lod.empty() || fb.pixel_count() == 0) return 0.0;
+  double bytes = 0.0;
+  for (float lod : fb.lod) {
+    if (std::isnan(lod)) continue;
+    const float clamped = std::clamp(lod, 0.0f, max_lod);
+    bytes += (clamped == std::floor(clamped) ? 4.0 : 8.0) * 12.0;
+  }
+  return bytes / double(fb.pixel_count());
+}
+
+// builtin:textured with one renderer and level-of-detail rule.
+void BM_Texture(benchmark::State& state, std::string renderer_name, TextureLod lod) {
+  Scene scene = builtin("textured");
+  scene.image.width = 640;
+  scene.image.height = 480;
+  RenderOptions options;
+  options.mode = RenderMode::Local;
+  options.texture_lod = lod;
+  FrameRenderer renderer(renderer_name, scene, options);
+  RenderOutput out = renderer.frame();
+  PhaseTimes phases;
+  for (auto _ : state) {
+    out = renderer.frame();
+    benchmark::DoNotOptimize(out.buffers.color.data());
+    phases.add(out);
+  }
+  add_counters(state, out, double(scene.image.width) * scene.image.height);
+  phases.report(state);
+  float max_lod = 0.0f;
+  for (const Texture& t : scene.textures)
+    if (t.mips) max_lod = std::max(max_lod, t.mips->max_lod());
+  state.counters["texel_bytes/pixel"] = texel_bytes_per_pixel(out.buffers, max_lod);
 }
 
 // The frame sweeps over renderers, scenes, triangle counts and widths: BM_Frame renders whole
@@ -588,6 +633,21 @@ void register_all() {
                                    scene)
           ->Arg(scene == "soup" ? 1000000 : 100000)
           ->Unit(benchmark::kMillisecond);
+  // Textures: the z-buffers' own level of detail, the tracers' three.
+  for (const RendererInfo& info : renderers()) {
+    const bool tracer = info.order == LoopOrder::PixelMajor;
+    const std::vector<std::pair<std::string, TextureLod>> lods =
+        tracer ? std::vector<std::pair<std::string, TextureLod>>{{"cones", TextureLod::Cones},
+                                                                 {"differentials",
+                                                                  TextureLod::Differentials},
+                                                                 {"none", TextureLod::None}}
+               : std::vector<std::pair<std::string, TextureLod>>{{"zbuffer", TextureLod::Cones}};
+    for (const auto& [lod_name, lod] : lods)
+      benchmark::RegisterBenchmark(("BM_Texture/" + info.name + "/" + lod_name).c_str(), BM_Texture,
+                                   info.name, lod)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+  }
   // Our own loops (raster's threads are llvmpipe's, embree's partly Embree's).
   for (std::string r : {"raytrace", "softraster"})
     for (long threads : {1L, 2L})

@@ -8,9 +8,12 @@
    first repeating the top level, and every file it names present.
 3. A compare where nothing is visible (the near plane beyond the only object) writes a
    metrics.json with a warning per renderer that the schema also accepts.
-4. Documents the schema must refuse, each a copy of the real one with one thing wrong: the
+4. A textured compare (builtin:textured, raster,softraster) writes the `lod` block (pixels
+   textured in both, mean and p99 of |lod_a - lod_b|) that the schema accepts, with a
+   plausible mean; the untextured cornell compare has none.
+5. Documents the schema must refuse, each a copy of the real one with one thing wrong: the
    dropped mismatched_off_edge count back in `visibility`, a mismatch class missing, no pairs,
-   an unknown depth format, a negative count.
+   an unknown depth format, a negative count, a lod block without its p99.
 
 Usage: check_metrics_schema.py --rvr build/bin/rvr --source-dir . [--work-dir DIR]
 Exits 1 with one line per failure.
@@ -79,6 +82,25 @@ def check_three(rvr, validator, work):
     return doc
 
 
+def check_textured(rvr, validator, work, untextured):
+    if untextured is not None and "lod" in untextured:
+        failure("builtin:cornell (no textures): metrics.json has a lod block")
+    doc = compare(rvr, "builtin:textured", ["raster", "softraster"], work / "textured")
+    if doc is None:
+        return None
+    accepted(validator, doc, "textured")
+    lod = doc.get("lod")
+    if lod is None or lod["pixels"] < 64 * 48 // 4:
+        failure(f"builtin:textured: want a lod block over most of the floor, got {lod}")
+        return None
+    if lod != doc["pairs"][0].get("lod"):
+        failure("builtin:textured: pairs[0] does not repeat the lod block")
+    if not (0 <= lod["mean_abs"] < 1.0 and lod["mean_abs"] <= lod["p99_abs"] + 1e-12):
+        failure(f"builtin:textured: implausible lod difference {lod}")
+    print(f"textured: lod {lod}")
+    return doc
+
+
 def check_nothing_visible(rvr, validator, work):
     scene = work / "empty.json"
     scene.write_text(json.dumps({
@@ -137,9 +159,15 @@ def main():
     if validator is None:
         return 1
     doc = check_three(args.rvr, validator, work)
+    textured = check_textured(args.rvr, validator, work, doc)
     check_nothing_visible(args.rvr, validator, work)
     if doc is not None:
         check_refused(validator, doc)
+    if textured is not None:
+        bad = copy.deepcopy(textured)
+        del bad["lod"]["p99_abs"]
+        if not schema_errors(validator, bad):
+            failure("the schema accepts a metrics.json with a lod block without p99_abs")
     if FAILURES:
         print(f"{len(FAILURES)} failure(s)")
         return 1

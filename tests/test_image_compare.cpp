@@ -285,6 +285,29 @@ TEST(Aovs, WritesEveryRequestedFile) {
   EXPECT_GT(cost_png->at(3, 2, 1), 0.9f);
 }
 
+TEST(Aovs, LodIsTheLevelOfDetailAndNanWhereNothingIsTextured) {
+  TempDir dir;
+  FrameBuffers fb = flat(3, 2);
+  fb.lod.assign(fb.pixel_count(), std::numeric_limits<float>::quiet_NaN());
+  fb.lod[fb.index(1, 0)] = 2.75f;
+  fb.lod[fb.index(2, 1)] = -1.5f;
+  ASSERT_TRUE(write_aovs(dir / "r.png", fb, {"lod"}).ok());
+  auto lod = read_image(dir / "r.lod.exr");
+  ASSERT_TRUE(lod.ok());
+  ASSERT_EQ(lod->channels, 1);
+  EXPECT_EQ(lod->channel_names, (std::vector<std::string>{"lod"}));
+  EXPECT_EQ(lod->at(1, 0, 0), 2.75f);
+  EXPECT_EQ(lod->at(2, 1, 0), -1.5f);
+  EXPECT_TRUE(std::isnan(lod->at(0, 0, 0)));
+  // An untextured frame has no lod buffer: NaN everywhere.
+  fb.lod.clear();
+  ASSERT_TRUE(write_aovs(dir / "u.png", fb, {"lod"}).ok());
+  auto none = read_image(dir / "u.lod.exr");
+  ASSERT_TRUE(none.ok());
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 3; ++x) EXPECT_TRUE(std::isnan(none->at(x, y, 0)));
+}
+
 TEST(Aovs, OnlyTheRequestedOnes) {
   TempDir dir;
   FrameBuffers fb = flat(2, 2);
@@ -299,7 +322,7 @@ TEST(Aovs, UnknownAovIsAnError) {
   auto st = write_aovs(dir / "r.png", flat(2, 2), {"depth", "albedo"});
   ASSERT_FALSE(st.ok());
   EXPECT_EQ(st.error().kind, ErrorKind::BadInput);
-  EXPECT_EQ(st.error().message, "unknown aov 'albedo' (known: depth, id, normal, cost)");
+  EXPECT_EQ(st.error().message, "unknown aov 'albedo' (known: depth, id, normal, cost, lod)");
   EXPECT_TRUE(list_dir(dir.path()).empty());  // nothing written before the check
 }
 
@@ -336,6 +359,28 @@ TEST(Compare, IdenticalBuffersAgreeCompletely) {
   EXPECT_EQ(m.color.max_abs, 0.0);
   EXPECT_TRUE(std::isinf(m.color.psnr_db) && m.color.psnr_db > 0);
   EXPECT_NEAR(m.color.ssim, 1.0, 1e-12);
+}
+
+TEST(Compare, LodDifferenceOverThePixelsTexturedInBoth) {
+  FrameBuffers a = flat(10, 10), b = flat(10, 10);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  a.lod.assign(100, nan);
+  b.lod.assign(100, nan);
+  // Pixels 0-49 textured in both: 49 differ by 0.25, one by 2; 50-59 textured in a only.
+  for (size_t i = 0; i < 50; ++i) {
+    a.lod[i] = 1.0f + float(i % 5);
+    b.lod[i] = a.lod[i] + (i == 7 ? -2.0f : 0.25f);
+  }
+  for (size_t i = 50; i < 60; ++i) a.lod[i] = 3.0f;
+  const ComparisonMetrics m = compare_buffers(a, b);
+  EXPECT_EQ(m.lod.pixels, 50u);
+  EXPECT_NEAR(m.lod.mean_abs, (49 * 0.25 + 2.0) / 50.0, 1e-12);
+  // Nearest rank: the 99th percentile of 50 values is the largest.
+  EXPECT_DOUBLE_EQ(m.lod.p99_abs, 2.0);
+  // Without a lod buffer on one side (an untextured render) there is nothing to compare.
+  b.lod.clear();
+  EXPECT_EQ(compare_buffers(a, b).lod.pixels, 0u);
+  EXPECT_EQ(compare_buffers(a, b).lod.mean_abs, 0.0);
 }
 
 TEST(Compare, LoneMismatchIsExcusedButAWrongRegionCountsItsInterior) {

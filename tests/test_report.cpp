@@ -217,6 +217,32 @@ TEST(MetricsJson, InfiniteAndNanValuesStayValidJson) {
   EXPECT_TRUE(doc["renderers"]["raster"]["stats"]["weird"].is_null());
 }
 
+TEST(MetricsJson, LodBlockOnlyWhenSomePixelIsTexturedInBoth) {
+  ReportInput in = sample_input("out");
+  auto plain = nlohmann::json::parse(metrics_json(in));
+  EXPECT_FALSE(plain.contains("lod"));
+  EXPECT_FALSE(plain["pairs"][0].contains("lod"));
+  in.metrics.lod = {1234, 0.0625, 0.375};
+  auto doc = nlohmann::json::parse(metrics_json(in));
+  EXPECT_EQ(doc["lod"]["pixels"], 1234);
+  EXPECT_EQ(doc["lod"]["mean_abs"], 0.0625);
+  EXPECT_EQ(doc["lod"]["p99_abs"], 0.375);
+  EXPECT_EQ(doc["pairs"][0]["lod"], doc["lod"]);
+}
+
+TEST_F(ReportDir, LodRowsBesideTheColourOnesWhenTextured) {
+  ReportInput in = sample_input(dir_.string());
+  auto plain = report_html(in);
+  ASSERT_TRUE(plain.ok()) << plain.error().message;
+  EXPECT_EQ(plain->find("<code>p99_abs</code>"), std::string::npos);
+  in.metrics.lod = {1234, 0.0625, 0.375};
+  auto html = report_html(in);
+  ASSERT_TRUE(html.ok()) << html.error().message;
+  EXPECT_NE(html->find("<code>mean_abs</code></td><td class=\"num\">0.0625<"), std::string::npos);
+  EXPECT_NE(html->find("<code>p99_abs</code></td><td class=\"num\">0.375<"), std::string::npos);
+  EXPECT_NE(html->find("1234 pixels textured in both"), std::string::npos);
+}
+
 TEST(MetricsJson, DuplicateRendererNamesAreKeptApart) {
   ReportInput in = sample_input("out");
   in.renderers[1].name = "raster";

@@ -69,6 +69,9 @@ void print_pair(const ReportPair& p, const std::string& name_a, const std::strin
                 m.depth.outliers_elsewhere);
   std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
               m.color.psnr_db, m.color.max_abs, m.color.ssim);
+  if (m.lod.pixels > 0)
+    std::printf("  texture lod       |a - b| mean %.3g  p99 %.3g levels over %zu pixels\n",
+                m.lod.mean_abs, m.lod.p99_abs, m.lod.pixels);
 }
 
 // The exit status the thresholds give: 1 when a pair's id agreement is below

@@ -114,9 +114,9 @@ int run(int argc, char** argv) {
   add_common_options(*render_cmd, render.common);
   render_cmd->add_option("-r,--renderer", render.renderer, renderer_help())->required();
   render_cmd->add_option("-o,--output", render.out, "output image (.png, .exr)");
-  render_cmd->add_option("--aov", render.aovs, "extra outputs: depth,id,normal,cost")
+  render_cmd->add_option("--aov", render.aovs, "extra outputs: depth,id,normal,cost,lod")
       ->delimiter(',')
-      ->check(CLI::IsMember({"depth", "id", "normal", "cost"}));
+      ->check(CLI::IsMember({"depth", "id", "normal", "cost", "lod"}));
   render_cmd->add_option("--stats", render.stats, "write counters and phase times as JSON");
 
   CompareArgs compare;

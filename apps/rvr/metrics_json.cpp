@@ -91,6 +91,10 @@ ordered_json pair_metrics(const ComparisonMetrics& m) {
                   {"psnr_db", psnr_number(c.psnr_db)},
                   {"max_abs", number(c.max_abs)},
                   {"ssim", number(c.ssim)}};
+  if (m.lod.pixels > 0)
+    doc["lod"] = {{"pixels", m.lod.pixels},
+                  {"mean_abs", number(m.lod.mean_abs)},
+                  {"p99_abs", number(m.lod.p99_abs)}};
   return doc;
 }
 

@@ -386,6 +386,16 @@ Expected<std::string> report_html(const ReportInput& input) {
          "Structural similarity of the luminance of the colours clamped to [0, 1], 11&times;11 "
          "Gaussian window (&sigma; 1.5), averaged over the image; 1 = identical."},
     };
+    const LodMetrics& lod = pairs.front().metrics.lod;
+    if (lod.pixels > 0) {
+      rows.push_back({"lod", "mean_abs", fmt("%.3g", lod.mean_abs),
+                      "Mean |lod<sub>A</sub> &minus; lod<sub>B</sub>| in mip levels over the " +
+                          std::to_string(lod.pixels) +
+                          " pixels textured in both: how far the two loop orders' texture levels "
+                          "of detail differ (docs/design.md, Textures)."});
+      rows.push_back(
+          {"lod", "p99_abs", fmt("%.3g", lod.p99_abs), "99th percentile of the same difference."});
+    }
     h << "<h2>Metrics</h2>\n<table><thead><tr><th>group</th><th>metric</th><th>value</th>"
          "<th>meaning</th></tr></thead><tbody>\n";
     for (const auto& row : rows)

@@ -52,12 +52,14 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   RenderOptions visibility_options = options;
   visibility_options.mode = RenderMode::Visibility;
   visibility_options.cost_aov = false;  // the cost AOV is the tracer's
+  // Primary hits take the z-buffer's level of detail (its own screen-space derivatives).
+  visibility_options.visibility_lod = true;
   auto t_zbuffer = Clock::now();
   Expected<RenderOutput> zbuffer = rasterizer_->render(scene, visibility_options);
   const double zbuffer_seconds = seconds_since(t_zbuffer);
   if (!zbuffer) return zbuffer.error();
   const FrameBuffers& ids = zbuffer->buffers;
-  PrimaryVisibility visible{ids.width, ids.height, ids.object_id, ids.primitive_id};
+  PrimaryVisibility visible{ids.width, ids.height, ids.object_id, ids.primitive_id, ids.lod};
 
   // Several samples per pixel: one more z-buffer pass per sample (the accumulation buffer),
   // each drawn through that sample's place in the pixel and lens point, its hits rebuilt and
@@ -85,7 +87,7 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
       if (!pass) return pass.error();
       const FrameBuffers& pass_ids = pass->buffers;
       const PrimaryVisibility pass_visible{pass_ids.width, pass_ids.height, pass_ids.object_id,
-                                           pass_ids.primitive_id};
+                                           pass_ids.primitive_id, pass_ids.lod};
       t_pass = Clock::now();
       auto pass_stats = tracer.add_visible_sample(scene, options, geometry, pass_visible, k, sum);
       trace_seconds += seconds_since(t_pass);

@@ -12,8 +12,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <limits>
+#include <memory>
 #include <new>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -24,6 +26,7 @@
 #include "gl_shaders.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/image_sample.h"
+#include "rvr/shared/surface_colour.h"
 #include "rvr/shared/timer.h"
 
 namespace rvr {
@@ -41,6 +44,14 @@ struct Vertex {
 };
 static_assert(sizeof(Vertex) == 9 * sizeof(float), "Vertex must be tightly packed for GL");
 
+// The same corner's texture coordinates and vertex colour, in a buffer of their own that exists
+// only when some object varies in colour (untextured scenes upload exactly what they did).
+struct SurfaceVertex {
+  glm::vec2 uv{0.0f};
+  glm::vec3 colour{1.0f};
+};
+static_assert(sizeof(SurfaceVertex) == 5 * sizeof(float), "tightly packed for GL");
+
 // One object's glDrawArrays and the uniforms that go with it.
 struct DrawItem {
   GLint first = 0;
@@ -49,6 +60,8 @@ struct DrawItem {
   const Material* material = nullptr;
   bool smooth = false;
   bool use_primitive_id = false;
+  GLuint texture = 0;  // the material's texture, 0: not textured
+  bool coloured = false;
 };
 
 struct SceneUniforms {
@@ -56,12 +69,13 @@ struct SceneUniforms {
         smooth = -1, use_primitive_id = -1, object_id = -1, diffuse = -1, specular = -1,
         emission = -1, shininess = -1, lights = -1, light_first = -1, light_end = -1, base = -1,
         shadows = -1, shadow_maps = -1, face_rotation = -1, shadow_bias = -1, shadow_texel = -1,
-        shadow_pcf = -1;
+        shadow_pcf = -1, textured = -1, coloured = -1, texture = -1;
 };
 
 // Texture units of the scene pass.
 constexpr GLint kLightUnit = 0;
 constexpr GLint kShadowUnit = 1;
+constexpr GLint kTextureUnit = 2;
 
 // Shadow maps (full mode). Every light sample (a point light, or one stratum centre of an area
 // light) gets a full cube: six 90 degree faces around the sample, stored as six layers of one
@@ -120,16 +134,31 @@ std::string material_names(const Draws& draws, Pred uses) {
 }
 
 // Colour attachments of the scene FBO, in fragment-output order (gl_shaders.h).
-enum Target : int { kColour, kObjectId, kPrimitiveId, kViewDepth, kNormal, kCost, kTargetCount };
+enum Target : int {
+  kColour,
+  kObjectId,
+  kPrimitiveId,
+  kViewDepth,
+  kNormal,
+  kLod,
+  kCost,
+  kTargetCount
+};
 
-constexpr std::array<GLenum, kTargetCount> kTargetFormats = {GL_RGBA32F, GL_R32UI,   GL_R32UI,
-                                                             GL_R32F,    GL_RGBA32F, GL_R32F};
+constexpr std::array<GLenum, kTargetCount> kTargetFormats = {
+    GL_RGBA32F, GL_R32UI, GL_R32UI, GL_R32F, GL_RGBA32F, GL_R32F, GL_R32F};
 
 Status append_mesh(const TriangleMesh& mesh, const std::string& name, std::vector<Vertex>& out) {
   const size_t n = mesh.positions.size();
   if (mesh.smooth() && mesh.normals.size() != n)
     return bad_input(
         fmt::format("object '{}': {} normals for {} positions", name, mesh.normals.size(), n));
+  if (mesh.textured() && mesh.uvs.size() != n)
+    return bad_input(fmt::format("object '{}': {} texture coordinates for {} positions", name,
+                                 mesh.uvs.size(), n));
+  if (mesh.coloured() && mesh.colours.size() != n)
+    return bad_input(fmt::format("object '{}': {} vertex colours for {} positions", name,
+                                 mesh.colours.size(), n));
   for (const glm::uvec3& t : mesh.triangles) {
     if (t.x >= n || t.y >= n || t.z >= n)
       return bad_input(
@@ -150,12 +179,27 @@ Status append_mesh(const TriangleMesh& mesh, const std::string& name, std::vecto
   return ok_status();
 }
 
+// The texture coordinates (after the material's uv_transform, an affine map: transforming the
+// corners is transforming every interpolated point) and vertex colours of `mesh`'s corners, in
+// append_mesh's order; defaults for what the mesh does not have.
+void append_surface(const TriangleMesh& mesh, const Material& m, bool textured,
+                    std::vector<SurfaceVertex>& out) {
+  for (const glm::uvec3& t : mesh.triangles)
+    for (int c = 0; c < 3; ++c) {
+      SurfaceVertex v;
+      if (textured) v.uv = m.uv_transform.apply(mesh.uvs[t[c]]);
+      if (mesh.coloured()) v.colour = mesh.colours[t[c]];
+      out.push_back(v);
+    }
+}
+
 // What upload() made of the scene: one draw per object, the CSG objects it could not draw, the
 // light samples it put in the light buffer (none in visibility mode).
 struct SceneUpload {
   std::vector<DrawItem> draws;
   std::vector<std::string> skipped_csg;
   std::vector<LightSample> samples;
+  bool textured = false;  // some object is textured: the lod target is drawn and read back
 };
 
 // Full mode's shadow maps: their side, how many light samples share one batch of maps, and the
@@ -251,7 +295,14 @@ struct GlRasterizer::Impl {
   GLint cost_view = -1, cost_projection = -1;
   GLint shadow_light = -1, shadow_rotation = -1, shadow_projection = -1;
   GLuint vao = 0, vertex_buffer = 0, light_buffer = 0, light_texture = 0, query = 0;
-  GLint max_size = 0;  // largest framebuffer side the driver accepts
+  GLuint surface_buffer = 0;  // SurfaceVertex per corner, when some object varies in colour
+  // The scene's textures as GL textures (0: not used by a drawn object), and the mip chains they
+  // hold, so a render of the same scene uploads none again.
+  std::vector<GLuint> textures;
+  std::vector<std::shared_ptr<const MipChain>> texture_sources;
+  bool query_lod = false;   // ARB_texture_query_lod: the lod AOV is the driver's own
+  bool lod_target = false;  // this render draws the lod target
+  GLint max_size = 0;       // largest framebuffer side the driver accepts
   GLint max_samples = 1, max_texture_size = 0, max_layers = 0;
   bool clip_control = false;  // ARB_clip_control: reversed-Z depth (d32f_reversed)
 
@@ -270,6 +321,7 @@ struct GlRasterizer::Impl {
 
   // Kept to reuse their capacity across renders.
   std::vector<Vertex> vertices;
+  std::vector<SurfaceVertex> surface_vertices;
   std::vector<uint32_t> scratch;  // one-channel readback
   std::vector<glm::vec4> scratch_rgba;
 
@@ -289,7 +341,9 @@ struct GlRasterizer::Impl {
   void release_msaa();
   void release_shadow_maps();
   void release_targets();
+  void release_textures();
   void release();
+  Status upload_textures(const Scene& scene);
 
   // One frame, in the order render() runs them.
   Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options);
@@ -358,6 +412,9 @@ Status GlRasterizer::Impl::create_resources() {
   su.shadow_bias = loc("u_shadow_bias");
   su.shadow_texel = loc("u_shadow_texel");
   su.shadow_pcf = loc("u_shadow_pcf");
+  su.textured = loc("u_textured");
+  su.coloured = loc("u_coloured");
+  su.texture = loc("u_texture");
   cost_view = gl().GetUniformLocation(cost_program, "u_view");
   cost_projection = gl().GetUniformLocation(cost_program, "u_projection");
 
@@ -373,6 +430,21 @@ Status GlRasterizer::Impl::create_resources() {
   attrib(shaders::kAttribPosition, offsetof(Vertex, position));
   attrib(shaders::kAttribNormal, offsetof(Vertex, normal));
   attrib(shaders::kAttribGeometricNormal, offsetof(Vertex, geometric_normal));
+  gl().GenBuffers(1, &surface_buffer);
+  gl().BindBuffer(GL_ARRAY_BUFFER, surface_buffer);
+  gl().VertexAttribPointer(shaders::kAttribUv, 2, GL_FLOAT, GL_FALSE, sizeof(SurfaceVertex),
+                           reinterpret_cast<const void*>(offsetof(SurfaceVertex, uv)));
+  gl().VertexAttribPointer(shaders::kAttribColour, 3, GL_FLOAT, GL_FALSE, sizeof(SurfaceVertex),
+                           reinterpret_cast<const void*>(offsetof(SurfaceVertex, colour)));
+  // Disabled until a scene varies in colour: the constant values of an untextured surface.
+  gl().VertexAttrib2f(shaders::kAttribUv, 0.0f, 0.0f);
+  gl().VertexAttrib3f(shaders::kAttribColour, 1.0f, 1.0f, 1.0f);
+  GLint extensions = 0;
+  gl().GetIntegerv(GL_NUM_EXTENSIONS, &extensions);
+  for (GLint i = 0; i < extensions; ++i) {
+    const auto* name = reinterpret_cast<const char*>(gl().GetStringi(GL_EXTENSIONS, GLuint(i)));
+    if (name && std::string_view(name) == "GL_ARB_texture_query_lod") query_lod = true;
+  }
 
   gl().GenBuffers(1, &light_buffer);
   gl().GenTextures(1, &light_texture);
@@ -565,6 +637,8 @@ void GlRasterizer::Impl::release() {
     if (cost_program) gl().DeleteProgram(cost_program);
     if (shadow_program) gl().DeleteProgram(shadow_program);
     release_shadow_maps();
+    release_textures();
+    if (surface_buffer) gl().DeleteBuffers(1, &surface_buffer);
     if (vao) gl().DeleteVertexArrays(1, &vao);
     if (vertex_buffer) gl().DeleteBuffers(1, &vertex_buffer);
     if (light_buffer) gl().DeleteBuffers(1, &light_buffer);
@@ -579,7 +653,9 @@ void GlRasterizer::Impl::release() {
   msaa_samples = 0;
   shadow_fbo = shadow_texture = 0;
   shadow_size = shadow_layers = 0;
-  vao = vertex_buffer = light_buffer = light_texture = query = 0;
+  vao = vertex_buffer = light_buffer = light_texture = query = surface_buffer = 0;
+  textures.clear();
+  texture_sources.clear();
   scene_fbo = cost_fbo = depth_buffer = 0;
   targets.fill(0);
   width = height = 0;
@@ -590,6 +666,10 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
   SceneUpload up;
   vertices.clear();
   vertices.reserve(3 * scene.triangle_count());  // meshes; tessellated shapes add a little
+  surface_vertices.clear();
+  bool varies = false;
+  for (const Object& o : scene.objects) varies = varies || varies_in_colour(scene, o);
+  if (varies) RVR_TRY(upload_textures(scene));
   const Material fallback = default_material();
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
@@ -604,6 +684,13 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
         RVR_TRY(append_mesh(o.mesh, o.name, vertices));
         d.smooth = o.mesh.smooth();
         d.use_primitive_id = true;
+        if (varies) {
+          const bool tex = textured(scene, o);
+          if (tex) d.texture = textures[size_t(d.material->texture)];
+          d.coloured = o.mesh.coloured();
+          up.textured = up.textured || tex;
+          append_surface(o.mesh, *d.material, tex, surface_vertices);
+        }
         break;
       case ObjectType::Sphere:
       case ObjectType::Plane:
@@ -616,12 +703,24 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
         continue;
     }
     d.count = GLsizei(GLint(vertices.size()) - d.first);
+    if (varies) surface_vertices.resize(vertices.size());  // shapes: the defaults
     if (d.count > 0) up.draws.push_back(d);
   }
   gl().BindVertexArray(vao);
   gl().BindBuffer(GL_ARRAY_BUFFER, vertex_buffer);
   gl().BufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)), vertices.data(),
                   GL_STATIC_DRAW);
+  for (GLuint a : {shaders::kAttribUv, shaders::kAttribColour}) {
+    if (varies)
+      gl().EnableVertexAttribArray(a);
+    else
+      gl().DisableVertexAttribArray(a);
+  }
+  if (varies) {
+    gl().BindBuffer(GL_ARRAY_BUFFER, surface_buffer);
+    gl().BufferData(GL_ARRAY_BUFFER, GLsizeiptr(surface_vertices.size() * sizeof(SurfaceVertex)),
+                    surface_vertices.data(), GL_STATIC_DRAW);
+  }
 
   if (options.mode != RenderMode::Visibility) up.samples = light_samples(scene.lights);
   std::vector<glm::vec4> light_texels;
@@ -639,6 +738,59 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
   gl().TexBuffer(GL_TEXTURE_BUFFER, GL_RGBA32F, light_buffer);
   RVR_GL_CHECK("uploading geometry and lights");
   return up;
+}
+
+// --- textures: each textured material's mip chain, level by level (the very texels every
+// renderer samples, not the driver's own reductions), filtered LINEAR_MIPMAP_LINEAR
+Status GlRasterizer::Impl::upload_textures(const Scene& scene) {
+  std::vector<bool> used(scene.textures.size(), false);
+  for (const Object& o : scene.objects)
+    if (textured(scene, o)) used[size_t(scene.materials[o.material].texture)] = true;
+  textures.resize(scene.textures.size(), 0);
+  texture_sources.resize(scene.textures.size(), nullptr);
+  auto wrap_mode = [](TextureWrap w) -> GLint {
+    switch (w) {
+      case TextureWrap::ClampToEdge:
+        return GL_CLAMP_TO_EDGE;
+      case TextureWrap::MirroredRepeat:
+        return GL_MIRRORED_REPEAT;
+      case TextureWrap::Repeat:
+        break;
+    }
+    return GL_REPEAT;
+  };
+  gl().ActiveTexture(GLenum(GL_TEXTURE0 + kTextureUnit));
+  gl().PixelStorei(GL_UNPACK_ALIGNMENT, 4);  // rows of float RGB texels: multiples of 4 bytes
+  for (size_t i = 0; i < scene.textures.size(); ++i) {
+    const Texture& t = scene.textures[i];
+    if (!used[i] || (textures[i] && texture_sources[i] == t.mips)) continue;
+    if (t.mips->width() > max_texture_size || t.mips->height() > max_texture_size)
+      return bad_input(fmt::format("texture '{}' is {}x{}: this GL's largest is {} per side",
+                                   t.file, t.mips->width(), t.mips->height(), max_texture_size));
+    if (!textures[i]) gl().GenTextures(1, &textures[i]);
+    gl().BindTexture(GL_TEXTURE_2D, textures[i]);
+    const std::vector<TextureLevel>& levels = t.mips->levels;
+    for (size_t k = 0; k < levels.size(); ++k)
+      gl().TexImage2D(GL_TEXTURE_2D, GLint(k), GL_RGB32F, levels[k].width, levels[k].height, 0,
+                      GL_RGB, GL_FLOAT, levels[k].texels.data());
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, GLint(levels.size()) - 1);
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap_mode(t.wrap_u));
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap_mode(t.wrap_v));
+    texture_sources[i] = t.mips;
+  }
+  gl().ActiveTexture(GL_TEXTURE0);
+  RVR_GL_CHECK("uploading textures");
+  return ok_status();
+}
+
+void GlRasterizer::Impl::release_textures() {
+  for (GLuint& t : textures)
+    if (t) gl().DeleteTextures(1, &t);
+  textures.clear();
+  texture_sources.clear();
 }
 
 // --- shadow-map plan (full mode): resolution, batches, light-space projection
@@ -711,7 +863,12 @@ void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size
   gl().Uniform1f(su.shadow_texel,
                  pass.shadows.map_size > 0 ? 2.0f / float(pass.shadows.map_size) : 0.0f);
   gl().Uniform1i(su.shadow_pcf, pass.options.shadow_pcf ? 1 : 0);
+  gl().Uniform1i(su.texture, kTextureUnit);
+  gl().ActiveTexture(GLenum(GL_TEXTURE0 + kTextureUnit));
   for (const DrawItem& d : pass.upload.draws) {
+    gl().Uniform1i(su.textured, d.texture != 0 ? 1 : 0);
+    gl().Uniform1i(su.coloured, d.coloured ? 1 : 0);
+    gl().BindTexture(GL_TEXTURE_2D, d.texture);
     gl().Uniform1ui(su.object_id, d.object);
     gl().Uniform1i(su.smooth, d.smooth ? 1 : 0);
     gl().Uniform1i(su.use_primitive_id, d.use_primitive_id ? 1 : 0);
@@ -721,6 +878,7 @@ void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size
     gl().Uniform1f(su.shininess, d.material->shininess);
     gl().DrawArrays(GL_TRIANGLES, d.first, d.count);
   }
+  gl().ActiveTexture(GL_TEXTURE0);
 }
 
 void GlRasterizer::Impl::clear_scene_targets(const Scene& scene, GLfloat depth_clear) {
@@ -736,12 +894,17 @@ void GlRasterizer::Impl::clear_scene_targets(const Scene& scene, GLfloat depth_c
   gl().ClearBufferuiv(GL_COLOR, kPrimitiveId, no_id);
   gl().ClearBufferfv(GL_COLOR, kViewDepth, far_view);
   gl().ClearBufferfv(GL_COLOR, kNormal, glm::value_ptr(zero));
+  if (lod_target) {
+    const GLfloat not_textured[4] = {std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f, 0.0f};
+    gl().ClearBufferfv(GL_COLOR, kLod, not_textured);
+  }
   gl().ClearBufferfv(GL_DEPTH, 0, &depth_clear);
 }
 
 void GlRasterizer::Impl::draw_to_every_target() {
   std::array<GLenum, kCost> all_outputs{};
   for (int i = 0; i < kCost; ++i) all_outputs[size_t(i)] = GLenum(GL_COLOR_ATTACHMENT0 + i);
+  if (!lod_target) all_outputs[kLod] = GL_NONE;  // untextured: the lod output is dropped
   gl().DrawBuffers(GLsizei(all_outputs.size()), all_outputs.data());
 }
 
@@ -923,6 +1086,11 @@ Status GlRasterizer::Impl::readback(int w, int h, const ScenePass& pass, FrameBu
   read_scalar(scene_fbo, kObjectId, GL_RED_INTEGER, GL_UNSIGNED_INT, fb.object_id);
   read_scalar(scene_fbo, kPrimitiveId, GL_RED_INTEGER, GL_UNSIGNED_INT, fb.primitive_id);
   read_scalar(scene_fbo, kViewDepth, GL_RED, GL_FLOAT, fb.depth);
+  fb.lod.clear();
+  if (lod_target) {
+    fb.lod.resize(n);
+    read_scalar(scene_fbo, kLod, GL_RED, GL_FLOAT, fb.lod);
+  }
   if (pass.options.cost_aov)
     read_scalar(cost_fbo, 0, GL_RED, GL_FLOAT, fb.cost);
   else
@@ -962,6 +1130,11 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   if (!uploaded) return uploaded.error();
   out.stats["time.upload"] = seconds_since(t);
 
+  lod_target =
+      uploaded->textured && (options.mode != RenderMode::Visibility || options.visibility_lod);
+  if (lod_target)
+    out.info["lod"] = query_lod ? "textureQueryLOD (ARB_texture_query_lod)"
+                                : "log2 of the longer of dFdx, dFdy in texels";
   Expected<ShadowPlan> shadows = plan_shadows(options, uploaded->samples, out);
   if (!shadows) return shadows.error();
 

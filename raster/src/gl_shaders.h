@@ -8,6 +8,10 @@ namespace rvr::shaders {
 constexpr unsigned kAttribPosition = 0;
 constexpr unsigned kAttribNormal = 1;           // shading normal (smooth meshes)
 constexpr unsigned kAttribGeometricNormal = 2;  // cross(v1 - v0, v2 - v0), same on all 3 corners
+// Textured or vertex-coloured objects only (a second buffer, filled when some object varies in
+// colour); elsewhere the attributes are disabled and read their constant values: uv 0, colour 1.
+constexpr unsigned kAttribUv = 3;      // the mesh's uv after the material's uv_transform
+constexpr unsigned kAttribColour = 4;  // linear RGB vertex colour
 
 // Fragment outputs of the scene pass, in FBO attachment order.
 constexpr unsigned kOutColour = 0;
@@ -15,11 +19,14 @@ constexpr unsigned kOutObjectId = 1;
 constexpr unsigned kOutPrimitiveId = 2;
 constexpr unsigned kOutViewDepth = 3;
 constexpr unsigned kOutNormal = 4;
+constexpr unsigned kOutLod = 5;  // drawn only when some object is textured
 
 inline constexpr const char* kSceneVertex = R"glsl(#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec3 a_geometric_normal;
+layout(location = 3) in vec2 a_uv;
+layout(location = 4) in vec3 a_colour;
 
 uniform mat4 u_view;
 uniform mat4 u_projection;
@@ -29,6 +36,8 @@ out float v_view_depth;
 out vec3 v_normal;
 // flat: taken from one corner unchanged, so the facing decision is exactly the CPU's.
 flat out vec3 v_geometric_normal;
+out vec2 v_uv;
+out vec3 v_colour;
 
 void main() {
   vec4 eye = u_view * vec4(a_position, 1.0);
@@ -36,15 +45,20 @@ void main() {
   v_view_depth = -eye.z;
   v_normal = a_normal;
   v_geometric_normal = a_geometric_normal;
+  v_uv = a_uv;
+  v_colour = a_colour;
   gl_Position = u_projection * eye;
 }
 )glsl";
 
 inline constexpr const char* kSceneFragment = R"glsl(#version 330 core
+#extension GL_ARB_texture_query_lod : enable
 in vec3 v_world;
 in float v_view_depth;
 in vec3 v_normal;
 flat in vec3 v_geometric_normal;
+in vec2 v_uv;
+in vec3 v_colour;
 
 uniform vec3 u_eye;
 uniform vec3 u_ambient;
@@ -58,6 +72,13 @@ uniform vec3 u_diffuse;
 uniform vec3 u_specular;
 uniform vec3 u_emission;
 uniform float u_shininess;
+
+// The base colour (rvr/shared/surface_colour.h): u_diffuse times the texture (trilinear, the
+// object's mip chain as every renderer builds it) times the interpolated vertex colour.
+uniform bool u_textured;
+uniform bool u_coloured;
+uniform sampler2D u_texture;
+vec3 g_diffuse;
 
 // Light sample i: texel 2i = position, texel 2i+1 = intensity. A buffer texture holds
 // millions of texels, where a uniform array would stop at a few hundred samples.
@@ -84,6 +105,7 @@ layout(location = 1) out uint o_object_id;
 layout(location = 2) out uint o_primitive_id;
 layout(location = 3) out float o_view_depth;
 layout(location = 4) out vec4 o_normal;
+layout(location = 5) out float o_lod;
 
 vec3 face_viewer(vec3 shading_normal, vec3 geometric_normal, vec3 to_viewer) {
   return dot(geometric_normal, to_viewer) < 0.0 ? -shading_normal : shading_normal;
@@ -143,7 +165,7 @@ float shadow_visibility(int i, vec3 P, vec3 L, vec3 geometric_normal) {
 }
 
 vec3 shade_local(vec3 P, vec3 N, vec3 V, vec3 geometric_normal) {
-  vec3 colour = u_base ? u_emission + u_ambient * u_diffuse : vec3(0.0);
+  vec3 colour = u_base ? u_emission + u_ambient * g_diffuse : vec3(0.0);
   for (int i = u_light_first; i < u_light_end; ++i) {
     vec3 light_position = texelFetch(u_lights, 2 * i).xyz;
     vec3 light_intensity = texelFetch(u_lights, 2 * i + 1).xyz;
@@ -154,7 +176,7 @@ vec3 shade_local(vec3 P, vec3 N, vec3 V, vec3 geometric_normal) {
     float n_dot_l = max(0.0, dot(N, Ld));
     vec3 H = normalize(Ld + V);
     float n_dot_h = max(0.0, dot(N, H));
-    vec3 brdf = u_diffuse * n_dot_l + u_specular * specular_power(n_dot_h, u_shininess);
+    vec3 brdf = g_diffuse * n_dot_l + u_specular * specular_power(n_dot_h, u_shininess);
     if (brdf == vec3(0.0)) continue;
     float vis = u_shadows ? shadow_visibility(i, P, light_position, geometric_normal) : 1.0;
     colour += vis * brdf * light_intensity / dist2;
@@ -162,7 +184,27 @@ vec3 shade_local(vec3 P, vec3 N, vec3 V, vec3 geometric_normal) {
   return colour;
 }
 
+// The level of detail GL samples the texture at: the driver's own (textureQueryLOD) where it
+// offers it, else the specification's formula on the fragment's derivatives.
+float texture_lod() {
+#ifdef GL_ARB_texture_query_lod
+  return textureQueryLOD(u_texture, v_uv).y;
+#else
+  vec2 size = vec2(textureSize(u_texture, 0));
+  return log2(max(length(dFdx(v_uv) * size), length(dFdy(v_uv) * size)));
+#endif
+}
+
 void main() {
+  // u_textured is uniform: its branch is uniform control flow, where derivatives are defined.
+  float lod = uintBitsToFloat(0x7fc00000u);  // NaN: not textured
+  g_diffuse = u_diffuse;
+  if (u_textured) {
+    lod = texture_lod();
+    g_diffuse = g_diffuse * texture(u_texture, v_uv).rgb;
+  }
+  if (u_coloured) g_diffuse = g_diffuse * v_colour;
+  o_lod = lod;
   vec3 P = v_world;
   vec3 V = normalize(u_eye - P);
   vec3 shading_normal = u_smooth ? normalize(v_normal) : normalize(v_geometric_normal);

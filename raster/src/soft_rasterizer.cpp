@@ -24,11 +24,13 @@
 #include "rvr/shared/image_sample.h"
 #include "rvr/shared/shade_kernel.h"
 #include "rvr/shared/shading.h"
+#include "rvr/shared/surface_colour.h"
 #include "rvr/shared/timer.h"
 #include "soft/deferred_shading.h"
 #include "soft/draw_triangles.h"
 #include "soft/fill_dispatch.h"
 #include "soft/shadow_cube.h"
+#include "soft/surface_texture.h"
 #include "soft/tile_raster.h"
 
 namespace rvr {
@@ -99,6 +101,12 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     if (m.smooth() && m.normals.size() != m.positions.size())
       return bad_input(fmt::format("object '{}': {} normals for {} positions", o.name,
                                    m.normals.size(), m.positions.size()));
+    if (m.textured() && m.uvs.size() != m.positions.size())
+      return bad_input(fmt::format("object '{}': {} texture coordinates for {} positions", o.name,
+                                   m.uvs.size(), m.positions.size()));
+    if (m.coloured() && m.colours.size() != m.positions.size())
+      return bad_input(fmt::format("object '{}': {} vertex colours for {} positions", o.name,
+                                   m.colours.size(), m.positions.size()));
     for (const glm::uvec3& tri : m.triangles)
       if (std::max({tri.x, tri.y, tri.z}) >= m.positions.size())
         return bad_input(fmt::format("object '{}': triangle index out of range ({} positions)",
@@ -115,6 +123,12 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
           : glm::dmat4(projection_matrix(scene.camera, w, h)) *
                 glm::dmat4(view_matrix(scene.camera));
   const DrawList list = soft::make_draw_list(std::move(objects));
+  // Textured and vertex-coloured objects (none: no per-pixel work at all).
+  std::optional<soft::SurfaceColours> surfaces;
+  if (options.mode != RenderMode::Visibility || options.visibility_lod) {
+    surfaces.emplace(scene, view_projection, w, h);
+    if (!surfaces->any()) surfaces.reset();
+  }
   const size_t submitted = list.triangles();
   out.stats["time.setup"] = seconds_since(t);
 
@@ -148,8 +162,8 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   if (options.mode == RenderMode::Visibility) {
     t = Clock::now();
     if (progress) progress->begin("readback", uint64_t(w) * uint64_t(h), "pixels");
-    soft::write_visibility(list, target, scene.image.background, options.cost_aov, arena, progress,
-                           fb);
+    soft::write_visibility(list, target, scene.image.background, options.cost_aov,
+                           surfaces ? &*surfaces : nullptr, arena, progress, fb);
     out.stats["time.readback"] = seconds_since(t);
   }
 
@@ -166,10 +180,14 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     const DrawObject* object;
     uint32_t primitive;
     glm::vec3 P, N, V, geometric;
+    bool varies = false;  // textured or vertex-coloured: `own` is its material at P
+    Material own;         // the object's, with the base colour at P as its diffuse
+    const Material& material() const { return varies ? own : *object->material; }
   };
   auto surface_at = [&](size_t o) {
     Surface s;
-    s.object = &list.objects[target.object(o)];
+    const uint32_t id = target.object(o);
+    s.object = &list.objects[id];
     s.primitive = target.primitive(o);
     const TriangleMesh& mesh = *s.object->mesh;
     const glm::vec3 b = target.barycentric(o);
@@ -184,6 +202,14 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
                          : s.geometric;
     s.V = glm::normalize(eye - s.P);
     s.N = face_viewer(shading, s.geometric, s.V);
+    if (surfaces && surfaces->varies(id)) {
+      // The level of detail the deferred pass sampled at (kept in fb.lod when textured).
+      const float lod = fb.lod.empty() ? 0.0f : fb.lod[o];
+      s.varies = true;
+      s.own = with_diffuse(
+          *s.object->material,
+          base_colour(scene, scene.objects[id], *s.object->material, s.primitive, b.y, b.z, lod));
+    }
     return s;
   };
   if (shade) {
@@ -195,6 +221,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     shading.colour = shadows ? soft::ShadedColour::Base : soft::ShadedColour::Local;
     shading.samples = &samples;
     shading.cost = options.cost_aov;
+    shading.surfaces = surfaces ? &*surfaces : nullptr;
     soft::shade_pixels(list, target, shading, shade_kernels(isa), arena, progress, fb);
     out.stats["time.shade"] = seconds_since(t);
   }
@@ -266,7 +293,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
                               if (!target.covered(o)) continue;
                               const Surface s = surface_at(o);
                               add_light_samples(
-                                  *s.object->material, s.P, s.N, s.V, samples, first, end,
+                                  s.material(), s.P, s.N, s.V, samples, first, end,
                                   [&](size_t i, const glm::vec3& P, const glm::vec3& L) {
                                     return cubes[i - first].visibility(P, L, s.geometric, settings);
                                   },

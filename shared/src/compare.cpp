@@ -210,6 +210,24 @@ DepthMetrics depth_metrics(const FrameBuffers& a, const FrameBuffers& b) {
 
 }  // namespace
 
+LodMetrics lod_metrics(const FrameBuffers& a, const FrameBuffers& b) {
+  LodMetrics m;
+  const size_t n = a.pixel_count();
+  if (a.lod.size() != n || b.lod.size() != n || b.pixel_count() != n) return m;
+  std::vector<double> errors;
+  double sum = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(a.lod[i]) || !std::isfinite(b.lod[i])) continue;
+    const double d = std::abs(double(a.lod[i]) - double(b.lod[i]));
+    errors.push_back(d);
+    sum += d;
+  }
+  m.pixels = errors.size();
+  m.mean_abs = errors.empty() ? 0.0 : sum / double(errors.size());
+  m.p99_abs = percentile(errors, 0.99);
+  return m;
+}
+
 std::vector<bool> id_boundaries(const FrameBuffers& fb) {
   const int w = fb.width, h = fb.height;
   std::vector<bool> edge(ids_sized(fb) ? fb.pixel_count() : 0, false);
@@ -257,6 +275,7 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b,
   m.visibility = with_coverage(m.visibility, a, b);
   m.visibility.classes = count_classes(classify_mismatches(a, b, context));
   m.depth = depth_metrics(a, b);
+  m.lod = lod_metrics(a, b);
 
   // Colour, linear values, peak 1.
   double sq = 0.0, max_abs = 0.0;

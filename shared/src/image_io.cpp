@@ -329,8 +329,8 @@ Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
                   const std::vector<std::string>& aovs) {
   try {
     for (const auto& name : aovs)
-      if (name != "depth" && name != "id" && name != "normal" && name != "cost")
-        return bad_input("unknown aov '" + name + "' (known: depth, id, normal, cost)");
+      if (name != "depth" && name != "id" && name != "normal" && name != "cost" && name != "lod")
+        return bad_input("unknown aov '" + name + "' (known: depth, id, normal, cost, lod)");
     const size_t n = fb.pixel_count();
     if (fb.depth.size() != n || fb.object_id.size() != n || fb.primitive_id.size() != n ||
         fb.normal.size() != n || fb.cost.size() != n)
@@ -364,6 +364,14 @@ Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
         if (st.ok()) {
           st = write_image(base + ".cost.png", cost_image(fb), false);
         }
+      } else if (name == "lod") {
+        // NaN where the visible surface is not textured (everywhere in an untextured scene).
+        Image img = aov_image(fb, {"lod"});
+        if (fb.lod.size() == n)
+          std::copy(fb.lod.begin(), fb.lod.end(), img.pixels.begin());
+        else
+          std::fill(img.pixels.begin(), img.pixels.end(), std::numeric_limits<float>::quiet_NaN());
+        st = write_image(base + ".lod.exr", img, false);
       }
       if (!st.ok()) return st;
     }

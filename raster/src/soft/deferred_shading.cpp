@@ -11,6 +11,7 @@
 
 #include "rvr/shared/shade_batch.h"
 #include "rvr/shared/shading.h"
+#include "rvr/shared/surface_colour.h"
 
 namespace rvr::soft {
 
@@ -20,6 +21,8 @@ namespace {
 struct ObjectShading {
   const TriangleMesh* mesh = nullptr;
   bool smooth = false;
+  bool varies = false;  // textured or vertex-coloured: a material per pixel
+  const Material* source = nullptr;
   ShadeMaterial material{};
 };
 
@@ -127,8 +130,13 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
     ObjectShading& s = objects[i];
     s.mesh = d.mesh;
     s.smooth = d.smooth;
+    s.source = d.material;
+    s.varies = settings.surfaces && d.material && settings.surfaces->varies(uint32_t(i));
     if (d.material) s.material = shade_material(*d.material, settings.ambient);
   }
+  const SurfaceColours* surfaces = settings.surfaces;
+  if (surfaces && surfaces->textured())
+    fb.lod.assign(fb.pixel_count(), std::numeric_limits<float>::quiet_NaN());
   // The light samples as the kernel reads them (none: the colour is the base).
   const bool lit = settings.colour == ShadedColour::Local && settings.samples;
   const ShadeLightArrays light_arrays(lit ? *settings.samples : std::vector<LightSample>{});
@@ -143,6 +151,7 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
       ShadeBatch batch;
+      PlanesCache planes;
       // Flat pixels leave their slots' vertex normals as they were: defined values, not read.
       std::fill(&batch.normal[0][0][0], &batch.normal[0][0][0] + 9 * kShadeBatch, 0.0f);
       size_t pixel[kShadeBatch];  // frame-buffer index of each slot
@@ -197,8 +206,20 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
             mixed = true;  // from now on each slot carries its material
             for (int k = 0; k < i; ++k) put_material(batch, k, objects[batch_object].material);
           }
-          if (mixed) put_material(batch, i, s.material);
           for (int a = 0; a < 3; ++a) batch.bary[a][i] = barycentrics[3 * o + size_t(a)];
+          if (s.varies) {
+            if (!mixed) {
+              mixed = true;
+              for (int k = 0; k < i; ++k) put_material(batch, k, objects[batch_object].material);
+            }
+            const glm::vec3 b(batch.bary[0][i], batch.bary[1][i], batch.bary[2][i]);
+            const SurfaceSample here = surfaces->at(id, *s.source, primitive, b, x - 1, y, planes);
+            put_material(batch, i,
+                         shade_material(with_diffuse(*s.source, here.base), settings.ambient));
+            if (!fb.lod.empty()) fb.lod[o] = here.lod;
+          } else if (mixed) {
+            put_material(batch, i, s.material);
+          }
           if (id != last_object || primitive != last_primitive) {
             last_object = id;
             last_primitive = primitive;
@@ -222,10 +243,13 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
 }
 
 void write_visibility(const DrawList& list, const DepthTarget& target, const glm::vec3& background,
-                      bool cost, tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb) {
+                      bool cost, const SurfaceColours* surfaces, tbb::task_arena& arena,
+                      ProgressSink* progress, FrameBuffers& fb) {
   const int w = target.width(), h = target.height();
   allocate_frame(w, h, fb);  // every pixel is written below
   const VisibilityRows visibility(list, target, cost);
+  if (surfaces && surfaces->textured())
+    fb.lod.assign(fb.pixel_count(), std::numeric_limits<float>::quiet_NaN());
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
       for (int y = r.begin(); y != r.end(); ++y) {
@@ -234,6 +258,14 @@ void write_visibility(const DrawList& list, const DepthTarget& target, const glm
         fill_vec3(fb.color.data() + row, size_t(w), background);
         std::memset(static_cast<void*>(fb.normal.data() + row), 0,
                     size_t(w) * sizeof(glm::vec3));  // +0.0f is all zero bits
+        if (fb.lod.empty()) continue;
+        PlanesCache planes;
+        for (int x = 0; x < w; ++x) {
+          const uint32_t id = fb.object_id[row + size_t(x)];
+          if (id == kNoId || !list.objects[id].material) continue;
+          fb.lod[row + size_t(x)] = surfaces->lod(id, *list.objects[id].material,
+                                                  fb.primitive_id[row + size_t(x)], x, y, planes);
+        }
       }
       if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));
     });

@@ -15,6 +15,7 @@
 #include "rvr/shared/scene.h"
 #include "rvr/shared/shade_kernel.h"
 #include "soft/draw_triangles.h"
+#include "soft/surface_texture.h"
 #include "soft/tile_raster.h"
 
 namespace rvr::soft {
@@ -31,6 +32,9 @@ struct DeferredShading {
   ShadedColour colour = ShadedColour::Local;
   const std::vector<LightSample>* samples = nullptr;  // Local: the light samples, in order
   bool cost = true;  // false: the cost buffer is 0 everywhere (RenderOptions::cost_aov)
+  // Not null when some object varies in colour: those pixels get their own material (diffuse =
+  // the base colour there), and the lod buffer is written when some object is textured.
+  const SurfaceColours* surfaces = nullptr;
 };
 
 // Sizes fb to the target and writes every pixel of every buffer.
@@ -41,7 +45,9 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
 // Visibility mode: sizes fb to the target and writes every pixel of every buffer without
 // shading: depth, object and primitive id and cost (0 everywhere when !cost) as shade_pixels
 // writes them, colour the background, normal 0.
+// `surfaces` not null and some object textured: fb.lod too (the hybrids' primary hits).
 void write_visibility(const DrawList& list, const DepthTarget& target, const glm::vec3& background,
-                      bool cost, tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb);
+                      bool cost, const SurfaceColours* surfaces, tbb::task_arena& arena,
+                      ProgressSink* progress, FrameBuffers& fb);
 
 }  // namespace rvr::soft

@@ -15,6 +15,9 @@ struct PrimaryVisibility {
   // the object for meshes, 0 for analytic shapes (spheres, squares), as every renderer reports.
   std::span<const uint32_t> object_id;
   std::span<const uint32_t> primitive_id;
+  // Empty, or the z-buffer's texture level of detail per pixel (FrameBuffers::lod: NaN where the
+  // surface is not textured): a primary hit rebuilt from this buffer samples its texture there.
+  std::span<const float> lod;
 };
 
 }  // namespace rvr

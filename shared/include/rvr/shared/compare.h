@@ -73,11 +73,22 @@ struct ColorMetrics {  // linear RGB, peak value 1 for PSNR and SSIM
   double ssim = 1.0;  // luminance, 11x11 Gaussian window (sigma 1.5)
 };
 
+// The texture level of detail each renderer sampled at (FrameBuffers::lod), over the pixels
+// textured in both (a finite lod in each): |lod_a - lod_b| in mip levels.
+struct LodMetrics {
+  size_t pixels = 0;  // textured in both; 0: nothing to compare (the values below are 0)
+  double mean_abs = 0.0;
+  double p99_abs = 0.0;
+};
+
 struct ComparisonMetrics {
   VisibilityMetrics visibility;
   DepthMetrics depth;
   ColorMetrics color;
+  LodMetrics lod;
 };
+
+LodMetrics lod_metrics(const FrameBuffers& a, const FrameBuffers& b);
 
 // Both buffers must have the same size. The context gives the mismatch classes their geometry
 // and depth resolutions; without it they use the id-boundary rule (see MismatchContext).

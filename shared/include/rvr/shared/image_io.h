@@ -37,9 +37,10 @@ Image color_image(const FrameBuffers& fb);
 // the map, is the 99th percentile of the non-zero costs (at least 1) and is returned too.
 Image cost_image(const FrameBuffers& fb, float* scale = nullptr);
 
-// Writes the AOVs named in `aovs` ("depth", "id", "normal", "cost") beside `out_path`:
+// Writes the AOVs named in `aovs` ("depth", "id", "normal", "cost", "lod") beside `out_path`:
 // OUT.depth.exr, OUT.id.exr (channels id, prim; background -1), OUT.normal.exr,
-// OUT.cost.exr and a colour-mapped OUT.cost.png. OUT is out_path without its extension.
+// OUT.cost.exr and a colour-mapped OUT.cost.png, OUT.lod.exr (the texture level of detail
+// sampled, NaN where the surface is not textured). OUT is out_path without its extension.
 Status write_aovs(const std::string& out_path, const FrameBuffers& fb,
                   const std::vector<std::string>& aovs);
 

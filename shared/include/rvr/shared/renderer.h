@@ -60,6 +60,9 @@ struct RenderOptions {
   // Tracers: how a ray chooses a texture's level of detail (the z-buffers take theirs from
   // screen-space derivatives; the hybrids' primary hits from their z-buffer's).
   TextureLod texture_lod = TextureLod::Cones;
+  // Z-buffers in visibility mode: also write FrameBuffers::lod (their level of detail of each
+  // textured pixel), which the hybrids' primary hits then sample at.
+  bool visibility_lod = false;
   // softraster: hierarchical z (each 8x8 block's farthest depth rejects triangles behind it).
   bool hiz = true;
   // Cost AOV: false: the caller does not read the cost AOV, which is then 0 everywhere (the
