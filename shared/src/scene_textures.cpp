@@ -61,7 +61,7 @@ const SceneTextures::Image& SceneTextures::image(const std::string& file, const 
   } else if (resolved.empty()) {
     warnings_.push_back(fmt::format(
         "{}: texture {} not found (looked in {} and its subfolders): rendered without it", label,
-        quote_json(file), quote_json(folder.empty() ? "." : folder)));
+        quote_json(file), "'" + (folder.empty() ? std::string(".") : folder) + "'"));
   } else {
     Expected<std::shared_ptr<const MipChain>> mips = read_texture_file(resolved);
     if (mips) {
