@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "model_corpus.h"
+#include "rvr/shared/html_escape.h"
 #include "rvr/shared/image_io.h"
 
 namespace fs = std::filesystem;
@@ -402,7 +403,7 @@ TEST_F(Cli, LoaderWarningsReachMetricsReportAndStats) {
       };
       EXPECT_EQ(listed(metrics["warnings"]), 1) << metrics["warnings"];
       EXPECT_EQ(listed(stat["warnings"]), 1) << stat["warnings"];
-      EXPECT_NE(html.find("<li>" + w), std::string::npos) << w;
+      EXPECT_NE(html.find("<li>" + rvr::escape_html(w)), std::string::npos) << w;
       for (const std::string* err : {&cmp.err, &render.err}) {
         size_t first = err->find("warning: " + w);
         EXPECT_NE(first, std::string::npos) << *err;

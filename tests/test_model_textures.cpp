@@ -16,6 +16,7 @@
 #include "model_corpus.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/scene_writer.h"
 #include "rvr/shared/surface_colour.h"
 
 namespace fs = std::filesystem;
@@ -97,7 +98,9 @@ void expect_square_uvs(const rvr::TriangleMesh& mesh, bool colours) {
     const int corner = corner_of(mesh.positions[v]);
     ASSERT_GE(corner, 0) << "vertex " << v << " is no corner of the square";
     EXPECT_EQ(mesh.uvs[v], kUvs[corner]) << "vertex " << v;
-    if (colours) EXPECT_EQ(mesh.colours[v], kColours[corner]) << "vertex " << v;
+    if (colours) {
+      EXPECT_EQ(mesh.colours[v], kColours[corner]) << "vertex " << v;
+    }
   }
 }
 
@@ -107,12 +110,6 @@ std::string obj_square(const std::string& mtl) {
     s += "v " + corpus::num(p.x) + " " + corpus::num(p.y) + " " + corpus::num(p.z) + "\n";
   for (const glm::vec2& t : kUvs) s += "vt " + corpus::num(t.x) + " " + corpus::num(t.y) + "\n";
   return s + "usemtl wood\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n";
-}
-
-bool warned(const rvr::Scene& s, const std::string& text) {
-  for (const std::string& w : s.warnings)
-    if (w.find(text) != std::string::npos) return true;
-  return false;
 }
 
 std::string all_warnings(const rvr::Scene& s) {
@@ -304,6 +301,43 @@ TEST_F(ModelTextures, GltfAndGlbEmbeddedPngUvSetColoursWrapAndTransform) {
   }
 }
 
+// `rvr scenes --export` of a GLB: the embedded image becomes an EXR beside the document, the
+// mesh's uvs and colours go to its PLY, the transform and wrap modes to the material; all read
+// back the same, bit for bit.
+TEST_F(ModelTextures, ExportedGlbReadsBackWithItsTextureUvsAndColours) {
+  std::string p = write("square.glb", gltf_square(png_bytes(dir_ / "scratch.png"), true, {}));
+  rvr::Scene original = rvr::load_scene(p).value();
+  fs::create_directories(dir_ / "out");
+  rvr::Expected<rvr::SceneDocument> doc =
+      rvr::write_scene(original, "square", (dir_ / "out").string());
+  ASSERT_TRUE(doc.ok()) << doc.error().message;
+  ASSERT_EQ(doc->texture_files.size(), 1u);
+  EXPECT_EQ(doc->texture_files[0].name, "square.texture0.exr");
+  for (const rvr::SceneMeshFile& m : doc->mesh_files)
+    corpus::write_file(dir_ / "out" / m.name, m.bytes);
+  for (const rvr::SceneTextureFile& t : doc->texture_files) {
+    ASSERT_TRUE(rvr::write_image((dir_ / "out" / t.name).string(), t.image).ok());
+  }
+  rvr::Expected<rvr::Scene> back =
+      rvr::parse_scene(doc->json, "square.json", (dir_ / "out").string());
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  EXPECT_TRUE(back->warnings.empty()) << all_warnings(*back);
+  ASSERT_EQ(back->textures.size(), 1u);
+  expect_texels_of_the_png(back->textures[0]);
+  const rvr::TextureLevel &a = original.textures[0].mips->levels[0],
+                          &b = back->textures[0].mips->levels[0];
+  EXPECT_EQ(a.texels, b.texels);
+  EXPECT_EQ(back->textures[0].wrap_u, rvr::TextureWrap::ClampToEdge);
+  EXPECT_EQ(back->textures[0].wrap_v, rvr::TextureWrap::MirroredRepeat);
+  const rvr::Material &ma = original.materials.at(original.objects[0].material),
+                      &mb = back->materials.at(back->objects[0].material);
+  EXPECT_EQ(mb.texture, 0);
+  EXPECT_EQ(ma.uv_transform.offset, mb.uv_transform.offset);
+  EXPECT_EQ(ma.uv_transform.rotation, mb.uv_transform.rotation);
+  EXPECT_EQ(ma.uv_transform.scale, mb.uv_transform.scale);
+  expect_square_uvs(back->objects.at(0).mesh, true);
+}
+
 // PLY vertex colours (bytes, Assimp divides by 255) are kept per vertex, not averaged.
 TEST_F(ModelTextures, PlyVertexColoursArrivePerVertex) {
   const uint8_t bytes[4][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {10, 128, 250}};
@@ -313,7 +347,10 @@ TEST_F(ModelTextures, PlyVertexColoursArrivePerVertex) {
       "element face 2\nproperty list uchar int vertex_indices\nend_header\n";
   for (int i = 0; i < 4; ++i) {
     ply += corpus::num(kCorners[i].x) + " " + corpus::num(kCorners[i].y) + " 0";
-    for (int c = 0; c < 3; ++c) ply += " " + std::to_string(bytes[i][c]);
+    for (int c = 0; c < 3; ++c) {
+      ply += ' ';
+      ply += std::to_string(bytes[i][c]);
+    }
     ply += "\n";
   }
   ply += "3 0 1 2\n3 0 2 3\n";
