@@ -207,7 +207,9 @@ struct GltfSquare {
   glm::vec2 scale{2.0f, 3.0f};
 };
 
-std::string gltf_square(const std::string& png, bool glb, const GltfSquare& g) {
+// `uri`, when not empty, names an external image file instead of embedding `png`.
+std::string gltf_square(const std::string& png, bool glb, const GltfSquare& g,
+                        const std::string& uri = "") {
   std::string bin;
   for (const glm::vec3& p : kCorners)
     for (int k = 0; k < 3; ++k) corpus::put<float>(bin, p[k]);
@@ -228,8 +230,9 @@ std::string gltf_square(const std::string& png, bool glb, const GltfSquare& g) {
   if (glb) bin += png;
   while (bin.size() % 4) bin += '\0';
   auto n = [](float x) { return corpus::num(x); };
-  std::string image = glb ? R"({"bufferView":5,"mimeType":"image/png"})"
-                          : R"({"uri":"data:image/png;base64,)" + corpus::base64(png) + "\"}";
+  std::string image = !uri.empty() ? R"({"uri":")" + uri + "\"}"
+                      : glb        ? R"({"bufferView":5,"mimeType":"image/png"})"
+                            : R"({"uri":"data:image/png;base64,)" + corpus::base64(png) + "\"}";
   std::string views = R"({"buffer":0,"byteOffset":0,"byteLength":48},)"
                       R"({"buffer":0,"byteOffset":48,"byteLength":32},)"
                       R"({"buffer":0,"byteOffset":80,"byteLength":32},)"
@@ -299,6 +302,20 @@ TEST_F(ModelTextures, GltfAndGlbEmbeddedPngUvSetColoursWrapAndTransform) {
     EXPECT_NEAR(m.uv_transform.rotation, g.rotation, 1e-6f);
     EXPECT_EQ(m.uv_transform.scale, g.scale);
   }
+}
+
+// An external image as a glTF exporter names it: a URI with an escaped space, in a folder
+// whose case differs from the disk's.
+TEST_F(ModelTextures, GltfExternalImageWithEscapedNameAndAnotherCase) {
+  fs::create_directories(dir_ / "maps");
+  corpus::write_file(dir_ / "maps" / "old oak.png", png_bytes(dir_ / "scratch.png"));
+  std::string p = write("square.gltf", gltf_square("", false, {}, "Maps/old%20oak.png"));
+  rvr::Scene s = rvr::load_scene(p).value();
+  EXPECT_TRUE(s.warnings.empty()) << all_warnings(s);
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(fs::path(s.textures[0].resolved), dir_ / "maps" / "old oak.png");
+  expect_texels_of_the_png(s.textures[0]);
+  expect_square_uvs(s.objects.at(0).mesh, true);
 }
 
 // `rvr scenes --export` of a GLB: the embedded image becomes an EXR beside the document, the

@@ -98,6 +98,35 @@ fs::path search_by_name(const fs::path& folder, const std::string& name) {
   return other_case;
 }
 
+// `p` with its URI escapes (%20 for a space, as glTF exporters write file names) decoded;
+// empty when it has none or a malformed one.
+std::string percent_decoded(const std::string& p) {
+  if (p.find('%') == std::string::npos) return {};
+  std::string out;
+  for (size_t i = 0; i < p.size(); ++i) {
+    if (p[i] != '%') {
+      out += p[i];
+      continue;
+    }
+    if (i + 2 >= p.size() || !std::isxdigit(static_cast<unsigned char>(p[i + 1])) ||
+        !std::isxdigit(static_cast<unsigned char>(p[i + 2]))) {
+      return {};
+    }
+    out += static_cast<char>(std::stoi(p.substr(i + 1, 2), nullptr, 16));
+    i += 2;
+  }
+  return out.find('\0') == std::string::npos ? out : std::string();
+}
+
+// The path as written, then with each name matched regardless of case.
+fs::path find_as_written(const std::string& p, const fs::path& base) {
+  if (windows_absolute(p)) return {};
+  const fs::path written = fs::path(p).is_absolute() ? fs::path(p) : base / p;
+  if (is_file(written)) return written;
+  if (fs::path(p).is_relative()) return match_case_insensitively(base, fs::path(p));
+  return {};
+}
+
 }  // namespace
 
 std::string find_texture_file(const std::string& named, const std::string& folder) {
@@ -106,19 +135,19 @@ std::string find_texture_file(const std::string& named, const std::string& folde
   if (p.rfind("file://", 0) == 0) p = p.substr(7);
   if (p.empty() || p.find('\0') != std::string::npos) return {};
   const fs::path base = folder.empty() ? fs::path(".") : fs::path(folder);
-  const bool windows = windows_absolute(p);
-  if (!windows) {
-    const fs::path written = fs::path(p).is_absolute() ? fs::path(p) : base / p;
-    if (is_file(written)) return written.string();
-    if (fs::path(p).is_relative()) {
-      const fs::path matched = match_case_insensitively(base, fs::path(p));
-      if (!matched.empty()) return matched.string();
-    }
+  const std::string decoded = percent_decoded(p);
+  for (const std::string& candidate : {p, decoded}) {
+    if (candidate.empty()) continue;
+    const fs::path found = find_as_written(candidate, base);
+    if (!found.empty()) return found.string();
   }
-  const std::string name = fs::path(p).filename().string();
-  if (name.empty() || name == "." || name == "..") return {};
-  const fs::path found = search_by_name(base, name);
-  return found.empty() ? std::string() : found.string();
+  for (const std::string& candidate : {p, decoded}) {
+    const std::string name = fs::path(candidate).filename().string();
+    if (candidate.empty() || name.empty() || name == "." || name == "..") continue;
+    const fs::path found = search_by_name(base, name);
+    if (!found.empty()) return found.string();
+  }
+  return {};
 }
 
 }  // namespace rvr::scene_load
