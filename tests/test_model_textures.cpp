@@ -355,6 +355,77 @@ TEST_F(ModelTextures, ExportedGlbReadsBackWithItsTextureUvsAndColours) {
   expect_square_uvs(back->objects.at(0).mesh, true);
 }
 
+// 3DS, as 3D Studio wrote it: a DOS 8.3 texture name in capitals (MAT_TEXMAP / MAT_MAPNAME)
+// and one uv per vertex (TEX_VERTS); Assimp reads it Z-up turned to Y-up and one vertex per
+// face corner. Every loaded vertex carries the uv written for its cube vertex.
+glm::vec2 cube_uv(int v) {
+  return {float(v) / 8.0f + 1.0f / 16.0f, 1.0f - float(v) / 8.0f - 1.0f / 32.0f};
+}
+
+std::string textured_cube_3ds(const std::string& map_name) {
+  using corpus::chunk3ds;
+  std::string white;
+  for (int k = 0; k < 3; ++k) corpus::put<uint8_t>(white, 255);
+  std::string material =
+      chunk3ds(0xAFFF, chunk3ds(0xA000, std::string("wood\0", 5)) +
+                           chunk3ds(0xA020, chunk3ds(0x0011, white)) +
+                           chunk3ds(0xA200, chunk3ds(0xA300, map_name + std::string(1, '\0'))));
+  std::string verts, uvs;
+  corpus::put<uint16_t>(verts, 8);
+  corpus::put<uint16_t>(uvs, 8);
+  for (int v = 0; v < 8; ++v) {
+    for (float c : corpus::cube_vertex(v)) corpus::put<float>(verts, c);
+    corpus::put<float>(uvs, cube_uv(v).x);
+    corpus::put<float>(uvs, cube_uv(v).y);
+  }
+  auto tris = corpus::cube_triangles();
+  std::string faces, group = std::string("wood\0", 5);
+  corpus::put<uint16_t>(faces, uint16_t(tris.size()));
+  corpus::put<uint16_t>(group, uint16_t(tris.size()));
+  for (size_t f = 0; f < tris.size(); ++f) {
+    for (int i : tris[f]) corpus::put<uint16_t>(faces, uint16_t(i));
+    corpus::put<uint16_t>(faces, 0);
+    corpus::put<uint16_t>(group, uint16_t(f));
+  }
+  std::string mesh = chunk3ds(0x4100, chunk3ds(0x4110, verts) + chunk3ds(0x4140, uvs) +
+                                          chunk3ds(0x4120, faces + chunk3ds(0x4130, group)));
+  std::string object = chunk3ds(0x4000, std::string("cube\0", 5) + mesh);
+  std::string version;
+  corpus::put<uint32_t>(version, 3);
+  std::string editor = chunk3ds(0x3D3D, chunk3ds(0x3D3E, version) + material + object);
+  return chunk3ds(0x4D4D, chunk3ds(0x0002, version) + editor);
+}
+
+TEST_F(ModelTextures, ThreeDsDosNameInCapitalsAndPerVertexUvs) {
+  corpus::write_file(dir_ / "wood.png", png_bytes(dir_ / "scratch.png"));
+  rvr::Scene s = rvr::load_scene(write("cube.3ds", textured_cube_3ds("WOOD.PNG"))).value();
+  EXPECT_TRUE(s.warnings.empty()) << all_warnings(s);
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(fs::path(s.textures[0].resolved), dir_ / "wood.png");
+  expect_texels_of_the_png(s.textures[0]);
+  ASSERT_EQ(s.objects.size(), 1u);
+  const rvr::TriangleMesh& mesh = s.objects[0].mesh;
+  ASSERT_EQ(mesh.triangle_count(), 12u);
+  ASSERT_EQ(mesh.uvs.size(), mesh.positions.size());
+  // The cube vertex of each loaded vertex, found by its uv (all 8 differ); the turn to Y-up is
+  // a rotation, so distances from vertex 0 are kept: |p - p0| = |cube_vertex(v) - 0|.
+  int origin = -1;
+  for (size_t v = 0; v < mesh.positions.size(); ++v)
+    if (mesh.uvs[v] == cube_uv(0)) origin = int(v);
+  ASSERT_GE(origin, 0) << "no vertex has the uv of cube vertex 0";
+  for (size_t v = 0; v < mesh.positions.size(); ++v) {
+    int written = -1;
+    for (int c = 0; c < 8; ++c)
+      if (mesh.uvs[v] == cube_uv(c)) written = c;
+    ASSERT_GE(written, 0) << "vertex " << v << " has a uv no vertex was given";
+    auto corner = corpus::cube_vertex(written);
+    const float expected =
+        std::sqrt(corner[0] * corner[0] + corner[1] * corner[1] + corner[2] * corner[2]);
+    EXPECT_NEAR(glm::length(mesh.positions[v] - mesh.positions[size_t(origin)]), expected, 1e-5f)
+        << "vertex " << v;
+  }
+}
+
 // PLY vertex colours (bytes, Assimp divides by 255) are kept per vertex, not averaged.
 TEST_F(ModelTextures, PlyVertexColoursArrivePerVertex) {
   const uint8_t bytes[4][3] = {{255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {10, 128, 250}};
