@@ -198,6 +198,23 @@ TEST_F(ModelTextures, MissingTextureIsAWarningNamingIt) {
             glm::vec3(0.5f, 0.25f, 1.0f));
 }
 
+// A texture file that is there but is no image: one warning naming it, no error.
+TEST_F(ModelTextures, UndecodableTextureIsAWarningNamingIt) {
+  write("wood.png", "this is not a PNG file");
+  write("square.mtl", "newmtl wood\nmap_Kd wood.png\n");
+  std::string obj = write("square.obj", obj_square("square.mtl"));
+  rvr::Expected<rvr::Scene> s = rvr::load_scene(obj);
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  ASSERT_EQ(s->warnings.size(), 1u) << all_warnings(*s);
+  const std::string named =
+      "cannot read texture 'wood.png' at '" + (dir_ / "wood.png").string() + "' (";
+  EXPECT_NE(s->warnings[0].find(named), std::string::npos) << s->warnings[0];
+  EXPECT_NE(s->warnings[0].find("): rendered without it"), std::string::npos) << s->warnings[0];
+  ASSERT_EQ(s->textures.size(), 1u);
+  EXPECT_FALSE(s->textures[0].mips);
+  EXPECT_FALSE(rvr::textured(*s, s->objects[0]));
+}
+
 // A glTF square: TEXCOORD_0 (a decoy), TEXCOORD_1 (the set the texture names), COLOR_0, a
 // sampler with clamp and mirrored repeat, KHR_texture_transform; the PNG embedded as a data
 // URI (.gltf) or in the GLB's buffer. glTF's uvs are v down: the mesh's are (u, 1 - v).

@@ -67,8 +67,9 @@ const SceneTextures::Image& SceneTextures::image(const std::string& file, const 
     if (mips) {
       image.mips = *mips;
     } else {
-      warnings_.push_back(fmt::format("{}: cannot read texture {} ({}): rendered without it", label,
-                                      quote_json(resolved), reason_of(mips.error().message)));
+      warnings_.push_back(
+          fmt::format("{}: cannot read texture {} at '{}' ({}): rendered without it", label,
+                      quote_json(file), resolved, reason_of(mips.error().message)));
     }
   }
   return image;
