@@ -468,8 +468,16 @@ TEST_F(ModelTextures, PlyVertexColoursArrivePerVertex) {
     ASSERT_GE(corner, 0);
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(mesh.colours[v][c], bytes[corner][c] / 255.0, 1e-6);
   }
-  EXPECT_EQ(s.materials.at(s.objects[0].material).diffuse, glm::vec3(1.0f));
+  const rvr::Material& m = s.materials.at(s.objects[0].material);
+  EXPECT_EQ(m.diffuse, glm::vec3(1.0f));
   EXPECT_TRUE(rvr::varies_in_colour(s, s.objects[0]));
+  // What every renderer shades with (surface_colour.h): at a corner, that corner's colour.
+  for (int k = 0; k < 3; ++k) {
+    const float b1 = k == 1 ? 1.0f : 0.0f, b2 = k == 2 ? 1.0f : 0.0f;
+    const int corner = corner_of(mesh.positions[mesh.triangles[0][k]]);
+    const glm::vec3 c = rvr::base_colour(s, s.objects[0], m, 0, b1, b2, 0.0f);
+    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(c[ch], bytes[corner][ch] / 255.0, 1e-6);
+  }
 }
 
 }  // namespace
