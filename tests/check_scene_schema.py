@@ -127,6 +127,15 @@ EDGE_VALID = [
     ("material name with spaces",
      lambda d: (d["materials"].update({"a b": {}}), d["objects"][0].update(material="a b"))),
     ("a mesh keeping its file's materials", setter("objects", 3, "material", "from_file")),
+    ("a texture file that is missing (a warning)",
+     setter("materials", "white", "texture", "no/such/image.png")),
+    ("a texture with wrap per axis and a transform",
+     setter("materials", "white", "texture",
+            {"file": "img.png", "wrap": ["clamp", "mirror"],
+             "transform": {"offset": [0.5, -1], "rotation": 0.3, "scale": [2, -1]}})),
+    ("a triangle's uvs and colours",
+     lambda d: d["objects"][2].update(uvs=[[0, 0], [1, 0], [0, 1]],
+                                      colors=[[1, 0, 0], [0, 1, 0], [0, 0, 1]])),
 ]
 
 # Refused by the schema AND by the loader.
@@ -199,6 +208,14 @@ LOADER_ONLY = [
     ("non-uniform scale on a sphere", setter("objects", 0, "transform", {"scale": [1, 2, 1]})),
     ("missing mesh file", setter("objects", 3, "file", "no/such/file.obj")),
     ("from_file on a sphere", setter("objects", 0, "material", "from_file")),
+    ("texture not a string or object", setter("materials", "white", "texture", 3)),
+    ("texture without file", setter("materials", "white", "texture", {"wrap": "clamp"})),
+    ("unknown wrap mode", setter("materials", "white", "texture", {"file": "a.png", "wrap": "tile"})),
+    ("texture scale 0",
+     setter("materials", "white", "texture", {"file": "a.png", "transform": {"scale": [0, 1]}})),
+    ("a triangle with 2 uvs", setter("objects", 2, "uvs", [[0, 0], [1, 0]])),
+    ("a negative vertex colour",
+     setter("objects", 2, "colors", [[0, 0, 0], [0, -1, 0], [0, 0, 0]])),
 ]
 
 

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "model_corpus.h"
+#include "rvr/shared/html_escape.h"
 #include "rvr/shared/image_io.h"
 
 namespace fs = std::filesystem;
@@ -366,11 +367,13 @@ TEST_F(Cli, NothingVisibleWarnsAndFailsTheAgreementThreshold) {
 
 // Every scene loader warning reaches metrics.json (`warnings`), report.html and render --stats
 // beside the renderers', and stderr once: an STL whose facet normals contradict the winding,
-// with a zero-area facet (tests/model_corpus.h), and an OBJ whose material names a colour
-// texture (not sampled).
+// with a zero-area facet (tests/model_corpus.h), and a textured OBJ whose texture file is
+// missing.
 TEST_F(Cli, LoaderWarningsReachMetricsReportAndStats) {
   fs::path stl = write("stated.stl", rvr::test::corpus::ascii_stl_cube_with_stated_normals(true));
-  fs::path obj = write("tex.obj", rvr::test::corpus::obj_cube("mtllib tex.mtl\n", "paint"));
+  fs::path obj = write("tex.obj",
+                       "mtllib tex.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\n"
+                       "vt 1 1\nvt 0 1\nusemtl paint\nf 1/1 2/2 3/3 4/4\n");
   write("tex.mtl", "newmtl paint\nKd 0.8 0.5 0.2\nmap_Kd wood.png\n");
   struct Case {
     fs::path file;
@@ -379,7 +382,7 @@ TEST_F(Cli, LoaderWarningsReachMetricsReportAndStats) {
   for (const Case& c : {Case{stl,
                              {": 5 facets have normals that contradict the winding",
                               ": dropped 1 degenerate triangle"}},
-                        Case{obj, {": 1 mesh has colour textures, which are not sampled"}}}) {
+                        Case{obj, {": material 'paint': texture 'wood.png' not found"}}}) {
     SCOPED_TRACE(c.file.string());
     fs::path out = dir_ / "cmp", stats = dir_ / "stats.json";
     RunResult cmp = run("compare " + c.file.string() +
@@ -400,7 +403,7 @@ TEST_F(Cli, LoaderWarningsReachMetricsReportAndStats) {
       };
       EXPECT_EQ(listed(metrics["warnings"]), 1) << metrics["warnings"];
       EXPECT_EQ(listed(stat["warnings"]), 1) << stat["warnings"];
-      EXPECT_NE(html.find("<li>" + w), std::string::npos) << w;
+      EXPECT_NE(html.find("<li>" + rvr::escape_html(w)), std::string::npos) << w;
       for (const std::string* err : {&cmp.err, &render.err}) {
         size_t first = err->find("warning: " + w);
         EXPECT_NE(first, std::string::npos) << *err;

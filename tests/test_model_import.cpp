@@ -83,8 +83,12 @@ TEST_F(ModelFiles, BlenderPlyHeaderWithFreeTextLineLoads) {
   std::string p = write("blender.ply", corpus::blender_ply_cube(200, 30, 20));
   expect_loads_like_assimp(p, 12);
   rvr::Scene s = rvr::load_scene(p).value();
-  // No material in PLY: the vertex colours' mean is the diffuse colour.
-  expect_near3(material_of(s).diffuse, glm::vec3(200, 30, 20) / 255.0f, kByteTolerance);
+  // No material in PLY: a white one, and the vertex colours (bytes / 255) on every vertex.
+  expect_near3(material_of(s).diffuse, glm::vec3(1.0f), 0.0f);
+  const rvr::TriangleMesh& mesh = s.objects.at(0).mesh;
+  ASSERT_EQ(mesh.colours.size(), mesh.positions.size());
+  for (const glm::vec3& c : mesh.colours)
+    expect_near3(c, glm::vec3(200, 30, 20) / 255.0f, kByteTolerance);
 }
 
 TEST_F(ModelFiles, ObjWithMissingMtllibLoadsWithTheDefaultMaterial) {
@@ -251,7 +255,9 @@ TEST_F(ModelFiles, GlbBaseColourCameraAndPunctualLight) {
   expect_gltf_contents(rvr::load_scene(p).value(), e);
 }
 
-TEST_F(ModelFiles, TexturedMeshUsesItsFactorAndWarns) {
+// The corpus cube names a texture but has no texture coordinates: its colour factor alone,
+// and a warning naming the mesh.
+TEST_F(ModelFiles, TexturedMaterialWithoutTextureCoordinatesUsesItsFactorAndWarns) {
   corpus::GltfExtras e;
   e.texture = true;
   std::string p = write("textured.gltf", corpus::gltf_json(e, false));
@@ -259,8 +265,10 @@ TEST_F(ModelFiles, TexturedMeshUsesItsFactorAndWarns) {
   rvr::Scene s = rvr::load_scene(p).value();
   expect_near3(material_of(s).diffuse, {e.base_color[0], e.base_color[1], e.base_color[2]},
                kTextTolerance);
+  EXPECT_EQ(material_of(s).texture, -1);
   bool warned = false;
-  for (const std::string& w : s.warnings) warned |= w.find("not sampled") != std::string::npos;
+  for (const std::string& w : s.warnings)
+    warned |= w.find("has a colour texture but no texture coordinates") != std::string::npos;
   EXPECT_TRUE(warned) << (s.warnings.empty() ? "no warnings" : s.warnings.front());
 }
 

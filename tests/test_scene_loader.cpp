@@ -14,6 +14,7 @@
 
 #include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/image_io.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/scene_writer.h"
 
@@ -560,6 +561,57 @@ std::vector<BadCase> bad_cases() {
        "t.json: objects[0].b.b.radius: must be > 0, got 0"},
       {"deep csg", one_object(R"({"type": "csg", )" + deep_csg.substr(1)),
        "csg tree nested deeper than 64 levels"},
+      // Textures, texture coordinates and vertex colours.
+      {"texture not a string", material(R"("texture": 3)"),
+       "t.json: materials.m.texture: must be an image file name or an object with \"file\", got "
+       "number 3"},
+      {"texture empty", material(R"("texture": "")"),
+       "t.json: materials.m.texture: must not be empty"},
+      {"texture without file", material(R"("texture": {"wrap": "clamp"})"),
+       "t.json: materials.m.texture.file: is required (the image file)"},
+      {"texture unknown key", material(R"("texture": {"file": "a.png", "wrapp": "clamp"})"),
+       "t.json: materials.m.texture: unknown key 'wrapp' for a texture (did you mean 'wrap'?)"},
+      {"unknown wrap", material(R"("texture": {"file": "a.png", "wrap": "clampp"})"),
+       "t.json: materials.m.texture.wrap: unknown wrap mode 'clampp' (did you mean 'clamp'?)"},
+      {"wrap of three",
+       material(R"("texture": {"file": "a.png", "wrap": ["clamp", "clamp", "clamp"]})"),
+       "t.json: materials.m.texture.wrap: must be a wrap mode or an array of 2, got array of 3"},
+      {"bad v wrap", material(R"("texture": {"file": "a.png", "wrap": ["clamp", 1]})"),
+       "t.json: materials.m.texture.wrap[1]: must be a string"},
+      {"transform scale 0",
+       material(R"("texture": {"file": "a.png", "transform": {"scale": [1, 0]}})"),
+       "t.json: materials.m.texture.transform.scale[1]: must not be 0"},
+      {"transform offset of 3",
+       material(R"("texture": {"file": "a.png", "transform": {"offset": [1, 0, 0]}})"),
+       "t.json: materials.m.texture.transform.offset: must be an array of 2 numbers, got array of "
+       "3"},
+      {"transform rotation overflows",
+       material(R"("texture": {"file": "a.png", "transform": {"rotation": 1e400}})"),
+       "t.json: materials.m.texture.transform.rotation: must be a finite number"},
+      {"triangle uvs of 2",
+       one_object(R"({"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]],
+                      "uvs": [[0,0],[1,0]]})"),
+       "t.json: objects[0].uvs: must be an array of 3 (one per vertex), got array of 2"},
+      {"triangle uv of 3 numbers",
+       one_object(R"({"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]],
+                      "uvs": [[0,0],[1,0,0],[0,1]]})"),
+       "t.json: objects[0].uvs[1]: must be an array of 2 numbers, got array of 3"},
+      {"triangle uv not finite",
+       one_object(R"({"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]],
+                      "uvs": [[0,0],[1,0],[0,1e999]]})"),
+       "t.json: objects[0].uvs[2][1]: must be a finite number"},
+      {"triangle colour negative",
+       one_object(R"({"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]],
+                      "colors": [[0,0,0],[1,0,-1],[0,1,0]]})"),
+       "t.json: objects[0].colors[1][2]: must be >= 0"},
+      {"mesh colours of the wrong count",
+       one_object(R"({"type": "mesh", "file": "quad.obj", "colors": [[1,1,1]]})"),
+       "t.json: objects[0].colors: must be an array of 4 (one per vertex of 'quad.obj' as "
+       "loaded), got array of 1"},
+      {"uvs with from_file",
+       one_object(R"({"type": "mesh", "file": "quad.obj", "material": "from_file",
+                      "uvs": []})"),
+       "t.json: objects[0].uvs: is not allowed with \"material\": \"from_file\""},
   };
 }
 
@@ -568,6 +620,7 @@ TEST_F(SceneLoader, BadInputsGiveExactMessages) {
   write_file(dir_ / "points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
   write_file(dir_ / "flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 2 3 4\n");
   write_file(dir_ / "inf.obj", "v 1e999 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  write_file(dir_ / "quad.obj", kQuadObj);
   std::vector<BadCase> cases = bad_cases();
   EXPECT_GE(cases.size(), 30u);
   for (const BadCase& c : cases) {
@@ -582,6 +635,73 @@ TEST_F(SceneLoader, BadInputsGiveExactMessages) {
         << c.label << "\n  got:      " << s.error().message << "\n  expected: " << c.expected;
     EXPECT_EQ(s.error().message.find('\n'), std::string::npos) << c.label;
   }
+}
+
+// Textures (file or object, wrap modes, transform), uvs and colours on triangles and meshes;
+// a texture file that is missing is a warning naming it and the material's path.
+TEST_F(SceneLoader, TexturesUvsAndColours) {
+  write_file(dir_ / "quad.obj", kQuadObj);
+  rvr::Image image;
+  image.width = 2;
+  image.height = 1;
+  image.channels = 3;
+  image.pixels = {0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f};  // black, white: sRGB 0 and 1 are exact
+  fs::create_directories(dir_ / "img");
+  ASSERT_TRUE(rvr::write_image((dir_ / "img" / "bw.png").string(), image, false).ok());
+  Scene s = parse_ok(scene(R"("materials": {
+      "plain": {"texture": "img/bw.png"},
+      "tiles": {"texture": {"file": "img/bw.png", "wrap": ["clamp", "mirror"],
+                            "transform": {"offset": [0.5, 0.25], "rotation": 1.5, "scale": [2, 4]}}},
+      "lost": {"texture": {"file": "nowhere.png", "wrap": "mirror"}}},
+    "objects": [
+      {"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]], "material": "tiles",
+       "uvs": [[0, 0], [1, 0.5], [0.25, 1]], "colors": [[1, 0, 0], [0, 1, 0], [0, 0, 0.5]]},
+      {"type": "mesh", "file": "quad.obj", "material": "plain",
+       "uvs": [[0, 0], [1, 0], [1, 1], [0, 1]]},
+      {"type": "mesh", "file": "quad.obj", "material": "lost"}])"));
+  ASSERT_EQ(s.materials.size(), 4u);
+  const rvr::Material &plain = s.materials[1], &tiles = s.materials[2], &lost = s.materials[3];
+  // One image, two textures (their wrap modes differ), and the missing one.
+  ASSERT_EQ(s.textures.size(), 3u);
+  EXPECT_EQ(plain.texture, 0);
+  EXPECT_EQ(tiles.texture, 1);
+  EXPECT_EQ(lost.texture, 2);
+  EXPECT_TRUE(plain.uv_transform.identity());
+  EXPECT_EQ(tiles.uv_transform.offset, glm::vec2(0.5f, 0.25f));
+  EXPECT_EQ(tiles.uv_transform.rotation, 1.5f);
+  EXPECT_EQ(tiles.uv_transform.scale, glm::vec2(2.0f, 4.0f));
+  EXPECT_EQ(s.textures[0].wrap_u, rvr::TextureWrap::Repeat);
+  EXPECT_EQ(s.textures[0].wrap_v, rvr::TextureWrap::Repeat);
+  EXPECT_EQ(s.textures[1].wrap_u, rvr::TextureWrap::ClampToEdge);
+  EXPECT_EQ(s.textures[1].wrap_v, rvr::TextureWrap::MirroredRepeat);
+  EXPECT_EQ(s.textures[2].wrap_u, rvr::TextureWrap::MirroredRepeat);
+  ASSERT_TRUE(s.textures[0].mips);
+  EXPECT_EQ(s.textures[0].mips, s.textures[1].mips);  // decoded once
+  const rvr::TextureLevel& level = s.textures[0].mips->levels[0];
+  ASSERT_EQ(level.width, 2);
+  ASSERT_EQ(level.height, 1);
+  EXPECT_EQ(level.at(0, 0), glm::vec3(0.0f));
+  EXPECT_EQ(level.at(1, 0), glm::vec3(1.0f));
+  EXPECT_FALSE(s.textures[2].mips);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(s.warnings[0], "materials.lost.texture: texture 'nowhere.png' not found (looked in '" +
+                               dir_.string() + "' and its subfolders): rendered without it");
+
+  const rvr::TriangleMesh& tri = s.objects[0].mesh;
+  ASSERT_EQ(tri.uvs.size(), 3u);
+  EXPECT_EQ(tri.uvs[1], glm::vec2(1.0f, 0.5f));
+  EXPECT_EQ(tri.colours[2], glm::vec3(0.0f, 0.0f, 0.5f));
+  // The quad's uvs follow its vertices as loaded: in the order the faces first use them
+  // ("f 1 4 3", "f 1 3 2": OBJ vertices 1, 4, 3, 2).
+  const rvr::TriangleMesh& quad = s.objects[1].mesh;
+  ASSERT_EQ(quad.positions.size(), 4u);
+  const glm::vec2 uvs[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  const glm::vec3 obj_positions[4] = {{0, 0, 0}, {0, 0, 1}, {1, 0, 1}, {1, 0, 0}};
+  for (size_t v = 0; v < 4; ++v) {
+    EXPECT_EQ(quad.positions[v], obj_positions[v]);
+    EXPECT_EQ(quad.uvs[v], uvs[v]);
+  }
+  EXPECT_FALSE(s.objects[2].mesh.textured());
 }
 
 TEST_F(SceneLoader, DeepJsonInsideStringsIsNotNesting) {

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "rvr/shared/image_io.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/scene_writer.h"
 
@@ -52,12 +53,27 @@ void expect_same_csg(const CsgNode& a, const CsgNode& b, const std::string& path
 
 // The loader may join identical vertices of a mesh file, so meshes are compared triangle by
 // triangle, corner by corner (triangle order is the primitive id and must be kept). Vertex
-// normals are renormalised by the loader (in double), which may move the last bit.
+// normals are renormalised by the loader (in double), which may move the last bit; texture
+// coordinates and vertex colours must come back bit for bit.
 void expect_same_mesh(const TriangleMesh& a, const TriangleMesh& b) {
   ASSERT_EQ(a.triangles.size(), b.triangles.size());
   ASSERT_EQ(a.smooth(), b.smooth());
+  ASSERT_EQ(a.textured(), b.textured());
+  ASSERT_EQ(a.coloured(), b.coloured());
   for (size_t t = 0; t < a.triangles.size(); ++t) {
     for (int k = 0; k < 3; ++k) {
+      if (a.textured()) {
+        const glm::vec2 ua = a.uvs[a.triangles[t][k]], ub = b.uvs[b.triangles[t][k]];
+        if (!same_bits(ua.x, ub.x) || !same_bits(ua.y, ub.y)) {
+          ADD_FAILURE() << "triangle " << t << " corner " << k << " uv differs";
+          return;
+        }
+      }
+      if (a.coloured() && !same3("original", "loaded", a.colours[a.triangles[t][k]],
+                                 b.colours[b.triangles[t][k]])) {
+        ADD_FAILURE() << "triangle " << t << " corner " << k << " colour differs";
+        return;
+      }
       const glm::vec3& pa = a.positions[a.triangles[t][k]];
       const glm::vec3& pb = b.positions[b.triangles[t][k]];
       if (!same3("original", "loaded", pa, pb)) {
@@ -104,6 +120,32 @@ void expect_same_scene(const Scene& a, const Scene& b) {
     EXPECT_SAME(ma.mirror, mb.mirror);
     EXPECT_SAME(ma.transparency, mb.transparency);
     EXPECT_SAME(ma.ior, mb.ior);
+    EXPECT_EQ(ma.texture, mb.texture);
+    EXPECT_SAME(ma.uv_transform.offset.x, mb.uv_transform.offset.x);
+    EXPECT_SAME(ma.uv_transform.offset.y, mb.uv_transform.offset.y);
+    EXPECT_SAME(ma.uv_transform.rotation, mb.uv_transform.rotation);
+    EXPECT_SAME(ma.uv_transform.scale.x, mb.uv_transform.scale.x);
+    EXPECT_SAME(ma.uv_transform.scale.y, mb.uv_transform.scale.y);
+  }
+
+  ASSERT_EQ(a.textures.size(), b.textures.size());
+  for (size_t i = 0; i < a.textures.size(); ++i) {
+    SCOPED_TRACE("textures[" + std::to_string(i) + "]");
+    const Texture &ta = a.textures[i], &tb = b.textures[i];
+    EXPECT_EQ(ta.wrap_u, tb.wrap_u);
+    EXPECT_EQ(ta.wrap_v, tb.wrap_v);
+    ASSERT_EQ(bool(ta.mips), bool(tb.mips));
+    if (!ta.mips) continue;
+    ASSERT_EQ(ta.mips->levels.size(), tb.mips->levels.size());
+    const TextureLevel &la = ta.mips->levels[0], &lb = tb.mips->levels[0];
+    ASSERT_EQ(la.width, lb.width);
+    ASSERT_EQ(la.height, lb.height);
+    for (size_t t = 0; t < la.texels.size(); ++t) {
+      if (!same3("original", "loaded", la.texels[t], lb.texels[t])) {
+        ADD_FAILURE() << "texel " << t << " differs";
+        break;
+      }
+    }
   }
 
   ASSERT_EQ(a.lights.size(), b.lights.size());
@@ -175,20 +217,26 @@ TEST_P(SceneWriter, BuiltinSceneReadsBackTheSame) {
   for (char& c : safe) c = c == ':' ? '_' : c;
   dir /= safe;
   fs::create_directories(dir);
-  Expected<SceneDocument> doc = write_scene(*original, "scene");
+  Expected<SceneDocument> doc = write_scene(*original, "scene", dir.string());
   ASSERT_TRUE(doc.ok()) << doc.error().message;
   for (const SceneMeshFile& m : doc->mesh_files) {
     std::ofstream out(dir / m.name, std::ios::binary);
     out.write(m.bytes.data(), std::streamsize(m.bytes.size()));
     ASSERT_TRUE(out.good());
   }
+  // Textures held in memory (builtin:textured's checkerboard) are written as EXR beside it.
+  for (const SceneTextureFile& t : doc->texture_files) {
+    Status written = write_image((dir / t.name).string(), t.image);
+    ASSERT_TRUE(written.ok()) << written.error().message;
+  }
   Expected<Scene> loaded = parse_scene(doc->json, "exported", dir.string());
-  fs::remove_all(dir.parent_path());
   ASSERT_TRUE(loaded.ok()) << loaded.error().message;
   expect_same_scene(*original, *loaded);
 
-  // Writing the loaded scene again gives the same document (a fixed point).
-  Expected<SceneDocument> again = write_scene(*loaded, "scene");
+  // Writing the loaded scene again gives the same document (a fixed point): its textures are
+  // files now, named relative to the same folder.
+  Expected<SceneDocument> again = write_scene(*loaded, "scene", dir.string());
+  fs::remove_all(dir.parent_path());
   ASSERT_TRUE(again.ok()) << again.error().message;
   EXPECT_EQ(doc->json, again->json);
 }
@@ -199,6 +247,52 @@ INSTANTIATE_TEST_SUITE_P(Builtin, SceneWriter, ::testing::ValuesIn(names()),
                            for (char& c : n) c = std::isalnum((unsigned char)c) ? c : '_';
                            return n;
                          });
+
+// A scene with a texture read from a file (in another folder than the exported document), a
+// transform and wrap modes per axis, a mesh with texture coordinates and vertex colours (to
+// PLY) and a triangle with both (inline): exported, read back, the same; the texture named by
+// its path relative to the document's folder, not copied.
+TEST(SceneWriterTextures, FileTexturesUvsAndColoursReadBackTheSame) {
+  fs::path dir = fs::temp_directory_path() / ("rvr-scene-writer-tex-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "in" / "img");
+  fs::create_directories(dir / "out");
+  Image image;
+  image.width = 2;
+  image.height = 2;
+  image.channels = 3;
+  image.pixels = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f, 0.8f, 0.9f, 1.0f, 0.0f, 0.5f};
+  ASSERT_TRUE(write_image((dir / "in" / "img" / "t.png").string(), image, false).ok());
+  std::ofstream(dir / "in" / "strip.ply", std::ios::binary)
+      << "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+         "property float z\nproperty float s\nproperty float t\nproperty uchar red\n"
+         "property uchar green\nproperty uchar blue\nelement face 2\n"
+         "property list uchar int vertex_indices\nend_header\n"
+         "0 0 0 0.1 0.2 255 0 0\n1 0 0 0.9 0.3 0 255 0\n1 1 0 0.7 0.8 0 0 255\n"
+         "0 1 0 0.3 0.6 10 20 30\n3 0 1 2\n3 0 2 3\n";
+  const std::string text = R"({"camera": {"eye": [0, 0, 4], "target": [0, 0, 0], "up": [0, 1, 0]},
+    "materials": {"tex": {"texture": {"file": "img/t.png", "wrap": ["clamp", "mirror"],
+                  "transform": {"offset": [0.25, 0.5], "rotation": 0.3, "scale": [2, 3]}}}},
+    "objects": [
+      {"type": "mesh", "file": "strip.ply", "material": "tex"},
+      {"type": "triangle", "vertices": [[0,0,1],[1,0,1],[0,1,1]], "material": "tex",
+       "uvs": [[0.5, 0.25], [1, 0], [0, 1]], "colors": [[1, 0.5, 0], [0, 1, 0.5], [0.5, 0, 1]]}]})";
+  Expected<Scene> original = parse_scene(text, "in.json", (dir / "in").string());
+  ASSERT_TRUE(original.ok()) << original.error().message;
+  ASSERT_TRUE(original->warnings.empty()) << original->warnings.front();
+  ASSERT_TRUE(original->objects[0].mesh.textured() && original->objects[0].mesh.coloured());
+  Expected<SceneDocument> doc = write_scene(*original, "scene", (dir / "out").string());
+  ASSERT_TRUE(doc.ok()) << doc.error().message;
+  EXPECT_TRUE(doc->texture_files.empty());
+  EXPECT_NE(doc->json.find(R"("file": "../in/img/t.png")"), std::string::npos) << doc->json;
+  for (const SceneMeshFile& m : doc->mesh_files) {
+    std::ofstream(dir / "out" / m.name, std::ios::binary) << m.bytes;
+  }
+  Expected<Scene> loaded = parse_scene(doc->json, "out.json", (dir / "out").string());
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  expect_same_scene(*original, *loaded);
+  fs::remove_all(dir);
+}
 
 TEST(SceneWriterFloats, ShortestDecimalReadsBackToTheSameFloat) {
   // Awkward floats in every float field of a material, through the loader and back.

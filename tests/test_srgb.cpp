@@ -3,6 +3,7 @@
 // the ends sampled. Any differing float would change the bytes of every PNG rvr writes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -45,6 +46,21 @@ TEST(Srgb8, LinearBranchNegativesNansAndLargeValues) {
     EXPECT_EQ(rvr::srgb8(v), by_formula(v)) << v;
   EXPECT_EQ(rvr::srgb8(0.5f), 188);  // 1.055 * 0.5^(1/2.4) - 0.055 = 0.7354 -> 187.5... -> 188
   EXPECT_EQ(rvr::srgb8(0.0031308f * 0.5f), 5);  // 12.92 * 0.0015654 * 255 = 5.16
+}
+
+// srgb_decode against IEC 61966-2-1's decoding in double at every 8-bit value (what 8-bit
+// textures hold), and back: encoding the decoded value gives the byte again.
+TEST(SrgbDecode, EveryByteDecodesToTheStandardsValueAndEncodesBack) {
+  for (int b = 0; b <= 255; ++b) {
+    const double c = b / 255.0;
+    const double linear = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    const float decoded = rvr::srgb_decode(float(b) / 255.0f);
+    EXPECT_NEAR(decoded, linear, 1e-6 * std::max(linear, 1e-3)) << "byte " << b;
+    EXPECT_EQ(rvr::srgb8(decoded), b) << "byte " << b;
+  }
+  EXPECT_EQ(rvr::srgb_decode(-0.5f), 0.0f);
+  EXPECT_EQ(rvr::srgb_decode(std::nanf("")), 0.0f);
+  EXPECT_EQ(rvr::srgb_decode(2.0f), 1.0f);
 }
 
 }  // namespace

@@ -56,8 +56,17 @@ int export_scene(const ScenesArgs& a) {
   if (is_file) name = std::filesystem::path(a.export_name).stem().string();
   std::filesystem::path out(a.out);
   std::string prefix = a.out.empty() ? name : out.stem().string();
-  SceneDocument doc = take(write_scene(scene, prefix));
+  std::string folder = out.parent_path().string();
+  SceneDocument doc = take(write_scene(scene, prefix, folder.empty() ? "." : folder));
   if (a.out.empty()) {
+    if (!doc.texture_files.empty()) {
+      fail(bad_input(fmt::format(
+          "{}: has {} texture{} held in memory only (embedded in the model or built in): give "
+          "-o FILE.json to write {} as EXR next to it",
+          is_file ? a.export_name : "builtin:" + name, doc.texture_files.size(),
+          doc.texture_files.size() == 1 ? "" : "s",
+          doc.texture_files.size() == 1 ? "it" : "them")));
+    }
     if (!doc.mesh_files.empty()) {
       fail(bad_input(fmt::format(
           "{}: has {} mesh{} of more than one triangle, which rvr-scene/1 reads only "
@@ -70,6 +79,9 @@ int export_scene(const ScenesArgs& a) {
   }
   for (const SceneMeshFile& m : doc.mesh_files) {
     check(write_text_file((out.parent_path() / m.name).string(), m.bytes));
+  }
+  for (const SceneTextureFile& t : doc.texture_files) {
+    check(write_image((out.parent_path() / t.name).string(), t.image));
   }
   check(write_text_file(a.out, doc.json));
   return 0;

@@ -332,14 +332,36 @@ const aiScene* post_process(Assimp::Importer& importer, unsigned flags, const st
   return ai;
 }
 
-// Appends mesh m's vertices (with normals when `normals`: the file's, or zero to be repaired)
-// and triangles; other faces are counted in `skipped`.
-void append_mesh(TriangleMesh& mesh, const aiScene* ai, unsigned m, bool normals,
-                 const std::string& file, const std::string& path, size_t* skipped) {
+// A vertex colour from a file: Assimp gives 0..1 (bytes divided by 255); non-finite and
+// negative components become 0, components above 1 are 1.
+glm::vec3 vertex_colour(const aiColor4D& c) {
+  auto clean = [](float x) { return std::isfinite(x) && x > 0.0f ? std::min(x, 1.0f) : 0.0f; };
+  return {clean(c.r), clean(c.g), clean(c.b)};
+}
+
+// Appends mesh m's vertices (with normals when `normals`: the file's, or zero to be repaired;
+// the texture coordinates of set `uv_set` when it is >= 0 and the mesh has it; its first set
+// of vertex colours when `colours` and it has them) and triangles; other faces are counted in
+// `skipped`. A mesh appended to one that already holds vertices keeps uvs and colours only
+// when every mesh appended has them.
+void append_mesh(TriangleMesh& mesh, const aiScene* ai, unsigned m, bool normals, int uv_set,
+                 bool colours, const std::string& file, const std::string& path, size_t* skipped) {
   const aiMesh* am = ai->mMeshes[m];
   if (!am->mVertices) return;
   uint32_t base = static_cast<uint32_t>(mesh.positions.size());
+  const aiVector3D* uvs =
+      uv_set >= 0 && uv_set < AI_MAX_NUMBER_OF_TEXTURECOORDS ? am->mTextureCoords[uv_set] : nullptr;
+  const aiColor4D* cols = colours ? am->mColors[0] : nullptr;
+  if (!uvs || mesh.uvs.size() != base) mesh.uvs.clear();
+  if (!cols || mesh.colours.size() != base) mesh.colours.clear();
+  const bool keep_uvs = uvs && mesh.uvs.size() == base;
+  const bool keep_colours = cols && mesh.colours.size() == base;
   for (unsigned v = 0; v < am->mNumVertices; ++v) {
+    if (keep_uvs) {
+      glm::vec2 uv(uvs[v].x, uvs[v].y);
+      mesh.uvs.push_back(std::isfinite(uv.x) && std::isfinite(uv.y) ? uv : glm::vec2(0.0f));
+    }
+    if (keep_colours) mesh.colours.push_back(vertex_colour(cols[v]));
     const aiVector3D& p = am->mVertices[v];
     glm::vec3 pos(p.x, p.y, p.z);
     if (!finite(pos)) {
@@ -445,6 +467,8 @@ void replace_contradicting_facet_normals(TriangleMesh& mesh, size_t* opposite, s
         --uses[t[k]];
         mesh.positions.push_back(mesh.positions[t[k]]);
         mesh.normals.push_back(geometric);
+        if (!mesh.uvs.empty()) mesh.uvs.push_back(mesh.uvs[t[k]]);
+        if (!mesh.colours.empty()) mesh.colours.push_back(mesh.colours[t[k]]);
         t[k] = uint32_t(mesh.positions.size() - 1);
       } else {
         mesh.normals[t[k]] = geometric;
@@ -453,18 +477,24 @@ void replace_contradicting_facet_normals(TriangleMesh& mesh, size_t* opposite, s
   }
 }
 
-// Merges vertices whose position and normal are the same bits, renumbering the triangles;
-// first occurrences keep their order. Stands in for aiProcess_JoinIdenticalVertices on model
-// files: Assimp's OBJ reader makes one vertex per face corner, and Assimp's join (which also
-// merges positions a few float steps apart) took 0.10-0.15 s of a 70,000-triangle OBJ; this
-// takes about a tenth of it. Geometry is the file's, bit for bit.
+// Merges vertices whose position, normal, texture coordinates and vertex colour are the same
+// bits, renumbering the triangles; first occurrences keep their order. Stands in for
+// aiProcess_JoinIdenticalVertices on model files: Assimp's OBJ reader makes one vertex per face
+// corner, and Assimp's join (which also merges positions a few float steps apart) took
+// 0.10-0.15 s of a 70,000-triangle OBJ; this takes about a tenth of it. Geometry is the
+// file's, bit for bit.
 void weld_identical_vertices(TriangleMesh& mesh) {
-  const bool normals = mesh.normals.size() == mesh.positions.size();
   const size_t n = mesh.positions.size();
+  const bool normals = mesh.normals.size() == n;
+  const bool uvs = mesh.uvs.size() == n;
+  const bool colours = mesh.colours.size() == n;
+  using Key = std::array<uint32_t, 11>;
   auto bits_of = [&](size_t v) {
-    std::array<uint32_t, 6> b{};
+    Key b{};
     std::memcpy(b.data(), &mesh.positions[v], sizeof(glm::vec3));
     if (normals) std::memcpy(b.data() + 3, &mesh.normals[v], sizeof(glm::vec3));
+    if (uvs) std::memcpy(b.data() + 6, &mesh.uvs[v], sizeof(glm::vec2));
+    if (colours) std::memcpy(b.data() + 8, &mesh.colours[v], sizeof(glm::vec3));
     return b;
   };
   // Open addressing, no allocation per vertex: slots hold 1 + the input index of the first
@@ -473,26 +503,30 @@ void weld_identical_vertices(TriangleMesh& mesh) {
   while (size < 2 * n) size *= 2;
   std::vector<uint32_t> slot(size, 0);
   std::vector<uint32_t> remap(n);
-  std::vector<glm::vec3> positions, new_normals;
-  positions.reserve(n);
+  TriangleMesh welded;
+  welded.positions.reserve(n);
   for (size_t v = 0; v < n; ++v) {
-    const std::array<uint32_t, 6> key = bits_of(v);
-    uint64_t h = 1469598103934665603ull;  // FNV-1a over the six words
+    const Key key = bits_of(v);
+    uint64_t h = 1469598103934665603ull;  // FNV-1a over the words
     for (uint32_t b : key) h = (h ^ b) * 1099511628211ull;
     size_t i = size_t(h ^ (h >> 29)) & (size - 1);
     while (slot[i] != 0 && bits_of(slot[i] - 1) != key) i = (i + 1) & (size - 1);
     if (slot[i] == 0) {
       slot[i] = uint32_t(v + 1);
-      remap[v] = uint32_t(positions.size());
-      positions.push_back(mesh.positions[v]);
-      if (normals) new_normals.push_back(mesh.normals[v]);
+      remap[v] = uint32_t(welded.positions.size());
+      welded.positions.push_back(mesh.positions[v]);
+      if (normals) welded.normals.push_back(mesh.normals[v]);
+      if (uvs) welded.uvs.push_back(mesh.uvs[v]);
+      if (colours) welded.colours.push_back(mesh.colours[v]);
     } else {
       remap[v] = remap[slot[i] - 1];
     }
   }
   for (glm::uvec3& t : mesh.triangles) t = {remap[t.x], remap[t.y], remap[t.z]};
-  mesh.positions = std::move(positions);
-  if (normals) mesh.normals = std::move(new_normals);
+  mesh.positions = std::move(welded.positions);
+  if (normals) mesh.normals = std::move(welded.normals);
+  if (uvs) mesh.uvs = std::move(welded.uvs);
+  if (colours) mesh.colours = std::move(welded.colours);
 }
 
 // Colours from files: negative or non-finite components become 0.
@@ -501,29 +535,46 @@ glm::vec3 file_colour(const aiColor3D& c) {
   return {clean(c.r), clean(c.g), clean(c.b)};
 }
 
+// The file's own image as bytes: a compressed image (mHeight 0: mWidth bytes, its format in
+// achFormatHint) as it is, raw ARGB8888 texels (mWidth x mHeight, the top row first) as RGB.
+EmbeddedImage embedded_image(const aiTexture& t, unsigned index) {
+  EmbeddedImage image;
+  image.name =
+      t.mFilename.length > 0 ? t.mFilename.C_Str() : fmt::format("embedded image {}", index);
+  if (!t.pcData) return image;
+  if (t.mHeight == 0) {
+    image.format = t.achFormatHint;
+    image.bytes.assign(reinterpret_cast<const char*>(t.pcData), t.mWidth);
+    return image;
+  }
+  image.format = "rgb8";
+  image.width = int(t.mWidth);
+  image.height = int(t.mHeight);
+  const size_t texels = size_t(t.mWidth) * size_t(t.mHeight);
+  image.bytes.resize(3 * texels);
+  for (size_t i = 0; i < texels; ++i) {
+    image.bytes[3 * i + 0] = char(t.pcData[i].r);
+    image.bytes[3 * i + 1] = char(t.pcData[i].g);
+    image.bytes[3 * i + 2] = char(t.pcData[i].b);
+  }
+  return image;
+}
+
 // The material of an imported mesh; empty when the file has none of its own (no material,
 // Assimp's stand-in "DefaultMaterial", or the unnamed one its PLY, OFF and STL readers make)
-// and no vertex colours either. A mesh with vertex colours (PLY, OFF) takes their mean as its
-// diffuse colour.
-std::optional<Material> part_material(const aiScene* ai, const aiMesh* am, bool* textured) {
+// and no vertex colours either. A mesh with vertex colours and no material of its own (PLY,
+// OFF) gets a white one, so that its base colour is its vertex colours; with a material, the
+// vertex colours multiply its diffuse colour (glTF's COLOR_0 times baseColorFactor).
+std::optional<Material> part_material(const aiScene* ai, const aiMesh* am) {
   const aiMaterial* mat =
       am->mMaterialIndex < ai->mNumMaterials ? ai->mMaterials[am->mMaterialIndex] : nullptr;
   aiString name;
   bool stand_in = !mat || mat->Get(AI_MATKEY_NAME, name) != AI_SUCCESS || name.length == 0 ||
                   std::strcmp(name.C_Str(), AI_DEFAULT_MATERIAL_NAME) == 0;
-  std::optional<glm::vec3> vertex_colour;
-  if (am->mColors[0] && am->mNumVertices > 0) {
-    glm::dvec3 sum(0.0);
-    for (unsigned v = 0; v < am->mNumVertices; ++v) {
-      const aiColor4D& c = am->mColors[0][v];
-      sum += glm::dvec3(file_colour(aiColor3D(c.r, c.g, c.b)));
-    }
-    vertex_colour = glm::min(glm::vec3(sum / double(am->mNumVertices)), glm::vec3(1.0f));
-  }
   if (stand_in) {
-    if (!vertex_colour) return std::nullopt;
+    if (!am->mColors[0]) return std::nullopt;
     Material m = default_material();
-    m.diffuse = *vertex_colour;
+    m.diffuse = glm::vec3(1.0f);
     m.name = "vertex colours";
     return m;
   }
@@ -549,10 +600,75 @@ std::optional<Material> part_material(const aiScene* ai, const aiMesh* am, bool*
       shininess > 0.0f) {
     m.shininess = std::min(shininess, 1e4f);
   }
-  if (vertex_colour) m.diffuse = *vertex_colour;
-  *textured = mat->GetTextureCount(aiTextureType_DIFFUSE) > 0 ||
-              mat->GetTextureCount(aiTextureType_BASE_COLOR) > 0;
   return m;
+}
+
+TextureWrap texture_wrap(int mode) {
+  switch (mode) {
+    case aiTextureMapMode_Clamp:
+    case aiTextureMapMode_Decal:
+      return TextureWrap::ClampToEdge;
+    case aiTextureMapMode_Mirror:
+      return TextureWrap::MirroredRepeat;
+    default:
+      return TextureWrap::Repeat;
+  }
+}
+
+// KHR_texture_transform from the aiUVTransform Assimp's glTF reader (5.2) makes of it, which
+// is for its v-up texture coordinates: mScaling = scale, mRotation = -rotation and
+// mTranslation = (s.x/2 (1 - cos r + sin r) + offset.x,
+//                 s.y/2 (sin r + cos r - 1) + 1 - s.y - offset.y), solved here for offset.
+UvTransform gltf_uv_transform(const aiUVTransform& t) {
+  UvTransform u;
+  u.scale = {t.mScaling.x, t.mScaling.y};
+  u.rotation = -t.mRotation;
+  const float c = std::cos(u.rotation), s = std::sin(u.rotation);
+  u.offset.x = t.mTranslation.x - 0.5f * u.scale.x * (1.0f - c + s);
+  u.offset.y = 0.5f * u.scale.y * (s + c - 1.0f) + 1.0f - u.scale.y - t.mTranslation.y;
+  const bool finite_all = std::isfinite(u.offset.x) && std::isfinite(u.offset.y) &&
+                          std::isfinite(u.rotation) && std::isfinite(u.scale.x) &&
+                          std::isfinite(u.scale.y);
+  return finite_all ? u : UvTransform{};
+}
+
+// The material's base-colour texture (glTF's baseColorTexture, else the diffuse texture of
+// other formats) and the texture coordinate set it uses; empty without one. An embedded image
+// (Assimp's "*N", or a file name an FBX file embeds) is named "*N", N its index in the
+// scene's textures (and in ImportedModel::images). `gltf`: the file is glTF, whose texture
+// transform Assimp gives in its own form (gltf_uv_transform); other formats' transforms are applied
+// to the texture coordinates by aiProcess_TransformUVCoords.
+std::optional<ModelTexture> base_colour_texture(const aiScene* ai, const aiMesh* am, bool gltf,
+                                                int* uv_set) {
+  const aiMaterial* mat =
+      am->mMaterialIndex < ai->mNumMaterials ? ai->mMaterials[am->mMaterialIndex] : nullptr;
+  if (!mat) return std::nullopt;
+  aiTextureType type = aiTextureType_NONE;
+  aiString file;
+  for (aiTextureType t : {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE}) {
+    if (mat->GetTextureCount(t) > 0 && mat->GetTexture(t, 0, &file) == AI_SUCCESS &&
+        file.length > 0) {
+      type = t;
+      break;
+    }
+  }
+  if (type == aiTextureType_NONE) return std::nullopt;
+  ModelTexture texture;
+  texture.file = file.C_Str();
+  int source = 0, wrap_u = aiTextureMapMode_Wrap, wrap_v = aiTextureMapMode_Wrap;
+  if (mat->Get(AI_MATKEY_UVWSRC(type, 0), source) != AI_SUCCESS || source < 0) source = 0;
+  mat->Get(AI_MATKEY_MAPPINGMODE_U(type, 0), wrap_u);
+  mat->Get(AI_MATKEY_MAPPINGMODE_V(type, 0), wrap_v);
+  texture.wrap_u = texture_wrap(wrap_u);
+  texture.wrap_v = texture_wrap(wrap_v);
+  aiUVTransform transform;
+  if (gltf && mat->Get(AI_MATKEY_UVTRANSFORM(type, 0), transform) == AI_SUCCESS) {
+    texture.transform = gltf_uv_transform(transform);
+  }
+  *uv_set = source;
+  auto [embedded, index] = ai->GetEmbeddedTextureAndIndex(file.C_Str());
+  if (embedded && index >= 0) texture.file = "*" + std::to_string(index);
+  return texture;
 }
 
 // The node's transform to world space (the product of its ancestors').
@@ -698,10 +814,14 @@ TriangleMesh import_mesh_here(const fs::path& full, const std::string& file,
       aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
   if (smooth) flags |= aiProcess_GenSmoothNormals;  // ignored where the file has normals
   const aiScene* ai = post_process(importer, flags, file, path);
+  // Texture coordinates (the set the file's own base-colour texture uses, else the first) for
+  // a textured material of the scene, and vertex colours, which multiply its diffuse colour.
   TriangleMesh mesh;
   for (unsigned m = 0; m < ai->mNumMeshes; ++m) {
     if (placeholder) continue;
-    append_mesh(mesh, ai, m, smooth, file, path, skipped_primitives);
+    int uv_set = 0;
+    base_colour_texture(ai, ai->mMeshes[m], false, &uv_set);
+    append_mesh(mesh, ai, m, smooth, uv_set, true, file, path, skipped_primitives);
   }
   if (mesh.triangles.empty()) fail_no_triangles(contents, *skipped_primitives, file, path);
   return mesh;
@@ -724,28 +844,47 @@ ImportedModel import_model_here(const fs::path& full, const std::string& file,
   // Only FBX: Assimp (5.2) reports the axes of FBX alone, and applies Collada's itself.
   if (ext == ".fbx") model.up = metadata_up(raw);
   // The file's normals where it has them (smooth shading); flat faces where it has none.
-  // Vertices are joined afterwards by weld_identical_vertices, except where a mesh has vertex
-  // colours, whose mean (part_material) is taken over Assimp's joined vertices.
-  bool vertex_colours = false;
-  for (unsigned m = 0; m < raw->mNumMeshes; ++m)
-    vertex_colours |= raw->mMeshes[m]->mColors[0] != nullptr;
+  // Vertices are joined afterwards by weld_identical_vertices. The texture transforms of
+  // formats other than glTF are applied to the texture coordinates by Assimp
+  // (aiProcess_TransformUVCoords); glTF's are kept as the material's (base_colour_texture).
+  const bool gltf = ext == ".gltf" || ext == ".glb";
   const aiScene* ai = post_process(importer,
                                    aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                                       (vertex_colours ? aiProcess_JoinIdenticalVertices : 0u),
+                                       (gltf ? 0u : unsigned(aiProcess_TransformUVCoords)),
                                    file, path);
-  size_t textured = 0, opposite_normals = 0, zero_normals = 0;
+  size_t opposite_normals = 0, zero_normals = 0;
+  std::vector<std::string> without_uvs;
+  bool embedded = false;
   const bool stl = ext == ".stl";
   for (unsigned m = 0; m < ai->mNumMeshes && !placeholder; ++m) {
     const aiMesh* am = ai->mMeshes[m];
     ModelPart part;
     part.name = am->mName.length > 0 ? am->mName.C_Str() : fmt::format("mesh{}", m);
-    append_mesh(part.mesh, ai, m, am->mNormals != nullptr, file, path, &model.skipped_primitives);
+    int uv_set = -1;
+    part.texture = base_colour_texture(ai, am, gltf, &uv_set);
+    append_mesh(part.mesh, ai, m, am->mNormals != nullptr, uv_set, true, file, path,
+                &model.skipped_primitives);
     if (part.mesh.triangles.empty()) continue;
+    if (part.texture && !part.mesh.textured()) {
+      without_uvs.push_back(quote_json(part.name));
+      part.texture.reset();
+    }
+    embedded |= part.texture && part.texture->file.rfind('*', 0) == 0;
     if (stl) replace_contradicting_facet_normals(part.mesh, &opposite_normals, &zero_normals);
     weld_identical_vertices(part.mesh);
-    part.material = part_material(ai, am, &part.textured);
-    textured += part.textured;
+    part.material = part_material(ai, am);
     model.parts.push_back(std::move(part));
+  }
+  for (unsigned i = 0; embedded && i < ai->mNumTextures && ai->mTextures; ++i) {
+    model.images.push_back(ai->mTextures[i] ? embedded_image(*ai->mTextures[i], i)
+                                            : EmbeddedImage{});
+  }
+  if (!without_uvs.empty()) {
+    std::string names;
+    for (const std::string& n : without_uvs) names += (names.empty() ? "" : ", ") + n;
+    model.warnings.push_back(fmt::format(
+        "mesh{} {} ha{} a colour texture but no texture coordinates: rendered without it",
+        without_uvs.size() == 1 ? "" : "es", names, without_uvs.size() == 1 ? "s" : "ve"));
   }
   if (model.parts.empty()) fail_no_triangles(contents, model.skipped_primitives, file, path);
   if (opposite_normals + zero_normals > 0) {
@@ -754,11 +893,6 @@ ImportedModel import_model_here(const fs::path& full, const std::string& file,
         "{} facet{} normals that contradict the winding ({} pointing against it, {} zero or "
         "non-finite): shaded with the facets' geometric normals",
         n, n == 1 ? " has" : "s have", opposite_normals, zero_normals));
-  }
-  if (textured > 0) {
-    model.warnings.push_back(fmt::format(
-        "{} mesh{} colour textures, which are not sampled: rendered with the base colour factor",
-        textured, textured == 1 ? " has" : "es have"));
   }
   return model;
 }

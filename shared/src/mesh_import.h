@@ -17,12 +17,33 @@ namespace rvr::scene_load {
 TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
                          const std::string& path, bool smooth, size_t* skipped_primitives);
 
+// A material's base-colour texture as the model file names it, before it is found and read.
+struct ModelTexture {
+  std::string file;  // as the file writes it; "*N" for the file's own image N (ImportedModel)
+  TextureWrap wrap_u = TextureWrap::Repeat;
+  TextureWrap wrap_v = TextureWrap::Repeat;
+  UvTransform transform;  // glTF's KHR_texture_transform
+};
+
+// An image the model file holds itself (glTF data URIs and GLB buffers, FBX embedded media):
+// a compressed image file's bytes (PNG, JPEG, ...: `format` its extension), or raw 8-bit RGB
+// texels (`format` "rgb8", width x height, the top row first).
+struct EmbeddedImage {
+  std::string name;
+  std::string format;
+  int width = 0;
+  int height = 0;
+  std::string bytes;
+};
+
 // One mesh of a model file with its own material (the file's meshes are joined by material).
+// The mesh keeps the texture coordinates of the set its base-colour texture uses (when it has
+// one) and its vertex colours (linear RGB).
 struct ModelPart {
   std::string name;
-  TriangleMesh mesh;                 // vertex normals when the file has them, else flat
-  std::optional<Material> material;  // empty: the file gives none (use the default)
-  bool textured = false;             // has a colour texture, which is not sampled
+  TriangleMesh mesh;                    // vertex normals when the file has them, else flat
+  std::optional<Material> material;     // empty: the file gives none (use the default)
+  std::optional<ModelTexture> texture;  // the material's base-colour texture
 };
 
 // What a model file holds beyond its triangles: its first camera and its point lights, in
@@ -41,6 +62,7 @@ struct ImportedModel {
   std::vector<size_t> unattenuated_lights;
   size_t skipped_primitives = 0;
   std::vector<std::string> warnings;
+  std::vector<EmbeddedImage> images;  // the file's own images that textures name "*N"
 };
 
 ImportedModel import_model(const std::string& file, const std::string& base_dir,

@@ -18,6 +18,7 @@
 #include "rvr/shared/camera_framing.h"
 #include "rvr/shared/scene_loader.h"
 #include "scene_json_errors.h"
+#include "scene_textures.h"
 #include "scene_transforms.h"
 
 namespace rvr {
@@ -146,6 +147,9 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
   scene.materials.push_back(default_material());
   std::set<std::string> taken;
   size_t dropped = 0, repaired = 0;
+  std::vector<std::string> texture_warnings;
+  SceneTextures textures(scene, texture_warnings);
+  const std::string folder = fs::path(path).parent_path().string();
   for (ModelPart& part : model.parts) {
     Object o;
     o.name = part.name;
@@ -155,6 +159,12 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
     if (o.mesh.triangles.empty()) continue;
     if (part.material) {
       part.material->name = unique_name(part.material->name, taken);
+      if (part.texture) {
+        part.material->texture =
+            textures.add(part.texture->file, folder, part.texture->wrap_u, part.texture->wrap_v,
+                         &model.images, "material " + quote_json(part.material->name));
+        part.material->uv_transform = part.texture->transform;
+      }
       scene.materials.push_back(*part.material);
       o.material = static_cast<uint32_t>(scene.materials.size() - 1);
     }
@@ -204,6 +214,7 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
   }
   scene.image.exposure = overrides.exposure.value_or(automatic_exposure(scene, bounds));
   scene.warnings = model.warnings;
+  scene.warnings.insert(scene.warnings.end(), texture_warnings.begin(), texture_warnings.end());
   if (model.skipped_primitives > 0) {
     scene.warnings.push_back(
         fmt::format("ignored {} point/line primitives", model.skipped_primitives));

@@ -78,6 +78,8 @@ void put(Writer& w, const TriangleMesh& m) {
   w.array(m.positions);
   w.array(m.normals);
   w.array(m.triangles);
+  w.array(m.uvs);
+  w.array(m.colours);
 }
 
 TriangleMesh get_mesh(Reader& r) {
@@ -85,6 +87,8 @@ TriangleMesh get_mesh(Reader& r) {
   m.positions = r.array<glm::vec3>();
   m.normals = r.array<glm::vec3>();
   m.triangles = r.array<glm::uvec3>();
+  m.uvs = r.array<glm::vec2>();
+  m.colours = r.array<glm::vec3>();
   return m;
 }
 
@@ -110,6 +114,45 @@ Material get_material(Reader& r) {
   m.transparency = r.pod<float>();
   m.ior = r.pod<float>();
   return m;
+}
+
+void put(Writer& w, const ModelTexture& t) {
+  static_assert(std::is_trivially_copyable_v<UvTransform>);
+  w.text(t.file);
+  w.pod(t.wrap_u);
+  w.pod(t.wrap_v);
+  w.pod(t.transform);
+}
+
+ModelTexture get_texture(Reader& r) {
+  ModelTexture t;
+  t.file = r.text();
+  t.wrap_u = r.pod<TextureWrap>();
+  t.wrap_v = r.pod<TextureWrap>();
+  t.transform = r.pod<UvTransform>();
+  if (uint8_t(t.wrap_u) > uint8_t(TextureWrap::MirroredRepeat) ||
+      uint8_t(t.wrap_v) > uint8_t(TextureWrap::MirroredRepeat)) {
+    throw std::runtime_error("model bytes: bad wrap mode");
+  }
+  return t;
+}
+
+void put(Writer& w, const EmbeddedImage& i) {
+  w.text(i.name);
+  w.text(i.format);
+  w.pod(i.width);
+  w.pod(i.height);
+  w.text(i.bytes);
+}
+
+EmbeddedImage get_image(Reader& r) {
+  EmbeddedImage i;
+  i.name = r.text();
+  i.format = r.text();
+  i.width = r.pod<int>();
+  i.height = r.pod<int>();
+  i.bytes = r.text();
+  return i;
 }
 
 }  // namespace
@@ -138,7 +181,8 @@ std::string encode(const ImportedModel& model) {
     put(w, part.mesh);
     w.pod(uint8_t(part.material.has_value()));
     if (part.material) put(w, *part.material);
-    w.pod(uint8_t(part.textured));
+    w.pod(uint8_t(part.texture.has_value()));
+    if (part.texture) put(w, *part.texture);
   }
   w.pod(uint8_t(model.camera.has_value()));
   if (model.camera) w.pod(*model.camera);
@@ -151,6 +195,8 @@ std::string encode(const ImportedModel& model) {
   w.pod(uint64_t(model.skipped_primitives));
   w.pod(uint64_t(model.warnings.size()));
   for (const std::string& s : model.warnings) w.text(s);
+  w.pod(uint64_t(model.images.size()));
+  for (const EmbeddedImage& i : model.images) put(w, i);
   return w.take();
 }
 
@@ -163,7 +209,7 @@ ImportedModel decode_model(const std::string& bytes) {
     part.name = r.text();
     part.mesh = get_mesh(r);
     if (r.pod<uint8_t>()) part.material = get_material(r);
-    part.textured = r.pod<uint8_t>() != 0;
+    if (r.pod<uint8_t>()) part.texture = get_texture(r);
     model.parts.push_back(std::move(part));
   }
   if (r.pod<uint8_t>()) model.camera = r.pod<Camera>();
@@ -174,6 +220,8 @@ ImportedModel decode_model(const std::string& bytes) {
   model.skipped_primitives = size_t(r.pod<uint64_t>());
   uint64_t warnings = r.pod<uint64_t>();
   for (uint64_t i = 0; i < warnings; ++i) model.warnings.push_back(r.text());
+  uint64_t images = r.pod<uint64_t>();
+  for (uint64_t i = 0; i < images; ++i) model.images.push_back(get_image(r));
   r.expect_end();
   return model;
 }

@@ -38,6 +38,7 @@
 #include "rvr/shared/camera_framing.h"
 #include "scene_json_errors.h"
 #include "scene_json_parse.h"
+#include "scene_textures.h"
 #include "scene_transforms.h"
 
 namespace rvr {
@@ -61,7 +62,10 @@ constexpr const char* kFromFile = "from_file";
 class Reader {
  public:
   Reader(Scene& scene, std::string base_dir, std::vector<std::string> material_order)
-      : scene_(scene), base_dir_(std::move(base_dir)), material_order_(std::move(material_order)) {}
+      : scene_(scene),
+        base_dir_(std::move(base_dir)),
+        material_order_(std::move(material_order)),
+        textures_(scene, scene.warnings) {}
 
   void read(const json& root) {
     check_object(root, "");
@@ -182,7 +186,8 @@ class Reader {
   Material read_material(const json& v, const std::string& path, const std::string& name) {
     check_object(v, path);
     check_keys(v, path,
-               {"diffuse", "specular", "emission", "shininess", "mirror", "transparency", "ior"});
+               {"diffuse", "specular", "emission", "shininess", "mirror", "transparency", "ior",
+                "texture"});
     Material m;
     m.name = name;
     if (const json* d = find(v, "diffuse")) m.diffuse = colour(*d, key_path(path, "diffuse"));
@@ -203,7 +208,101 @@ class Reader {
     if (const json* i = find(v, "ior")) {
       m.ior = real_at_least(*i, key_path(path, "ior"), 1, Bound::Closed);
     }
+    if (const json* t = find(v, "texture")) read_texture(*t, key_path(path, "texture"), m);
     return m;
+  }
+
+  // "texture": "FILE" or {"file", "wrap", "transform"}. A file that cannot be found or read is
+  // a warning (SceneTextures); a malformed value is an error.
+  void read_texture(const json& v, const std::string& path, Material& m) {
+    std::string file_path = path;
+    const json* file = &v;
+    TextureWrap wrap_u = TextureWrap::Repeat, wrap_v = TextureWrap::Repeat;
+    if (v.is_object()) {
+      check_keys(v, path, {"file", "wrap", "transform"}, "a texture");
+      file_path = key_path(path, "file");
+      file = &require(v, path, "file", "the image file");
+      if (const json* w = find(v, "wrap")) read_wrap(*w, key_path(path, "wrap"), wrap_u, wrap_v);
+      if (const json* t = find(v, "transform")) {
+        m.uv_transform = read_uv_transform(*t, key_path(path, "transform"));
+      }
+    } else if (!v.is_string()) {
+      fail(path, "must be an image file name or an object with \"file\", got " + describe(v));
+    }
+    const std::string& name = string(*file, file_path);
+    if (name.empty()) fail(file_path, "must not be empty");
+    if (name.find('\0') != std::string::npos) fail(file_path, "must not contain a NUL character");
+    m.texture = textures_.add(name, base_dir_, wrap_u, wrap_v, nullptr, path);
+  }
+
+  static TextureWrap wrap_mode(const json& v, const std::string& path) {
+    static const std::vector<std::string> kModes = {"repeat", "clamp", "mirror"};
+    const std::string& mode = string(v, path);
+    for (size_t i = 0; i < kModes.size(); ++i) {
+      if (mode == kModes[i]) return TextureWrap(i);
+    }
+    std::string s = suggestion(mode, kModes);
+    fail(path, "unknown wrap mode " + quote_json(mode) +
+                   (s.empty() ? "" : " (did you mean '" + s + "'?)") + "; expected one of " +
+                   join(kModes));
+  }
+
+  // "repeat", or ["clamp", "repeat"] for u and v.
+  static void read_wrap(const json& v, const std::string& path, TextureWrap& u, TextureWrap& w) {
+    if (v.is_array()) {
+      if (v.size() != 2) fail(path, "must be a wrap mode or an array of 2, got " + describe(v));
+      u = wrap_mode(v[0], index_path(path, 0));
+      w = wrap_mode(v[1], index_path(path, 1));
+      return;
+    }
+    u = w = wrap_mode(v, path);
+  }
+
+  static glm::vec2 vec2(const json& v, const std::string& path) {
+    if (!v.is_array() || v.size() != 2) {
+      fail(path, "must be an array of 2 numbers, got " + describe(v));
+    }
+    return {real(v[0], index_path(path, 0)), real(v[1], index_path(path, 1))};
+  }
+
+  static UvTransform read_uv_transform(const json& v, const std::string& path) {
+    check_object(v, path);
+    check_keys(v, path, {"offset", "rotation", "scale"}, "a texture transform");
+    UvTransform t;
+    if (const json* o = find(v, "offset")) t.offset = vec2(*o, key_path(path, "offset"));
+    if (const json* r = find(v, "rotation")) t.rotation = real(*r, key_path(path, "rotation"));
+    if (const json* s = find(v, "scale")) {
+      t.scale = vec2(*s, key_path(path, "scale"));
+      for (int i = 0; i < 2; ++i) {
+        if (t.scale[i] == 0.0f)
+          fail(index_path(key_path(path, "scale"), size_t(i)), "must not be 0");
+      }
+    }
+    return t;
+  }
+
+  // "uvs" and "colors" of a triangle or mesh object: one per vertex of the mesh as loaded.
+  static void read_vertex_values(const json& v, const std::string& path, TriangleMesh& mesh,
+                                 const std::string& vertices) {
+    const size_t n = mesh.positions.size();
+    auto check_count = [&](const json& a, const std::string& p) {
+      if (!a.is_array() || a.size() != n) {
+        fail(p, fmt::format("must be an array of {} (one per vertex{}), got {}", n, vertices,
+                            describe(a)));
+      }
+    };
+    if (const json* u = find(v, "uvs")) {
+      std::string p = key_path(path, "uvs");
+      check_count(*u, p);
+      mesh.uvs.clear();
+      for (size_t i = 0; i < n; ++i) mesh.uvs.push_back(vec2((*u)[i], index_path(p, i)));
+    }
+    if (const json* c = find(v, "colors")) {
+      std::string p = key_path(path, "colors");
+      check_count(*c, p);
+      mesh.colours.clear();
+      for (size_t i = 0; i < n; ++i) mesh.colours.push_back(colour((*c)[i], index_path(p, i)));
+    }
   }
 
   void read_lights(const json& v) {
@@ -269,9 +368,9 @@ class Reader {
     } else if (type == "plane") {
       keys.insert(keys.end(), {"point", "normal", "half_size"});
     } else if (type == "triangle") {
-      keys.insert(keys.end(), {"vertices"});
+      keys.insert(keys.end(), {"vertices", "uvs", "colors"});
     } else if (type == "mesh") {
-      keys.insert(keys.end(), {"file", "smooth"});
+      keys.insert(keys.end(), {"file", "smooth", "uvs", "colors"});
     } else if (type == "csg") {
       keys.insert(keys.end(), {"op", "a", "b"});
     } else {
@@ -329,6 +428,7 @@ class Reader {
       }
       for (size_t k = 0; k < 3; ++k) o.mesh.positions.push_back(vec3(verts[k], index_path(vp, k)));
       o.mesh.triangles.emplace_back(0, 1, 2);
+      read_vertex_values(v, path, o.mesh, "");
       size_t dropped = 0, repaired = 0;
       finish_mesh(o.mesh, t, path, &dropped, &repaired);
       if (dropped > 0) fail(vp, "the triangle is degenerate (zero area)");
@@ -339,11 +439,19 @@ class Reader {
       bool smooth = false;
       if (const json* s = find(v, "smooth")) smooth = boolean(*s, key_path(path, "smooth"));
       if (from_file) {
+        for (const char* k : {"uvs", "colors"}) {
+          if (find(v, k)) {
+            fail(key_path(path, k),
+                 "is not allowed with \"material\": \"from_file\" (the "
+                 "file's own are kept)");
+          }
+        }
         read_mesh_from_file(o, file, fp, t, label);
         return;
       }
       size_t skipped = 0, dropped = 0, repaired = 0;
       o.mesh = import_mesh(file, base_dir_, fp, smooth, &skipped);
+      read_vertex_values(v, path, o.mesh, " of " + quote_json(file) + " as loaded");
       size_t total = o.mesh.triangles.size();
       finish_mesh(o.mesh, t, path, &dropped, &repaired);
       if (o.mesh.triangles.empty()) {
@@ -386,6 +494,16 @@ class Reader {
       o.material = 0;
       if (part.material) {
         part.material->name = file_material_name(file, part.material->name);
+        if (part.texture) {
+          const std::string folder =
+              (fs::path(file).is_absolute() ? fs::path(file) : fs::path(base_dir_) / file)
+                  .parent_path()
+                  .string();
+          part.material->texture =
+              textures_.add(part.texture->file, folder, part.texture->wrap_u, part.texture->wrap_v,
+                            &model.images, label + ": material " + quote_json(part.material->name));
+          part.material->uv_transform = part.texture->transform;
+        }
         scene_.materials.push_back(*part.material);
         o.material = static_cast<uint32_t>(scene_.materials.size() - 1);
       }
@@ -540,6 +658,7 @@ class Reader {
   std::string base_dir_;
   std::vector<std::string> material_order_;
   std::map<std::string, uint32_t> material_index_;
+  SceneTextures textures_;
 };
 
 Expected<Scene> parse_scene_impl(const std::string& text, const std::string& source,

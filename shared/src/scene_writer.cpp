@@ -9,7 +9,9 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
@@ -54,6 +56,76 @@ json vec(const glm::vec3& v, const std::string& path) {
   return json::array({num(v.x, path + "[0]"), num(v.y, path + "[1]"), num(v.z, path + "[2]")});
 }
 
+json vec2(const glm::vec2& v, const std::string& path) {
+  return json::array({num(v.x, path + "[0]"), num(v.y, path + "[1]")});
+}
+
+const char* wrap_name(TextureWrap w) {
+  switch (w) {
+    case TextureWrap::ClampToEdge:
+      return "clamp";
+    case TextureWrap::MirroredRepeat:
+      return "mirror";
+    case TextureWrap::Repeat:
+      break;
+  }
+  return "repeat";
+}
+
+// Level 0 of a texture as an image, the top row first (the level's last row).
+Image texture_image(const MipChain& mips) {
+  const TextureLevel& level = mips.levels.at(0);
+  Image img;
+  img.width = level.width;
+  img.height = level.height;
+  img.channels = 3;
+  img.channel_names = {"R", "G", "B"};
+  img.pixels.resize(size_t(level.width) * size_t(level.height) * 3);
+  for (int y = 0; y < level.height; ++y) {
+    for (int x = 0; x < level.width; ++x) {
+      const glm::vec3& c = level.at(x, level.height - 1 - y);
+      for (int k = 0; k < 3; ++k) img.at(x, y, k) = c[k];
+    }
+  }
+  return img;
+}
+
+// Where the document names texture i: its file relative to the document's folder (absolute
+// when there is no relative way), a file written beside the document for a texture in memory
+// only, the name it had for one that was not found.
+std::string texture_file(const Scene& scene, size_t i, const std::string& mesh_prefix,
+                         const std::string& document_folder, SceneDocument& doc) {
+  namespace fs = std::filesystem;
+  const Texture& t = scene.textures[i];
+  if (!t.resolved.empty()) {
+    std::error_code ec;
+    const fs::path file = fs::absolute(t.resolved, ec);
+    const fs::path folder = fs::absolute(document_folder.empty() ? "." : document_folder, ec);
+    fs::path relative = fs::proximate(file, folder, ec);
+    return (ec || relative.empty() ? file : relative).generic_string();
+  }
+  if (!t.mips || t.mips->levels.empty()) return t.file;
+  std::string name = fmt::format("{}.texture{}.exr", mesh_prefix, i);
+  doc.texture_files.push_back({name, texture_image(*t.mips)});
+  return name;
+}
+
+json texture_json(const Material& m, const std::string& file, const std::string& path,
+                  const Scene& scene) {
+  const Texture& t = scene.textures[size_t(m.texture)];
+  json o = json::object();
+  o["file"] = file;
+  o["wrap"] = t.wrap_u == t.wrap_v ? json(wrap_name(t.wrap_u))
+                                   : json::array({wrap_name(t.wrap_u), wrap_name(t.wrap_v)});
+  if (!m.uv_transform.identity()) {
+    const UvTransform& u = m.uv_transform;
+    o["transform"] = {{"offset", vec2(u.offset, path + ".transform.offset")},
+                      {"rotation", num(u.rotation, path + ".transform.rotation")},
+                      {"scale", vec2(u.scale, path + ".transform.scale")}};
+  }
+  return o;
+}
+
 json material_json(const Material& m, const std::string& path) {
   json o = json::object();
   o["diffuse"] = vec(m.diffuse, path + ".diffuse");
@@ -69,7 +141,8 @@ json material_json(const Material& m, const std::string& path) {
 bool same_material(const Material& a, const Material& b) {
   return a.diffuse == b.diffuse && a.specular == b.specular && a.emission == b.emission &&
          a.shininess == b.shininess && a.mirror == b.mirror && a.transparency == b.transparency &&
-         a.ior == b.ior;
+         a.ior == b.ior && a.texture == b.texture && a.uv_transform.identity() &&
+         b.uv_transform.identity();
 }
 
 json sphere_members(json o, const Sphere& s, const std::string& path) {
@@ -145,25 +218,33 @@ void put_f32(std::string& out, float v) {
 
 std::string ply(const TriangleMesh& mesh, const std::string& path) {
   if (mesh.positions.size() > uint64_t(INT32_MAX)) fail(path + ": too many vertices for PLY");
-  bool smooth = mesh.smooth();
-  if (smooth && mesh.normals.size() != mesh.positions.size()) {
-    fail(path + ": normals and positions differ in number");
-  }
+  const size_t n = mesh.positions.size();
+  const bool smooth = mesh.smooth(), uvs = mesh.textured(), colours = mesh.coloured();
+  if (smooth && mesh.normals.size() != n) fail(path + ": normals and positions differ in number");
+  if (uvs && mesh.uvs.size() != n) fail(path + ": uvs and positions differ in number");
+  if (colours && mesh.colours.size() != n) fail(path + ": colours and positions differ in number");
   std::string out = fmt::format(
       "ply\nformat binary_little_endian 1.0\ncomment written by rvr scenes --export\n"
       "element vertex {}\nproperty float x\nproperty float y\nproperty float z\n",
-      mesh.positions.size());
+      n);
   if (smooth) out += "property float nx\nproperty float ny\nproperty float nz\n";
+  if (uvs) out += "property float s\nproperty float t\n";
+  if (colours) out += "property float red\nproperty float green\nproperty float blue\n";
   out += fmt::format("element face {}\nproperty list uchar int vertex_indices\nend_header\n",
                      mesh.triangles.size());
-  for (size_t i = 0; i < mesh.positions.size(); ++i) {
-    for (int k = 0; k < 3; ++k) {
-      if (!std::isfinite(mesh.positions[i][k])) fail(path + ": a vertex is not finite");
-      put_f32(out, mesh.positions[i][k]);
+  auto finite_values = [&](const float* v, int count, const char* what) {
+    for (int k = 0; k < count; ++k) {
+      if (!std::isfinite(v[k])) fail(path + ": " + what + " is not finite");
+      put_f32(out, v[k]);
     }
+  };
+  for (size_t i = 0; i < n; ++i) {
+    finite_values(&mesh.positions[i].x, 3, "a vertex");
     if (smooth) {
       for (int k = 0; k < 3; ++k) put_f32(out, mesh.normals[i][k]);
     }
+    if (uvs) finite_values(&mesh.uvs[i].x, 2, "a texture coordinate");
+    if (colours) finite_values(&mesh.colours[i].x, 3, "a vertex colour");
   }
   for (const glm::uvec3& t : mesh.triangles) {
     put_u8(out, 3);
@@ -175,7 +256,8 @@ std::string ply(const TriangleMesh& mesh, const std::string& path) {
   return out;
 }
 
-SceneDocument write(const Scene& scene, const std::string& mesh_prefix) {
+SceneDocument write(const Scene& scene, const std::string& mesh_prefix,
+                    const std::string& document_folder) {
   SceneDocument doc;
   json root = json::object();
   root["format"] = "rvr-scene/1";
@@ -203,12 +285,21 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix) {
   }
   json materials = json::object();
   std::set<std::string> names;
+  std::map<size_t, std::string> texture_files;  // texture index -> the name written
   for (size_t i = 1; i < scene.materials.size(); ++i) {
     const Material& m = scene.materials[i];
     std::string path = fmt::format("materials[{}]", i);
     if (m.name.empty()) fail(path + ": has no name");
     if (!names.insert(m.name).second) fail(path + ": duplicate material name '" + m.name + "'");
     materials[m.name] = material_json(m, path);
+    if (m.texture >= 0) {
+      if (size_t(m.texture) >= scene.textures.size()) fail(path + ": texture index out of range");
+      auto [it, added] = texture_files.try_emplace(size_t(m.texture));
+      if (added) {
+        it->second = texture_file(scene, size_t(m.texture), mesh_prefix, document_folder, doc);
+      }
+      materials[m.name]["texture"] = texture_json(m, it->second, path + ".texture", scene);
+    }
   }
   root["materials"] = std::move(materials);
 
@@ -262,6 +353,23 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix) {
             verts.push_back(vec(mesh.positions[v], fmt::format("{}.vertices[{}]", path, k)));
           }
           j["vertices"] = std::move(verts);
+          if (mesh.textured() || mesh.coloured()) {
+            json uvs = json::array(), colours = json::array();
+            for (int k = 0; k < 3; ++k) {
+              uint32_t v = mesh.triangles[0][k];
+              if (mesh.textured()) {
+                if (v >= mesh.uvs.size()) fail(path + ": uvs and positions differ in number");
+                uvs.push_back(vec2(mesh.uvs[v], fmt::format("{}.uvs[{}]", path, k)));
+              }
+              if (mesh.coloured()) {
+                if (v >= mesh.colours.size())
+                  fail(path + ": colours and positions differ in number");
+                colours.push_back(vec(mesh.colours[v], fmt::format("{}.colors[{}]", path, k)));
+              }
+            }
+            if (mesh.textured()) j["uvs"] = std::move(uvs);
+            if (mesh.coloured()) j["colors"] = std::move(colours);
+          }
         } else {
           std::string file = fmt::format("{}.mesh{}.ply", mesh_prefix, i);
           j["type"] = "mesh";
@@ -290,10 +398,11 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix) {
 
 }  // namespace
 
-Expected<SceneDocument> write_scene(const Scene& scene, const std::string& mesh_prefix) {
+Expected<SceneDocument> write_scene(const Scene& scene, const std::string& mesh_prefix,
+                                    const std::string& document_folder) {
   std::string source = scene.source.empty() ? "scene" : scene.source;
   try {
-    return write(scene, mesh_prefix);
+    return write(scene, mesh_prefix, document_folder);
   } catch (const WriteError& e) {
     return bad_input(source + ": " + e.what);
   } catch (const std::exception& e) {

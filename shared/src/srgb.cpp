@@ -19,6 +19,12 @@ float srgb_encode(float v) {
   return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
 }
 
+float srgb_decode(float c) {
+  if (!(c > 0.0f)) return 0.0f;  // also NaN
+  if (c >= 1.0f) return 1.0f;
+  return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+}
+
 namespace {
 
 uint8_t srgb8_by_formula(float v) {

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "rvr/shared/expected.h"
+#include "rvr/shared/image_io.h"
 #include "rvr/shared/scene.h"
 
 namespace rvr {
@@ -17,17 +18,30 @@ struct SceneMeshFile {
   std::string bytes;  // the PLY file
 };
 
+// A texture the document names that exists in memory only (a model file's embedded image, a
+// built-in scene's texture): its level 0 as a linear EXR, which reads back to the same texels.
+struct SceneTextureFile {
+  std::string name;  // as written in the document, relative to the document's folder
+  Image image;       // to be written with write_image
+};
+
 struct SceneDocument {
-  std::string json;                       // the rvr-scene/1 text, ending in a newline
-  std::vector<SceneMeshFile> mesh_files;  // to be written next to the document
+  std::string json;                             // the rvr-scene/1 text, ending in a newline
+  std::vector<SceneMeshFile> mesh_files;        // to be written next to the document
+  std::vector<SceneTextureFile> texture_files;  // likewise
 };
 
 // Writes `scene` as rvr-scene/1. Every key is written, defaults included; floats are written
 // as the shortest decimal that reads back to the same float. An object of type Triangles
-// with exactly one triangle and no normals becomes a `triangle` object; any other mesh
-// becomes a `mesh` object whose file is named mesh_prefix + ".mesh" + object index + ".ply".
-// Fails (bad input) on what the format cannot express: a materials[0] that is not the
-// built-in default, duplicate or empty material names, a material index out of range.
-Expected<SceneDocument> write_scene(const Scene& scene, const std::string& mesh_prefix);
+// with exactly one triangle and no normals becomes a `triangle` object (with its `uvs` and
+// `colors`); any other mesh becomes a `mesh` object whose file is named mesh_prefix + ".mesh"
+// + object index + ".ply" (texture coordinates and vertex colours as float properties s, t and
+// red, green, blue). A texture read from a file is named by its path relative to
+// `document_folder` (the folder the document is written to; the image is not copied); one in
+// memory only goes to mesh_prefix + ".texture" + index + ".exr"; one that was not found keeps
+// the name it had. Fails (bad input) on what the format cannot express: a materials[0] that is
+// not the built-in default, duplicate or empty material names, a material index out of range.
+Expected<SceneDocument> write_scene(const Scene& scene, const std::string& mesh_prefix,
+                                    const std::string& document_folder = ".");
 
 }  // namespace rvr
