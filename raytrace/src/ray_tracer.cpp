@@ -162,12 +162,15 @@ class FrameTracer {
             visible.object_id[i] != kNoId &&
             geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i], hit,
                                         counters.traversal);
+        // A hit rebuilt from the z-buffer samples its texture at the z-buffer's level.
+        const float* given_lod = rebuilt && !visible.lod.empty() ? &visible.lod[i] : nullptr;
         if (rebuilt) {
           counters.rebuilt++;
           HitRecord csg;
           if (geometry_.has_csg() && geometry_.closest_csg(ray, csg, counters.traversal) &&
               (csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive))) {
             hit = csg;
+            given_lod = nullptr;
             counters.csg_pixels++;
           }
         } else {
@@ -175,7 +178,7 @@ class FrameTracer {
           counters.fallback_missed += visible.object_id[i] != kNoId;
           if (!geometry_.closest(ray, hit, counters.traversal)) hit = HitRecord{};
         }
-        sum[i] += shade_hit(ray, hit, 0, counters, &rng, textured_footprint());
+        sum[i] += shade_hit(ray, hit, 0, counters, &rng, textured_footprint(), given_lod);
       }
   }
 
@@ -214,9 +217,14 @@ class FrameTracer {
     // The ids the z-buffer drew, and which pixels need a ray at all.
     uint32_t object[kPacketRays], primitive[kPacketRays];
     bool drawn[kPacketRays], rebuilt[kPacketRays];
+    // The z-buffer's texture level of detail, taken by the hits rebuilt from it (given).
+    float zbuffer_lod[kPacketRays];
+    bool given[kPacketRays];
     for (int y = y0, k = 0; y < y1; ++y)
       for (int x = x0; x < x1; ++x, ++k) {  // ray k is pixel (x, y)
         const size_t i = size_t(y) * size_t(visible.width) + size_t(x);
+        given[k] = false;
+        zbuffer_lod[k] = visible.lod.empty() ? kNoLod : visible.lod[i];
         object[k] = visible.object_id[i];
         primitive[k] = visible.primitive_id[i];
         drawn[k] = object[k] != kNoId;
@@ -242,6 +250,7 @@ class FrameTracer {
         continue;
       }
       counters.rebuilt++;
+      given[k] = !visible.lod.empty();
       if (geometry_.has_csg()) {
         // No z-buffer draws CSG: the ray meets the CSG objects alone; the nearer hit wins, ties
         // by primitive index as in closest().
@@ -249,6 +258,7 @@ class FrameTracer {
         if (geometry_.closest_csg(PrimaryRays::ray_of(packet, k), csg, work[k]) &&
             (csg.t < hits[k].t || (csg.t == hits[k].t && csg.primitive < hits[k].primitive))) {
           hits[k] = csg;
+          given[k] = false;
           counters.csg_pixels++;
         }
       }
@@ -282,7 +292,7 @@ class FrameTracer {
             scene_.objects[geometry_.hit_ids(hits[k]).first].type == ObjectType::Csg)
           counters.csg_pixels++;
     counters.primary += uint64_t(n) - (counters.background - background_before);
-    finish_block(x0, y0, w, packet, hits, work, out, counters);
+    finish_block(x0, y0, w, packet, hits, work, out, counters, zbuffer_lod, given);
   }
 
  private:
@@ -325,8 +335,11 @@ class FrameTracer {
   // work[k]. Every buffer of every pixel is written into `out`: the AOVs from the centre hit; in
   // local mode the surface and colour computed by the shading kernels, the block's hits as one
   // batch; in full mode (shadow, reflection and refraction rays) one pixel at a time.
+  // given_lod[k], where given[k] (both may be null: none), is the texture level of detail ray
+  // k's hit samples at instead of its own footprint's (a hybrid's z-buffer's).
   void finish_block(int x0, int y0, int w, const RayPacket& packet, const HitRecord* hits,
-                    const TraversalCounters* work, TileOutput& out, RayCounters& counters) const {
+                    const TraversalCounters* work, TileOutput& out, RayCounters& counters,
+                    const float* given_lod = nullptr, const bool* given = nullptr) const {
     static_assert(kPacketRays <= kShadeBatch, "a block's hits fit one batch");
     const auto start = Clock::now();
     const RenderMode mode = options_.mode;
@@ -359,8 +372,9 @@ class FrameTracer {
           out.normal[i] = glm::vec3(0.0f);
           if (textured_ && object_textured_[object]) {
             const glm::vec3 D(packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]);
-            out.lod[i] =
-                textured_hit_lod(scene_.objects[object], primitive, D, hit.t, primary_footprint_);
+            out.lod[i] = given && given[k] ? given_lod[k]
+                                           : textured_hit_lod(scene_.objects[object], primitive, D,
+                                                              hit.t, primary_footprint_);
           }
         } else if (mode == RenderMode::Local) {
           const int slot = batch.count++;
@@ -371,9 +385,9 @@ class FrameTracer {
             // Its own material: the diffuse replaced by the base colour at the hit.
             const glm::vec3 D(packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]);
             const Material& m = scene_.materials[material];
-            const glm::vec3 base =
-                varying_base_colour(scene_.objects[object], out.primitive_id[i], hit.u, hit.v, D,
-                                    hit.t, &primary_footprint_, out.lod[i]);
+            const glm::vec3 base = varying_base_colour(
+                scene_.objects[object], out.primitive_id[i], hit.u, hit.v, D, hit.t,
+                &primary_footprint_, out.lod[i], given && given[k] ? &given_lod[k] : nullptr);
             if (!mixed) {
               mixed = true;
               for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
@@ -397,8 +411,9 @@ class FrameTracer {
           out.object_id[i] = s.object;
           out.primitive_id[i] = s.primitive;
           out.normal[i] = N;
-          out.color[i] = shade(ray, s, N, V, 0, counters, nullptr, textured_footprint(),
-                               textured_ ? &out.lod[i] : nullptr);
+          out.color[i] =
+              shade(ray, s, N, V, 0, counters, nullptr, textured_footprint(),
+                    textured_ ? &out.lod[i] : nullptr, given && given[k] ? &given_lod[k] : nullptr);
         }
         if (supersampled) out.color[i] = supersample(x, y, counters);
         // Work for this pixel: its centre ray and every ray its shading traced.
@@ -506,13 +521,15 @@ class FrameTracer {
   }
 
   // The colour a ray brings back from its closest hit (primitive kNoPrimitive: it missed).
+  // given_lod: as in shade().
   glm::vec3 shade_hit(const Ray& ray, const HitRecord& hit, int depth, RayCounters& counters,
-                      PixelRng* rng, const RayFootprint* footprint) const {
+                      PixelRng* rng, const RayFootprint* footprint,
+                      const float* given_lod = nullptr) const {
     if (hit.primitive == kNoPrimitive) return scene_.image.background;
     SurfaceHit s = geometry_.surface(ray, hit);
     glm::vec3 V = -glm::normalize(ray.dir);
     return shade(ray, s, face_viewer(s.shading_normal, s.geometric_normal, V), V, depth, counters,
-                 rng, footprint, nullptr);
+                 rng, footprint, nullptr, given_lod);
   }
 
   // The primary rays' footprint when the scene has a texture to sample, else null (no ray
@@ -538,27 +555,33 @@ class FrameTracer {
   }
 
   // The base colour at barycentrics (u, v) of `triangle` of object o, whose colour varies
-  // (varies_in_colour), and in lod the texture's level of detail there (NaN: not textured).
+  // (varies_in_colour), and in lod the texture's level of detail there (NaN: not textured):
+  // `given` when not null (a hybrid's primary hit takes its z-buffer's), else the footprint's.
   glm::vec3 varying_base_colour(const Object& o, uint32_t triangle, float u, float v,
                                 const glm::vec3& D, float t, const RayFootprint* footprint,
-                                float& lod) const {
+                                float& lod, const float* given = nullptr) const {
     lod = kNoLod;
-    if (footprint && textured(scene_, o)) lod = textured_hit_lod(o, triangle, D, t, *footprint);
+    if (given)
+      lod = *given;
+    else if (footprint && textured(scene_, o))
+      lod = textured_hit_lod(o, triangle, D, t, *footprint);
     return base_colour(scene_, o, scene_.materials[o.material], triangle, u, v, lod);
   }
 
   // rng is the pixel's stream when it takes several samples (area lights are then jittered
   // inside their strata), null for one sample at the pixel centre. footprint: the ray's, when
-  // the scene has a texture; lod, when not null, receives the texture's level of detail at s.
+  // the scene has a texture; lod, when not null, receives the texture's level of detail at s;
+  // given_lod, when not null, is the level to sample at s (a z-buffer's, for a hybrid's hit).
   glm::vec3 shade(const Ray& ray, const SurfaceHit& s, const glm::vec3& N, const glm::vec3& V,
                   int depth, RayCounters& counters, PixelRng* rng, const RayFootprint* footprint,
-                  float* lod) const {
+                  float* lod, const float* given_lod = nullptr) const {
     std::optional<Material> coloured;  // the material with the base colour at s, where it varies
     if (varies_ && object_varies_[s.object]) {
       float hit_lod;
-      coloured.emplace(with_diffuse(scene_.materials[s.material],
-                                    varying_base_colour(scene_.objects[s.object], s.primitive, s.u,
-                                                        s.v, ray.dir, s.t, footprint, hit_lod)));
+      coloured.emplace(
+          with_diffuse(scene_.materials[s.material],
+                       varying_base_colour(scene_.objects[s.object], s.primitive, s.u, s.v, ray.dir,
+                                           s.t, footprint, hit_lod, given_lod)));
       if (lod) *lod = hit_lod;
     }
     const Material& m = coloured ? *coloured : scene_.materials[s.material];
