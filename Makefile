@@ -34,7 +34,8 @@ check: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L fast
 
 # The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer (any UB fails the
-# test), in its own build folder: -O2 with line tables and assertions on (no NDEBUG). Leaks
+# test), in its own build folder: -O2 with line tables, assert, RVR_CHECK and RVR_DCHECK on (no
+# NDEBUG, and RVR_ENABLE_DCHECK so it stays on whatever the build type). Leaks
 # inside Mesa and Assimp are suppressed by tests/sanitize/lsan.supp (third-party code only).
 # Only the CLI and the test binaries are built (not the benchmarks).
 SANITIZE_DIR ?= build-asan
@@ -65,7 +66,7 @@ sanitize: deps
 	cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 		-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" \
 		-DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
-		-DRVR_LINK_OSMESA=ON -DRVR_TEST_TIMEOUT_SCALE=10
+		-DRVR_LINK_OSMESA=ON -DRVR_TEST_TIMEOUT_SCALE=10 -DRVR_ENABLE_DCHECK=ON
 	cmake --build $(SANITIZE_DIR) -j $(JOBS) --target $(SANITIZE_TARGETS)
 	cd $(SANITIZE_DIR) && \
 		ASAN_OPTIONS=detect_leaks=1:$(SANITIZE_ASAN) LSAN_OPTIONS=$(SANITIZE_LSAN) \
@@ -82,7 +83,7 @@ FUZZ_SECONDS ?= 60
 FUZZ_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 fuzz: deps
 	cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
-		-DRVR_BUILD_FUZZERS=ON -DRVR_BUILD_TESTS=OFF -DCMAKE_CXX_FLAGS="$(FUZZ_FLAGS)" \
+		-DRVR_BUILD_FUZZERS=ON -DRVR_BUILD_TESTS=OFF -DRVR_ENABLE_DCHECK=ON -DCMAKE_CXX_FLAGS="$(FUZZ_FLAGS)" \
 		-DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
 	cmake --build $(FUZZ_DIR) -j $(JOBS) --target fuzz_scene fuzz_mesh
 	FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run.sh $(FUZZ_DIR)

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
+
+#include "rvr/shared/check.h"
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -73,6 +76,8 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
   auto tests = [block](uint32_t n) { return float((n + block - 1) / block); };
   auto start = std::chrono::steady_clock::now();
   Bvh bvh;
+  RVR_CHECK(bounds.size() < size_t(~0u), "primitive indices are uint32_t and ~0u means none; ",
+            bounds.size(), " primitives");
   const uint32_t n = uint32_t(bounds.size());
   bvh.stats_.primitives = n;
   if (n == 0) return bvh;
@@ -88,6 +93,7 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
     tasks.push_back(root);
   }
   const float root_area = std::max(tasks[0].box.surface_area(), 1e-30f);
+  size_t leaf_primitives = 0;
   while (!tasks.empty()) {
     BuildTask task = tasks.back();
     tasks.pop_back();
@@ -106,9 +112,12 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
       node.lo = box.lo;
       node.hi = box.hi;
       node.offset = task.begin;
+      RVR_CHECK(count >= 1 && count <= std::numeric_limits<uint16_t>::max(),
+                "a leaf's primitive count must fit BvhNode::count (uint16_t): ", count);
       node.count = uint16_t(count);
       node.axis = 0;
       bvh.stats_.leaves++;
+      leaf_primitives += count;
       bvh.stats_.sah_cost += area_ratio * kIntersectCost * tests(count);
     };
 
@@ -126,6 +135,7 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
         for (int a = 0; a < 3; ++a) {
           if (extent[a] <= 0.0f) continue;
           int b = std::min(kBins - 1, int((c[a] - centroid_box.lo[a]) * scale[a]));
+          RVR_DCHECK(b >= 0, "centroid below its node's centroid bounds: bin ", b);
           bin_count[a][b]++;
           bin_box[a][b].grow(prim);
         }
@@ -195,6 +205,8 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
         std::swap(*i, *(j - 1));
       }
       mid = uint32_t(i - refs.data());
+      RVR_CHECK(mid > task.begin && mid < task.end, "a SAH split leaves both sides non-empty: [",
+                task.begin, ", ", mid, ", ", task.end, ")");
     } else {
       // No useful SAH split (all centroids equal, or too deep): split at the object median.
       axis = int(std::max_element(&extent[0], &extent[0] + 3) - &extent[0]);
@@ -216,6 +228,14 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
     tasks.push_back({mid, task.end, index, task.depth + 1, right_box, right_centroids});
     tasks.push_back({task.begin, mid, ~0u, task.depth + 1, left_box, left_centroids});
   }
+  RVR_CHECK(bvh.nodes_.size() == 2 * bvh.stats_.leaves - 1,
+            "a binary tree has one inner node fewer than leaves: ", bvh.nodes_.size(), " nodes, ",
+            bvh.stats_.leaves, " leaves");
+  RVR_CHECK(bvh.stats_.max_depth < size_t(kStackSize),
+            "object medians past kMedianDepth keep the depth within the traversal stack: depth ",
+            bvh.stats_.max_depth);
+  RVR_CHECK(leaf_primitives == n, "every primitive lies in exactly one leaf: ", leaf_primitives,
+            " in leaves of ", n);
   bvh.order_.resize(n);
   for (uint32_t i = 0; i < n; ++i) bvh.order_[i] = refs[i].id;
   bvh.nodes_.shrink_to_fit();

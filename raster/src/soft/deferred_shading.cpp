@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/shade_batch.h"
 #include "rvr/shared/shading.h"
 
@@ -152,6 +153,7 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
       bool mixed = false;
       auto flush = [&] {
         if (batch.count == 0) return;
+        RVR_DCHECK(batch.count <= kShadeBatch, "flushed when full: ", batch.count);
         const int n = batch.count;
         pad_batch(batch, mixed);
         batch.material = mixed ? nullptr : &objects[batch_object].material;
@@ -188,6 +190,9 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
           const uint32_t id = object_of[o];
           const ObjectShading& s = objects[id];
           const uint32_t primitive = primitive_of[o];
+          RVR_DCHECK(id < objects.size() && primitive < objects[id].mesh->triangles.size(),
+                     "the z-buffer stores ids of drawn triangles: object ", id, ", primitive ",
+                     primitive);
 
           const int i = batch.count++;
           pixel[i] = o;
