@@ -42,23 +42,23 @@ SANITIZE_DIR ?= build-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 SANITIZE_TARGETS := rvr $(patsubst tests/%.cpp,%,$(wildcard tests/test_*.cpp))
 # Brute-force conformance (`raytrace_none_*`: every scene traced with no acceleration
-# structure) takes 10 s natively and ~9 minutes under ASan; the same tracer code runs under
-# ASan with the BVH in every other conformance case, and the brute-force path in test_bvh.
+# structure) is left out: under ASan it alone would take longer than the rest of the suite; the
+# same tracer code runs under ASan with the BVH in every other conformance case, and the
+# brute-force path in test_bvh.
 SANITIZE_EXCLUDE ?= Conformance[.]AgreesWithTheOtherLoopOrder/raytrace_none_
-# LeakSanitizer's exit-time scan (gcc 12's libsanitizer) crashes now and then ("Tracer caught
-# signal 11") on a garbage dynamic-TLS entry of Mesa opened with dlopen: about 1 run in 10 of
-# an EGL test, rarer with OSMesa. RVR_LINK_OSMESA=ON loads libOSMesa and LLVM at start-up
-# (static TLS), which cured it in 48 runs, but Mesa's EGL driver is still opened by libEGL, so
-# tests that make EGL contexts run with ASan and UBSan but without the leak check. LSAN
-# use_tls=0 avoids the crash too but reports TLS-held objects of OpenImageIO's dependencies as
-# leaks. The same rasterizer code is leak-checked through OSMesa in every other raster test.
+# LeakSanitizer's exit-time scan (gcc 12's libsanitizer) can crash ("Tracer caught signal 11")
+# on a garbage dynamic-TLS entry of a Mesa library opened with dlopen. RVR_LINK_OSMESA=ON loads
+# libOSMesa and LLVM at start-up (static TLS), which avoids it, but Mesa's EGL driver is still
+# opened by libEGL, so tests that make EGL contexts run with ASan and UBSan but without the
+# leak check. LSAN use_tls=0 avoids the crash too but reports TLS-held objects of OpenImageIO's
+# dependencies as leaks. The same rasterizer code is leak-checked through OSMesa in every
+# other raster test.
 SANITIZE_EGL ?= Egl|egl
 # intercept_tls_get_addr=0: at exit, libgnutls's destructor (an OpenImageIO dependency) reads its
-# thread-local data through __tls_get_addr, and gcc 12's interceptor records a garbage block for
-# it (start 0x3a7b, size ~2^36, caught with a gdb watchpoint), which the exit-time scan then
-# reads: "Tracer caught signal 11" on every run of `rvr compare cube.3ds` on an Intel Xeon
-# machine, never on the AMD one before. Without the interception dynamic TLS blocks are not
-# scanned as roots: that can only add leak reports (objects held only there), never hide one.
+# thread-local data through __tls_get_addr, for which gcc 12's interceptor can record a garbage
+# block that the exit-time scan then reads ("Tracer caught signal 11"). Without the
+# interception dynamic TLS blocks are not scanned as roots: that can only add leak reports
+# (objects held only there), never hide one.
 SANITIZE_ASAN := strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1:intercept_tls_get_addr=0
 SANITIZE_LSAN := suppressions=$(CURDIR)/tests/sanitize/lsan.supp:print_suppressions=0
 SANITIZE_UBSAN := print_stacktrace=1:halt_on_error=1
@@ -89,8 +89,8 @@ fuzz: deps
 	FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run.sh $(FUZZ_DIR)
 
 # A sweep of a few minutes: JSON into bench/results/, charts into bench/charts/. Three
-# repetitions in random order, medians kept: on 2 shared cores the machine speed drifts by 2x
-# over minutes, and interleaving spreads the drift over every benchmark alike.
+# repetitions in random order, medians kept: on a shared machine the speed drifts over minutes,
+# and interleaving spreads the drift over every benchmark alike.
 # BM_Visibility: the frame chart's z-buffers, tracers and hybrids, without the brute-force and
 # binary-BVH tracers, and without 10^7 triangles for llvmpipe and the hybrids (seconds a frame).
 BENCH_FILTER ?= BM_Frame/(raster|softraster|raytrace|raytrace_bvh2|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_Frame/(hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_Visibility/(softraster|raytrace|embree)/(tessphere|soup)/[0-9]+/1024|BM_Visibility/(raster|hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_DepthComplexity|BM_Effects|BM_Trace|BM_Build|BM_Threads

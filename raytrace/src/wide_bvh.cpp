@@ -11,12 +11,9 @@ namespace rvr {
 namespace {
 
 // For the SAH of the binary tree the wide one is made from: a wide node visit tests eight boxes
-// at once, so it costs about as much as testing one 4-triangle block. Measured on this machine
-// against Embree, interleaved (primary and random rays, tessphere:100000, soup:100000 and
-// 1000000): traversal costs 0.5, 1, 2 and 4, leaves of at most 4 or 8 triangles, 16 or 32 bins
-// are all within the noise (+-10%) of each other; cost 1 with leaves of up to 8 triangles needs
-// the least memory (49 bytes per triangle on soup:20000, 54 on tessphere:20000, against 59 with
-// leaves of at most 4).
+// at once, so it costs about as much as testing one 4-triangle block. Trace speed hardly depends
+// on this cost or on the leaf size (bench/JOURNAL.md); cost 1 with leaves of up to 8 triangles
+// takes the least memory.
 constexpr float kWideTraversalCost = 1.0f;
 
 class Collapser {

@@ -25,11 +25,9 @@ struct ObjectShading {
 };
 
 // Asks for transparent huge pages over a buffer not yet touched. The frame's buffers are fresh
-// memory every frame (the caller takes them away): 31 MB at 1024x768, first touched here, one
-// page fault per 4 KiB (page faults were a fifth of the samples of a tessphere:100000 frame).
-// Where the system grants huge pages on request, that is one fault per 2 MiB (measured: 4,600
-// faults a frame before, 2,000 after). Advice only: no byte written changes, and a refusal (an
-// error return) leaves the small pages.
+// memory every frame (the caller takes them away), tens of MB first touched here: one page
+// fault per 4 KiB, or, where the system grants huge pages on request, one per 2 MiB. Advice
+// only: no byte written changes, and a refusal (an error return) leaves the small pages.
 template <class T>
 void ask_for_huge_pages(PixelVector<T>& v) {
   constexpr uintptr_t kHuge = uintptr_t(2) << 20;

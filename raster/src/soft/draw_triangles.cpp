@@ -21,8 +21,8 @@ using Clock = std::chrono::steady_clock;
 // a time in parallel, binned, and drawn into every tile before the next: memory holds one chunk,
 // whatever the triangle count. Each chunk's tile pass fetches again the frame-buffer lines its
 // triangles touch: scattered triangles (a soup) touch most of the frame in every chunk, so fewer,
-// larger chunks save that traffic (soup 10^6: 16 chunks of 65,536 -> 4 of 262,144 took 10-15%
-// off the frame); 262,144 set-up triangles are 48 MiB, well inside the memory target at 10^7.
+// larger chunks save that traffic; 262,144 set-up triangles are 48 MiB, well inside the memory
+// target at 10^7.
 constexpr size_t kChunk = size_t(1) << 18;
 // 8192 set-up triangles are 1.5 MiB: one huge page each (HugePageAllocator).
 constexpr size_t kSubChunk = 8192;

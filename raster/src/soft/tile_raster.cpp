@@ -34,8 +34,8 @@ DepthTarget::DepthTarget(int width, int height, double near_plane, double far_pl
 
 void DepthTarget::clear() {
   const size_t n = size_t(width_) * size_t(height_);
-  // Sized without a serial fill (tens of MB at 1024x768, a serial share of the frame that
-  // kept two threads from doubling the speed), then filled in parallel slices.
+  // Sized without a serial fill (tens of MB at 1024x768: a serial fill would be a serial share
+  // of every frame), then filled in parallel slices.
   depth_.resize(n);
   if (!depth_only_) {
     object_.resize(n);
