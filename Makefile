@@ -1,29 +1,45 @@
 # The README's commands: `make demo` and `make test` do everything on a fresh Debian 12 machine.
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
-PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
-	libpng-dev libopenexr-dev \
-	openimageio-tools libbenchmark-dev libgtest-dev libembree-dev libtbb-dev \
-	nlohmann-json3-dev libcli11-dev libfmt-dev libassimp-dev python3-matplotlib \
-	clang-14 libclang-rt-14-dev python3-glad libegl-dev libegl-mesa0 chromium python3-websocket \
-	python3-jsonschema
+# DEMO_PACKAGES: what building the rvr command and running it need (the libraries it links or
+# opens, the GL loader generator, OSMesa and EGL). TEST_PACKAGES: what only the tests, the
+# benchmarks, `make sanitize` and `make fuzz` need (GoogleTest, Google Benchmark, idiff, the
+# browser tests' Chromium, the schema and chart checks' Python modules, clang for libFuzzer).
+DEMO_PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
+	libpng-dev libopenexr-dev libembree-dev libtbb-dev nlohmann-json3-dev libcli11-dev \
+	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0
+TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools python3-matplotlib \
+	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev
+PACKAGES := $(DEMO_PACKAGES) $(TEST_PACKAGES)
 
-.PHONY: all deps build demo test check sanitize fuzz bench study clean format
+.PHONY: all deps deps-demo build demo test check sanitize fuzz bench study clean format
 
 all: build
 
-deps:
-	@missing=$$(for p in $(PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
-	if [ -z "$$missing" ]; then echo "deps: all packages present"; exit 0; fi; \
-	if [ "$$(id -u)" != 0 ]; then echo "deps: run as root: apt-get update && apt-get install -y $$missing"; exit 1; fi; \
-	echo "deps: installing $$missing"; \
+# Installs the missing packages of $(1) (as root), or says which are missing.
+define install_missing
+	@missing=$$(for p in $(1); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
+	if [ -z "$$missing" ]; then echo "$@: all packages present"; exit 0; fi; \
+	if [ "$$(id -u)" != 0 ]; then echo "$@: run as root: apt-get update && apt-get install -y $$missing"; exit 1; fi; \
+	echo "$@: installing $$missing"; \
 	apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing
+endef
 
+deps-demo:
+	$(call install_missing,$(DEMO_PACKAGES))
+
+deps:
+	$(call install_missing,$(PACKAGES))
+
+# Everything: the CLI, the benchmarks and the tests.
 build: deps
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DRVR_BUILD_TESTS=ON -DRVR_BUILD_BENCH=ON
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
-demo: build
+# Only the rvr command (no tests, no benchmarks), so only DEMO_PACKAGES are installed.
+demo: deps-demo
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DRVR_BUILD_TESTS=OFF -DRVR_BUILD_BENCH=OFF
+	cmake --build $(BUILD_DIR) -j $(JOBS) --target rvr
 	$(BUILD_DIR)/bin/rvr compare builtin:cornell -o rvr-out
 
 test: build
