@@ -275,6 +275,12 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
     tasks.push_back(
         {task.begin, part.mid, ~0u, task.depth + 1, part.left_box, part.left_centroids});
   }
+  RVR_CHECK(bvh.nodes_.size() == 2 * bvh.stats_.leaves - 1,
+            "a binary tree has one inner node fewer than leaves: ", bvh.nodes_.size(), " nodes, ",
+            bvh.stats_.leaves, " leaves");
+  RVR_CHECK(bvh.stats_.max_depth < size_t(kStackSize),
+            "object medians past kMedianDepth keep the depth within the traversal stack: depth ",
+            bvh.stats_.max_depth);
   RVR_CHECK(leaf_primitives == n, "every primitive lies in exactly one leaf: ", leaf_primitives,
             " in leaves of ", n);
   bvh.order_.resize(n);
