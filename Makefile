@@ -9,10 +9,10 @@ DEMO_PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimag
 	libpng-dev libopenexr-dev libembree-dev libtbb-dev nlohmann-json3-dev libcli11-dev \
 	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0
 TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools python3-matplotlib \
-	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev
+	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev clang-tidy-14 iwyu
 PACKAGES := $(DEMO_PACKAGES) $(TEST_PACKAGES)
 
-.PHONY: all deps deps-demo build demo test check sanitize fuzz bench study clean format
+.PHONY: all deps deps-demo build demo test check sanitize fuzz bench study clean format lint
 
 all: build
 
@@ -129,6 +129,19 @@ study: build
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')
+
+# clang-tidy 14 (.clang-tidy: bugprone-*, performance-*, readability-function-size at 120 lines,
+# less the checks listed there as noise) over every project translation unit in the build's
+# compile_commands.json; any finding fails. LINT_FILES narrows it (a regular expression on paths).
+LINT_FILES ?= $(CURDIR)/(apps|shared|raster|raytrace|hybrid|renderers|study|image_codec)/
+# Then include-what-you-use on apps/rvr (tools/iwyu.imp maps glm's, nlohmann's, CLI11's and
+# libstdc++'s internal headers to their public ones): any include to add or remove fails.
+lint: build
+	run-clang-tidy-14 -p $(BUILD_DIR) -j $(JOBS) -quiet '$(LINT_FILES)'
+	iwyu_tool -p $(BUILD_DIR) -j $(JOBS) apps/rvr -- -Xiwyu --no_fwd_decls -Xiwyu --cxx17ns \
+		-Xiwyu --mapping_file=$(CURDIR)/tools/iwyu.imp > $(BUILD_DIR)/iwyu.txt 2>&1 || true
+	@if grep -q 'should \(add\|remove\) these lines' $(BUILD_DIR)/iwyu.txt; then \
+		cat $(BUILD_DIR)/iwyu.txt; echo "lint: include-what-you-use asks for changes in apps/rvr"; exit 1; fi
 
 clean:
 	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) rvr-out

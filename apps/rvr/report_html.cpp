@@ -3,20 +3,18 @@
 // report.html is one self-contained file: the images are embedded as base64 data URIs, the CSS
 // and the few lines of script are inline, nothing is fetched from anywhere.
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <exception>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
+#include <initializer_list>
 #include <map>
-#include <nlohmann/json.hpp>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "colour_bar.h"
@@ -25,6 +23,9 @@
 #include "report_css.h"
 #include "report_script.h"
 #include "report_text.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/html_escape.h"
 #include "rvr/shared/mismatch_classes.h"
 #include "timing_chart.h"
 
