@@ -1,29 +1,45 @@
 # The README's commands: `make demo` and `make test` do everything on a fresh Debian 12 machine.
 BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
-PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
-	libpng-dev libopenexr-dev \
-	openimageio-tools libbenchmark-dev libgtest-dev libembree-dev libtbb-dev \
-	nlohmann-json3-dev libcli11-dev libfmt-dev libassimp-dev python3-matplotlib \
-	clang-14 libclang-rt-14-dev python3-glad libegl-dev libegl-mesa0 chromium python3-websocket \
-	python3-jsonschema
+# DEMO_PACKAGES: what building the rvr command and running it need (the libraries it links or
+# opens, the GL loader generator, OSMesa and EGL). TEST_PACKAGES: what only the tests, the
+# benchmarks, `make sanitize` and `make fuzz` need (GoogleTest, Google Benchmark, idiff, the
+# browser tests' Chromium, the schema and chart checks' Python modules, clang for libFuzzer).
+DEMO_PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
+	libpng-dev libopenexr-dev libembree-dev libtbb-dev nlohmann-json3-dev libcli11-dev \
+	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0
+TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools python3-matplotlib \
+	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev clang-tidy-14 iwyu
+PACKAGES := $(DEMO_PACKAGES) $(TEST_PACKAGES)
 
-.PHONY: all deps build demo test check sanitize fuzz bench study clean format
+.PHONY: all deps deps-demo build demo test check sanitize fuzz bench study clean format lint
 
 all: build
 
-deps:
-	@missing=$$(for p in $(PACKAGES); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
-	if [ -z "$$missing" ]; then echo "deps: all packages present"; exit 0; fi; \
-	if [ "$$(id -u)" != 0 ]; then echo "deps: run as root: apt-get update && apt-get install -y $$missing"; exit 1; fi; \
-	echo "deps: installing $$missing"; \
+# Installs the missing packages of $(1) (as root), or says which are missing.
+define install_missing
+	@missing=$$(for p in $(1); do dpkg-query -W -f='$${Status}\n' $$p 2>/dev/null | grep -q '^install ok installed' || echo $$p; done); \
+	if [ -z "$$missing" ]; then echo "$@: all packages present"; exit 0; fi; \
+	if [ "$$(id -u)" != 0 ]; then echo "$@: run as root: apt-get update && apt-get install -y $$missing"; exit 1; fi; \
+	echo "$@: installing $$missing"; \
 	apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $$missing
+endef
 
+deps-demo:
+	$(call install_missing,$(DEMO_PACKAGES))
+
+deps:
+	$(call install_missing,$(PACKAGES))
+
+# Everything: the CLI, the benchmarks and the tests.
 build: deps
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DRVR_BUILD_TESTS=ON -DRVR_BUILD_BENCH=ON
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
-demo: build
+# Only the rvr command (no tests, no benchmarks), so only DEMO_PACKAGES are installed.
+demo: deps-demo
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DRVR_BUILD_TESTS=OFF -DRVR_BUILD_BENCH=OFF
+	cmake --build $(BUILD_DIR) -j $(JOBS) --target rvr
 	$(BUILD_DIR)/bin/rvr compare builtin:cornell -o rvr-out
 
 test: build
@@ -34,30 +50,31 @@ check: build
 	cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L fast
 
 # The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer (any UB fails the
-# test), in its own build folder: -O2 with line tables and assertions on (no NDEBUG). Leaks
+# test), in its own build folder: -O2 with line tables, assert, RVR_CHECK and RVR_DCHECK on (no
+# NDEBUG, and RVR_ENABLE_DCHECK so it stays on whatever the build type). Leaks
 # inside Mesa and Assimp are suppressed by tests/sanitize/lsan.supp (third-party code only).
 # Only the CLI and the test binaries are built (not the benchmarks).
 SANITIZE_DIR ?= build-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 SANITIZE_TARGETS := rvr $(patsubst tests/%.cpp,%,$(wildcard tests/test_*.cpp))
 # Brute-force conformance (`raytrace_none_*`: every scene traced with no acceleration
-# structure) takes 10 s natively and ~9 minutes under ASan; the same tracer code runs under
-# ASan with the BVH in every other conformance case, and the brute-force path in test_bvh.
+# structure) is left out: under ASan it alone would take longer than the rest of the suite; the
+# same tracer code runs under ASan with the BVH in every other conformance case, and the
+# brute-force path in test_bvh.
 SANITIZE_EXCLUDE ?= Conformance[.]AgreesWithTheOtherLoopOrder/raytrace_none_
-# LeakSanitizer's exit-time scan (gcc 12's libsanitizer) crashes now and then ("Tracer caught
-# signal 11") on a garbage dynamic-TLS entry of Mesa opened with dlopen: about 1 run in 10 of
-# an EGL test, rarer with OSMesa. RVR_LINK_OSMESA=ON loads libOSMesa and LLVM at start-up
-# (static TLS), which cured it in 48 runs, but Mesa's EGL driver is still opened by libEGL, so
-# tests that make EGL contexts run with ASan and UBSan but without the leak check. LSAN
-# use_tls=0 avoids the crash too but reports TLS-held objects of OpenImageIO's dependencies as
-# leaks. The same rasterizer code is leak-checked through OSMesa in every other raster test.
+# LeakSanitizer's exit-time scan (gcc 12's libsanitizer) can crash ("Tracer caught signal 11")
+# on a garbage dynamic-TLS entry of a Mesa library opened with dlopen. RVR_LINK_OSMESA=ON loads
+# libOSMesa and LLVM at start-up (static TLS), which avoids it, but Mesa's EGL driver is still
+# opened by libEGL, so tests that make EGL contexts run with ASan and UBSan but without the
+# leak check. LSAN use_tls=0 avoids the crash too but reports TLS-held objects of OpenImageIO's
+# dependencies as leaks. The same rasterizer code is leak-checked through OSMesa in every
+# other raster test.
 SANITIZE_EGL ?= Egl|egl
 # intercept_tls_get_addr=0: at exit, libgnutls's destructor (an OpenImageIO dependency) reads its
-# thread-local data through __tls_get_addr, and gcc 12's interceptor records a garbage block for
-# it (start 0x3a7b, size ~2^36, caught with a gdb watchpoint), which the exit-time scan then
-# reads: "Tracer caught signal 11" on every run of `rvr compare cube.3ds` on an Intel Xeon
-# machine, never on the AMD one before. Without the interception dynamic TLS blocks are not
-# scanned as roots: that can only add leak reports (objects held only there), never hide one.
+# thread-local data through __tls_get_addr, for which gcc 12's interceptor can record a garbage
+# block that the exit-time scan then reads ("Tracer caught signal 11"). Without the
+# interception dynamic TLS blocks are not scanned as roots: that can only add leak reports
+# (objects held only there), never hide one.
 SANITIZE_ASAN := strict_string_checks=1:detect_stack_use_after_return=1:check_initialization_order=1:intercept_tls_get_addr=0
 SANITIZE_LSAN := suppressions=$(CURDIR)/tests/sanitize/lsan.supp:print_suppressions=0
 SANITIZE_UBSAN := print_stacktrace=1:halt_on_error=1
@@ -65,7 +82,7 @@ sanitize: deps
 	cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 		-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" \
 		-DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
-		-DRVR_LINK_OSMESA=ON -DRVR_TEST_TIMEOUT_SCALE=10
+		-DRVR_LINK_OSMESA=ON -DRVR_TEST_TIMEOUT_SCALE=10 -DRVR_ENABLE_DCHECK=ON
 	cmake --build $(SANITIZE_DIR) -j $(JOBS) --target $(SANITIZE_TARGETS)
 	cd $(SANITIZE_DIR) && \
 		ASAN_OPTIONS=detect_leaks=1:$(SANITIZE_ASAN) LSAN_OPTIONS=$(SANITIZE_LSAN) \
@@ -82,14 +99,14 @@ FUZZ_SECONDS ?= 60
 FUZZ_FLAGS := -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 fuzz: deps
 	cmake -S . -B $(FUZZ_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-14 \
-		-DRVR_BUILD_FUZZERS=ON -DRVR_BUILD_TESTS=OFF -DCMAKE_CXX_FLAGS="$(FUZZ_FLAGS)" \
+		-DRVR_BUILD_FUZZERS=ON -DRVR_BUILD_TESTS=OFF -DRVR_ENABLE_DCHECK=ON -DCMAKE_CXX_FLAGS="$(FUZZ_FLAGS)" \
 		-DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined"
 	cmake --build $(FUZZ_DIR) -j $(JOBS) --target fuzz_scene fuzz_mesh
 	FUZZ_SECONDS=$(FUZZ_SECONDS) tests/fuzz/run.sh $(FUZZ_DIR)
 
 # A sweep of a few minutes: JSON into bench/results/, charts into bench/charts/. Three
-# repetitions in random order, medians kept: on 2 shared cores the machine speed drifts by 2x
-# over minutes, and interleaving spreads the drift over every benchmark alike.
+# repetitions in random order, medians kept: on a shared machine the speed drifts over minutes,
+# and interleaving spreads the drift over every benchmark alike.
 # BM_Visibility: the frame chart's z-buffers, tracers and hybrids, without the brute-force and
 # binary-BVH tracers, and without 10^7 triangles for llvmpipe and the hybrids (seconds a frame).
 BENCH_FILTER ?= BM_Frame/(raster|softraster|raytrace|raytrace_bvh2|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_Frame/(hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_Visibility/(softraster|raytrace|embree)/(tessphere|soup)/[0-9]+/1024|BM_Visibility/(raster|hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_DepthComplexity|BM_Effects|BM_Trace|BM_Build|BM_Threads
@@ -112,6 +129,19 @@ study: build
 
 format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')
+
+# clang-tidy 14 (.clang-tidy: bugprone-*, performance-*, readability-function-size at 120 lines,
+# less the checks listed there as noise) over every project translation unit in the build's
+# compile_commands.json; any finding fails. LINT_FILES narrows it (a regular expression on paths).
+LINT_FILES ?= $(CURDIR)/(apps|shared|raster|raytrace|hybrid|renderers|study|image_codec)/
+# Then include-what-you-use on apps/rvr (tools/iwyu.imp maps glm's, nlohmann's, CLI11's and
+# libstdc++'s internal headers to their public ones): any include to add or remove fails.
+lint: build
+	run-clang-tidy-14 -p $(BUILD_DIR) -j $(JOBS) -quiet '$(LINT_FILES)'
+	iwyu_tool -p $(BUILD_DIR) -j $(JOBS) apps/rvr -- -Xiwyu --no_fwd_decls -Xiwyu --cxx17ns \
+		-Xiwyu --mapping_file=$(CURDIR)/tools/iwyu.imp > $(BUILD_DIR)/iwyu.txt 2>&1 || true
+	@if grep -q 'should \(add\|remove\) these lines' $(BUILD_DIR)/iwyu.txt; then \
+		cat $(BUILD_DIR)/iwyu.txt; echo "lint: include-what-you-use asks for changes in apps/rvr"; exit 1; fi
 
 clean:
 	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) rvr-out

@@ -1,12 +1,31 @@
 #!/usr/bin/python3
 """Puts a study's generated study.md into bench/README.md, between the `<!-- study.md -->`
 marker and the next second-level heading, its headings moved down two levels. The README then
-shows the last `make study` run as generated, never edited by hand.
+shows the last `make study` run as generated, never edited by hand. The long per-renderer lists
+(scaling slopes, cost per triangle and per ray) stay in study.md only, so that the README
+remains a reference page: a line in their place points there.
 
 usage: paste_study.py STUDY_MD README_MD
 """
 import re
 import sys
+
+# Sections of study.md (second-level headings there) left out of the README.
+LEFT_OUT = ("Scaling", "Cost per triangle")
+
+
+def without_long_lists(study):
+    """study.md without the LEFT_OUT sections (each up to the next heading of its level or
+    above), and whether any was left out."""
+    kept, skipping, left_out = [], False, False
+    for line in study.splitlines():
+        heading = re.match(r"^(#+) (.*)", line)
+        if heading and len(heading.group(1)) <= 2:
+            skipping = len(heading.group(1)) == 2 and heading.group(2).startswith(LEFT_OUT)
+            left_out = left_out or skipping
+        if not skipping:
+            kept.append(line)
+    return "\n".join(kept), left_out
 
 
 def main():
@@ -24,8 +43,13 @@ def main():
     start += len(marker)
     following = re.search(r"^## ", readme[start:], flags=re.M)
     end = start + following.start() if following else len(readme)
+    study, left_out = without_long_lists(study)
     demoted = re.sub(r"^(#+) ", lambda m: "#" * (len(m.group(1)) + 2) + " ", study, flags=re.M)
-    readme = readme[:start] + "\n" + demoted.strip() + "\n\n" + readme[end:]
+    pasted = demoted.strip() + "\n"
+    if left_out:
+        pasted += ("\nThe scaling slopes and the cost per triangle and per ray of every renderer "
+                   "are in `bench/study/study.md`.\n")
+    readme = readme[:start] + "\n" + pasted + "\n" + readme[end:]
     with open(readme_path, "w", encoding="utf-8") as f:
         f.write(readme)
 

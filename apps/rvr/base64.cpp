@@ -1,6 +1,7 @@
 // RFC 4648 base64 (see base64.h).
 #include "base64.h"
 
+#include <cstddef>
 #include <cstdint>
 
 namespace rvr {

@@ -2,7 +2,7 @@
 // and check; main catches Exit. Private to apps/rvr.
 #pragma once
 
-#include <utility>
+#include <utility>  // IWYU pragma: keep (std::move in take(), a template)
 
 #include "rvr/shared/expected.h"
 

@@ -1,24 +1,12 @@
 // The inferno colour bar (see colour_bar.h).
 #include "colour_bar.h"
 
-#include <algorithm>
-#include <cmath>
-#include <cstdint>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <exception>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <map>
-#include <nlohmann/json.hpp>
-#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "report_text.h"
+#include "rvr/shared/html_escape.h"
 
 namespace rvr::report {
 namespace {

@@ -1,34 +1,27 @@
 // The options render and compare share (see commands.h).
-#include <fmt/format.h>
-#include <sys/resource.h>
-#include <unistd.h>
-
 #include <CLI/CLI.hpp>
-#include <chrono>
-#include <csignal>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <iostream>
-#include <nlohmann/json.hpp>
+#include <glm/glm.hpp>
 #include <optional>
-#include <thread>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <utility>
 
 #include "cli_exit.h"
 #include "commands.h"
 #include "one_of.h"
-#include "report.h"
 #include "rvr/raster/gl_rasterizer.h"
-#include "rvr/raytrace/ray_tracer.h"
-#include "rvr/renderers/compare_renderers.h"
-#include "rvr/renderers/registry.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/image_io.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/isa.h"
 #include "rvr/shared/limits.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
-#include "rvr/shared/scene_writer.h"
-#include "terminal_progress.h"
+#include "rvr/shared/timer.h"
 
 namespace rvr::cli {
 

@@ -1,34 +1,24 @@
 // rvr render: one renderer, one image, its AOVs and --stats.
-#include <fmt/format.h>
 #include <sys/resource.h>
-#include <unistd.h>
 
-#include <CLI/CLI.hpp>
-#include <chrono>
-#include <csignal>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iostream>
+#include <glm/glm.hpp>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
-#include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
-#include "report.h"
-#include "rvr/raster/gl_rasterizer.h"
-#include "rvr/raytrace/ray_tracer.h"
-#include "rvr/renderers/compare_renderers.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/compare.h"
 #include "rvr/shared/image_io.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/limits.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/scene_writer.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
+#include "rvr/shared/timer.h"
 #include "terminal_progress.h"
 
 namespace rvr::cli {

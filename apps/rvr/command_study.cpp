@@ -8,23 +8,36 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
+#include <initializer_list>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <system_error>
 #include <thread>
+#include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
 #include "cpu_probe.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/isa.h"
 #include "rvr/study/merge.h"
 #include "rvr/study/renderer_frames.h"
 #include "rvr/study/run_study.h"
+#include "rvr/study/study.h"
 #include "rvr/study/study_html.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/study_markdown.h"
+#include "rvr/study/sweep_plan.h"
 #include "terminal_progress.h"
 
 namespace {
@@ -151,7 +164,8 @@ void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
   cmd->add_option("--mode", a.mode, "visibility | local | full (default local)")
       ->check(CLI::IsMember({"visibility", "local", "full"}));
   cmd->add_option("--budget", a.budget, "seconds the sweep may take (default 300)");
-  cmd->add_option("--repetitions", a.repetitions, "frames timed per renderer and point (>= 5, default 5)");
+  cmd->add_option("--repetitions", a.repetitions,
+                  "frames timed per renderer and point (>= 5, default 5)");
   cmd->add_option("--seed", a.seed, "seed of the interleaving order and the bootstrap");
   cmd->add_flag("-q,--quiet", a.quiet, "no progress line");
   CLI::Option* shard =

@@ -1,33 +1,9 @@
 // Probing the CPU for rvr info (see cpu_probe.h).
 #include "cpu_probe.h"
 
-#include <fmt/format.h>
-#include <sys/resource.h>
-#include <unistd.h>
-
-#include <CLI/CLI.hpp>
-#include <chrono>
 #include <csignal>
-#include <cstdio>
-#include <filesystem>
 #include <fstream>
-#include <iostream>
-#include <nlohmann/json.hpp>
-#include <optional>
-#include <thread>
-
-#include "report.h"
-#include "rvr/raster/gl_rasterizer.h"
-#include "rvr/raytrace/ray_tracer.h"
-#include "rvr/renderers/compare_renderers.h"
-#include "rvr/renderers/registry.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/limits.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/scene_writer.h"
-#include "terminal_progress.h"
+#include <initializer_list>
 
 namespace rvr::cli {
 

@@ -1,36 +1,24 @@
 // rvr: render one scene two ways and tell the truth about the difference. This program only
 // parses, calls the libraries and writes; errors come back as values and are printed here.
 #include <fmt/format.h>
-#include <fmt/ranges.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <chrono>
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <iostream>
-#include <nlohmann/json.hpp>
-#include <optional>
+#include <exception>
+#include <initializer_list>
+#include <new>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
-#include "report.h"
-#include "rvr/raster/gl_rasterizer.h"
-#include "rvr/raytrace/ray_tracer.h"
-#include "rvr/renderers/compare_renderers.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/limits.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/scene_writer.h"
 #include "suggest.h"
 #include "terminal_progress.h"
 

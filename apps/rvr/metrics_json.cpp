@@ -5,23 +5,18 @@
 // non-finite number as null.
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <exception>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
+#include <initializer_list>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
-#include <set>
-#include <sstream>
 #include <string>
 #include <vector>
 
 #include "report.h"
 #include "report_text.h"
+#include "rvr/shared/compare.h"
 #include "rvr/shared/mismatch_classes.h"
 
 namespace rvr {

@@ -3,20 +3,18 @@
 // report.html is one self-contained file: the images are embedded as base64 data URIs, the CSS
 // and the few lines of script are inline, nothing is fetched from anywhere.
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <exception>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
+#include <initializer_list>
 #include <map>
-#include <nlohmann/json.hpp>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "colour_bar.h"
@@ -25,6 +23,9 @@
 #include "report_css.h"
 #include "report_script.h"
 #include "report_text.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/html_escape.h"
 #include "rvr/shared/mismatch_classes.h"
 #include "timing_chart.h"
 
@@ -153,307 +154,386 @@ std::string other_pairs(const std::vector<ReportPair>& pairs, const std::vector<
   return h.str();
 }
 
+// The renderer names of every pair's indices (placeholders where the input lists fewer).
+std::vector<std::string> renderer_names(const ReportInput& input,
+                                        const std::vector<ReportPair>& pairs) {
+  std::vector<std::string> names;
+  for (const auto& r : input.renderers) names.push_back(r.name);
+  for (const ReportPair& p : pairs)
+    while (names.size() <= std::max(p.a, p.b)) names.push_back(names.empty() ? "A" : "B");
+  return names;
+}
+
+// Every image the page embeds, as data URIs.
+struct ReportImages {
+  std::vector<std::string> renders, costs;    // per renderer; a cost URI is empty without a file
+  std::string diff, id_mismatch, depth_diff;  // of the first pair
+  std::vector<std::string> classes;           // per pair
+};
+
+// Reads every image first, so that a missing file fails before any HTML is built.
+Expected<ReportImages> embed_images(const ReportInput& input,
+                                    const std::vector<ReportPair>& pairs) {
+  ReportImages images;
+  for (const auto& r : input.renderers) {
+    auto uri = data_uri(input.out_dir, r.image_file);
+    if (!uri) return uri.error();
+    images.renders.push_back(std::move(uri.value()));
+  }
+  for (const auto& r : input.renderers) {
+    if (r.cost_file.empty()) {
+      images.costs.emplace_back();
+      continue;
+    }
+    auto uri = data_uri(input.out_dir, r.cost_file);
+    if (!uri) return uri.error();
+    images.costs.push_back(std::move(uri.value()));
+  }
+  const ReportPair& first = pairs.front();
+  for (auto [file, to] :
+       {std::pair{"diff", &images.diff}, std::pair{"id_mismatch", &images.id_mismatch},
+        std::pair{"depth_diff", &images.depth_diff}}) {
+    auto uri = data_uri(input.out_dir, first.file(file));
+    if (!uri) return uri.error();
+    *to = std::move(uri.value());
+  }
+  for (const ReportPair& p : pairs) {
+    auto uri = data_uri(input.out_dir, p.file("mismatch_classes"));
+    if (!uri) return uri.error();
+    images.classes.push_back(std::move(uri.value()));
+  }
+  return images;
+}
+
+std::string page_head(const std::string& title) {
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+    << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+    << "<title>" << escape_html(title) << "</title>\n<style>" << kCss << "</style>\n"
+    << "</head>\n<body>\n<main>\n";
+  return h.str();
+}
+
+// The title, what was rendered, the command line and the verdict badges of the first pair.
+std::string summary(const ReportInput& input, const std::string& title, const ReportPair& first) {
+  const auto& vis = first.metrics.visibility;
+  const auto& col = first.metrics.color;
+  std::ostringstream h;
+  h << "<h1>" << escape_html(title) << "</h1>\n";
+  h << "<div class=\"meta\"><span><b>scene</b> " << escape_html(input.scene)
+    << "</span><span><b>size</b> " << input.width << "&times;" << input.height
+    << "</span><span><b>mode</b> " << escape_html(input.mode) << "</span><span><b>pixels</b> "
+    << vis.pixels << "</span></div>\n";
+  if (!input.command_line.empty())
+    h << "<pre class=\"cmd\">" << escape_html(input.command_line) << "</pre>\n";
+  h << "<div class=\"badges\">"
+    << "<span class=\"badge "
+    << (vis.classes.occlusion + vis.classes.coverage == 0 ? "good" : "bad") << "\">"
+    << "visibility errors (occlusion + coverage): " << vis.classes.occlusion + vis.classes.coverage
+    << "</span>"
+    << "<span class=\"badge " << (vis.covered_pixels == 0 ? "bad" : "neutral") << "\">covered "
+    << fmt("%.2f", vis.covered_fraction * 100.0) << "%</span>"
+    << "<span class=\"badge neutral\">id agreement " << fmt("%.4f", vis.id_agreement * 100.0)
+    << "%</span>"
+    << "<span class=\"badge neutral\">PSNR "
+    << (std::isinf(col.psnr_db) && col.psnr_db > 0 ? std::string("&infin; (identical)")
+                                                   : fmt("%.2f dB", col.psnr_db))
+    << "</span><span class=\"badge neutral\">SSIM " << fmt("%.5f", col.ssim) << "</span></div>\n";
+  return h.str();
+}
+
+// Every warning of the run and of each renderer, prominently; nothing when there is none.
+std::string warnings(const ReportInput& input) {
+  size_t warning_count = input.warnings.size();
+  for (const auto& r : input.renderers) warning_count += r.warnings.size();
+  if (warning_count == 0) return "";
+  std::ostringstream h;
+  h << "<div class=\"warn\"><h2>&#9888; Warnings (" << warning_count << ")</h2><ul>\n";
+  for (const auto& w : input.warnings) h << "<li>" << escape_html(w) << "</li>\n";
+  for (const auto& r : input.renderers)
+    for (const auto& w : r.warnings)
+      h << "<li><b>" << escape_html(r.name) << "</b>: " << escape_html(w) << "</li>\n";
+  h << "</ul></div>\n";
+  return h.str();
+}
+
+// The renders side by side, then (with two or more) the flip between the first two.
+std::string renders(const ReportInput& input, const ReportImages& images, const std::string& name_a,
+                    const std::string& name_b) {
+  std::ostringstream h;
+  h << "<h2>Renders</h2>\n<div class=\"grid\">\n";
+  for (size_t i = 0; i < input.renderers.size(); ++i) {
+    const auto& r = input.renderers[i];
+    h << "<figure><img src=\"" << images.renders[i] << "\" alt=\"" << escape_html(r.name)
+      << "\"><figcaption><b>" << escape_html(r.name) << "</b> &middot; "
+      << escape_html(r.image_file) << " &middot; " << fmt_seconds(r.seconds)
+      << "</figcaption></figure>\n";
+  }
+  h << "</div>\n";
+  if (input.renderers.size() >= 2) {
+    h << "<h2>Flip</h2>\n<div class=\"grid\"><figure><div class=\"flip\">"
+      << "<img src=\"" << images.renders[0] << "\" alt=\"" << escape_html(name_a) << "\">"
+      << "<img id=\"flip-top\" class=\"top\" src=\"" << images.renders[1] << "\" alt=\""
+      << escape_html(name_b) << "\"></div>"
+      << "<div class=\"flipctl\"><span>" << escape_html(name_a)
+      << "</span><input id=\"flip-range\" type=\"range\" min=\"0\" max=\"100\" value=\"50\" "
+      << "aria-label=\"slider between the two renders\"><span>" << escape_html(name_b)
+      << "</span><button id=\"flip-button\" type=\"button\">flip</button></div>"
+      << "<figcaption>Left of the cut: " << escape_html(name_a)
+      << "; right of it: " << escape_html(name_b)
+      << ". Drag the slider, or flip between the whole images.</figcaption></figure></div>\n";
+  }
+  return h.str();
+}
+
+// The depth scale's decades as ticks of its colour bar.
+std::vector<std::pair<double, std::string>> depth_ticks(double low, double high) {
+  std::vector<std::pair<double, std::string>> ticks;
+  if (low > 0 && high > low) {
+    const double decades = std::log10(high / low);
+    // The ends are floats: 1e-2f is 0.0099999998, still a tick.
+    for (double e = std::ceil(std::log10(low) - 1e-6); e <= std::log10(high) + 1e-6; e += 1)
+      ticks.push_back({(e - std::log10(low)) / decades, short_number(std::pow(10.0, e))});
+  }
+  return ticks;
+}
+
+// The first pair's heat maps: colour difference, mismatch classes, id mismatches and depth.
+std::string differences(const ReportInput& input, const ReportPair& first,
+                        const ReportImages& images, const std::string& name_a,
+                        const std::string& name_b) {
+  const double low = input.depth_diff_scale.low, high = input.depth_diff_scale.high;
+  std::ostringstream h;
+  h << "<h2>Differences</h2>\n<div class=\"grid\">\n"
+    << "<figure><img src=\"" << images.diff
+    << "\" alt=\"colour difference heat map\"><figcaption><b>diff.png</b>: per pixel, the "
+       "largest |difference| over R, G, B of the linear colours, on the inferno colour map "
+       "(black = 0, yellow-white &ge; "
+    << fmt("%g", input.heat_map_scale) << ")."
+    << inferno_bar("bar-diff", "colour difference scale",
+                   {{0.0, "0"},
+                    {0.5, fmt("%g", input.heat_map_scale / 2)},
+                    {1.0, "&ge; " + fmt("%g", input.heat_map_scale)}})
+    << "</figcaption></figure>\n"
+    << "<figure><img src=\"" << images.classes.front()
+    << "\" alt=\"mismatch classes\"><figcaption><b>" << escape_html(first.file("mismatch_classes"))
+    << "</b>: each pixel whose (object, primitive) id differs, coloured by why, over a dimmed "
+       "grey version of "
+    << escape_html(name_a) << " (the reference of the edge test):" << class_legend()
+    << "</figcaption></figure>\n"
+    << "<figure><img src=\"" << images.id_mismatch
+    << "\" alt=\"object id mismatches\"><figcaption><b>id_mismatch.png</b>: pixels whose "
+       "object id differs, in red, over a grey version of "
+    << escape_html(name_a) << ".</figcaption></figure>\n"
+    << "<figure><div class=\"marked\"><img src=\"" << images.depth_diff
+    << "\" alt=\"relative depth difference\">"
+    << outlier_marks(first.metrics.depth, input.width, input.height)
+    << "</div><figcaption><b>depth_diff.png</b>: relative "
+       "view-depth difference |d<sub>A</sub> &minus; d<sub>B</sub>| / max(d<sub>A</sub>, "
+       "d<sub>B</sub>) of "
+    << escape_html(name_a) << " and " << escape_html(name_b)
+    << " where both hit something (whatever the ids), on a <b>log scale</b>: black &le; "
+    << short_number(low) << ", each decade an equal stretch of the colour map, yellow-white "
+    << "&ge; " << short_number(high) << ". <span class=\"nowrap\">" << swatch(kDepthDiffBackground)
+    << "background in both</span>; <span class=\"nowrap\">" << swatch(kDepthDiffHitVsBackground)
+    << "background in one, a hit in the other</span>."
+    << inferno_bar("bar-depth", "relative depth difference scale, logarithmic",
+                   depth_ticks(low, high))
+    << "</figcaption></figure>\n</div>\n";
+  return h.str();
+}
+
+// Work per pixel: what each loop order pays where.
+std::string work_per_pixel(const ReportInput& input, const ReportImages& images) {
+  std::ostringstream h;
+  h << "<h2>Work per pixel</h2>\n<div class=\"grid\">\n";
+  for (size_t i = 0; i < input.renderers.size(); ++i) {
+    const auto& r = input.renderers[i];
+    if (r.cost_file.empty()) {
+      h << "<figure><figcaption><b>" << escape_html(r.name)
+        << "</b>: no per-pixel work reported.</figcaption></figure>\n";
+      continue;
+    }
+    h << "<figure><img src=\"" << images.costs[i] << "\" alt=\"" << escape_html(r.name)
+      << " work per pixel\"><figcaption><b>" << escape_html(r.cost_file) << "</b>: "
+      << (r.stats.count("fragments.generated") ? "fragments generated per pixel (overdraw)"
+                                               : "BVH nodes visited + primitive tests per pixel")
+      << "; mean " << fmt("%.3g", r.cost_mean) << ", yellow-white &ge; " << fmt("%g", r.cost_scale)
+      << " (the 99th percentile).</figcaption></figure>\n";
+  }
+  h << "</div>\n";
+  return h.str();
+}
+
+// The first pair's metrics, each with what it means; flagged where it should be 0 and is not.
+std::vector<MetricRow> metric_rows(const ComparisonMetrics& m) {
+  const auto& vis = m.visibility;
+  const auto& dep = m.depth;
+  const auto& col = m.color;
+  const bool identical = std::isinf(col.psnr_db) && col.psnr_db > 0;
+  std::vector<MetricRow> rows = {
+      {"visibility", "pixels", std::to_string(vis.pixels), "width &times; height."},
+      {"visibility", "id_agreement", fmt("%.6f", vis.id_agreement),
+       "Fraction of pixels where both renders see the same object and the same primitive."},
+      {"visibility", "mismatched_pixels", std::to_string(vis.mismatched_pixels),
+       "Pixels whose (object, primitive) id differs."},
+      {"visibility", "covered_fraction", fmt("%.6f", vis.covered_fraction),
+       "Fraction of pixels where either render shows a surface.", vis.covered_pixels == 0},
+      {"visibility", "covered_agreement", fmt("%.6f", vis.covered_agreement),
+       "Fraction of those covered pixels whose ids agree; 0 when nothing is visible.",
+       vis.covered_pixels == 0},
+      {"visibility", "mismatch_classes.edge", std::to_string(vis.classes.edge),
+       "Mismatches whose pixel centre lies within " + short_number(kEdgeTolerancePixels) +
+           " pixel of an edge of a hit primitive: a tie the fill rules may break either way."},
+      {"visibility", "mismatch_classes.depth_precision",
+       std::to_string(vis.classes.depth_precision),
+       "Both hit, and the two surfaces lie within the depth buffers' resolution of each other "
+       "at that depth: z-fighting, decided by the depth format, not by the loop order."},
+      {"visibility", "mismatch_classes.occlusion", std::to_string(vis.classes.occlusion),
+       "Both hit, one surface farther than the other by more than that: a visibility error. "
+       "Should be 0.",
+       vis.classes.occlusion != 0},
+      {"visibility", "mismatch_classes.coverage", std::to_string(vis.classes.coverage),
+       "A surface in one render, background in the other, away from the surface's edges. "
+       "Should be 0.",
+       vis.classes.coverage != 0},
+      {"depth", "max_rel_error", fmt("%.3g", dep.max_rel_error),
+       "Largest |d<sub>A</sub> &minus; d<sub>B</sub>| / max(d<sub>A</sub>, d<sub>B</sub>) of "
+       "view-axis depth over pixels where the ids agree (background excluded)."},
+      {"depth", "mean_rel_error", fmt("%.3g", dep.mean_rel_error),
+       "Mean of the same relative depth error."},
+      {"depth", "p99_rel_error", fmt("%.3g", dep.p99_rel_error),
+       "99th percentile of the same error: 99% of those pixels are at or below it."},
+      {"depth", "p999_rel_error", fmt("%.3g", dep.p999_rel_error), "99.9th percentile."},
+      {"depth", "outliers", std::to_string(dep.outliers),
+       "Pixels whose relative depth error is above " + short_number(kDepthOutlierThreshold) +
+           " (see Depth outliers below)."},
+      {"depth", "outliers_at_silhouettes", std::to_string(dep.outliers_at_silhouettes),
+       "Of those, on an object's outline: an edge-on facet under the z-buffer's vertex "
+       "snapping."},
+      {"depth", "outliers_elsewhere", std::to_string(dep.outliers_elsewhere),
+       "Of those, anywhere else: unexplained, a real disagreement. Should be 0.",
+       dep.outliers_elsewhere != 0},
+      {"color", "rmse", fmt("%.4g", col.rmse),
+       "Root mean square difference of linear RGB over every pixel and channel."},
+      {"color", "psnr_db",
+       identical ? std::string("&infin; (999 in metrics.json)") : fmt("%.2f", col.psnr_db),
+       "20&middot;log<sub>10</sub>(1 / rmse), peak value 1; higher is closer. Identical images "
+       "have infinite PSNR, written as 999 in metrics.json."},
+      {"color", "max_abs", fmt("%.4g", col.max_abs),
+       "Largest absolute difference of one channel of one pixel (linear)."},
+      {"color", "ssim", fmt("%.5f", col.ssim),
+       "Structural similarity of the luminance of the colours clamped to [0, 1], 11&times;11 "
+       "Gaussian window (&sigma; 1.5), averaged over the image; 1 = identical."},
+  };
+  const LodMetrics& lod = m.lod;
+  if (lod.pixels > 0) {
+    rows.push_back({"lod", "mean_abs", fmt("%.3g", lod.mean_abs),
+                    "Mean |lod<sub>A</sub> &minus; lod<sub>B</sub>| in mip levels over the " +
+                        std::to_string(lod.pixels) +
+                        " pixels textured in both: how far the two loop orders' texture levels "
+                        "of detail differ (docs/design.md, Textures)."});
+    rows.push_back(
+        {"lod", "p99_abs", fmt("%.3g", lod.p99_abs), "99th percentile of the same difference."});
+  }
+  return rows;
+}
+
+std::string metrics_table(const std::vector<MetricRow>& rows) {
+  std::ostringstream h;
+  h << "<h2>Metrics</h2>\n<table><thead><tr><th>group</th><th>metric</th><th>value</th>"
+       "<th>meaning</th></tr></thead><tbody>\n";
+  for (const auto& row : rows)
+    h << "<tr><td>" << row.group << "</td><td><code>" << row.name << "</code></td><td class=\"num"
+      << (row.flagged ? " bad" : "") << "\">" << row.value << "</td><td class=\"why\">" << row.why
+      << "</td></tr>\n";
+  h << "</tbody></table>\n";
+  return h.str();
+}
+
+// Timings: seconds and every "time.*" stat, one row per renderer.
+std::string timings(const ReportInput& input) {
+  std::ostringstream h;
+  std::set<std::string> time_keys;
+  for (const auto& r : input.renderers)
+    for (const auto& [k, v] : r.stats)
+      if (k.rfind("time.", 0) == 0) time_keys.insert(k);
+  h << "<h2>Timings</h2>\n"
+    << timing_chart(input.renderers)
+    << "<p class=\"why\" style=\"color:#4a5366;font-size:13px\">Each bar: the scene load "
+       "(shared, outside the render call), the phases the renderer reports (time.* below) "
+       "and, as <i>other</i>, the rest of its render call.</p>\n"
+    << "<div class=\"scroll\"><table><thead><tr><th>renderer</th><th>seconds</th>"
+       "<th>relative</th>";
+  for (const auto& k : time_keys) h << "<th>" << escape_html(k) << "</th>";
+  h << "<th>warnings</th></tr></thead><tbody>\n";
+  const double base = input.renderers.empty() ? 0.0 : input.renderers[0].seconds;
+  for (const auto& r : input.renderers) {
+    h << "<tr><td><b>" << escape_html(r.name) << "</b></td><td class=\"num\">"
+      << fmt_seconds(r.seconds) << "</td><td class=\"num\">"
+      << (base > 0 ? fmt("%.2f&times;", r.seconds / base) : std::string("n/a")) << "</td>";
+    for (const auto& k : time_keys) {
+      auto it = r.stats.find(k);
+      h << "<td class=\"num\">" << (it == r.stats.end() ? "&ndash;" : fmt_seconds(it->second))
+        << "</td>";
+    }
+    h << "<td class=\"num\">" << r.warnings.size() << "</td></tr>\n";
+  }
+  h << "</tbody></table></div>\n<p class=\"why\" style=\"color:#4a5366;font-size:13px\">seconds: "
+       "wall-clock time of the render call; relative: divided by the first renderer's; "
+       "time.*: the phases each renderer reports.</p>\n";
+  return h.str();
+}
+
+// Every renderer's information and counters, folded away.
+std::string all_statistics(const ReportInput& input) {
+  std::ostringstream h;
+  for (const auto& r : input.renderers) {
+    if (r.stats.empty()) continue;
+    h << "<details><summary>All statistics of <b>" << escape_html(r.name) << "</b> ("
+      << r.stats.size() << ")</summary><table><tbody>\n";
+    for (const auto& [k, v] : r.info)
+      h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">" << escape_html(v)
+        << "</td></tr>\n";
+    for (const auto& [k, v] : r.stats)
+      h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">" << fmt("%.6g", v)
+        << "</td></tr>\n";
+    h << "</tbody></table></details>\n";
+  }
+  return h.str();
+}
+
+std::string page_end(const ReportInput& input) {
+  std::ostringstream h;
+  h << "<footer>Written by rvr compare. Colour metrics use linear RGB with peak 1; the "
+       "heat map scale is "
+    << fmt("%g", input.heat_map_scale) << ".</footer>\n</main>\n";
+  if (input.renderers.size() >= 2) h << "<script>" << kScript << "</script>\n";
+  h << "</body>\n</html>\n";
+  return h.str();
+}
+
 }  // namespace
 
 Expected<std::string> report_html(const ReportInput& input) {
   try {
     const std::vector<ReportPair> pairs = report_pairs(input);
-    const auto& vis = pairs.front().metrics.visibility;
-    const auto& dep = pairs.front().metrics.depth;
-    const auto& col = pairs.front().metrics.color;
-    std::vector<std::string> names;
-    for (const auto& r : input.renderers) names.push_back(r.name);
-    for (const ReportPair& p : pairs)
-      while (names.size() <= std::max(p.a, p.b)) names.push_back(names.empty() ? "A" : "B");
-    const std::string name_a = names[pairs.front().a];
-    const std::string name_b = names[pairs.front().b];
-
-    // Every image first, so a missing file fails before any HTML is built.
-    std::vector<std::string> render_uris;
-    for (const auto& r : input.renderers) {
-      auto uri = data_uri(input.out_dir, r.image_file);
-      if (!uri) return uri.error();
-      render_uris.push_back(std::move(uri.value()));
-    }
-    std::vector<std::string> cost_uris;
-    for (const auto& r : input.renderers) {
-      if (r.cost_file.empty()) {
-        cost_uris.emplace_back();
-        continue;
-      }
-      auto uri = data_uri(input.out_dir, r.cost_file);
-      if (!uri) return uri.error();
-      cost_uris.push_back(std::move(uri.value()));
-    }
     const ReportPair& first = pairs.front();
-    auto diff_uri = data_uri(input.out_dir, first.file("diff"));
-    if (!diff_uri) return diff_uri.error();
-    auto mismatch_uri = data_uri(input.out_dir, first.file("id_mismatch"));
-    if (!mismatch_uri) return mismatch_uri.error();
-    auto depth_uri = data_uri(input.out_dir, first.file("depth_diff"));
-    if (!depth_uri) return depth_uri.error();
-    std::vector<std::string> class_uris;
-    for (const ReportPair& p : pairs) {
-      auto uri = data_uri(input.out_dir, p.file("mismatch_classes"));
-      if (!uri) return uri.error();
-      class_uris.push_back(std::move(uri.value()));
-    }
+    const std::vector<std::string> names = renderer_names(input, pairs);
+    const std::string& name_a = names[first.a];
+    const std::string& name_b = names[first.b];
+    Expected<ReportImages> images = embed_images(input, pairs);
+    if (!images) return images.error();
 
-    std::ostringstream h;
     const std::string title = "rvr compare: " + name_a + " vs " + name_b + " on " + input.scene;
-    h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-      << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-      << "<title>" << escape_html(title) << "</title>\n<style>" << kCss << "</style>\n"
-      << "</head>\n<body>\n<main>\n";
-
-    h << "<h1>" << escape_html(title) << "</h1>\n";
-    h << "<div class=\"meta\"><span><b>scene</b> " << escape_html(input.scene)
-      << "</span><span><b>size</b> " << input.width << "&times;" << input.height
-      << "</span><span><b>mode</b> " << escape_html(input.mode) << "</span><span><b>pixels</b> "
-      << vis.pixels << "</span></div>\n";
-    if (!input.command_line.empty())
-      h << "<pre class=\"cmd\">" << escape_html(input.command_line) << "</pre>\n";
-
-    // Verdict badges.
-    h << "<div class=\"badges\">"
-      << "<span class=\"badge "
-      << (vis.classes.occlusion + vis.classes.coverage == 0 ? "good" : "bad") << "\">"
-      << "visibility errors (occlusion + coverage): "
-      << vis.classes.occlusion + vis.classes.coverage << "</span>"
-      << "<span class=\"badge " << (vis.covered_pixels == 0 ? "bad" : "neutral") << "\">covered "
-      << fmt("%.2f", vis.covered_fraction * 100.0) << "%</span>"
-      << "<span class=\"badge neutral\">id agreement " << fmt("%.4f", vis.id_agreement * 100.0)
-      << "%</span>"
-      << "<span class=\"badge neutral\">PSNR "
-      << (std::isinf(col.psnr_db) && col.psnr_db > 0 ? std::string("&infin; (identical)")
-                                                     : fmt("%.2f dB", col.psnr_db))
-      << "</span><span class=\"badge neutral\">SSIM " << fmt("%.5f", col.ssim) << "</span></div>\n";
-
-    // Warnings, prominently.
-    size_t warning_count = input.warnings.size();
-    for (const auto& r : input.renderers) warning_count += r.warnings.size();
-    if (warning_count > 0) {
-      h << "<div class=\"warn\"><h2>&#9888; Warnings (" << warning_count << ")</h2><ul>\n";
-      for (const auto& w : input.warnings) h << "<li>" << escape_html(w) << "</li>\n";
-      for (const auto& r : input.renderers)
-        for (const auto& w : r.warnings)
-          h << "<li><b>" << escape_html(r.name) << "</b>: " << escape_html(w) << "</li>\n";
-      h << "</ul></div>\n";
-    }
-
-    // Renders side by side.
-    h << "<h2>Renders</h2>\n<div class=\"grid\">\n";
-    for (size_t i = 0; i < input.renderers.size(); ++i) {
-      const auto& r = input.renderers[i];
-      h << "<figure><img src=\"" << render_uris[i] << "\" alt=\"" << escape_html(r.name)
-        << "\"><figcaption><b>" << escape_html(r.name) << "</b> &middot; "
-        << escape_html(r.image_file) << " &middot; " << fmt_seconds(r.seconds)
-        << "</figcaption></figure>\n";
-    }
-    h << "</div>\n";
-
-    if (input.renderers.size() >= 2) {
-      h << "<h2>Flip</h2>\n<div class=\"grid\"><figure><div class=\"flip\">"
-        << "<img src=\"" << render_uris[0] << "\" alt=\"" << escape_html(name_a) << "\">"
-        << "<img id=\"flip-top\" class=\"top\" src=\"" << render_uris[1] << "\" alt=\""
-        << escape_html(name_b) << "\"></div>"
-        << "<div class=\"flipctl\"><span>" << escape_html(name_a)
-        << "</span><input id=\"flip-range\" type=\"range\" min=\"0\" max=\"100\" value=\"50\" "
-        << "aria-label=\"slider between the two renders\"><span>" << escape_html(name_b)
-        << "</span><button id=\"flip-button\" type=\"button\">flip</button></div>"
-        << "<figcaption>Left of the cut: " << escape_html(name_a)
-        << "; right of it: " << escape_html(name_b)
-        << ". Drag the slider, or flip between the whole images.</figcaption></figure></div>\n";
-    }
-
-    // Heat maps. The depth scale's decades as ticks of its colour bar.
-    const double low = input.depth_diff_scale.low, high = input.depth_diff_scale.high;
-    std::vector<std::pair<double, std::string>> depth_ticks;
-    if (low > 0 && high > low) {
-      const double decades = std::log10(high / low);
-      // The ends are floats: 1e-2f is 0.0099999998, still a tick.
-      for (double e = std::ceil(std::log10(low) - 1e-6); e <= std::log10(high) + 1e-6; e += 1)
-        depth_ticks.push_back({(e - std::log10(low)) / decades, short_number(std::pow(10.0, e))});
-    }
-    h << "<h2>Differences</h2>\n<div class=\"grid\">\n"
-      << "<figure><img src=\"" << diff_uri.value()
-      << "\" alt=\"colour difference heat map\"><figcaption><b>diff.png</b>: per pixel, the "
-         "largest |difference| over R, G, B of the linear colours, on the inferno colour map "
-         "(black = 0, yellow-white &ge; "
-      << fmt("%g", input.heat_map_scale) << ")."
-      << inferno_bar("bar-diff", "colour difference scale",
-                     {{0.0, "0"},
-                      {0.5, fmt("%g", input.heat_map_scale / 2)},
-                      {1.0, "&ge; " + fmt("%g", input.heat_map_scale)}})
-      << "</figcaption></figure>\n"
-      << "<figure><img src=\"" << class_uris.front()
-      << "\" alt=\"mismatch classes\"><figcaption><b>"
-      << escape_html(first.file("mismatch_classes"))
-      << "</b>: each pixel whose (object, primitive) id differs, coloured by why, over a dimmed "
-         "grey version of "
-      << escape_html(name_a) << " (the reference of the edge test):" << class_legend()
-      << "</figcaption></figure>\n"
-      << "<figure><img src=\"" << mismatch_uri.value()
-      << "\" alt=\"object id mismatches\"><figcaption><b>id_mismatch.png</b>: pixels whose "
-         "object id differs, in red, over a grey version of "
-      << escape_html(name_a) << ".</figcaption></figure>\n"
-      << "<figure><div class=\"marked\"><img src=\"" << depth_uri.value()
-      << "\" alt=\"relative depth difference\">" << outlier_marks(dep, input.width, input.height)
-      << "</div><figcaption><b>depth_diff.png</b>: relative "
-         "view-depth difference |d<sub>A</sub> &minus; d<sub>B</sub>| / max(d<sub>A</sub>, "
-         "d<sub>B</sub>) of "
-      << escape_html(name_a) << " and " << escape_html(name_b)
-      << " where both hit something (whatever the ids), on a <b>log scale</b>: black &le; "
-      << short_number(low) << ", each decade an equal stretch of the colour map, yellow-white "
-      << "&ge; " << short_number(high) << ". <span class=\"nowrap\">"
-      << swatch(kDepthDiffBackground) << "background in both</span>; <span class=\"nowrap\">"
-      << swatch(kDepthDiffHitVsBackground) << "background in one, a hit in the other</span>."
-      << inferno_bar("bar-depth", "relative depth difference scale, logarithmic", depth_ticks)
-      << "</figcaption></figure>\n</div>\n";
-
-    // Work per pixel: what each loop order pays where.
-    h << "<h2>Work per pixel</h2>\n<div class=\"grid\">\n";
-    for (size_t i = 0; i < input.renderers.size(); ++i) {
-      const auto& r = input.renderers[i];
-      if (r.cost_file.empty()) {
-        h << "<figure><figcaption><b>" << escape_html(r.name)
-          << "</b>: no per-pixel work reported.</figcaption></figure>\n";
-        continue;
-      }
-      h << "<figure><img src=\"" << cost_uris[i] << "\" alt=\"" << escape_html(r.name)
-        << " work per pixel\"><figcaption><b>" << escape_html(r.cost_file) << "</b>: "
-        << (r.stats.count("fragments.generated") ? "fragments generated per pixel (overdraw)"
-                                                 : "BVH nodes visited + primitive tests per pixel")
-        << "; mean " << fmt("%.3g", r.cost_mean) << ", yellow-white &ge; "
-        << fmt("%g", r.cost_scale) << " (the 99th percentile).</figcaption></figure>\n";
-    }
-    h << "</div>\n";
-
-    // Metrics.
-    const bool identical = std::isinf(col.psnr_db) && col.psnr_db > 0;
-    std::vector<MetricRow> rows = {
-        {"visibility", "pixels", std::to_string(vis.pixels), "width &times; height."},
-        {"visibility", "id_agreement", fmt("%.6f", vis.id_agreement),
-         "Fraction of pixels where both renders see the same object and the same primitive."},
-        {"visibility", "mismatched_pixels", std::to_string(vis.mismatched_pixels),
-         "Pixels whose (object, primitive) id differs."},
-        {"visibility", "covered_fraction", fmt("%.6f", vis.covered_fraction),
-         "Fraction of pixels where either render shows a surface.", vis.covered_pixels == 0},
-        {"visibility", "covered_agreement", fmt("%.6f", vis.covered_agreement),
-         "Fraction of those covered pixels whose ids agree; 0 when nothing is visible.",
-         vis.covered_pixels == 0},
-        {"visibility", "mismatch_classes.edge", std::to_string(vis.classes.edge),
-         "Mismatches whose pixel centre lies within " + short_number(kEdgeTolerancePixels) +
-             " pixel of an edge of a hit primitive: a tie the fill rules may break either way."},
-        {"visibility", "mismatch_classes.depth_precision",
-         std::to_string(vis.classes.depth_precision),
-         "Both hit, and the two surfaces lie within the depth buffers' resolution of each other "
-         "at that depth: z-fighting, decided by the depth format, not by the loop order."},
-        {"visibility", "mismatch_classes.occlusion", std::to_string(vis.classes.occlusion),
-         "Both hit, one surface farther than the other by more than that: a visibility error. "
-         "Should be 0.",
-         vis.classes.occlusion != 0},
-        {"visibility", "mismatch_classes.coverage", std::to_string(vis.classes.coverage),
-         "A surface in one render, background in the other, away from the surface's edges. "
-         "Should be 0.",
-         vis.classes.coverage != 0},
-        {"depth", "max_rel_error", fmt("%.3g", dep.max_rel_error),
-         "Largest |d<sub>A</sub> &minus; d<sub>B</sub>| / max(d<sub>A</sub>, d<sub>B</sub>) of "
-         "view-axis depth over pixels where the ids agree (background excluded)."},
-        {"depth", "mean_rel_error", fmt("%.3g", dep.mean_rel_error),
-         "Mean of the same relative depth error."},
-        {"depth", "p99_rel_error", fmt("%.3g", dep.p99_rel_error),
-         "99th percentile of the same error: 99% of those pixels are at or below it."},
-        {"depth", "p999_rel_error", fmt("%.3g", dep.p999_rel_error), "99.9th percentile."},
-        {"depth", "outliers", std::to_string(dep.outliers),
-         "Pixels whose relative depth error is above " + short_number(kDepthOutlierThreshold) +
-             " (see Depth outliers below)."},
-        {"depth", "outliers_at_silhouettes", std::to_string(dep.outliers_at_silhouettes),
-         "Of those, on an object's outline: an edge-on facet under the z-buffer's vertex "
-         "snapping."},
-        {"depth", "outliers_elsewhere", std::to_string(dep.outliers_elsewhere),
-         "Of those, anywhere else: unexplained, a real disagreement. Should be 0.",
-         dep.outliers_elsewhere != 0},
-        {"color", "rmse", fmt("%.4g", col.rmse),
-         "Root mean square difference of linear RGB over every pixel and channel."},
-        {"color", "psnr_db",
-         identical ? std::string("&infin; (999 in metrics.json)") : fmt("%.2f", col.psnr_db),
-         "20&middot;log<sub>10</sub>(1 / rmse), peak value 1; higher is closer. Identical images "
-         "have infinite PSNR, written as 999 in metrics.json."},
-        {"color", "max_abs", fmt("%.4g", col.max_abs),
-         "Largest absolute difference of one channel of one pixel (linear)."},
-        {"color", "ssim", fmt("%.5f", col.ssim),
-         "Structural similarity of the luminance of the colours clamped to [0, 1], 11&times;11 "
-         "Gaussian window (&sigma; 1.5), averaged over the image; 1 = identical."},
-    };
-    const LodMetrics& lod = pairs.front().metrics.lod;
-    if (lod.pixels > 0) {
-      rows.push_back({"lod", "mean_abs", fmt("%.3g", lod.mean_abs),
-                      "Mean |lod<sub>A</sub> &minus; lod<sub>B</sub>| in mip levels over the " +
-                          std::to_string(lod.pixels) +
-                          " pixels textured in both: how far the two loop orders' texture levels "
-                          "of detail differ (docs/design.md, Textures)."});
-      rows.push_back(
-          {"lod", "p99_abs", fmt("%.3g", lod.p99_abs), "99th percentile of the same difference."});
-    }
-    h << "<h2>Metrics</h2>\n<table><thead><tr><th>group</th><th>metric</th><th>value</th>"
-         "<th>meaning</th></tr></thead><tbody>\n";
-    for (const auto& row : rows)
-      h << "<tr><td>" << row.group << "</td><td><code>" << row.name << "</code></td><td class=\"num"
-        << (row.flagged ? " bad" : "") << "\">" << row.value << "</td><td class=\"why\">" << row.why
-        << "</td></tr>\n";
-    h << "</tbody></table>\n" << outlier_table(dep, name_a, name_b);
-    h << other_pairs(pairs, names, class_uris);
-
-    // Timings: seconds and every "time.*" stat, one row per renderer.
-    std::set<std::string> time_keys;
-    for (const auto& r : input.renderers)
-      for (const auto& [k, v] : r.stats)
-        if (k.rfind("time.", 0) == 0) time_keys.insert(k);
-    h << "<h2>Timings</h2>\n"
-      << timing_chart(input.renderers)
-      << "<p class=\"why\" style=\"color:#4a5366;font-size:13px\">Each bar: the scene load "
-         "(shared, outside the render call), the phases the renderer reports (time.* below) "
-         "and, as <i>other</i>, the rest of its render call.</p>\n"
-      << "<div class=\"scroll\"><table><thead><tr><th>renderer</th><th>seconds</th>"
-         "<th>relative</th>";
-    for (const auto& k : time_keys) h << "<th>" << escape_html(k) << "</th>";
-    h << "<th>warnings</th></tr></thead><tbody>\n";
-    const double base = input.renderers.empty() ? 0.0 : input.renderers[0].seconds;
-    for (const auto& r : input.renderers) {
-      h << "<tr><td><b>" << escape_html(r.name) << "</b></td><td class=\"num\">"
-        << fmt_seconds(r.seconds) << "</td><td class=\"num\">"
-        << (base > 0 ? fmt("%.2f&times;", r.seconds / base) : std::string("n/a")) << "</td>";
-      for (const auto& k : time_keys) {
-        auto it = r.stats.find(k);
-        h << "<td class=\"num\">" << (it == r.stats.end() ? "&ndash;" : fmt_seconds(it->second))
-          << "</td>";
-      }
-      h << "<td class=\"num\">" << r.warnings.size() << "</td></tr>\n";
-    }
-    h << "</tbody></table></div>\n<p class=\"why\" style=\"color:#4a5366;font-size:13px\">seconds: "
-         "wall-clock time of the render call; relative: divided by the first renderer's; "
-         "time.*: the phases each renderer reports.</p>\n";
-
-    // All counters, folded away.
-    for (const auto& r : input.renderers) {
-      if (r.stats.empty()) continue;
-      h << "<details><summary>All statistics of <b>" << escape_html(r.name) << "</b> ("
-        << r.stats.size() << ")</summary><table><tbody>\n";
-      for (const auto& [k, v] : r.info)
-        h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">"
-          << escape_html(v) << "</td></tr>\n";
-      for (const auto& [k, v] : r.stats)
-        h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">"
-          << fmt("%.6g", v) << "</td></tr>\n";
-      h << "</tbody></table></details>\n";
-    }
-
-    h << "<footer>Written by rvr compare. Colour metrics use linear RGB with peak 1; the "
-         "heat map scale is "
-      << fmt("%g", input.heat_map_scale) << ".</footer>\n</main>\n";
-    if (input.renderers.size() >= 2) h << "<script>" << kScript << "</script>\n";
-    h << "</body>\n</html>\n";
+    std::ostringstream h;
+    h << page_head(title) << summary(input, title, first) << warnings(input)
+      << renders(input, *images, name_a, name_b)
+      << differences(input, first, *images, name_a, name_b) << work_per_pixel(input, *images)
+      << metrics_table(metric_rows(first.metrics))
+      << outlier_table(first.metrics.depth, name_a, name_b)
+      << other_pairs(pairs, names, images->classes) << timings(input) << all_statistics(input)
+      << page_end(input);
     return h.str();
   } catch (const std::exception& e) {
     return internal_error(std::string("cannot build report.html: ") + e.what());

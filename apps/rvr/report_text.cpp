@@ -1,22 +1,11 @@
 // Numbers and text as the report writes them (see report_text.h).
 #include "report_text.h"
 
-#include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <exception>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
-#include <map>
-#include <nlohmann/json.hpp>
-#include <set>
-#include <sstream>
+#include <initializer_list>
 #include <string>
-#include <vector>
 
 namespace rvr::report {
 

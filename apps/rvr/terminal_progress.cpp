@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cerrno>
 #include <cmath>
+#include <compare>
 #include <cstdlib>
 #include <cstring>
 

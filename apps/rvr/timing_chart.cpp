@@ -3,22 +3,20 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <exception>
-#include <filesystem>
-#include <fstream>
+#include <initializer_list>
 #include <iterator>
 #include <map>
-#include <nlohmann/json.hpp>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "report_text.h"
+#include "rvr/shared/html_escape.h"
 
 namespace rvr::report {
 namespace {
@@ -36,9 +34,8 @@ struct Phase {
 // traced and rebuilt ray), which stands beside time.zbuffer (its visibility passes). The
 // tracers' time.shade is their time.render's share after the primary hits (softraster, which
 // has no time.render, stacks its shading pass).
-const std::map<std::string, std::string> kNestedPhases = {{"time.bvh_build", "time.build"},
-                                                          {"time.render", "time.trace"},
-                                                          {"time.shade", "time.render"}};
+const std::map<std::string, std::string> kNestedPhases = {
+    {"time.bvh_build", "time.build"}, {"time.render", "time.trace"}, {"time.shade", "time.render"}};
 
 // Totals of other phases (softraster's time.visibility is time.setup + its clear +
 // time.bin + time.raster; the tracers' is their time.render's share until the primary hits):

@@ -7,6 +7,7 @@
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/check.h"
 #include "rvr/shared/image_sample.h"
 #include "rvr/shared/timer.h"
 
@@ -59,6 +60,10 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   const double zbuffer_seconds = seconds_since(t_zbuffer);
   if (!zbuffer) return zbuffer.error();
   const FrameBuffers& ids = zbuffer->buffers;
+  RVR_CHECK(ids.width == scene.image.width && ids.height == scene.image.height &&
+                ids.object_id.size() == ids.pixel_count() &&
+                ids.primitive_id.size() == ids.pixel_count(),
+            "the z-buffer pass fills an id per pixel of the scene's frame");
   PrimaryVisibility visible{ids.width, ids.height, ids.object_id, ids.primitive_id, ids.lod};
 
   // Several samples per pixel: one more z-buffer pass per sample (the accumulation buffer),
@@ -86,6 +91,8 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
       zbuffer_pass_seconds += seconds_since(t_pass);
       if (!pass) return pass.error();
       const FrameBuffers& pass_ids = pass->buffers;
+      RVR_CHECK(pass_ids.width == ids.width && pass_ids.height == ids.height,
+                "every sample's z-buffer pass has the centre pass's frame");
       const PrimaryVisibility pass_visible{pass_ids.width, pass_ids.height, pass_ids.object_id,
                                            pass_ids.primitive_id, pass_ids.lod};
       t_pass = Clock::now();

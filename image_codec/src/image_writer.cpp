@@ -96,8 +96,8 @@ int write_png(const char* path, int w, int h, int channels, const unsigned char*
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   // The bytes are sRGB-encoded (display referred), as OpenImageIO tags them.
   png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_ABSOLUTE);
-  // No row filter and zlib level 2: on rendered images as small as OpenImageIO's default
-  // (adaptive filters, level 6) and about three times faster (1024x768: ~20 ms instead of ~65).
+  // No row filter and zlib level 2: on rendered images (large flat areas) the files are as small
+  // as with OpenImageIO's default (adaptive filters, level 6) for much less compression work.
   png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_NONE);
   png_set_compression_level(png, 2);
   png_write_info(png, info);

@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
+
+#include "rvr/shared/check.h"
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -23,7 +26,8 @@ void advise_huge_pages(void* p, size_t bytes) {
 
 namespace {
 
-// 32 bins measured no better than 16 on soup:1000000 (BM_Trace, interleaved with Embree).
+// Bins per axis of the SAH sweep: as in Embree's binned builder; more bins find no cheaper
+// splits worth the extra binning work (bench/JOURNAL.md).
 constexpr int kBins = 16;
 constexpr float kIntersectCost = 1.0f;
 // Past this depth splits are object medians, so the depth (and the traversal stack) stays
@@ -65,22 +69,166 @@ void bounds_of(const PrimRef* first, const PrimRef* last, Aabb& box, Aabb& centr
   }
 }
 
+// The SAH's costs: a node visit against `block` primitives tested at a time in a leaf.
+struct SahCosts {
+  float traversal;
+  uint32_t block;
+  // Whole blocks: the integer division rounds up to the blocks a leaf of n fills.
+  float tests(uint32_t n) const {
+    return float((n + block - 1) / block);  // NOLINT(bugprone-integer-division)
+  }
+  float leaf(uint32_t n) const { return kIntersectCost * tests(n); }
+};
+
+std::vector<PrimRef> prim_refs(const std::vector<Aabb>& bounds) {
+  std::vector<PrimRef> refs(bounds.size());
+  for (uint32_t i = 0; i < uint32_t(bounds.size()); ++i)
+    refs[i] = {bounds[i].lo, i, bounds[i].hi, 0};
+  return refs;
+}
+
+// The binned SAH split of a node's primitives of least cost (axis -1 when no axis has extent or
+// no split leaves both sides non-empty): centroids binned into kBins slots per axis, then a sweep
+// of the bins from the right for the area and count right of every split and one from the left.
+Split find_binned_split(const PrimRef* first, const PrimRef* last, const BuildTask& task,
+                        const SahCosts& costs) {
+  const Aabb& centroid_box = task.centroid_box;
+  const glm::vec3 extent = centroid_box.hi - centroid_box.lo;
+  Aabb bin_box[3][kBins];
+  uint32_t bin_count[3][kBins] = {};
+  float scale[3];
+  for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0.0f ? float(kBins) / extent[a] : 0.0f;
+  for (const PrimRef* r = first; r != last; ++r) {
+    glm::vec3 c = r->centroid2();
+    Aabb prim{r->lo, r->hi};
+    for (int a = 0; a < 3; ++a) {
+      if (extent[a] <= 0.0f) continue;
+      int b = std::min(kBins - 1, int((c[a] - centroid_box.lo[a]) * scale[a]));
+      RVR_DCHECK(b >= 0, "centroid below its node's centroid bounds: bin ", b);
+      bin_count[a][b]++;
+      bin_box[a][b].grow(prim);
+    }
+  }
+  Split best;
+  float inv_area = 1.0f / std::max(task.box.surface_area(), 1e-30f);
+  for (int a = 0; a < 3; ++a) {
+    if (extent[a] <= 0.0f) continue;
+    float right_area[kBins];
+    uint32_t right_count[kBins];
+    Aabb acc;
+    uint32_t cnt = 0;
+    for (int b = kBins - 1; b > 0; --b) {
+      acc.grow(bin_box[a][b]);
+      cnt += bin_count[a][b];
+      right_area[b] = acc.surface_area();
+      right_count[b] = cnt;
+    }
+    acc = Aabb();
+    cnt = 0;
+    for (int b = 0; b < kBins - 1; ++b) {
+      acc.grow(bin_box[a][b]);
+      cnt += bin_count[a][b];
+      if (cnt == 0 || right_count[b + 1] == 0) continue;
+      float cost = costs.traversal + kIntersectCost * inv_area *
+                                         (acc.surface_area() * costs.tests(cnt) +
+                                          right_area[b + 1] * costs.tests(right_count[b + 1]));
+      if (cost < best.cost) best = {a, b, cost};
+    }
+  }
+  return best;
+}
+
+// A node's primitives split in two: [begin, mid) and [mid, end) of the PrimRef array, with each
+// side's bounds and centroid bounds (the children's tasks).
+struct Partition {
+  uint32_t mid = 0;
+  int axis = 0;
+  Aabb left_box, left_centroids, right_box, right_centroids;
+};
+
+// Hoare partition at the split's bin that also gathers each side's bounds, so the children need
+// no pass of their own.
+Partition partition_at_bin(std::vector<PrimRef>& refs, const BuildTask& task, const Split& split) {
+  Partition p;
+  p.axis = split.axis;
+  const glm::vec3 extent = task.centroid_box.hi - task.centroid_box.lo;
+  const float scale = float(kBins) / extent[p.axis];
+  const float lo = task.centroid_box.lo[p.axis];
+  auto goes_left = [&](const PrimRef& r) {
+    return std::min(kBins - 1, int((r.centroid2()[p.axis] - lo) * scale)) <= split.bin;
+  };
+  PrimRef* i = refs.data() + task.begin;
+  PrimRef* j = refs.data() + task.end;
+  for (;;) {
+    while (i < j && goes_left(*i)) {
+      p.left_box.grow(Aabb{i->lo, i->hi});
+      p.left_centroids.grow(i->centroid2());
+      ++i;
+    }
+    while (i < j && !goes_left(*(j - 1))) {
+      --j;
+      p.right_box.grow(Aabb{j->lo, j->hi});
+      p.right_centroids.grow(j->centroid2());
+    }
+    if (i >= j) break;
+    std::swap(*i, *(j - 1));
+  }
+  p.mid = uint32_t(i - refs.data());
+  return p;
+}
+
+// No useful SAH split (all centroids equal, or too deep): the object median along the axis of
+// widest centroid extent.
+Partition partition_at_median(std::vector<PrimRef>& refs, const BuildTask& task) {
+  Partition p;
+  const glm::vec3 extent = task.centroid_box.hi - task.centroid_box.lo;
+  p.axis = int(std::max_element(&extent[0], &extent[0] + 3) - &extent[0]);
+  p.mid = task.begin + (task.end - task.begin) / 2;
+  PrimRef* first = refs.data() + task.begin;
+  PrimRef* mid = refs.data() + p.mid;
+  PrimRef* last = refs.data() + task.end;
+  std::nth_element(first, mid, last, [&](const PrimRef& a, const PrimRef& b) {
+    return a.centroid2()[p.axis] < b.centroid2()[p.axis];
+  });
+  bounds_of(first, mid, p.left_box, p.left_centroids);
+  bounds_of(mid, last, p.right_box, p.right_centroids);
+  return p;
+}
+
+void set_leaf(BvhNode& node, const BuildTask& task) {
+  const uint32_t count = task.end - task.begin;
+  RVR_CHECK(count >= 1 && count <= std::numeric_limits<uint16_t>::max(),
+            "a leaf's primitive count must fit BvhNode::count (uint16_t): ", count);
+  node.lo = task.box.lo;
+  node.hi = task.box.hi;
+  node.offset = task.begin;
+  node.count = uint16_t(count);
+  node.axis = 0;
+}
+
+// An inner node; its `offset` (the second child) is set when that child is built.
+void set_inner(BvhNode& node, const BuildTask& task, int axis) {
+  node.lo = task.box.lo;
+  node.hi = task.box.hi;
+  node.count = 0;
+  node.axis = uint8_t(axis);
+}
+
 }  // namespace
 
 Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) {
-  const float kTraversalCost = options.traversal_cost;
-  const uint32_t block = uint32_t(std::max(1, options.leaf_block));
-  auto tests = [block](uint32_t n) { return float((n + block - 1) / block); };
+  const SahCosts costs{options.traversal_cost, uint32_t(std::max(1, options.leaf_block))};
+  const uint32_t max_leaf = uint32_t(std::min(options.max_leaf_size, int(kMaxLeafSize)));
   auto start = std::chrono::steady_clock::now();
   Bvh bvh;
+  RVR_CHECK(bounds.size() < size_t(~0u), "primitive indices are uint32_t and ~0u means none; ",
+            bounds.size(), " primitives");
   const uint32_t n = uint32_t(bounds.size());
   bvh.stats_.primitives = n;
   if (n == 0) return bvh;
 
-  std::vector<PrimRef> refs(n);
-  for (uint32_t i = 0; i < n; ++i) refs[i] = {bounds[i].lo, i, bounds[i].hi, 0};
+  std::vector<PrimRef> refs = prim_refs(bounds);
   bvh.nodes_.reserve(size_t(n) / 2 + 1);
-
   std::vector<BuildTask> tasks;
   {
     BuildTask root{0, n, ~0u, 0, {}, {}};
@@ -88,134 +236,53 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
     tasks.push_back(root);
   }
   const float root_area = std::max(tasks[0].box.surface_area(), 1e-30f);
+  size_t leaf_primitives = 0;
+  // Depth first: each task's node is appended when it is taken, so a first child lands right
+  // after its parent and a second child's index is written into the parent's `offset`.
   while (!tasks.empty()) {
-    BuildTask task = tasks.back();
+    const BuildTask task = tasks.back();
     tasks.pop_back();
-    uint32_t index = uint32_t(bvh.nodes_.size());
+    const uint32_t index = uint32_t(bvh.nodes_.size());
     if (task.parent != ~0u) bvh.nodes_[task.parent].offset = index;
     bvh.nodes_.push_back({});
-
-    const Aabb& box = task.box;
-    const Aabb& centroid_box = task.centroid_box;
-    uint32_t count = task.end - task.begin;
     bvh.stats_.max_depth = std::max(bvh.stats_.max_depth, task.depth);
-    float area_ratio = box.surface_area() / root_area;
+    const uint32_t count = task.end - task.begin;
+    const float area_ratio = task.box.surface_area() / root_area;
 
-    auto make_leaf = [&]() {
-      BvhNode& node = bvh.nodes_[index];
-      node.lo = box.lo;
-      node.hi = box.hi;
-      node.offset = task.begin;
-      node.count = uint16_t(count);
-      node.axis = 0;
+    const Split best =
+        count > 1 && task.depth < kMedianDepth
+            ? find_binned_split(refs.data() + task.begin, refs.data() + task.end, task, costs)
+            : Split{};
+    const bool must_split = count > max_leaf;
+    if (count == 1 || (!must_split && !(best.cost < costs.leaf(count)))) {
+      set_leaf(bvh.nodes_[index], task);
       bvh.stats_.leaves++;
-      bvh.stats_.sah_cost += area_ratio * kIntersectCost * tests(count);
-    };
-
-    float leaf_cost = kIntersectCost * tests(count);
-    Split best;
-    glm::vec3 extent = centroid_box.hi - centroid_box.lo;
-    if (count > 1 && task.depth < kMedianDepth) {
-      Aabb bin_box[3][kBins];
-      uint32_t bin_count[3][kBins] = {};
-      float scale[3];
-      for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0.0f ? float(kBins) / extent[a] : 0.0f;
-      for (const PrimRef* r = refs.data() + task.begin; r != refs.data() + task.end; ++r) {
-        glm::vec3 c = r->centroid2();
-        Aabb prim{r->lo, r->hi};
-        for (int a = 0; a < 3; ++a) {
-          if (extent[a] <= 0.0f) continue;
-          int b = std::min(kBins - 1, int((c[a] - centroid_box.lo[a]) * scale[a]));
-          bin_count[a][b]++;
-          bin_box[a][b].grow(prim);
-        }
-      }
-      float inv_area = 1.0f / std::max(box.surface_area(), 1e-30f);
-      for (int a = 0; a < 3; ++a) {
-        if (extent[a] <= 0.0f) continue;
-        // Sweep from the right to get the area and count right of every split.
-        float right_area[kBins];
-        uint32_t right_count[kBins];
-        Aabb acc;
-        uint32_t cnt = 0;
-        for (int b = kBins - 1; b > 0; --b) {
-          acc.grow(bin_box[a][b]);
-          cnt += bin_count[a][b];
-          right_area[b] = acc.surface_area();
-          right_count[b] = cnt;
-        }
-        acc = Aabb();
-        cnt = 0;
-        for (int b = 0; b < kBins - 1; ++b) {
-          acc.grow(bin_box[a][b]);
-          cnt += bin_count[a][b];
-          if (cnt == 0 || right_count[b + 1] == 0) continue;
-          float cost = kTraversalCost + kIntersectCost * inv_area *
-                                            (acc.surface_area() * tests(cnt) +
-                                             right_area[b + 1] * tests(right_count[b + 1]));
-          if (cost < best.cost) best = {a, b, cost};
-        }
-      }
-    }
-
-    bool must_split = count > uint32_t(std::min(options.max_leaf_size, int(kMaxLeafSize)));
-    if (count == 1 || (!must_split && !(best.cost < leaf_cost))) {
-      make_leaf();
+      leaf_primitives += count;
+      bvh.stats_.sah_cost += area_ratio * kIntersectCost * costs.tests(count);
       continue;
     }
 
-    uint32_t mid;
-    int axis;
-    Aabb left_box, left_centroids, right_box, right_centroids;
-    PrimRef* first = refs.data() + task.begin;
-    PrimRef* last = refs.data() + task.end;
-    if (best.axis >= 0) {
-      axis = best.axis;
-      float scale = float(kBins) / extent[axis];
-      float lo = centroid_box.lo[axis];
-      auto goes_left = [&](const PrimRef& r) {
-        return std::min(kBins - 1, int((r.centroid2()[axis] - lo) * scale)) <= best.bin;
-      };
-      // Hoare partition that also gathers each side's bounds, so the children need no pass of
-      // their own.
-      PrimRef* i = first;
-      PrimRef* j = last;
-      for (;;) {
-        while (i < j && goes_left(*i)) {
-          left_box.grow(Aabb{i->lo, i->hi});
-          left_centroids.grow(i->centroid2());
-          ++i;
-        }
-        while (i < j && !goes_left(*(j - 1))) {
-          --j;
-          right_box.grow(Aabb{j->lo, j->hi});
-          right_centroids.grow(j->centroid2());
-        }
-        if (i >= j) break;
-        std::swap(*i, *(j - 1));
-      }
-      mid = uint32_t(i - refs.data());
-    } else {
-      // No useful SAH split (all centroids equal, or too deep): split at the object median.
-      axis = int(std::max_element(&extent[0], &extent[0] + 3) - &extent[0]);
-      mid = task.begin + count / 2;
-      std::nth_element(first, refs.data() + mid, last, [&](const PrimRef& a, const PrimRef& b) {
-        return a.centroid2()[axis] < b.centroid2()[axis];
-      });
-      bounds_of(first, refs.data() + mid, left_box, left_centroids);
-      bounds_of(refs.data() + mid, last, right_box, right_centroids);
-    }
-
-    BvhNode& node = bvh.nodes_[index];
-    node.lo = box.lo;
-    node.hi = box.hi;
-    node.count = 0;
-    node.axis = uint8_t(axis);
-    bvh.stats_.sah_cost += area_ratio * kTraversalCost;
+    const Partition part =
+        best.axis >= 0 ? partition_at_bin(refs, task, best) : partition_at_median(refs, task);
+    RVR_CHECK(part.mid > task.begin && part.mid < task.end,
+              "a split leaves both sides non-empty: [", task.begin, ", ", part.mid, ", ", task.end,
+              ")");
+    set_inner(bvh.nodes_[index], task, part.axis);
+    bvh.stats_.sah_cost += area_ratio * costs.traversal;
     // Second child first onto the stack, so the first child is built next at index + 1.
-    tasks.push_back({mid, task.end, index, task.depth + 1, right_box, right_centroids});
-    tasks.push_back({task.begin, mid, ~0u, task.depth + 1, left_box, left_centroids});
+    tasks.push_back(
+        {part.mid, task.end, index, task.depth + 1, part.right_box, part.right_centroids});
+    tasks.push_back(
+        {task.begin, part.mid, ~0u, task.depth + 1, part.left_box, part.left_centroids});
   }
+  RVR_CHECK(bvh.nodes_.size() == 2 * bvh.stats_.leaves - 1,
+            "a binary tree has one inner node fewer than leaves: ", bvh.nodes_.size(), " nodes, ",
+            bvh.stats_.leaves, " leaves");
+  RVR_CHECK(bvh.stats_.max_depth < size_t(kStackSize),
+            "object medians past kMedianDepth keep the depth within the traversal stack: depth ",
+            bvh.stats_.max_depth);
+  RVR_CHECK(leaf_primitives == n, "every primitive lies in exactly one leaf: ", leaf_primitives,
+            " in leaves of ", n);
   bvh.order_.resize(n);
   for (uint32_t i = 0; i < n; ++i) bvh.order_[i] = refs[i].id;
   bvh.nodes_.shrink_to_fit();

@@ -8,6 +8,8 @@
 #include <limits>
 #include <vector>
 
+#include "rvr/shared/check.h"
+
 namespace rvr {
 
 struct EmbreeBackend {
@@ -70,6 +72,8 @@ void set_ray(RTCRay& r, const Ray& ray) {
 
 void EmbreeBackend::bounds(const RTCBoundsFunctionArguments* args) {
   auto* self = static_cast<const EmbreeBackend*>(args->geometryUserPtr);
+  RVR_CHECK(args->primID < self->owner->analytic_.size(),
+            "Embree asks for the bounds of an analytic object it was given: ", args->primID);
   Aabb b = TraceGeometry::analytic_bounds(self->owner->analytic_[args->primID]);
   *args->bounds_o = {b.lo.x, b.lo.y, b.lo.z, 0.0f, b.hi.x, b.hi.y, b.hi.z, 0.0f};
 }
@@ -249,6 +253,8 @@ void intersect_k(const EmbreeBackend& backend, const RayPacket& packet, int firs
 }  // namespace
 
 void embree_closest_packet(const EmbreeBackend& backend, const RayPacket& packet, HitRecord* hits) {
+  RVR_CHECK(backend.packet_width == 8 || backend.packet_width == 16,
+            "create() picks Embree's 8- or 16-wide packets: ", backend.packet_width);
   for (int i = 0; i < packet.count; ++i) hits[i] = HitRecord{};
   if (backend.packet_width == 16) {
     for (int first = 0; first < packet.count; first += 16)

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rvr/shared/check.h"
+
 namespace rvr {
 
 PixelRect screen_bounds(const CameraFrame& frame, float near, const Aabb& box) {
@@ -33,6 +35,8 @@ PixelRect screen_bounds(const CameraFrame& frame, float near, const Aabb& box) {
   r.x1 = std::min(frame.width, clamp(std::ceil(hi_x - 0.5f), frame.width) + 3);
   r.y0 = std::max(0, clamp(std::floor(lo_y - 0.5f), frame.height) - 2);
   r.y1 = std::min(frame.height, clamp(std::ceil(hi_y - 0.5f), frame.height) + 3);
+  RVR_DCHECK(r.x0 >= 0 && r.y0 >= 0 && r.x1 <= frame.width && r.y1 <= frame.height,
+             "a screen rectangle lies in the frame");
   return r;
 }
 

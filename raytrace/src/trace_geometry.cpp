@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "embree_backend.h"
+#include "rvr/shared/check.h"
 #include "rvr/shared/tessellate.h"
 
 namespace rvr {
@@ -544,12 +545,15 @@ SurfaceHit TraceGeometry::surface(const Ray& ray, const HitRecord& hit) const {
 
 std::pair<uint32_t, uint32_t> TraceGeometry::hit_ids(const HitRecord& hit) const {
   const uint32_t n_triangles = uint32_t(triangles_.size());
+  RVR_DCHECK(hit.primitive < n_triangles + analytic_.size(), "hit primitive ", hit.primitive,
+             " of ", n_triangles, " triangles and ", analytic_.size(), " analytic objects");
   if (hit.primitive < n_triangles)
     return {triangle_object_[hit.primitive], triangle_id_[hit.primitive]};
   return {analytic_[hit.primitive - n_triangles].object, 0u};
 }
 
 TriangleSurfaceData TraceGeometry::triangle_surface_data(uint32_t p) const {
+  RVR_DCHECK(p < triangles_.size(), "triangle ", p, " of ", triangles_.size());
   TriangleSurfaceData d;
   d.triangle = &triangles_[p];
   d.object = triangle_object_[p];

@@ -5,16 +5,15 @@
 #include <chrono>
 #include <cmath>
 
+#include "rvr/shared/check.h"
+
 namespace rvr {
 namespace {
 
 // For the SAH of the binary tree the wide one is made from: a wide node visit tests eight boxes
-// at once, so it costs about as much as testing one 4-triangle block. Measured on this machine
-// against Embree, interleaved (primary and random rays, tessphere:100000, soup:100000 and
-// 1000000): traversal costs 0.5, 1, 2 and 4, leaves of at most 4 or 8 triangles, 16 or 32 bins
-// are all within the noise (+-10%) of each other; cost 1 with leaves of up to 8 triangles needs
-// the least memory (49 bytes per triangle on soup:20000, 54 on tessphere:20000, against 59 with
-// leaves of at most 4).
+// at once, so it costs about as much as testing one 4-triangle block. Trace speed hardly depends
+// on this cost or on the leaf size (bench/JOURNAL.md); cost 1 with leaves of up to 8 triangles
+// takes the least memory.
 constexpr float kWideTraversalCost = 1.0f;
 
 class Collapser {
@@ -51,7 +50,10 @@ class Collapser {
       children[best] = opened + 1;
       children[n++] = binary_[opened].offset;
     }
+    RVR_CHECK(n >= 2 && n <= kWideBvhWidth, "a wide node has 2 to 8 children: ", n);
     uint32_t index = uint32_t(nodes_.size());
+    RVR_CHECK((index & kLeafFlag) == 0 && index != kEmptyTree,
+              "an inner node's index must not look like a leaf reference: ", index);
     nodes_.push_back(empty_node());
     stats_.child_slots += size_t(n);
     for (int i = 0; i < n; ++i) {
@@ -66,6 +68,9 @@ class Collapser {
     }
     return index;
   }
+
+  // Triangles in the leaves made so far: all of them once the root is collapsed.
+  size_t leaf_triangles() const { return leaf_triangles_; }
 
  private:
   static Aabb box_of(const BvhNode& n) { return Aabb{n.lo, n.hi}; }
@@ -85,6 +90,12 @@ class Collapser {
   uint32_t make_leaf(const BvhNode& node) {
     uint32_t first = uint32_t(blocks_.size());
     uint32_t count = node.count;
+    RVR_CHECK(count >= 1 && count <= uint32_t(kMaxLeafTriangles) && count < (1u << kLeafCountBits),
+              "a leaf's triangle count must fit its reference's ", kLeafCountBits,
+              " bits: ", count);
+    RVR_CHECK(first + (count + kTriangleBlock - 1) / kTriangleBlock <= kMaxBlocks,
+              "WideBvh::build refuses scenes whose blocks overflow the leaf reference: block ",
+              first);
     for (uint32_t k = 0; k < count; k += kTriangleBlock) {
       TriangleBlock block{};
       for (int lane = 0; lane < kTriangleBlock; ++lane) {
@@ -102,6 +113,7 @@ class Collapser {
       blocks_.push_back(block);
     }
     stats_.leaves++;
+    leaf_triangles_ += count;
     return kLeafFlag | first << kLeafCountBits | count;
   }
 
@@ -111,6 +123,7 @@ class Collapser {
   TraversalVector<WideNode>& nodes_;
   TraversalVector<TriangleBlock>& blocks_;
   WideBvhStats& stats_;
+  size_t leaf_triangles_ = 0;  // over all leaves made so far
 };
 
 }  // namespace
@@ -144,6 +157,15 @@ Expected<WideBvh> WideBvh::build(const std::vector<TrianglePrecomputed>& triangl
   w.blocks_.reserve(triangles.size() / 2 + 1);
   Collapser collapser(binary, triangles, w.nodes_, w.blocks_, w.stats_);
   w.root_ = collapser.collapse(0, 0);
+  RVR_CHECK(w.stats_.max_depth < 64,
+            "the traversal stacks (wide_kernels.inl) hold 64 inner levels; depth ",
+            w.stats_.max_depth);
+  RVR_CHECK(collapser.leaf_triangles() == triangles.size(),
+            "every triangle lies in exactly one leaf: ", collapser.leaf_triangles(), " of ",
+            triangles.size());
+  RVR_CHECK(w.nodes_.size() + w.stats_.leaves - 1 == w.stats_.child_slots,
+            "every node but the root fills one child slot: ", w.nodes_.size(), " nodes, ",
+            w.stats_.leaves, " leaves, ", w.stats_.child_slots, " slots");
   w.nodes_.shrink_to_fit();
   w.blocks_.shrink_to_fit();
   w.stats_.nodes = w.nodes_.size();

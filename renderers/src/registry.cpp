@@ -4,6 +4,7 @@
 #include "rvr/renderers/registry.h"
 
 #include <memory>
+#include <set>
 
 #include "prepared_hybrid.h"
 #include "prepared_tracer.h"
@@ -11,6 +12,7 @@
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/check.h"
 #include "rvr/shared/framebuffers.h"
 
 namespace rvr {
@@ -35,6 +37,22 @@ class Exposed : public R {
 template <class R, class... Args>
 Expected<std::unique_ptr<Renderer>> make(Args... args) {
   return std::unique_ptr<Renderer>(std::make_unique<Exposed<R>>(args...));
+}
+
+// The table's own invariants: every entry can be made, and the names the command line takes
+// (renderer names and name_variant) are unique, so -r picks one renderer.
+bool check_table(const std::vector<RendererInfo>& table) {
+  std::set<std::string> names;
+  for (const RendererInfo& r : table) {
+    RVR_CHECK(!r.name.empty() && r.create, "every renderer has a name and a factory");
+    RVR_CHECK(names.insert(r.name).second, "renderer name '", r.name, "' is in the table twice");
+    for (const RendererVariant& v : r.variants) {
+      RVR_CHECK(v.apply, "variant '", v.suffix, "' of ", r.name, " changes something");
+      RVR_CHECK(names.insert(r.name + "_" + v.suffix).second, "renderer name '", r.name, "_",
+                v.suffix, "' is in the table twice");
+    }
+  }
+  return true;
 }
 
 std::string joined(const std::vector<std::string>& names) {
@@ -134,6 +152,7 @@ const std::vector<RendererInfo>& renderers() {
               },
       },
   };
+  [[maybe_unused]] static const bool checked = check_table(table);
   return table;
 }
 

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/srgb.h"
 
 namespace rvr {
@@ -57,6 +58,9 @@ float luminance(const glm::vec3& c) {
 // window) the window is cut to the image and renormalised, so every pixel has a value.
 double mean_ssim(const std::vector<float>& ya, const std::vector<float>& yb, int w, int h) {
   if (w <= 0 || h <= 0) return 1.0;
+  RVR_CHECK(ya.size() == size_t(w) * size_t(h) && yb.size() == ya.size(),
+            "one luminance per pixel of the ", w, "x", h, " image: ", ya.size(), " and ",
+            yb.size());
   constexpr int R = 5;
   std::array<double, 2 * R + 1> g{};
   for (int k = -R; k <= R; ++k) g[k + R] = std::exp(-double(k * k) / (2.0 * 1.5 * 1.5));
@@ -121,6 +125,7 @@ double psnr_of(double rmse) {
 
 // The nearest-rank percentile `p` (0 < p <= 1) of `values`, which it reorders.
 double percentile(std::vector<double>& values, double p) {
+  RVR_CHECK(p > 0.0 && p <= 1.0, "a nearest-rank percentile lies in (0, 1]: ", p);
   if (values.empty()) return 0.0;
   const size_t rank = size_t(std::ceil(p * double(values.size())));
   const size_t at = std::min(values.size(), std::max<size_t>(rank, 1)) - 1;

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "image_codec_loader.h"
+#include "rvr/shared/check.h"
 #include "rvr/shared/srgb.h"
 
 namespace fs = std::filesystem;
@@ -201,6 +202,8 @@ bool write_pixels(const fs::path& temp, const Image& image, bool linear_to_srgb,
 // Linear inferno colours of `values` / `scale` (clamped to [0, 1]), through OpenImageIO; black
 // where the library cannot be loaded (the write that follows reports why).
 Image inferno_linear(std::span<const float> values, int width, int height, float scale) {
+  RVR_CHECK(width >= 0 && height >= 0 && values.size() == size_t(width) * size_t(height),
+            "one value per pixel of the ", width, "x", height, " map: ", values.size());
   std::vector<float> scaled(values.size());
   const float inv = scale > 0.0f ? 1.0f / scale : 0.0f;
   for (size_t i = 0; i < values.size(); ++i) {

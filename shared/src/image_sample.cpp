@@ -4,6 +4,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "rvr/shared/camera.h"
+#include "rvr/shared/check.h"
 
 namespace rvr {
 
@@ -25,6 +26,7 @@ float uniform(uint64_t& state) {
 }  // namespace
 
 ImageSample image_sample(const Camera& camera, uint64_t seed, int k, int spp, bool thin_lens) {
+  RVR_CHECK(spp >= 1 && k >= 0 && k < spp, "sample ", k, " of ", spp, " per pixel");
   ImageSample s;
   uint64_t state = mix(seed ^ 0x5851F42D4C957F2Dull) ^ uint64_t(uint32_t(k));
   const int m = int(std::sqrt(double(spp)));

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "rvr/shared/camera.h"
+#include "rvr/shared/check.h"
 #include "rvr/shared/srgb.h"
 #include "rvr/shared/tessellate.h"
 
@@ -200,6 +201,8 @@ double edge_distance_pixels(const PixelRays& rays, const std::array<glm::dvec3, 
 
 // Marks every pixel whose 3x3 neighbourhood (itself included) holds a marked pixel.
 std::vector<bool> dilate3x3(const std::vector<bool>& mask, int w, int h) {
+  RVR_CHECK(w >= 0 && h >= 0 && mask.size() == size_t(w) * size_t(h),
+            "one mask entry per pixel of the ", w, "x", h, " frame: ", mask.size());
   std::vector<bool> out(mask.size(), false);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {

@@ -5,6 +5,8 @@
 #include <mutex>
 #include <new>
 
+#include "rvr/shared/check.h"
+
 namespace rvr {
 namespace {
 
@@ -35,6 +37,8 @@ size_t rounded(size_t bytes, size_t align) {
 }  // namespace
 
 void* acquire_pixel_memory(size_t bytes, size_t align) {
+  RVR_CHECK(align >= sizeof(void*) && (align & (align - 1)) == 0,
+            "aligned_alloc takes a power-of-two alignment: ", align);
   const size_t size = rounded(bytes == 0 ? 1 : bytes, align);
   if (size >= kRecycledBytes) {
     Pool& pl = pool();
@@ -43,6 +47,7 @@ void* acquire_pixel_memory(size_t bytes, size_t align) {
     for (auto it = pl.free.rbegin(); it != pl.free.rend(); ++it) {
       if (it->bytes != size || it->align != align) continue;
       void* p = it->p;
+      RVR_DCHECK(pl.held >= size, "the pool holds every block it lists");
       pl.held -= size;
       pl.free.erase(std::next(it).base());
       return p;

@@ -1,5 +1,8 @@
 #include "rvr/shared/shade_batch.h"
 
+#include <limits>
+
+#include "rvr/shared/check.h"
 #include "rvr/shared/shading.h"
 
 namespace rvr {
@@ -36,6 +39,8 @@ ShadeMaterial shade_material(const Material& m, const glm::vec3& ambient) {
 }
 
 ShadeLightArrays::ShadeLightArrays(const std::vector<LightSample>& samples) {
+  RVR_CHECK(samples.size() <= size_t(std::numeric_limits<int>::max()),
+            "the kernels count light samples in an int: ", samples.size());
   for (const LightSample& l : samples)
     for (int a = 0; a < 3; ++a) {
       data_[a].push_back(l.position[a]);
@@ -47,6 +52,7 @@ ShadeLightArrays::ShadeLightArrays(const std::vector<LightSample>& samples) {
 }
 
 void put_material(ShadeLanes& b, int i, const ShadeMaterial& m) {
+  RVR_DCHECK(i >= 0 && i < kShadeBatch, "slot ", i, " of a batch of ", kShadeBatch);
   for (int a = 0; a < 3; ++a) {
     b.diffuse[a][i] = m.diffuse[a];
     b.specular[a][i] = m.specular[a];
@@ -56,6 +62,8 @@ void put_material(ShadeLanes& b, int i, const ShadeMaterial& m) {
 }
 
 void pad_batch(ShadeBatch& b, bool materials) {
+  RVR_CHECK(b.count >= 0 && padded(b.count) <= kShadeBatch,
+            "a shade batch holds 0..kShadeBatch pixels, padded to the widest kernel: ", b.count);
   const int last = b.count - 1;
   for (int i = b.count; i < padded(b.count); ++i) {
     copy3(b.bary, last, i);
@@ -69,6 +77,8 @@ void pad_batch(ShadeBatch& b, bool materials) {
 }
 
 void pad_batch(SurfaceBatch& b, bool materials) {
+  RVR_CHECK(b.count >= 0 && padded(b.count) <= kShadeBatch,
+            "a surface batch holds 0..kShadeBatch pixels, padded to the widest kernel: ", b.count);
   const int last = b.count - 1;
   for (int i = b.count; i < padded(b.count); ++i) {
     b.t[i] = b.t[last];

@@ -11,6 +11,8 @@
 #include <bit>
 #include <cmath>
 
+#include "rvr/shared/check.h"
+
 namespace rvr {
 
 float srgb_encode(float v) {
@@ -47,6 +49,8 @@ struct Srgb8Table {
         (srgb8_by_formula(std::bit_cast<float>(mid)) >= k ? hi : lo) = mid;
       }
       starts[size_t(k)] = std::bit_cast<float>(hi);
+      RVR_CHECK(starts[size_t(k)] > starts[size_t(k - 1)],
+                "srgb8 never decreases, so each value starts past the one before: ", k);
     }
     starts[256] = INFINITY;
     for (uint32_t b = 0; b < bucket.size(); ++b) {
@@ -67,6 +71,8 @@ uint8_t srgb8(float v) {
   // A bucket spans at most a third of a step (near 1, where the ramp is steepest per bucket:
   // 255 * d(encode)/dv * 2^-9 ~ 0.33), so the value is the bucket's or the next.
   out += v >= table.starts[out + 1] ? 1u : 0u;
+  RVR_DCHECK(v >= table.starts[out] && v < table.starts[out + 1],
+             "a bucket spans at most one step of the table");
   return uint8_t(out);
 }
 

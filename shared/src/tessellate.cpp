@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rvr/shared/check.h"
+
 namespace rvr {
 
 std::array<glm::vec3, 2> plane_axes(const glm::vec3& n) {
@@ -51,6 +53,11 @@ TriangleMesh tessellate_sphere(const Sphere& s, int segments) {
   }
   for (int k = 0; k < segments; ++k)
     mesh.triangles.push_back({south, ring_vertex(rings - 1, k + 1), ring_vertex(rings - 1, k)});
+  RVR_CHECK(mesh.positions.size() == size_t(2 + (rings - 1) * segments) &&
+                mesh.triangles.size() == size_t(2 * segments * (rings - 1)),
+            "a UV sphere of ", segments, " longitudes and ", rings, " rings has ",
+            2 * segments * (rings - 1), " triangles, not ", mesh.triangles.size());
+  RVR_CHECK(ring_vertex(rings - 1, segments - 1) < south, "ring vertices come before the pole");
   return mesh;
 }
 

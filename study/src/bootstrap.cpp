@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "rvr/shared/check.h"
+
 namespace rvr::study {
 
 uint64_t Rng::next() {
@@ -15,6 +17,7 @@ uint64_t Rng::next() {
 }
 
 size_t Rng::below(size_t n) {
+  RVR_CHECK(n > 0, "a draw below 0 has no value");
   return size_t(next() % uint64_t(n));
 }
 
@@ -43,6 +46,7 @@ std::vector<double> resample_medians(const std::vector<Measurement>& points, Rng
 }
 
 double quantile(std::vector<double> values, double q) {
+  RVR_CHECK(q >= 0.0 && q <= 1.0, "a quantile lies in [0, 1]: ", q);
   if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
   std::sort(values.begin(), values.end());
   double pos = q * double(values.size() - 1);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 
+#include "rvr/shared/check.h"
+
 namespace rvr::study {
 namespace {
 
@@ -44,6 +46,8 @@ struct Crossing {
 
 // Every sign change of d = log(t_a / t_b) over the points, in log n.
 std::vector<Crossing> crossings(const std::vector<double>& log_n, const std::vector<double>& d) {
+  RVR_CHECK(log_n.size() == d.size(), "one ratio per point: ", d.size(), " ratios at ",
+            log_n.size(), " points");
   std::vector<Crossing> out;
   for (size_t i = 0; i + 1 < d.size(); ++i) {
     if ((d[i] < 0) == (d[i + 1] < 0) || d[i] == 0) continue;
@@ -54,6 +58,8 @@ std::vector<Crossing> crossings(const std::vector<double>& log_n, const std::vec
 }
 
 std::vector<double> log_ratios(const std::vector<double>& ta, const std::vector<double>& tb) {
+  RVR_CHECK(ta.size() == tb.size(), "both renderers timed at the same points: ", ta.size(), " and ",
+            tb.size());
   std::vector<double> d;
   for (size_t i = 0; i < ta.size(); ++i) d.push_back(std::log(ta[i] / tb[i]));
   return d;

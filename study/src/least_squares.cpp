@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include "rvr/shared/check.h"
+
 namespace rvr::study {
 namespace {
 
@@ -70,6 +72,11 @@ Expected<std::vector<double>> weighted_least_squares(const Matrix& x, const std:
   if (cols.empty() || x.size() < cols.size())
     return bad_input("least squares: " + std::to_string(x.size()) + " points for " +
                      std::to_string(cols.size()) + " coefficients");
+  RVR_CHECK(y.size() == x.size() && w.size() == x.size(), "least squares: ", x.size(), " rows, ",
+            y.size(), " targets, ", w.size(), " weights");
+  for (const auto& row : x)
+    RVR_CHECK(row.size() == use.size(), "least squares: a row of ", row.size(), " features for ",
+              use.size(), " coefficients");
   Matrix a;
   std::vector<double> b, scale;
   weighted_system(x, y, w, cols, a, b, scale);
@@ -78,6 +85,7 @@ Expected<std::vector<double>> weighted_least_squares(const Matrix& x, const std:
   for (size_t j = cols.size(); j-- > 0;) {
     double s = b[j];
     for (size_t c = j + 1; c < cols.size(); ++c) s -= a[j][c] * beta[c];
+    RVR_DCHECK(a[j][j] != 0.0, "householder() refuses dependent columns");
     beta[j] = s / a[j][j];
   }
   std::vector<double> out(use.size(), 0.0);

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rvr/shared/check.h"
+
 namespace rvr::study {
 
 double median(std::vector<double> values) {
@@ -42,12 +44,15 @@ std::vector<double> hd_weights(size_t count) {
     w.push_back(beta_mass(a, double(i) / n, double(i + 1) / n));
     sum += w.back();
   }
+  RVR_CHECK(count == 0 || sum > 0.0, "the Beta masses of [0, 1] add up to 1, not ", sum);
   for (double& x : w) x /= sum;
   return w;
 }
 
 double hd_median(std::vector<double> values, const std::vector<double>& weights) {
   if (values.empty()) return 0.0;
+  RVR_CHECK(weights.size() == values.size(), "Harrell-Davis weights for ", weights.size(),
+            " values applied to ", values.size());
   std::sort(values.begin(), values.end());
   double total = 0;
   for (size_t i = 0; i < values.size(); ++i) total += weights[i] * values[i];

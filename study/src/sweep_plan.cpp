@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/scene_loader.h"
 
 namespace rvr::study {
@@ -45,6 +46,8 @@ Expected<Family> find_family(const std::string& name) {
 }
 
 std::vector<size_t> log_spaced(size_t low, size_t high, int count) {
+  RVR_CHECK(low >= 1 && low <= high, "a log-spaced range needs 1 <= low <= high: ", low, "..",
+            high);
   std::vector<size_t> out;
   for (int i = 0; i < count; ++i) {
     double f = count > 1 ? double(i) / double(count - 1) : 0.0;
@@ -110,6 +113,8 @@ Expected<Shard> parse_shard(const std::string& text) {
 }
 
 bool in_shard(size_t plan_index, const Shard& shard) {
+  RVR_CHECK(shard.count >= 1 && shard.index < shard.count,
+            "parse_shard gives 0 <= index < count: ", shard.index, "/", shard.count);
   return plan_index % shard.count == shard.index;
 }
 

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <limits>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/shade_batch.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/surface_colour.h"
@@ -27,11 +28,9 @@ struct ObjectShading {
 };
 
 // Asks for transparent huge pages over a buffer not yet touched. The frame's buffers are fresh
-// memory every frame (the caller takes them away): 31 MB at 1024x768, first touched here, one
-// page fault per 4 KiB (page faults were a fifth of the samples of a tessphere:100000 frame).
-// Where the system grants huge pages on request, that is one fault per 2 MiB (measured: 4,600
-// faults a frame before, 2,000 after). Advice only: no byte written changes, and a refusal (an
-// error return) leaves the small pages.
+// memory every frame (the caller takes them away), tens of MB first touched here: one page
+// fault per 4 KiB, or, where the system grants huge pages on request, one per 2 MiB. Advice
+// only: no byte written changes, and a refusal (an error return) leaves the small pages.
 template <class T>
 void ask_for_huge_pages(PixelVector<T>& v) {
   constexpr uintptr_t kHuge = uintptr_t(2) << 20;
@@ -161,6 +160,7 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
       bool mixed = false;
       auto flush = [&] {
         if (batch.count == 0) return;
+        RVR_DCHECK(batch.count <= kShadeBatch, "flushed when full: ", batch.count);
         const int n = batch.count;
         pad_batch(batch, mixed);
         batch.material = mixed ? nullptr : &objects[batch_object].material;
@@ -197,6 +197,9 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
           const uint32_t id = object_of[o];
           const ObjectShading& s = objects[id];
           const uint32_t primitive = primitive_of[o];
+          RVR_DCHECK(id < objects.size() && primitive < objects[id].mesh->triangles.size(),
+                     "the z-buffer stores ids of drawn triangles: object ", id, ", primitive ",
+                     primitive);
 
           const int i = batch.count++;
           pixel[i] = o;

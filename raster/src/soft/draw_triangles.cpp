@@ -7,6 +7,7 @@
 #include <atomic>
 #include <chrono>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/timer.h"
 #include "soft/setup_kernel.h"
 #include "soft/triangle_setup.h"
@@ -20,8 +21,8 @@ using Clock = std::chrono::steady_clock;
 // a time in parallel, binned, and drawn into every tile before the next: memory holds one chunk,
 // whatever the triangle count. Each chunk's tile pass fetches again the frame-buffer lines its
 // triangles touch: scattered triangles (a soup) touch most of the frame in every chunk, so fewer,
-// larger chunks save that traffic (soup 10^6: 16 chunks of 65,536 -> 4 of 262,144 took 10-15%
-// off the frame); 262,144 set-up triangles are 48 MiB, well inside the memory target at 10^7.
+// larger chunks save that traffic; 262,144 set-up triangles are 48 MiB, well inside the memory
+// target at 10^7.
 constexpr size_t kChunk = size_t(1) << 18;
 // 8192 set-up triangles are 1.5 MiB: one huge page each (HugePageAllocator).
 constexpr size_t kSubChunk = 8192;
@@ -199,6 +200,7 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
         local.clear();
         size_t local_clipped = 0;
         const size_t begin = chunk + s * kSubChunk, end = std::min(chunk_end, begin + kSubChunk);
+        RVR_DCHECK(begin < end && end - begin <= kSubChunk, "sub-chunk [", begin, ", ", end, ")");
         local.reserve(end - begin);
         size_t object = size_t(std::upper_bound(list.first.begin(), list.first.end(), begin) -
                                list.first.begin()) -
@@ -275,6 +277,8 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
         spans.resize(sub_out[s].size());
         for (size_t i = 0; i < spans.size(); ++i) {
           const SetupTriangle& st = sub_out[s][i];
+          RVR_DCHECK(st.x0 <= st.x1 && st.y0 <= st.y1 && st.x1 < width && st.y1 < height,
+                     "setup keeps only triangles with an on-screen pixel box");
           spans[i] = {uint16_t(st.x0 / kTile), uint16_t(st.y0 / kTile), uint16_t(st.x1 / kTile),
                       uint16_t(st.y1 / kTile)};
           for_tiles(spans[i], [&](size_t b) { ++c[b]; });
@@ -282,6 +286,10 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
       });
     });
     for (size_t s = 0; s < subs; ++s) {
+      RVR_CHECK(sub_out[s].size() < (size_t(1) << DepthTarget::kLocalBits),
+                "a sub-chunk's set-up triangles (clipping makes up to six of one) must fit a bin "
+                "entry's local index: ",
+                sub_out[s].size());
       result.clipped += sub_clipped[s];
       result.set_up += sub_out[s].size();
     }
@@ -301,6 +309,8 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
       }
     }
     bin_start[tile_count] = running;
+    RVR_CHECK(subs <= (size_t(1) << (32 - DepthTarget::kLocalBits)),
+              "a chunk's sub-chunk numbers must fit a bin entry's top bits: ", subs);
     bin.resize(running);
     arena.execute([&] {
       tbb::parallel_for(size_t(0), subs, [&](size_t s) {

@@ -8,6 +8,8 @@
 #include <array>
 #include <limits>
 
+#include "rvr/shared/check.h"
+
 namespace rvr::soft {
 
 DepthTarget::DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz,
@@ -23,13 +25,17 @@ DepthTarget::DepthTarget(int width, int height, double near_plane, double far_pl
       hiz_(hiz),
       depth_only_(depth_only),
       kernels_(&kernels) {
+  RVR_CHECK(width > 0 && height > 0 && width <= kMaxImageSide && height <= kMaxImageSide,
+            "the renderer refuses frames outside 1..kMaxImageSide: ", width, "x", height);
+  RVR_CHECK(near_plane > 0.0 && far_plane > near_plane,
+            "the camera keeps 0 < near < far: ", near_plane, ", ", far_plane);
   clear();
 }
 
 void DepthTarget::clear() {
   const size_t n = size_t(width_) * size_t(height_);
-  // Sized without a serial fill (tens of MB at 1024x768, a serial share of the frame that
-  // kept two threads from doubling the speed), then filled in parallel slices.
+  // Sized without a serial fill (tens of MB at 1024x768: a serial fill would be a serial share
+  // of every frame), then filled in parallel slices.
   depth_.resize(n);
   if (!depth_only_) {
     object_.resize(n);
@@ -91,9 +97,13 @@ void DepthTarget::update_block_max(int bx, int by) {
 
 void DepthTarget::draw_tile(int tx, int ty, const SetupTriangles* sub_chunks, const uint32_t* bin,
                             size_t count, TileCounters& counters) {
+  RVR_DCHECK(tx >= 0 && tx < tiles_x_ && ty >= 0 && ty < tiles_y_, "tile (", tx, ", ", ty,
+             ") outside the ", tiles_x_, "x", tiles_y_, " tiles");
   const int ox = tx * kTile, oy = ty * kTile;
   const int ex = std::min(ox + kTile, width_) - 1, ey = std::min(oy + kTile, height_) - 1;
   auto triangle = [&](size_t k) -> const SetupTriangle& {
+    RVR_DCHECK((bin[k] & ((1u << kLocalBits) - 1)) < sub_chunks[bin[k] >> kLocalBits].size(),
+               "a bin entry names a set-up triangle of its sub-chunk: ", bin[k]);
     return sub_chunks[bin[k] >> kLocalBits][bin[k] & ((1u << kLocalBits) - 1)];
   };
   // A bin's triangles lie scattered over the chunk (megabytes, beyond L2), and so do the pixels

@@ -1,8 +1,11 @@
 #include "soft/triangle_setup.h"
 
 #include <algorithm>
+#include <cstdlib>
+#include <iterator>
 #include <utility>
 
+#include "rvr/shared/check.h"
 #include "soft/setup_kernel.h"
 
 namespace rvr::soft {
@@ -24,6 +27,8 @@ inline int64_t round_half_away(double x) {
 
 TriangleSetup::TriangleSetup(int width, int height, const glm::dmat4& view_projection)
     : width_(width), height_(height), view_projection_(view_projection) {
+  RVR_CHECK(width > 0 && height > 0 && width <= kMaxImageSide && height <= kMaxImageSide,
+            "the renderer refuses frames outside 1..kMaxImageSide: ", width, "x", height);
   const double gx = kGuardPixels / width, gy = kGuardPixels / height;
   const glm::dvec4 frustum[6] = {{1, 0, 0, 1},  {-1, 0, 0, 1}, {0, 1, 0, 1},
                                  {0, -1, 0, 1}, {0, 0, 1, 1},  {0, 0, -1, 1}};
@@ -56,6 +61,8 @@ ProjectedVertex TriangleSetup::project(const glm::vec3& p) const {
     v.sy = (0.5 - k.y / k.w * 0.5) * height_;
     v.fx = round_half_away(v.sx * double(kSub));
     v.fy = round_half_away(v.sy * double(kSub));
+    RVR_DCHECK(std::abs(v.fx) < (int64_t(1) << 28) && std::abs(v.fy) < (int64_t(1) << 28),
+               "inside the guard band fixed point is below 2^28: ", v.fx, ", ", v.fy);
     v.inv_w = 1.0 / k.w;
   }
   return v;
@@ -122,6 +129,8 @@ void TriangleSetup::clip_and_emit(const ProjectedVertex* pv[3], uint32_t object,
     std::swap(v, scratch_);
     if (v.size() < 3) break;
   }
+  RVR_DCHECK(v.size() <= 3 + std::size(clip_planes_),
+             "each clip plane adds at most one vertex to a convex polygon: ", v.size());
   // A convex polygon as a fan: the inner diagonals are shared edges, drawn once by the rule.
   for (size_t i = 1; i + 1 < v.size(); ++i) {
     const ClipVertex* cv[3] = {&v[0], &v[i], &v[i + 1]};
@@ -150,6 +159,8 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
   SetupTriangle t;
   double sx[3], sy[3];
   for (int i = 0; i < 3; ++i) {
+    RVR_DCHECK(std::abs(fx[i]) < (int64_t(1) << 28) && std::abs(fy[i]) < (int64_t(1) << 28),
+               "guard-band fixed point must fit SetupTriangle's int32_t: ", fx[i], ", ", fy[i]);
     t.x[i] = int32_t(fx[order[i]]);
     t.y[i] = int32_t(fy[order[i]]);
     sx[i] = sx_in[order[i]];
@@ -168,6 +179,8 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
   t.x1 = std::min(width_ - 1, last_centre(max_x));
   t.y1 = std::min(height_ - 1, last_centre(max_y));
   if (t.x0 > t.x1 || t.y0 > t.y1) return;
+  RVR_DCHECK(t.x0 >= 0 && t.y0 >= 0 && t.x1 < width_ && t.y1 < height_,
+             "a set-up triangle's pixel box lies on screen");
   int64_t edge_dx[3], edge_dy[3];
   for (int i = 0; i < 3; ++i) {
     const int64_t dx = int64_t(t.x[(i + 1) % 3]) - t.x[i], dy = int64_t(t.y[(i + 1) % 3]) - t.y[i];

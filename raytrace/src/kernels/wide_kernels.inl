@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "rvr/raytrace/wide_bvh_layout.h"
+#include "rvr/shared/check.h"
 
 #ifndef RVR_KERNEL_NS
 #error "define RVR_KERNEL_NS (isa_sse, isa_avx2 or isa_avx512) before including this file"
@@ -250,6 +251,8 @@ inline uint32_t visit_children(const WideNode& node, unsigned mask, V8 near, Sta
   storeu(stack.ref + stack.top, payload);
   storeu(stack.dist + stack.top, key);
   stack.top += __builtin_popcount(mask) - 1;
+  RVR_DCHECK(stack.top <= kStackSize, "the wide BVH is at most 64 inner levels deep; stack at ",
+             stack.top);
   return stack.ref[stack.top];  // the nearest: stored, but not pushed
 }
 
@@ -293,6 +296,7 @@ bool traverse_from(const WideBvhView& bvh, const KernelRay& ray, uint32_t start,
           unsigned nearer = swap ? b : a, farther = swap ? a : b;
           stack.ref[stack.top] = node.child[farther];
           stack.dist[stack.top++] = nd[farther];
+          RVR_DCHECK(stack.top <= kStackSize, "stack at ", stack.top);
           ref = node.child[nearer];
         } else {
           ref = visit_children(node, mask, near, stack);
@@ -302,6 +306,7 @@ bool traverse_from(const WideBvhView& bvh, const KernelRay& ray, uint32_t start,
     if (!leaf_reached) continue;
     const uint32_t first = (ref & ~kLeafFlag) >> kLeafCountBits;
     const uint32_t triangles = ref & ((1u << kLeafCountBits) - 1);
+    RVR_DCHECK(triangles >= 1 && triangles <= uint32_t(kMaxLeafTriangles), "leaf of ", triangles);
     if (kCount) counters->tests += triangles;
     for (uint32_t k = 0; k < (triangles + kTriangleBlock - 1) / kTriangleBlock; ++k) {
       const TriangleBlock& b = bvh.blocks[first + k];
@@ -389,8 +394,9 @@ struct PacketBest8 {
 constexpr int kSingleRayThreshold = 2;
 
 struct PacketStack {
-  uint32_t ref[8 * 66];
-  alignas(32) float near[8 * 66][8];
+  static constexpr int kEntries = 8 * 66;
+  uint32_t ref[kEntries];
+  alignas(32) float near[kEntries][8];
   int top = 0;
 };
 
@@ -559,6 +565,8 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
         for (int l = 0; l < 8; ++l) stack.near[stack.top][l] = nears[k][l];
         ++stack.top;
       }
+      RVR_DCHECK(stack.top <= PacketStack::kEntries,
+                 "the wide BVH is at most 64 inner levels deep; stack at ", stack.top);
       continue;
     }
     const uint32_t first = (ref & ~kLeafFlag) >> kLeafCountBits;

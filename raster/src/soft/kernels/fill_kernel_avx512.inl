@@ -1,8 +1,8 @@
 // softraster's per-pixel loop for AVX-512 (included by fill_kernels.inl in the avx512 unit): 8
 // pixels a group, so an 8x8 block's row is one group, and the depth test, fragment counts and
 // writes as masked loads and stores instead of a scalar loop over the group's lanes. AVX-512's
-// masks make the uncovered lanes and a row's ragged end free (AVX2's masked stores were
-// measured slower than the scalar loop). Per lane the same double operations as the narrower
+// masks make the uncovered lanes and a row's ragged end free (the AVX2 kernel keeps the scalar
+// loop over the group's lanes: its masked stores do not pay off). Per lane the same double operations as the narrower
 // kernels, in the same order, so the bytes do not depend on the kernel.
 #include <immintrin.h>
 

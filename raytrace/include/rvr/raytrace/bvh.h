@@ -55,8 +55,8 @@ void advise_huge_pages(void* p, size_t bytes);
 // Allocator for the arrays traversal walks (nodes, leaf-ordered triangles): 64-byte aligned,
 // and arrays of 2 MiB or more on transparent huge pages where the kernel offers them only on
 // request (madvise mode, as here), as Embree does for its own. With 4 KiB pages a 100k-triangle
-// tree spans ~2,000 pages and traversal pays TLB misses: measured 6.5 vs 9.2 Mrays/s
-// (BM_Trace/bvh/primary/tessphere/100000) depending on where malloc happened to put it.
+// tree spans ~2,000 pages and traversal pays TLB misses, so its speed would depend on where
+// malloc happened to put it.
 template <class T>
 struct TraversalAllocator {
   using value_type = T;
@@ -89,10 +89,9 @@ using TraversalVector = std::vector<T, TraversalAllocator<T>>;
 
 struct BvhBuildOptions {
   int max_leaf_size = 8;
-  // A node visit against one primitive test, in the SAH. Measured on this machine for the binary
-  // tree (BM_Trace, BM_Build): 1 gives leaves of ~1 triangle and 98 bytes per triangle; 2 gives
-  // 71 B/tri; 3 gives 59 B/tri at the same rays/s on tessphere:100000 and 30% more on
-  // soup:1000000 than 1; 4 starts to lose speed.
+  // A node visit against one primitive test, in the SAH. Lower costs give smaller leaves and
+  // more nodes (more memory per triangle); 3 is where the binary tree's trace speed (BM_Trace)
+  // is best for the memory it takes (BM_Build reports both; bench/JOURNAL.md has the sweep).
   float traversal_cost = 3.0f;
   // Leaves are tested this many primitives at a time (SIMD blocks): the SAH counts a leaf of n
   // as ceil(n / leaf_block) tests, as Embree's builders do for their 4-triangle leaves.

@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/pixel_memory.h"
 
 namespace rvr {
@@ -73,11 +74,16 @@ struct FrameBuffers {
     normal[i] = glm::vec3(0.0f);
     cost[i] = 0.0f;
   }
-  size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
+  size_t index(int x, int y) const {
+    RVR_DCHECK(x >= 0 && x < width && y >= 0 && y < height, "pixel (", x, ", ", y, ") of a ", width,
+               "x", height, " frame");
+    return size_t(y) * size_t(width) + size_t(x);
+  }
   size_t pixel_count() const { return size_t(width) * size_t(height); }
 };
 
 inline void FrameBuffers::reset(int w, int h, const glm::vec3& background) {
+  RVR_CHECK(w >= 0 && h >= 0, "frame size ", w, "x", h);
   width = w;
   height = h;
   size_t n = pixel_count();
@@ -91,6 +97,7 @@ inline void FrameBuffers::reset(int w, int h, const glm::vec3& background) {
 }
 
 inline void FrameBuffers::allocate(int w, int h) {
+  RVR_CHECK(w >= 0 && h >= 0, "frame size ", w, "x", h);
   width = w;
   height = h;
   size_t n = pixel_count();

@@ -1,11 +1,11 @@
 // Memory for whole-frame buffers, recycled between frames. A frame's buffers are tens of MB;
 // taken fresh from the system every frame, each of their pages faults and is cleared by the
-// kernel on first touch (a fifth of a 10^5-triangle softraster frame at 1024x768, measured
-// with perf). Blocks of at least kRecycledBytes that are released are kept (up to
-// kRecycleLimitBytes in all, oldest freed first beyond that) and handed out again for a
-// request of the same size: the next frame's buffers reuse the last frame's pages, as a GPU
-// driver reuses its framebuffers. Contents of a recycled block are whatever was there: only
-// buffers whose every element is written before being read use this (PixelVector).
+// kernel on first touch, a large share of a softraster frame's time. Blocks of at least
+// kRecycledBytes that are released are kept (up to kRecycleLimitBytes in all, oldest freed first
+// beyond that) and handed out again for a request of the same size: the next frame's buffers reuse
+// the last frame's pages, as a GPU driver reuses its framebuffers. Contents of a recycled block are
+// whatever was there: only buffers whose every element is written before being read use this
+// (PixelVector).
 #pragma once
 
 #include <cstddef>
