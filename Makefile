@@ -6,7 +6,7 @@ PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-d
 	openimageio-tools libbenchmark-dev libgtest-dev libembree-dev libtbb-dev \
 	nlohmann-json3-dev libcli11-dev libfmt-dev libassimp-dev python3-matplotlib \
 	clang-14 libclang-rt-14-dev python3-glad libegl-dev libegl-mesa0 chromium python3-websocket \
-	python3-jsonschema
+	python3-jsonschema pybind11-dev python3-pybind11 python3-dev python3-pytest python3-openimageio
 
 .PHONY: all deps build demo test check sanitize fuzz bench study clean format
 

@@ -1,0 +1,38 @@
+# The module renders what the command line renders, to the bit: colour, depth and ids of
+# rvr.render against the EXR files `rvr render` writes for the same scene and options, read by
+# OpenImageIO's own Python binding (not by rvr's reader).
+import numpy as np
+import OpenImageIO as oiio
+import pytest
+
+import rvr
+
+SCENE = "builtin:cornell"
+WIDTH, HEIGHT = 96, 72
+
+
+def read_exr(path):
+    image = oiio.ImageBuf(str(path))
+    assert not image.has_error, image.geterror()
+    return image.get_pixels(oiio.FLOAT)
+
+
+@pytest.mark.parametrize("renderer", ["raytrace", "softraster", "raster", "hybrid_soft"])
+def test_render_matches_the_command_line(renderer, run_cli, tmp_path):
+    out = tmp_path / "render.exr"
+    done = run_cli("render", SCENE, "-r", renderer, "--mode", "local", "--width", str(WIDTH),
+                   "--height", str(HEIGHT), "--threads", "2", "--aov", "depth,id", "-q",
+                   "-o", str(out))
+    assert done.returncode == 0, done.stderr
+
+    r = rvr.render(rvr.Scene(SCENE, width=WIDTH, height=HEIGHT), renderer, mode="local",
+                   threads=2)
+    color = read_exr(out)
+    depth = read_exr(tmp_path / "render.depth.exr")
+    ids = read_exr(tmp_path / "render.id.exr")
+    assert color.shape == (HEIGHT, WIDTH, 3)
+    assert r.color.tobytes() == np.ascontiguousarray(color).tobytes()
+    assert r.depth.tobytes() == np.ascontiguousarray(depth[:, :, 0]).tobytes()
+    assert np.array_equal(r.object_id, ids[:, :, 0].astype(np.int32))
+    assert np.array_equal(r.primitive_id, ids[:, :, 1].astype(np.int32))
+    assert (r.object_id >= 0).any() and (r.object_id == -1).any()
