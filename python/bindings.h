@@ -9,5 +9,6 @@ void bind_errors(pybind11::module_& m);   // errors.cpp: rvr.BadInput
 void bind_scene(pybind11::module_& m);    // py_scene.cpp: rvr.Scene, rvr.scenes()
 void bind_render(pybind11::module_& m);   // py_render.cpp: rvr.render, rvr.Render, renderers()
 void bind_compare(pybind11::module_& m);  // py_compare.cpp: rvr.compare, rvr.diff
+void bind_study(pybind11::module_& m);    // py_study.cpp: rvr.study
 
 }  // namespace rvr::python

@@ -12,4 +12,5 @@ PYBIND11_MODULE(rvr, m) {
   rvr::python::bind_scene(m);
   rvr::python::bind_render(m);
   rvr::python::bind_compare(m);
+  rvr::python::bind_study(m);
 }

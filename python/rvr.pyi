@@ -86,3 +86,14 @@ def diff(
     fail_above: Optional[float] = None,
     out: str = "",
 ) -> dict[str, Any]: ...
+def study(
+    scenes: Sequence[str] = ("builtin:tessphere", "builtin:soup"),
+    *,
+    renderers: Sequence[str] = (),
+    width: int = 1024,
+    mode: str = "local",
+    budget: float = 300.0,
+    repetitions: int = 5,
+    seed: int = 1,
+    check_predictions: bool = True,
+) -> dict[str, Any]: ...
