@@ -41,6 +41,8 @@ PyRender render(const PyScene& scene, const std::string& renderer, const std::st
   RenderResultWithTime done = render_interruptibly(scene.scene, std::move(made), settings.options);
   result->output = take(std::move(done.output));
   result->times.render = done.seconds;
+  result->stats_json = render_stats_json(result->renderer, *result->scene, result->mode,
+                                         result->times, result->output);
   return PyRender{std::move(result)};
 }
 
@@ -121,11 +123,7 @@ void bind_render_class(py::module_& m) {
           [=](const PyRender& r) { return view(owner(r), buffers(r).cost.data(), shape(r)); },
           "H x W float32 work per pixel (nodes visited and tests, or fragments).")
       .def_property_readonly(
-          "stats",
-          [](const PyRender& r) {
-            const RenderResult& x = *r.result;
-            return json_loads(render_stats_json(x.renderer, *x.scene, x.mode, x.times, x.output));
-          },
+          "stats", [](const PyRender& r) { return json_loads(r.result->stats_json); },
           "The document `rvr render --stats` writes, as a dict.")
       .def_property_readonly(
           "warnings",

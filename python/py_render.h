@@ -17,6 +17,7 @@ struct RenderResult {
   RenderMode mode = RenderMode::Local;
   RenderTimes times;
   RenderOutput output;
+  std::string stats_json;  // the --stats document, made when the render finished
 };
 
 struct PyRender {

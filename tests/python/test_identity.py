@@ -1,6 +1,8 @@
 # The module renders what the command line renders, to the bit: colour, depth and ids of
 # rvr.render against the EXR files `rvr render` writes for the same scene and options, read by
 # OpenImageIO's own Python binding (not by rvr's reader).
+import json
+
 import numpy as np
 import OpenImageIO as oiio
 import pytest
@@ -22,7 +24,7 @@ def test_render_matches_the_command_line(renderer, run_cli, tmp_path):
     out = tmp_path / "render.exr"
     done = run_cli("render", SCENE, "-r", renderer, "--mode", "local", "--width", str(WIDTH),
                    "--height", str(HEIGHT), "--threads", "2", "--aov", "depth,id", "-q",
-                   "-o", str(out))
+                   "--stats", str(tmp_path / "stats.json"), "-o", str(out))
     assert done.returncode == 0, done.stderr
 
     r = rvr.render(rvr.Scene(SCENE, width=WIDTH, height=HEIGHT), renderer, mode="local",
@@ -36,3 +38,11 @@ def test_render_matches_the_command_line(renderer, run_cli, tmp_path):
     assert np.array_equal(r.object_id, ids[:, :, 0].astype(np.int32))
     assert np.array_equal(r.primitive_id, ids[:, :, 1].astype(np.int32))
     assert (r.object_id >= 0).any() and (r.object_id == -1).any()
+
+    # The --stats document: the same fields; the same counters, times apart.
+    cli = json.loads((tmp_path / "stats.json").read_text())
+    assert list(r.stats) == list(cli)
+    assert r.stats["info"] == cli["info"] and r.stats["warnings"] == cli["warnings"]
+    counters = {k: v for k, v in cli["stats"].items() if "time." not in k}
+    assert {k: r.stats["stats"][k] for k in counters} == counters
+    assert r.stats["stats"].keys() == cli["stats"].keys()
