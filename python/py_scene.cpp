@@ -4,12 +4,14 @@
 #include <pybind11/stl.h>
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "bindings.h"
 #include "errors.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/scene_for_render.h"
+#include "rvr/shared/scene_loader.h"
 #include "rvr/shared/scene_writer.h"
 
 namespace py = pybind11;
@@ -34,7 +36,7 @@ int checked_spp(int value) {
 glm::vec3 vec3_of(const char* name, const py::handle& value) {
   std::vector<float> v = py::cast<std::vector<float>>(value);
   if (v.size() != 3 || !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-    throw BadInputError(std::string("camera.") + name + ": expected three finite numbers");
+    throw BadInputError(std::string(name) + ": expected three finite numbers");
   return {v[0], v[1], v[2]};
 }
 
@@ -47,27 +49,39 @@ py::dict camera_dict(const Camera& c) {
   return d;
 }
 
+// `camera` as the scene loader reads it (its checks, its unit-length up), through a document
+// holding only the camera: one implementation of what a valid camera is.
+Camera loaded_camera(const Camera& c) {
+  auto vec = [](const glm::vec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+  const nlohmann::json document = {{"format", "rvr-scene/1"},
+                                   {"camera",
+                                    {{"eye", vec(c.eye)},
+                                     {"target", vec(c.target)},
+                                     {"up", vec(c.up)},
+                                     {"fov_y_deg", c.fov_y_deg},
+                                     {"near", c.near},
+                                     {"far", c.far},
+                                     {"aperture_radius", c.aperture_radius},
+                                     {"focus_distance", c.focus_distance}}}};
+  return take(parse_scene(document.dump(), "camera", ".")).camera;
+}
+
 // Sets the keys given (eye, target, up, fov); the others stay.
 void set_camera(Camera& camera, const py::dict& d) {
   for (const auto& [key, value] : d) {
     const std::string k = py::cast<std::string>(key);
     if (k == "eye")
-      camera.eye = vec3_of("eye", value);
+      camera.eye = vec3_of("camera.eye", value);
     else if (k == "target")
-      camera.target = vec3_of("target", value);
+      camera.target = vec3_of("camera.target", value);
     else if (k == "up")
-      camera.up = vec3_of("up", value);
-    else if (k == "fov") {
-      const float fov = py::cast<float>(value);
-      if (!(fov > 0.0f && fov < 180.0f))
-        throw BadInputError("camera.fov: must be > 0 and < 180 degrees, got " +
-                            std::to_string(fov));
-      camera.fov_y_deg = fov;
-    } else {
+      camera.up = vec3_of("camera.up", value);
+    else if (k == "fov")
+      camera.fov_y_deg = py::cast<float>(value);
+    else
       throw BadInputError("camera: unknown key '" + k + "' (known: eye, target, up, fov)");
-    }
   }
-  if (camera.eye == camera.target) throw BadInputError("camera: eye and target are the same point");
+  camera = loaded_camera(camera);
 }
 
 UpAxis up_axis_of(const std::string& s) {
@@ -101,7 +115,7 @@ PyScene load(const std::string& source, std::optional<int> width, std::optional<
   PyScene s;
   Scene scene = take(load_scene_for_render(request, RenderOptions{}, &s.load_seconds));
   if (camera) set_camera(scene.camera, *camera);
-  s.scene = std::make_shared<const Scene>(std::move(scene));
+  s.scene = std::make_shared<Scene>(std::move(scene));
   s.limits = request.limits;
   return s;
 }

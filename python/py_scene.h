@@ -11,14 +11,14 @@
 namespace rvr::python {
 
 struct PyScene {
-  std::shared_ptr<const Scene> scene;
-  Limits limits;  // checked again at each render, with its options
+  std::shared_ptr<Scene> scene;  // renders hold it as const
+  Limits limits;                 // checked again at each render, with its options
   double load_seconds = 0.0;
 
   // The scene to change: a copy first when a render still shares it.
   Scene& edit() {
-    if (scene.use_count() > 1) scene = std::make_shared<const Scene>(*scene);
-    return const_cast<Scene&>(*scene);
+    if (scene.use_count() > 1) scene = std::make_shared<Scene>(*scene);
+    return *scene;
   }
 };
 

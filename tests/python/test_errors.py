@@ -80,3 +80,12 @@ def test_bad_options_name_what_is_wrong():
         scene.width = 0
     with pytest.raises(rvr.BadInput, match="^camera: unknown key 'foo'"):
         scene.camera = {"foo": 1}
+
+
+def test_camera_errors_are_the_loaders():
+    scene = rvr.Scene("builtin:cornell", width=8, height=8)
+    with pytest.raises(rvr.BadInput, match=r"^camera: camera.up: must not be parallel"):
+        scene.camera = {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 0, 1]}
+    with pytest.raises(rvr.BadInput, match=r"^camera: camera.fov_y_deg: must be in \(0, 180\)"):
+        scene.camera = {"fov": 180}
+    assert scene.camera["fov"] != 180  # a refused camera leaves the scene's as it was

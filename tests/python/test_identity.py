@@ -46,3 +46,23 @@ def test_render_matches_the_command_line(renderer, run_cli, tmp_path):
     counters = {k: v for k, v in cli["stats"].items() if "time." not in k}
     assert {k: r.stats["stats"][k] for k in counters} == counters
     assert r.stats["stats"].keys() == cli["stats"].keys()
+
+
+def test_camera_settings_render_as_a_scene_file_of_them(run_cli, tmp_path):
+    # The camera set from Python, written by save() and rendered by the command line from that
+    # file: the same image as the module renders.
+    scene = rvr.Scene(SCENE, width=48, height=36,
+                      camera={"eye": [2.5, 3.0, -6.0], "target": [2.78, 2.0, 0.0], "fov": 50})
+    scene.camera = {"up": [0.1, 1.0, 0.0]}
+    path = tmp_path / "scene.json"
+    scene.save(str(path))
+    document = json.loads(path.read_text())
+    assert document["camera"]["eye"] == [2.5, 3.0, -6.0]
+    # Only up's direction counts: the loader keeps it at unit length, and so does the module.
+    assert np.allclose(document["camera"]["up"], np.array([0.1, 1.0, 0.0]) / np.hypot(0.1, 1.0))
+    assert document["camera"]["fov_y_deg"] == 50
+    out = tmp_path / "render.exr"
+    done = run_cli("render", str(path), "-r", "raytrace", "--mode", "local", "-q", "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    r = rvr.render(scene, "raytrace", mode="local")
+    assert r.color.tobytes() == np.ascontiguousarray(read_exr(out)).tobytes()

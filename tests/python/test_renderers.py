@@ -54,3 +54,24 @@ def test_compare_is_metrics_json(run_cli, tmp_path):
     for name in ["raster", "raytrace"]:
         for key in ["warnings", "info", "depth_format", "image"]:
             assert got["renderers"][name][key] == expected["renderers"][name][key]
+
+
+def test_changing_a_scene_leaves_earlier_renders_alone():
+    scene = rvr.Scene("builtin:cornell", width=32, height=24)
+    first = rvr.render(scene, "raytrace", threads=1)
+    before = first.depth.copy()
+    scene.width = 16
+    scene.camera = {"fov": 20}
+    second = rvr.render(scene, "raytrace", threads=1)
+    assert first.color.shape == (24, 32, 3) and second.color.shape == (24, 16, 3)
+    assert first.stats["width"] == 32 and second.stats["width"] == 16
+    assert np.array_equal(first.depth, before)
+    assert scene.camera["fov"] == 20
+
+
+def test_to_json_of_a_scene_of_single_triangles():
+    # builtin:occluders has no mesh of more than one triangle: rvr-scene/1 holds it inline.
+    scene = rvr.Scene("builtin:occluders:3", width=20, height=10)
+    document = json.loads(scene.to_json())
+    assert document["format"] == "rvr-scene/1"
+    assert document["image"]["width"] == 20 and document["image"]["height"] == 10
