@@ -41,9 +41,12 @@ SANITIZE_DIR ?= build-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
 SANITIZE_TARGETS := rvr rvr_python $(patsubst tests/%.cpp,%,$(wildcard tests/test_*.cpp))
 # The Python module's tests run Debian's python3, which is not built with ASan: the runtime is
-# preloaded so that it comes first, as ASan requires. CPython does not free everything at exit,
-# so they run without the leak check (the module's own leaks are python_memory's subject).
-SANITIZE_PRELOAD := $(shell gcc -print-file-name=libasan.so)
+# preloaded so that it comes first, as ASan requires, and libstdc++ with it, without which ASan's
+# __cxa_throw interceptor finds no real __cxa_throw (python3 does not link libstdc++) and the
+# first C++ exception aborts ("CHECK failed: asan_interceptors.cpp:320"). CPython does not free
+# everything at exit, so they run without the leak check (the module's own leaks are
+# python_memory's subject).
+SANITIZE_PRELOAD := $(shell gcc -print-file-name=libasan.so):$(shell gcc -print-file-name=libstdc++.so)
 SANITIZE_PYTHON ?= python_
 # Brute-force conformance (`raytrace_none_*`: every scene traced with no acceleration
 # structure) takes 10 s natively and ~9 minutes under ASan; the same tracer code runs under
