@@ -4,12 +4,14 @@ JOBS ?= $(shell nproc)
 # DEMO_PACKAGES: what building the rvr command and running it need (the libraries it links or
 # opens, the GL loader generator, OSMesa and EGL). TEST_PACKAGES: what only the tests, the
 # benchmarks, `make sanitize` and `make fuzz` need (GoogleTest, Google Benchmark, idiff, the
-# browser tests' Chromium, the schema and chart checks' Python modules, clang for libFuzzer).
+# browser tests' Chromium, the schema and chart checks' Python modules, clang for libFuzzer)
+# and the Python module with its tests (pybind11, pytest, OpenImageIO's Python reader).
 DEMO_PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
 	libpng-dev libopenexr-dev libembree-dev libtbb-dev nlohmann-json3-dev libcli11-dev \
 	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0
 TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools python3-matplotlib \
-	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev clang-tidy-14 iwyu
+	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev clang-tidy-14 iwyu \
+	pybind11-dev python3-pybind11 python3-dev python3-pytest python3-openimageio
 PACKAGES := $(DEMO_PACKAGES) $(TEST_PACKAGES)
 
 .PHONY: all deps deps-demo build demo test check sanitize fuzz bench study clean format lint
@@ -33,12 +35,12 @@ deps:
 
 # Everything: the CLI, the benchmarks and the tests.
 build: deps
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DRVR_BUILD_TESTS=ON -DRVR_BUILD_BENCH=ON
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DRVR_BUILD_TESTS=ON -DRVR_BUILD_BENCH=ON -DRVR_BUILD_PYTHON=ON
 	cmake --build $(BUILD_DIR) -j $(JOBS)
 
 # Only the rvr command (no tests, no benchmarks), so only DEMO_PACKAGES are installed.
 demo: deps-demo
-	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DRVR_BUILD_TESTS=OFF -DRVR_BUILD_BENCH=OFF
+	cmake -S . -B $(BUILD_DIR) -DCMAKE_BUILD_TYPE=Release -DRVR_BUILD_TESTS=OFF -DRVR_BUILD_BENCH=OFF -DRVR_BUILD_PYTHON=OFF
 	cmake --build $(BUILD_DIR) -j $(JOBS) --target rvr
 	$(BUILD_DIR)/bin/rvr compare builtin:cornell -o rvr-out
 
@@ -56,7 +58,15 @@ check: build
 # Only the CLI and the test binaries are built (not the benchmarks).
 SANITIZE_DIR ?= build-asan
 SANITIZE_FLAGS := -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
-SANITIZE_TARGETS := rvr $(patsubst tests/%.cpp,%,$(wildcard tests/test_*.cpp))
+SANITIZE_TARGETS := rvr rvr_python $(patsubst tests/%.cpp,%,$(wildcard tests/test_*.cpp))
+# The Python module's tests run Debian's python3, which is not built with ASan: the runtime is
+# preloaded so that it comes first, as ASan requires, and libstdc++ with it, without which ASan's
+# __cxa_throw interceptor finds no real __cxa_throw (python3 does not link libstdc++) and the
+# first C++ exception aborts ("CHECK failed: asan_interceptors.cpp:320"). CPython does not free
+# everything at exit, so they run without the leak check (the module's own leaks are
+# python_memory's subject).
+SANITIZE_PRELOAD := $(shell gcc -print-file-name=libasan.so):$(shell gcc -print-file-name=libstdc++.so)
+SANITIZE_PYTHON ?= python_
 # Brute-force conformance (`raytrace_none_*`: every scene traced with no acceleration
 # structure) is left out: under ASan it alone would take longer than the rest of the suite; the
 # same tracer code runs under ASan with the BVH in every other conformance case, and the
@@ -82,15 +92,15 @@ sanitize: deps
 	cmake -S . -B $(SANITIZE_DIR) -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 		-DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" -DCMAKE_CXX_FLAGS="$(SANITIZE_FLAGS)" \
 		-DCMAKE_EXE_LINKER_FLAGS="$(SANITIZE_FLAGS)" -DCMAKE_SHARED_LINKER_FLAGS="$(SANITIZE_FLAGS)" \
-		-DRVR_LINK_OSMESA=ON -DRVR_TEST_TIMEOUT_SCALE=10 -DRVR_ENABLE_DCHECK=ON
+		-DRVR_LINK_OSMESA=ON -DRVR_TEST_TIMEOUT_SCALE=10 -DRVR_ENABLE_DCHECK=ON -DRVR_PYTHON_PRELOAD=$(SANITIZE_PRELOAD)
 	cmake --build $(SANITIZE_DIR) -j $(JOBS) --target $(SANITIZE_TARGETS)
 	cd $(SANITIZE_DIR) && \
 		ASAN_OPTIONS=detect_leaks=1:$(SANITIZE_ASAN) LSAN_OPTIONS=$(SANITIZE_LSAN) \
 		UBSAN_OPTIONS=$(SANITIZE_UBSAN) \
-		ctest --output-on-failure -j $(JOBS) -E '$(SANITIZE_EXCLUDE)|$(SANITIZE_EGL)'
+		ctest --output-on-failure -j $(JOBS) -E '$(SANITIZE_EXCLUDE)|$(SANITIZE_EGL)|$(SANITIZE_PYTHON)'
 	cd $(SANITIZE_DIR) && \
 		ASAN_OPTIONS=detect_leaks=0:$(SANITIZE_ASAN) UBSAN_OPTIONS=$(SANITIZE_UBSAN) \
-		ctest --output-on-failure -j $(JOBS) -R '$(SANITIZE_EGL)' -E '$(SANITIZE_EXCLUDE)'
+		ctest --output-on-failure -j $(JOBS) -R '$(SANITIZE_EGL)|$(SANITIZE_PYTHON)' -E '$(SANITIZE_EXCLUDE)'
 
 # libFuzzer (clang 14) on the scene loader and the mesh importer path, FUZZ_SECONDS per
 # harness; see tests/fuzz/run.sh and notes in tests/fuzz/README.md.

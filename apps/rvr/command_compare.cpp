@@ -13,6 +13,9 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "report.h"
+#include "report_input.h"
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/raytrace/ray_tracer.h"
 #include "rvr/renderers/compare_renderers.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
@@ -25,18 +28,6 @@
 
 namespace rvr::cli {
 namespace {
-
-// The renderers' names as metrics.json keys them: a name used again gets "-2", "-3", ...
-std::vector<std::string> renderer_keys(const std::vector<std::string>& names) {
-  std::vector<std::string> keys;
-  for (const std::string& name : names) {
-    std::string key = name;
-    for (int k = 2; std::find(keys.begin(), keys.end(), key) != keys.end(); ++k)
-      key = name + "-" + std::to_string(k);
-    keys.push_back(key);
-  }
-  return keys;
-}
 
 // The summary of one pair on stdout.
 void print_pair(const ReportPair& p, const std::string& name_a, const std::string& name_b) {
@@ -112,46 +103,13 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   // Everything is computed before the first file is written.
   CompareResult result = take(compare_renderers(scene, a.renderers, options, compare));
 
-  ReportInput report;
-  report.scene = scene.source;
-  report.width = scene.image.width;
-  report.height = scene.image.height;
-  report.mode = to_string(options.mode);
-  report.command_line = command_line;
-  report.out_dir = a.out_dir;
-  report.heat_map_scale = compare.heat_map_scale;
-  report.depth_diff_scale = compare.depth_diff_scale;
-  // The scene loader's warnings (each names the file), then the comparison's.
-  report.warnings = scene.warnings;
-  report.warnings.insert(report.warnings.end(), result.warnings.begin(), result.warnings.end());
-  for (const ComparedRenderer& c : result.renderers) {
-    ReportRenderer r;
-    r.name = c.name;
-    r.image_file = r.name + ".png";
-    r.seconds = c.seconds;
-    r.warnings = c.output.warnings;
-    r.stats = c.output.stats;
-    r.info = c.output.info;
-    r.depth_format = to_string(depth_store_of(c.name, c.output));
-    r.stats["time.load"] = load_seconds;
-    if (c.has_cost) {
-      r.cost_file = r.name + ".cost.png";
-      r.cost_scale = c.cost_scale;
-      r.cost_mean = c.cost_mean;
-    }
-    report.renderers.push_back(r);
-  }
+  ReportContext context;
+  context.mode = to_string(options.mode);
+  context.load_seconds = load_seconds;
+  context.command_line = command_line;
+  context.out_dir = a.out_dir;
+  const ReportInput report = report_input(scene, result, compare, context);
   const std::vector<std::string> keys = renderer_keys(a.renderers);
-  for (size_t k = 0; k < result.pairs.size(); ++k) {
-    const ComparedPair& p = result.pairs[k];
-    ReportPair rp;
-    rp.a = p.a;
-    rp.b = p.b;
-    rp.metrics = p.metrics;
-    rp.suffix = k == 0 ? "" : "." + keys[p.a] + "_vs_" + keys[p.b];
-    report.pairs.push_back(rp);
-  }
-  report.metrics = report.pairs.front().metrics;
 
   for (size_t i = 0; i < result.renderers.size(); ++i) {
     check(write_image(a.out_dir + "/" + report.renderers[i].image_file, result.renderers[i].image));

@@ -20,6 +20,7 @@
 #include "rvr/shared/limits.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
+#include "rvr/shared/scene_for_render.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/timer.h"
 
@@ -170,8 +171,9 @@ std::pair<int, int> parse_image_size(const std::string& text) {
 }  // namespace
 
 Scene load(const CommonOptions& o, const RenderOptions& options, double& load_seconds) {
-  take(selected_isa());  // a bad RVR_ISA is refused before any work
-  SceneOverrides overrides;
+  SceneRequest request;
+  request.spec = o.scene;
+  SceneOverrides& overrides = request.overrides;
   overrides.width = o.width;
   overrides.height = o.height;
   if (!o.image.empty()) std::tie(overrides.width, overrides.height) = parse_image_size(o.image);
@@ -180,14 +182,10 @@ Scene load(const CommonOptions& o, const RenderOptions& options, double& load_se
   overrides.up = o.up == "z" ? UpAxis::Z : o.up == "y" ? UpAxis::Y : UpAxis::Auto;
   overrides.camera = o.camera == "auto" ? FromFile::Auto : FromFile::File;
   overrides.lights = o.lights == "auto" ? FromFile::Auto : FromFile::File;
-  auto start = Clock::now();
-  Scene scene = take(load_scene(o.scene, overrides));
-  if (o.spp) scene.image.samples_per_pixel = *o.spp;
-  load_seconds = seconds_since(start);
-  Limits limits = o.limits;
-  limits.max_memory_bytes = std::min<uint64_t>(o.max_memory_mb, uint64_t(1) << 40) << 20;
-  check(check_limits(scene, options, limits));
-  return scene;
+  request.spp = o.spp;
+  request.limits = o.limits;
+  request.limits.max_memory_bytes = std::min<uint64_t>(o.max_memory_mb, uint64_t(1) << 40) << 20;
+  return take(load_scene_for_render(request, options, &load_seconds));
 }
 
 }  // namespace rvr::cli

@@ -14,6 +14,11 @@
 
 #include "cli_exit.h"
 #include "commands.h"
+#include "render_stats.h"
+#include "report.h"
+#include "rvr/raster/gl_rasterizer.h"
+#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/compare_renderers.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/renderer.h"
@@ -22,20 +27,6 @@
 #include "terminal_progress.h"
 
 namespace rvr::cli {
-
-namespace {
-
-double peak_memory_bytes() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_maxrss) * 1024.0;
-}
-
-nlohmann::json finite_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
-}
-
-}  // namespace
 
 int run_render(const RenderArgs& a) {
   const bool stats_to_stdout = a.stats == "-";  // as tools read "-": standard output
@@ -69,33 +60,12 @@ int run_render(const RenderArgs& a) {
   for (const std::string& w : out.warnings)
     std::fprintf(stderr, "warning: %s: %s\n", a.renderer.c_str(), w.c_str());
   if (!a.stats.empty()) {
-    nlohmann::json j;
-    j["renderer"] = a.renderer;
-    j["scene"] = scene.source;
-    j["width"] = scene.image.width;
-    j["height"] = scene.image.height;
-    j["mode"] = to_string(options.mode);
-    j["time"] = {{"load", load_seconds}, {"render", render_seconds}, {"write", write_seconds}};
-    nlohmann::json counters = nlohmann::json::object();
-    for (const auto& [k, v] : out.stats) counters[k] = finite_or_null(v);
-    j["stats"] = counters;
-    j["info"] = out.info;
-    // The scene loader's warnings (each names the file), then the renderer's.
-    std::vector<std::string> warnings = scene.warnings;
-    warnings.insert(warnings.end(), out.warnings.begin(), out.warnings.end());
-    j["warnings"] = warnings;
-    j["peak_memory_bytes"] = peak_memory_bytes();
-    // The scene's own vertex and index data, to read peak memory against.
-    double scene_bytes = 0;
-    for (const Object& o : scene.objects)
-      scene_bytes += double(o.mesh.positions.size() * sizeof(glm::vec3) +
-                            o.mesh.normals.size() * sizeof(glm::vec3) +
-                            o.mesh.triangles.size() * sizeof(glm::uvec3));
-    j["scene_mesh_bytes"] = scene_bytes;
+    const std::string stats = render_stats_json(a.renderer, scene, options.mode,
+                                                {load_seconds, render_seconds, write_seconds}, out);
     if (stats_to_stdout)
-      std::fputs((j.dump(2) + "\n").c_str(), stdout);
+      std::fputs(stats.c_str(), stdout);
     else
-      check(write_text_file(a.stats, j.dump(2) + "\n"));
+      check(write_text_file(a.stats, stats));
   }
   if (!a.common.quiet) {
     std::fprintf(stderr, "%s: %s %dx%d %s in %.3f s -> %s\n", a.renderer.c_str(),

@@ -24,6 +24,7 @@
 
 #include "cli_exit.h"
 #include "commands.h"
+#include "study_setup.h"
 #include "cpu_probe.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/renderers/registry.h"
@@ -78,25 +79,10 @@ class StudyInterrupt {
   bool interrupted() const { return g_study_interrupted.load(); }
 };
 
-study::MachineInfo machine_info() {
-  study::MachineInfo m;
-  m.cpu = cpu_model();
-  m.threads = std::thread::hardware_concurrency();
-  m.kernels = describe_isa_choice();
-  m.versions = {{"rvr", kVersion},
-                {"embree", embree_version()},
-                {"tbb", tbb_version()},
-                {"compiler", __VERSION__}};
-  return m;
-}
-
 study::StudyRequest request_of(const StudyArgs& a) {
   study::StudyRequest r;
   r.scenes = a.scenes;
-  r.renderers = default_study_renderers();
-  for (const std::string& name : a.renderers)
-    if (std::find(r.renderers.begin(), r.renderers.end(), name) == r.renderers.end())
-      r.renderers.push_back(name);
+  r.renderers = study_renderers(a.renderers);
   r.width = a.width;
   r.mode = parse_mode(a.mode);
   r.budget_seconds = a.budget;
@@ -146,10 +132,6 @@ int run_merge(const StudyArgs& a, const std::string& command_line) {
 
 }  // namespace
 
-std::vector<std::string> default_study_renderers() {
-  return {"softraster", "raytrace", "hybrid_soft"};
-}
-
 void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
   cmd = app.add_subcommand(
       "study", "time the loop orders over swept scene sizes; fit cost models; find crossovers");
@@ -198,7 +180,7 @@ int run_study(const StudyArgs& a, const std::string& command_line) {
     hooks.cancelled = [&] { return interrupt.interrupted(); };
     result = take(study::run_study(request, hooks));
   }
-  result.machine = machine_info();
+  result.machine = machine_info(kVersion);
   result.command = command_line;
   std::string markdown = study::study_markdown(result);
   write_study(a.out_dir, result, markdown);

@@ -112,9 +112,6 @@ struct StudyArgs {
   bool quiet = false;
 };
 
-// The renderers a study runs by default: one per loop order.
-std::vector<std::string> default_study_renderers();
-
 void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd);
 int run_study(const StudyArgs& a, const std::string& command_line);
 

@@ -96,6 +96,13 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
   }
 
   phase("", "compare");
+  return compare_rendered(scene, std::move(result.renderers), compare);
+}
+
+CompareResult compare_rendered(const Scene& scene, std::vector<ComparedRenderer> rendered,
+                               const CompareOptions& compare) {
+  CompareResult result;
+  result.renderers = std::move(rendered);
   for (ComparedRenderer& r : result.renderers) {
     const FrameBuffers& fb = r.output.buffers;
     r.image = color_image(fb);

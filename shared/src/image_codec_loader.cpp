@@ -20,24 +20,36 @@ std::string executable_folder() {
   return slash == std::string::npos ? std::string() : exe.substr(0, slash);
 }
 
+// The folder of the shared object holding this code when it is not the executable (the Python
+// module), where its build puts the modules beside it too; empty otherwise.
+std::string library_folder() {
+  Dl_info info{};
+  if (!::dladdr(reinterpret_cast<const void*>(&executable_folder), &info) || !info.dli_fname)
+    return {};
+  const std::string object(info.dli_fname);
+  const auto slash = object.rfind('/');
+  return slash == std::string::npos ? std::string() : object.substr(0, slash);
+}
+
 template <class Table>
 struct Loaded {
   const Table* table = nullptr;
   std::string error;
 };
 
-// dlopens `module` (beside the executable first) and takes its table from `symbol`, which must
-// carry `abi_version`.
+// dlopens `module` (beside the executable first, then beside the shared object holding this
+// code) and takes its table from `symbol`, which must carry `abi_version`.
 template <class Table>
 Loaded<Table> load(const char* module, const char* symbol, int abi_version) {
   Loaded<Table> result;
   std::string tried;
   void* handle = nullptr;
-  const std::string folder = executable_folder();
-  if (!folder.empty()) {
+  const std::string executable = executable_folder(), library = library_folder();
+  for (const std::string& folder : {executable, library == executable ? std::string() : library}) {
+    if (handle || folder.empty()) continue;
     const std::string beside = folder + "/" + module;
     handle = ::dlopen(beside.c_str(), RTLD_NOW | RTLD_LOCAL);
-    if (!handle) tried = ::dlerror();
+    if (!handle) tried += (tried.empty() ? "" : "; ") + std::string(::dlerror());
   }
   if (!handle) {
     handle = ::dlopen(module, RTLD_NOW | RTLD_LOCAL);

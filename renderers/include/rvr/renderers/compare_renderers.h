@@ -71,4 +71,10 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
                                           const RenderOptions& options,
                                           const CompareOptions& compare = {});
 
+// The comparing half of compare_renderers, over renders already made (each with its name,
+// seconds and output; at least two, all of the scene's size): their images and cost pictures,
+// every pair and the warnings.
+CompareResult compare_rendered(const Scene& scene, std::vector<ComparedRenderer> rendered,
+                               const CompareOptions& compare = {});
+
 }  // namespace rvr

@@ -1,0 +1,19 @@
+#include "errors.h"
+
+#include "bindings.h"
+
+namespace rvr::python {
+
+[[noreturn]] void raise(const Error& e) {
+  if (e.kind == ErrorKind::BadInput) throw BadInputError(e.message);
+  throw std::runtime_error(e.message);
+}
+
+void bind_errors(pybind11::module_& m) {
+  auto& bad_input = pybind11::register_exception<BadInputError>(m, "BadInput", PyExc_ValueError);
+  bad_input.attr("__doc__") =
+      "Bad input: a scene, an option or a file rvr refuses. The message is the one the command "
+      "line prints after 'error: ', e.g. 'scene.json: objects[3].radius: must be > 0, got -1'.";
+}
+
+}  // namespace rvr::python

@@ -1,0 +1,27 @@
+// A finished render as Python holds it (rvr.Render): the frame buffers with the scene and the
+// settings they came from, shared with the numpy arrays made over them.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "render_stats.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
+
+namespace rvr::python {
+
+struct RenderResult {
+  std::string renderer;
+  std::shared_ptr<const Scene> scene;
+  RenderMode mode = RenderMode::Local;
+  RenderTimes times;
+  RenderOutput output;
+  std::string stats_json;  // the --stats document, made when the render finished
+};
+
+struct PyRender {
+  std::shared_ptr<const RenderResult> result;
+};
+
+}  // namespace rvr::python

@@ -1,0 +1,23 @@
+#include "rvr/shared/scene_for_render.h"
+
+#include <chrono>
+
+#include "rvr/shared/isa.h"
+#include "rvr/shared/timer.h"
+
+namespace rvr {
+
+Expected<Scene> load_scene_for_render(const SceneRequest& request, const RenderOptions& options,
+                                      double* load_seconds) {
+  // A bad RVR_ISA is refused before any work.
+  if (Expected<Isa> isa = selected_isa(); !isa) return isa.error();
+  const auto start = std::chrono::steady_clock::now();
+  Expected<Scene> scene = load_scene(request.spec, request.overrides);
+  if (!scene) return scene.error();
+  if (request.spp) scene->image.samples_per_pixel = *request.spp;
+  if (load_seconds) *load_seconds = seconds_since(start);
+  if (Status st = check_limits(*scene, options, request.limits); !st) return st.error();
+  return scene;
+}
+
+}  // namespace rvr

@@ -1,0 +1,32 @@
+# rvr.study gives the document `rvr study` writes as study.json: the same keys, the same
+# renderers and families, points for pandas; bad input is the command line's message.
+import json
+
+import pytest
+
+import rvr
+
+
+def test_study_is_study_json(run_cli, tmp_path):
+    args = ["builtin:tessphere", "--width", "32", "--budget", "2", "--repetitions", "5",
+            "-q", "-o", str(tmp_path)]
+    done = run_cli("study", *args)
+    assert done.returncode == 0, done.stderr
+    expected = json.loads((tmp_path / "study.json").read_text())
+    got = rvr.study(["builtin:tessphere"], width=32, budget=2, repetitions=5)
+    assert list(got) == list(expected)
+    assert list(got["renderers"]) == list(expected["renderers"])
+    assert set(got["renderers"]) == {"softraster", "raytrace", "hybrid_soft"}
+    assert got["machine"].keys() == expected["machine"].keys()
+    assert got["points"] and all(p.keys() == got["points"][0].keys() for p in got["points"])
+    assert got["points"][0].keys() == expected["points"][0].keys()
+
+
+def test_study_bad_input_is_the_command_lines(run_cli, tmp_path):
+    done = run_cli("study", "builtin:nonesuch", "--width", "32", "--budget", "2", "-q",
+                   "-o", str(tmp_path))
+    assert done.returncode == 2
+    expected = done.stderr.strip().splitlines()[-1][len("error: "):]
+    with pytest.raises(rvr.BadInput) as caught:
+        rvr.study(["builtin:nonesuch"], width=32, budget=2)
+    assert str(caught.value) == expected
