@@ -43,7 +43,7 @@ std::string background_warning(const ComparedRenderer& r) {
 }
 
 ComparedPair compare_pair(const Scene& scene, const CompareResult& result, size_t ia, size_t ib,
-                          const RenderOptions& options, const CompareOptions& compare) {
+                          const CompareOptions& compare) {
   const ComparedRenderer& ra = result.renderers[ia];
   const ComparedRenderer& rb = result.renderers[ib];
   const FrameBuffers& a = ra.output.buffers;
@@ -52,7 +52,7 @@ ComparedPair compare_pair(const Scene& scene, const CompareResult& result, size_
   context.scene = &scene;
   context.store_a = depth_store_of(ra.name, ra.output);
   context.store_b = depth_store_of(rb.name, rb.output);
-  if (options.spheres == SphereMode::Mesh) context.sphere_segments = options.sphere_segments;
+  context.sphere_segments = compare.sphere_segments;
   ComparedPair p;
   p.a = ia;
   p.b = ib;
@@ -96,7 +96,9 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
   }
 
   phase("", "compare");
-  return compare_rendered(scene, std::move(result.renderers), compare);
+  CompareOptions comparing = compare;
+  if (options.spheres == SphereMode::Mesh) comparing.sphere_segments = options.sphere_segments;
+  return compare_rendered(scene, std::move(result.renderers), comparing);
 }
 
 CompareResult compare_rendered(const Scene& scene, std::vector<ComparedRenderer> rendered,
@@ -118,7 +120,7 @@ CompareResult compare_rendered(const Scene& scene, std::vector<ComparedRenderer>
   }
   for (size_t i = 0; i < result.renderers.size(); ++i)
     for (size_t j = i + 1; j < result.renderers.size(); ++j)
-      result.pairs.push_back(compare_pair(scene, result, i, j, options, compare));
+      result.pairs.push_back(compare_pair(scene, result, i, j, compare));
   for (const ComparedRenderer& r : result.renderers)
     if (std::string w = background_warning(r); !w.empty()) result.warnings.push_back(std::move(w));
   return result;

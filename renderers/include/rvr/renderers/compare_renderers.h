@@ -33,6 +33,9 @@ struct CompareOptions {
   // Told ("1/2 raster", "render") before each renderer and ("", "compare") before comparing,
   // for whoever shows progress; may be empty.
   std::function<void(const std::string& label, const std::string& phase)> on_phase;
+  // > 0: the renders drew and traced spheres as tessellate_sphere(sphere, sphere_segments)
+  // (SphereMode::Mesh), whose facets are then primitives; compare_renderers sets it.
+  int sphere_segments = 0;
 };
 
 // Two of the renderers compared, a before b in the order asked for; a is the reference of the
