@@ -69,48 +69,20 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   // --- setup: objects to triangles, transform, clip, bin (in submission order)
   auto t = Clock::now();
   const auto t_visibility = t;
-  std::vector<TriangleMesh> tessellated;  // sphere and plane meshes, alive until shading ends
-  tessellated.reserve(scene.objects.size());
+  // Objects to meshes and materials; the tessellations live until shading ends.
+  Expected<PreparedScene> prepared =
+      prepare_objects(scene, options.spheres, options.sphere_segments);
+  if (!prepared) return prepared.error();
   std::vector<DrawObject> objects(scene.objects.size());
-  std::vector<std::string> skipped_csg;
   bool mirror = false, transparency = false;
-  const Material fallback = default_material();
   for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const Object& o = scene.objects[i];
+    const PreparedObject& p = prepared->objects[i];
     DrawObject& d = objects[i];
-    Expected<const Material*> material = object_material(scene, o, fallback);
-    if (!material) return material.error();
-    d.material = *material;
-    switch (o.type) {
-      case ObjectType::Triangles:
-        d.mesh = &o.mesh;
-        d.use_primitive_id = true;
-        break;
-      case ObjectType::Sphere:
-      case ObjectType::Plane:
-        tessellated.push_back(tessellate_shape(o, options.sphere_segments));
-        d.mesh = &tessellated.back();
-        d.use_primitive_id = names_triangles(o, options.spheres);
-        break;
-      case ObjectType::Csg:
-        skipped_csg.push_back(object_label(o, i));
-        continue;
-    }
-    const TriangleMesh& m = *d.mesh;
-    d.smooth = m.smooth();
-    if (m.smooth() && m.normals.size() != m.positions.size())
-      return bad_input(fmt::format("object '{}': {} normals for {} positions", o.name,
-                                   m.normals.size(), m.positions.size()));
-    if (m.textured() && m.uvs.size() != m.positions.size())
-      return bad_input(fmt::format("object '{}': {} texture coordinates for {} positions", o.name,
-                                   m.uvs.size(), m.positions.size()));
-    if (m.coloured() && m.colours.size() != m.positions.size())
-      return bad_input(fmt::format("object '{}': {} vertex colours for {} positions", o.name,
-                                   m.colours.size(), m.positions.size()));
-    for (const glm::uvec3& tri : m.triangles)
-      if (std::max({tri.x, tri.y, tri.z}) >= m.positions.size())
-        return bad_input(fmt::format("object '{}': triangle index out of range ({} positions)",
-                                     o.name, m.positions.size()));
+    d.material = p.material;
+    if (!p.mesh) continue;  // CSG: skipped, named in the warning
+    d.mesh = p.mesh;
+    d.smooth = p.smooth;
+    d.use_primitive_id = p.names_triangles;
     mirror |= d.material->mirror > 0.0f;
     transparency |= d.material->transparency > 0.0f;
   }
@@ -331,7 +303,8 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   out.info["hiz"] = options.hiz ? "on" : "off";
 
   // The warnings do not name the renderer: whoever prints them says whose they are.
-  if (!skipped_csg.empty()) out.warnings.push_back(skipped_csg_warning(skipped_csg));
+  if (!prepared->skipped_csg.empty())
+    out.warnings.push_back(skipped_csg_warning(prepared->skipped_csg));
   if (options.mode == RenderMode::Full) {
     if (mirror) out.warnings.push_back("mirror reflection not rendered");
     if (transparency) out.warnings.push_back("transparency not rendered");
