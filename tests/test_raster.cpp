@@ -397,6 +397,29 @@ TEST(GlRaster, CsgIsSkippedWithAWarning) {
   EXPECT_NE(out.warnings[0].find("carved"), std::string::npos);
 }
 
+// A scene with no material list (hand-made, as library users build them) is drawn in the
+// built-in grey, which the draws must still find when the scene pass reads their materials:
+// the same bytes as the grey given as the scene's one material.
+TEST(GlRaster, SceneWithoutMaterialsIsDrawnInTheBuiltInGrey) {
+  Scene listed = base_scene();
+  listed.materials = {default_material()};
+  listed.objects.push_back(quad(1.0f, 0.0f));
+  listed.objects.back().material = 0;
+  listed.objects.push_back(triangle({1, 1, 0.5f}, {2, 1, 0.5f}, {1.5f, 2, 0.5f}, 0));
+  Scene unlisted = listed;
+  unlisted.materials.clear();
+  const RenderOutput expected = render_ok(listed);
+  const RenderOutput out = render_ok(unlisted);
+  const FrameBuffers &a = out.buffers, &b = expected.buffers;
+  ASSERT_EQ(a.pixel_count(), b.pixel_count());
+  const size_t centre = a.index(kW / 2, kH / 2);
+  EXPECT_EQ(a.object_id[centre], 0u);
+  EXPECT_NE(a.color[centre], listed.image.background);
+  size_t differing = 0;
+  for (size_t i = 0; i < a.pixel_count(); ++i) differing += a.color[i] != b.color[i] ? 1 : 0;
+  EXPECT_EQ(differing, 0u);
+}
+
 TEST(GlRaster, VisibilityModeKeepsBackgroundColour) {
   Scene s = base_scene();
   s.objects.push_back(quad(1.0f, 0.0f));

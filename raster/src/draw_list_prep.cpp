@@ -3,10 +3,15 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "rvr/shared/tessellate.h"
 
 namespace rvr {
 
+namespace {
+
+// The object's material, or `fallback` when the scene has no materials at all.
 Expected<const Material*> object_material(const Scene& scene, const Object& o,
                                           const Material& fallback) {
   if (o.material < scene.materials.size()) return &scene.materials[o.material];
@@ -16,18 +21,70 @@ Expected<const Material*> object_material(const Scene& scene, const Object& o,
   return &fallback;  // a hand-made scene with no material list: the built-in grey
 }
 
+// The triangles drawn for an analytic sphere or square.
 TriangleMesh tessellate_shape(const Object& o, int sphere_segments) {
   return o.type == ObjectType::Sphere ? tessellate_sphere(o.sphere, sphere_segments)
                                       : tessellate_plane(o.plane);
 }
 
-bool names_triangles(const Object& o, SphereMode spheres) {
-  return o.type == ObjectType::Triangles ||
-         (o.type == ObjectType::Sphere && spheres == SphereMode::Mesh);
-}
-
+// How the skipped-CSG warning names an object.
 std::string object_label(const Object& o, size_t index) {
   return o.name.empty() ? fmt::format("csg#{}", index) : o.name;
+}
+
+// Whether the mesh's attributes match its positions and its triangles index only those.
+Status check_mesh(const TriangleMesh& m, const std::string& name) {
+  const size_t n = m.positions.size();
+  if (m.smooth() && m.normals.size() != n)
+    return bad_input(
+        fmt::format("object '{}': {} normals for {} positions", name, m.normals.size(), n));
+  if (m.textured() && m.uvs.size() != n)
+    return bad_input(
+        fmt::format("object '{}': {} texture coordinates for {} positions", name, m.uvs.size(), n));
+  if (m.coloured() && m.colours.size() != n)
+    return bad_input(
+        fmt::format("object '{}': {} vertex colours for {} positions", name, m.colours.size(), n));
+  for (const glm::uvec3& tri : m.triangles)
+    if (std::max({tri.x, tri.y, tri.z}) >= n)
+      return bad_input(
+          fmt::format("object '{}': triangle index out of range ({} positions)", name, n));
+  return ok_status();
+}
+
+}  // namespace
+
+Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
+                                        int sphere_segments) {
+  PreparedScene prepared;
+  prepared.fallback = std::make_unique<const Material>(default_material());
+  prepared.objects.resize(scene.objects.size());
+  for (size_t i = 0; i < scene.objects.size(); ++i) {
+    const Object& o = scene.objects[i];
+    PreparedObject& p = prepared.objects[i];
+    Expected<const Material*> material = object_material(scene, o, *prepared.fallback);
+    if (!material) return material.error();
+    p.material = *material;
+    switch (o.type) {
+      case ObjectType::Triangles:
+        p.mesh = &o.mesh;
+        p.own_mesh = true;
+        p.names_triangles = true;
+        break;
+      case ObjectType::Sphere:
+      case ObjectType::Plane:
+        prepared.tessellations.push_back(
+            std::make_unique<const TriangleMesh>(tessellate_shape(o, sphere_segments)));
+        p.mesh = prepared.tessellations.back().get();
+        p.names_triangles = o.type == ObjectType::Sphere && spheres == SphereMode::Mesh;
+        break;
+      case ObjectType::Csg:
+        prepared.skipped_csg.push_back(object_label(o, i));
+        continue;
+    }
+    if (Status checked = check_mesh(*p.mesh, o.name); !checked) return checked.error();
+    p.smooth = p.mesh->smooth();
+  }
+  return prepared;
 }
 
 std::string skipped_csg_warning(const std::vector<std::string>& labels) {

@@ -1,9 +1,11 @@
-// What both z-buffers do to a scene before drawing it: each object's material (the built-in grey
-// for a scene with no material list), the triangles of the analytic shapes, and the CSG objects
-// they skip, named in one warning.
+// What both z-buffers do to a scene before drawing it: each object classified once into what is
+// drawn for it (its material, the built-in grey for a scene with no material list; its triangles,
+// the object's own mesh or the tessellation of an analytic shape; whether those are smooth and
+// whether their indices are the primitive ids), and the CSG objects they skip, named in one
+// warning.
 #pragma once
 
-#include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,21 +15,33 @@
 
 namespace rvr {
 
-// The object's material, or `fallback` when the scene has no materials at all.
-Expected<const Material*> object_material(const Scene& scene, const Object& o,
-                                          const Material& fallback);
+// One scene object as a z-buffer draws it. `mesh` null: nothing to draw (a CSG object).
+struct PreparedObject {
+  const Material* material = nullptr;
+  const TriangleMesh* mesh = nullptr;  // the object's own mesh, or a tessellation of the scene
+  bool own_mesh = false;               // `mesh` is the object's mesh (textures apply to it)
+  bool smooth = false;                 // the mesh has vertex normals
+  // Whether the object's primitive ids are the indices of the triangles drawn: a mesh's, and a
+  // sphere's tessellation when the tracers trace that same tessellation (SphereMode::Mesh), so
+  // that the two loop orders name the same facet. Otherwise (an analytic sphere, a square) the
+  // tracer sees one primitive and the z-buffers write 0.
+  bool names_triangles = false;
+};
 
-// The triangles drawn for an analytic sphere or square.
-TriangleMesh tessellate_shape(const Object& o, int sphere_segments);
+// A scene prepared for a z-buffer. Owns the tessellations and the fallback material the objects
+// point to, so it must outlive every use of them; moving it keeps the pointers valid.
+struct PreparedScene {
+  std::vector<PreparedObject> objects;   // one per scene object, in scene order
+  std::vector<std::string> skipped_csg;  // how the skipped-CSG warning names each skipped object
+  std::vector<std::unique_ptr<const TriangleMesh>> tessellations;
+  std::unique_ptr<const Material> fallback;  // the built-in grey
+};
 
-// Whether the object's primitive ids are the indices of the triangles drawn: a mesh's, and a
-// sphere's tessellation when the tracers trace that same tessellation (SphereMode::Mesh), so
-// that the two loop orders name the same facet. Otherwise (an analytic sphere, a square) the
-// tracer sees one primitive and the z-buffers write 0.
-bool names_triangles(const Object& o, SphereMode spheres);
-
-// How the skipped-CSG warning names an object.
-std::string object_label(const Object& o, size_t index);
+// Every object of `scene` prepared, spheres tessellated with `sphere_segments` and named as
+// `spheres` says. Bad input: a material index out of range, or a mesh whose normals, texture
+// coordinates or vertex colours do not match its positions, or whose triangles index past them.
+Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
+                                        int sphere_segments);
 
 // The warning for the CSG objects a z-buffer cannot draw (`labels` not empty).
 std::string skipped_csg_warning(const std::vector<std::string>& labels);

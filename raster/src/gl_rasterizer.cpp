@@ -148,21 +148,8 @@ enum Target : int {
 constexpr std::array<GLenum, kTargetCount> kTargetFormats = {
     GL_RGBA32F, GL_R32UI, GL_R32UI, GL_R32F, GL_RGBA32F, GL_R32F, GL_R32F};
 
-Status append_mesh(const TriangleMesh& mesh, const std::string& name, std::vector<Vertex>& out) {
-  const size_t n = mesh.positions.size();
-  if (mesh.smooth() && mesh.normals.size() != n)
-    return bad_input(
-        fmt::format("object '{}': {} normals for {} positions", name, mesh.normals.size(), n));
-  if (mesh.textured() && mesh.uvs.size() != n)
-    return bad_input(fmt::format("object '{}': {} texture coordinates for {} positions", name,
-                                 mesh.uvs.size(), n));
-  if (mesh.coloured() && mesh.colours.size() != n)
-    return bad_input(fmt::format("object '{}': {} vertex colours for {} positions", name,
-                                 mesh.colours.size(), n));
+void append_mesh(const TriangleMesh& mesh, std::vector<Vertex>& out) {
   for (const glm::uvec3& t : mesh.triangles) {
-    if (t.x >= n || t.y >= n || t.z >= n)
-      return bad_input(
-          fmt::format("object '{}': triangle index out of range ({} positions)", name, n));
     const glm::vec3 &p0 = mesh.positions[t.x], &p1 = mesh.positions[t.y], &p2 = mesh.positions[t.z];
     // Same expression as the tracer's face normal, so both flip the same way (face_viewer).
     glm::vec3 g = glm::cross(p1 - p0, p2 - p0);
@@ -176,7 +163,6 @@ Status append_mesh(const TriangleMesh& mesh, const std::string& name, std::vecto
       out.push_back({p2, g, g});
     }
   }
-  return ok_status();
 }
 
 // The texture coordinates (after the material's uv_transform, an affine map: transforming the
@@ -197,7 +183,7 @@ void append_surface(const TriangleMesh& mesh, const Material& m, bool textured,
 // light samples it put in the light buffer (none in visibility mode).
 struct SceneUpload {
   std::vector<DrawItem> draws;
-  std::vector<std::string> skipped_csg;
+  PreparedScene prepared;  // the draws' materials and the skipped CSG objects
   std::vector<LightSample> samples;
   bool textured = false;  // some object is textured: the lod target is drawn and read back
 };
@@ -242,7 +228,8 @@ glm::mat4 reversed_z_projection(glm::mat4 projection, float near_plane, float fa
 // What a z-buffer cannot do, named for this scene only (shadows it does, with shadow maps).
 void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& options,
                                     const SceneUpload& upload, std::vector<std::string>& warnings) {
-  if (!upload.skipped_csg.empty()) warnings.push_back(skipped_csg_warning(upload.skipped_csg));
+  if (!upload.prepared.skipped_csg.empty())
+    warnings.push_back(skipped_csg_warning(upload.prepared.skipped_csg));
   if (options.mode != RenderMode::Full) return;
   std::string mirrors =
       material_names(upload.draws, [](const Material& m) { return m.mirror > 0.0f; });
@@ -670,37 +657,27 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
   bool varies = false;
   for (const Object& o : scene.objects) varies = varies || varies_in_colour(scene, o);
   if (varies) RVR_TRY(upload_textures(scene));
-  const Material fallback = default_material();
+  Expected<PreparedScene> prepared =
+      prepare_objects(scene, options.spheres, options.sphere_segments);
+  if (!prepared) return prepared.error();
+  up.prepared = std::move(*prepared);
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
+    const PreparedObject& p = up.prepared.objects[i];
+    if (!p.mesh) continue;  // CSG: skipped, named in the warning
     DrawItem d;
     d.object = uint32_t(i);
     d.first = GLint(vertices.size());
-    Expected<const Material*> material = object_material(scene, o, fallback);
-    if (!material) return material.error();
-    d.material = *material;
-    switch (o.type) {
-      case ObjectType::Triangles:
-        RVR_TRY(append_mesh(o.mesh, o.name, vertices));
-        d.smooth = o.mesh.smooth();
-        d.use_primitive_id = true;
-        if (varies) {
-          const bool tex = textured(scene, o);
-          if (tex) d.texture = textures[size_t(d.material->texture)];
-          d.coloured = o.mesh.coloured();
-          up.textured = up.textured || tex;
-          append_surface(o.mesh, *d.material, tex, surface_vertices);
-        }
-        break;
-      case ObjectType::Sphere:
-      case ObjectType::Plane:
-        RVR_TRY(append_mesh(tessellate_shape(o, options.sphere_segments), o.name, vertices));
-        d.smooth = o.type == ObjectType::Sphere;
-        d.use_primitive_id = names_triangles(o, options.spheres);
-        break;
-      case ObjectType::Csg:
-        up.skipped_csg.push_back(object_label(o, i));
-        continue;
+    d.material = p.material;
+    d.smooth = p.smooth;
+    d.use_primitive_id = p.names_triangles;
+    append_mesh(*p.mesh, vertices);
+    if (varies && p.own_mesh) {
+      const bool tex = textured(scene, o);
+      if (tex) d.texture = textures[size_t(d.material->texture)];
+      d.coloured = o.mesh.coloured();
+      up.textured = up.textured || tex;
+      append_surface(o.mesh, *d.material, tex, surface_vertices);
     }
     d.count = GLsizei(GLint(vertices.size()) - d.first);
     if (varies) surface_vertices.resize(vertices.size());  // shapes: the defaults

@@ -49,13 +49,272 @@ using soft::DrawList;
 using soft::DrawObject;
 using soft::DrawResult;
 
-Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options,
-                                   std::optional<DepthTarget>& kept) {
-  const int w = scene.image.width, h = scene.image.height;
+Status check_image_size(int w, int h) {
   if (w < 1 || h < 1) return bad_input(fmt::format("image size {}x{} is empty", w, h));
   if (w > soft::kMaxImageSide || h > soft::kMaxImageSide)
     return bad_input(fmt::format("image size {}x{}: softraster draws at most {} pixels a side", w,
                                  h, soft::kMaxImageSide));
+  return ok_status();
+}
+
+// The draw list of the prepared objects (a CSG object: no mesh, nothing drawn), and whether some
+// drawn material is a mirror or transparent (effects a z-buffer leaves out).
+struct SceneDraws {
+  DrawList list;
+  bool mirror = false, transparency = false;
+};
+
+SceneDraws scene_draws(const PreparedScene& prepared) {
+  SceneDraws draws;
+  std::vector<DrawObject> objects(prepared.objects.size());
+  for (size_t i = 0; i < objects.size(); ++i) {
+    const PreparedObject& p = prepared.objects[i];
+    DrawObject& d = objects[i];
+    d.material = p.material;
+    if (!p.mesh) continue;
+    d.mesh = p.mesh;
+    d.smooth = p.smooth;
+    d.use_primitive_id = p.names_triangles;
+    draws.mirror |= d.material->mirror > 0.0f;
+    draws.transparency |= d.material->transparency > 0.0f;
+  }
+  draws.list = soft::make_draw_list(std::move(objects));
+  return draws;
+}
+
+// The camera's view-projection; for one accumulation-buffer pass (the hybrid's), the camera as
+// that sample sees it.
+glm::dmat4 camera_view_projection(const Scene& scene, const RenderOptions& options, int w, int h) {
+  return options.image_sample
+             ? glm::dmat4(sample_projection_matrix(scene.camera, w, h, *options.image_sample)) *
+                   glm::dmat4(sample_view_matrix(scene.camera, *options.image_sample))
+             : glm::dmat4(projection_matrix(scene.camera, w, h)) *
+                   glm::dmat4(view_matrix(scene.camera));
+}
+
+// The kept target cleared, or built anew when its setup changed; inside the arena, so that its
+// parallel clear uses the threads the options allow. The camera pass's depth test as the format
+// would store depth (unset: the view depth in double precision); shadow maps keep exact
+// distances.
+DepthTarget& camera_target(const Scene& scene, const RenderOptions& options,
+                           const soft::FillKernels& kernels, tbb::task_arena& arena,
+                           std::optional<DepthTarget>& kept) {
+  const int w = scene.image.width, h = scene.image.height;
+  arena.execute([&] {
+    if (kept && kept->same_setup(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels))
+      kept->clear();
+    else
+      kept.emplace(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels);
+  });
+  kept->set_depth_format(!options.depth_format                        ? soft::kDepthExact
+                         : *options.depth_format == DepthFormat::D24  ? soft::kDepthD24
+                         : *options.depth_format == DepthFormat::D32F ? soft::kDepthD32F
+                                                                      : soft::kDepthD32FReversed);
+  return *kept;
+}
+
+// The visible surface at pixel o (covered): position, normals, direction to the eye. The shadow
+// pass adds the lights with it; the shading kernels do the same float operations.
+struct Surface {
+  const DrawObject* object;
+  uint32_t primitive;
+  glm::vec3 P, N, V, geometric;
+  bool varies = false;  // textured or vertex-coloured: `own` is its material at P
+  Material own;         // the object's, with the base colour at P as its diffuse
+  const Material& material() const { return varies ? own : *object->material; }
+};
+
+// What the visible surfaces of a shaded frame are rebuilt from.
+struct VisibleFrame {
+  const Scene& scene;
+  const DrawList& list;
+  const DepthTarget& target;
+  const soft::SurfaceColours* surfaces;
+  const FrameBuffers& fb;
+};
+
+Surface surface_at(const VisibleFrame& frame, size_t o) {
+  const DepthTarget& target = frame.target;
+  Surface s;
+  const uint32_t id = target.object(o);
+  s.object = &frame.list.objects[id];
+  s.primitive = target.primitive(o);
+  const TriangleMesh& mesh = *s.object->mesh;
+  const glm::vec3 b = target.barycentric(o);
+  const glm::uvec3& tri = mesh.triangles[s.primitive];
+  const glm::vec3 &p0 = mesh.positions[tri.x], &p1 = mesh.positions[tri.y],
+                  &p2 = mesh.positions[tri.z];
+  s.P = b.x * p0 + b.y * p1 + b.z * p2;
+  s.geometric = glm::normalize(glm::cross(p1 - p0, p2 - p0));
+  const glm::vec3 shading =
+      s.object->smooth ? glm::normalize(b.x * mesh.normals[tri.x] + b.y * mesh.normals[tri.y] +
+                                        b.z * mesh.normals[tri.z])
+                       : s.geometric;
+  s.V = glm::normalize(frame.scene.camera.eye - s.P);
+  s.N = face_viewer(shading, s.geometric, s.V);
+  if (frame.surfaces && frame.surfaces->varies(id)) {
+    // The level of detail the deferred pass sampled at (kept in fb.lod when textured).
+    const float lod = frame.fb.lod.empty() ? 0.0f : frame.fb.lod[o];
+    s.varies = true;
+    s.own = with_diffuse(*s.object->material,
+                         base_colour(frame.scene, frame.scene.objects[id], *s.object->material,
+                                     s.primitive, b.y, b.z, lod));
+  }
+  return s;
+}
+
+// The shadow maps' side (shrunk, with a warning, when the samples' cubes exceed the texel
+// budget), bias and filter; their projection is set by shadow_projection.
+Expected<soft::ShadowSettings> shadow_settings(const RenderOptions& options, size_t samples,
+                                               std::vector<std::string>& warnings) {
+  if (options.shadow_map_size < 1)
+    return bad_input(fmt::format("shadow map size {} must be positive", options.shadow_map_size));
+  if (!(options.shadow_bias >= 0.0f) || !std::isfinite(options.shadow_bias))
+    return bad_input(fmt::format("shadow bias {} must be >= 0", options.shadow_bias));
+  soft::ShadowSettings settings;
+  settings.size = std::min(options.shadow_map_size, soft::kMaxImageSide);
+  const double texels = 6.0 * double(samples) * double(settings.size) * double(settings.size);
+  if (texels > kShadowTexelBudget) {
+    const int fit = int(std::sqrt(kShadowTexelBudget / (6.0 * double(samples))));
+    settings.size = std::max(std::min(settings.size, kShadowMinSize), fit);
+  }
+  if (settings.size < options.shadow_map_size)
+    warnings.push_back(
+        fmt::format("shadow maps of {} texels per side for {} light samples ({} requested)",
+                    settings.size, samples, options.shadow_map_size));
+  settings.bias = options.shadow_bias;
+  settings.pcf = options.shadow_pcf;
+  return settings;
+}
+
+// How far the scene reaches from the light samples (at least 1e-3; 1 for an empty scene).
+float light_reach(const DrawList& list, const std::vector<LightSample>& samples) {
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+  bool any = false;
+  for (const DrawObject& d : list.objects)
+    if (d.mesh)
+      for (const glm::vec3& p : d.mesh->positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+        any = true;
+      }
+  float reach = 0.0f;
+  for (const LightSample& ls : samples)
+    reach = std::max(reach,
+                     glm::length(glm::max(glm::abs(ls.position - lo), glm::abs(ls.position - hi))));
+  if (!any) reach = 1.0f;
+  return std::max(reach, 1e-3f);
+}
+
+// Full mode's shadows: a cube of distance maps per light sample, drawn by this z-buffer, in
+// batches that fit kShadowBatchBytes; each batch then adds its samples' light to the covered
+// pixels.
+Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSample>& samples,
+                          const RenderOptions& options, const soft::FillKernels& kernels,
+                          tbb::task_arena& arena, FrameBuffers& fb, RenderOutput& out) {
+  Expected<soft::ShadowSettings> planned = shadow_settings(options, samples.size(), out.warnings);
+  if (!planned) return planned.error();
+  const auto t = Clock::now();
+  soft::ShadowSettings settings = *planned;
+  // Near and far only clip: the maps hold distances, so a near plane far below any feature size
+  // (1e-6 of the scene's reach from the lights) costs no precision.
+  const float reach = light_reach(frame.list, samples);
+  const float near_plane = 1e-6f * reach, far_plane = 2.0f * reach;
+  settings.projection =
+      glm::dmat4(glm::perspective(glm::radians(90.0f), 1.0f, near_plane, far_plane));
+  const size_t per_sample = 6 * size_t(settings.size) * size_t(settings.size) * sizeof(float);
+  const size_t batch = std::clamp<size_t>(kShadowBatchBytes / per_sample, 1, samples.size());
+  std::optional<DepthTarget> scratch_built;
+  arena.execute([&] {
+    scratch_built.emplace(settings.size, settings.size, near_plane, far_plane, options.hiz, kernels,
+                          /*depth_only=*/true);
+  });
+  DepthTarget& scratch = *scratch_built;
+  std::vector<soft::ShadowCube> cubes(batch);
+  DrawResult shadow_work;
+  double draw_seconds = 0;
+  ProgressSink* const progress = options.progress;
+  if (progress) progress->begin("shadows", samples.size(), "light samples");
+  for (size_t first = 0; first < samples.size(); first += batch) {
+    const size_t end = std::min(samples.size(), first + batch);
+    auto t_draw = Clock::now();
+    for (size_t i = first; i < end; ++i)
+      cubes[i - first].build(frame.list, samples[i].position, settings, scratch, arena,
+                             shadow_work);
+    draw_seconds += seconds_since(t_draw);
+    arena.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, fb.pixel_count()),
+                        [&](const tbb::blocked_range<size_t>& r) {
+                          for (size_t o = r.begin(); o != r.end(); ++o) {
+                            if (!frame.target.covered(o)) continue;
+                            const Surface s = surface_at(frame, o);
+                            add_light_samples(
+                                s.material(), s.P, s.N, s.V, samples, first, end,
+                                [&](size_t i, const glm::vec3& P, const glm::vec3& L) {
+                                  return cubes[i - first].visibility(P, L, s.geometric, settings);
+                                },
+                                fb.color[o]);
+                          }
+                        });
+    });
+    if (progress) progress->advance(end - first);
+  }
+  out.stats["time.shadows"] = seconds_since(t);
+  out.stats["time.shadow_maps"] = draw_seconds;
+  out.stats["shadows.map_size"] = double(settings.size);
+  out.stats["shadows.cubes"] = double(samples.size());
+  out.stats["shadows.triangles_setup"] = double(shadow_work.set_up);
+  out.stats["shadows.fragments"] = double(shadow_work.counters.generated);
+  out.stats["shadows.hiz_blocks_rejected"] = double(shadow_work.counters.blocks_rejected);
+  out.stats["memory.shadow_bytes"] =
+      double(batch * per_sample + scratch.bytes() + shadow_work.peak_chunk_bytes);
+  return ok_status();
+}
+
+// The camera pass's counts: triangles, fragments, covered pixels, blocks, memory.
+void record_draw_stats(const DrawResult& drawn, const DepthTarget& target, size_t submitted,
+                       bool shaded, const FrameBuffers& fb, RenderOutput& out) {
+  const soft::TileCounters& sum = drawn.counters;
+  uint64_t covered = 0;
+  for (size_t i = 0; i < fb.pixel_count(); ++i) covered += target.covered(i) ? 1 : 0;
+  out.stats["triangles.submitted"] = double(submitted);
+  out.stats["triangles.clipped"] = double(drawn.clipped);
+  out.stats["triangles.setup"] = double(drawn.set_up);
+  out.stats["fragments.generated"] = double(sum.generated);
+  out.stats["fragments.shaded"] = shaded ? double(covered) : 0.0;
+  out.stats["pixels.covered"] = double(covered);
+  out.stats["overdraw"] = covered > 0 ? double(sum.generated) / double(covered) : 0.0;
+  out.stats["blocks.full"] = double(sum.blocks_full);
+  out.stats["hiz.blocks_rejected"] = double(sum.blocks_rejected);
+  out.stats["hiz.triangles_rejected"] = double(sum.triangles_rejected);
+  out.stats["memory.raster_bytes"] = double(target.bytes() + drawn.peak_chunk_bytes);
+}
+
+// What this z-buffer leaves out of the scene. The warnings do not name the renderer: whoever
+// prints them says whose they are.
+void note_what_is_left_out(const Scene& scene, const RenderOptions& options,
+                           const PreparedScene& prepared, const SceneDraws& draws,
+                           std::vector<std::string>& warnings) {
+  if (!prepared.skipped_csg.empty()) warnings.push_back(skipped_csg_warning(prepared.skipped_csg));
+  if (options.mode == RenderMode::Full) {
+    if (draws.mirror) warnings.push_back("mirror reflection not rendered");
+    if (draws.transparency) warnings.push_back("transparency not rendered");
+    if (scene.camera.aperture_radius > 0.0f)
+      warnings.push_back("depth of field (aperture) not rendered: pinhole");
+  }
+  if (scene.image.samples_per_pixel > 1)
+    warnings.push_back(
+        fmt::format("{} samples per pixel requested; multisampling is not implemented, rendered 1",
+                    scene.image.samples_per_pixel));
+}
+
+// Setup (objects to triangles, then transform, clip, bin in submission order in the draw), the
+// draw into the camera's target, then per mode: visibility's read-back, or deferred shading of
+// each visible pixel once and, in full mode, the shadowed lights.
+Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options,
+                                   std::optional<DepthTarget>& kept) {
+  const int w = scene.image.width, h = scene.image.height;
+  if (Status size = check_image_size(w, h); !size) return size.error();
   RenderOutput out;
   ProgressSink* const progress = options.progress;
   // The per-pixel kernels: RenderOptions::isa, else RVR_ISA, else the best this CPU runs.
@@ -66,63 +325,15 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   out.info["kernel"] = kernels.isa;
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
 
-  // --- setup: objects to triangles, transform, clip, bin (in submission order)
+  // Setup: the objects' meshes and materials (the tessellations live until shading ends).
   auto t = Clock::now();
   const auto t_visibility = t;
-  std::vector<TriangleMesh> tessellated;  // sphere and plane meshes, alive until shading ends
-  tessellated.reserve(scene.objects.size());
-  std::vector<DrawObject> objects(scene.objects.size());
-  std::vector<std::string> skipped_csg;
-  bool mirror = false, transparency = false;
-  const Material fallback = default_material();
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
-    const Object& o = scene.objects[i];
-    DrawObject& d = objects[i];
-    Expected<const Material*> material = object_material(scene, o, fallback);
-    if (!material) return material.error();
-    d.material = *material;
-    switch (o.type) {
-      case ObjectType::Triangles:
-        d.mesh = &o.mesh;
-        d.use_primitive_id = true;
-        break;
-      case ObjectType::Sphere:
-      case ObjectType::Plane:
-        tessellated.push_back(tessellate_shape(o, options.sphere_segments));
-        d.mesh = &tessellated.back();
-        d.use_primitive_id = names_triangles(o, options.spheres);
-        break;
-      case ObjectType::Csg:
-        skipped_csg.push_back(object_label(o, i));
-        continue;
-    }
-    const TriangleMesh& m = *d.mesh;
-    d.smooth = m.smooth();
-    if (m.smooth() && m.normals.size() != m.positions.size())
-      return bad_input(fmt::format("object '{}': {} normals for {} positions", o.name,
-                                   m.normals.size(), m.positions.size()));
-    if (m.textured() && m.uvs.size() != m.positions.size())
-      return bad_input(fmt::format("object '{}': {} texture coordinates for {} positions", o.name,
-                                   m.uvs.size(), m.positions.size()));
-    if (m.coloured() && m.colours.size() != m.positions.size())
-      return bad_input(fmt::format("object '{}': {} vertex colours for {} positions", o.name,
-                                   m.colours.size(), m.positions.size()));
-    for (const glm::uvec3& tri : m.triangles)
-      if (std::max({tri.x, tri.y, tri.z}) >= m.positions.size())
-        return bad_input(fmt::format("object '{}': triangle index out of range ({} positions)",
-                                     o.name, m.positions.size()));
-    mirror |= d.material->mirror > 0.0f;
-    transparency |= d.material->transparency > 0.0f;
-  }
-
-  // One accumulation-buffer pass (the hybrid's): the camera as that sample sees it.
-  const glm::dmat4 view_projection =
-      options.image_sample
-          ? glm::dmat4(sample_projection_matrix(scene.camera, w, h, *options.image_sample)) *
-                glm::dmat4(sample_view_matrix(scene.camera, *options.image_sample))
-          : glm::dmat4(projection_matrix(scene.camera, w, h)) *
-                glm::dmat4(view_matrix(scene.camera));
-  const DrawList list = soft::make_draw_list(std::move(objects));
+  Expected<PreparedScene> prepared =
+      prepare_objects(scene, options.spheres, options.sphere_segments);
+  if (!prepared) return prepared.error();
+  const SceneDraws draws = scene_draws(*prepared);
+  const DrawList& list = draws.list;
+  const glm::dmat4 view_projection = camera_view_projection(scene, options, w, h);
   // Textured and vertex-coloured objects (none: no per-pixel work at all).
   std::optional<soft::SurfaceColours> surfaces;
   if (options.mode != RenderMode::Visibility || options.visibility_lod) {
@@ -132,20 +343,8 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   const size_t submitted = list.triangles();
   out.stats["time.setup"] = seconds_since(t);
 
-  // Built (or cleared) inside the arena: its parallel clear uses the threads the options allow.
-  arena.execute([&] {
-    if (kept && kept->same_setup(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels))
-      kept->clear();
-    else
-      kept.emplace(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels);
-  });
-  DepthTarget& target = *kept;
-  // The camera pass's depth test as the format would store depth (unset: the view depth in
-  // double precision); shadow maps keep exact distances.
-  target.set_depth_format(!options.depth_format                        ? soft::kDepthExact
-                          : *options.depth_format == DepthFormat::D24  ? soft::kDepthD24
-                          : *options.depth_format == DepthFormat::D32F ? soft::kDepthD32F
-                                                                       : soft::kDepthD32FReversed);
+  // Draw: every triangle into the camera's target.
+  DepthTarget& target = camera_target(scene, options, kernels, arena, kept);
   out.info["depth_format"] =
       options.depth_format ? to_string(*options.depth_format) : "exact (view depth, double)";
   // The fraction in triangles, the speed in fragments.
@@ -158,7 +357,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   out.stats["time.visibility"] = seconds_since(t_visibility);
   FrameBuffers& fb = out.buffers;
 
-  // --- visibility mode: the target's depth, ids and cost into the frame buffers, no shading
+  // Visibility mode: the target's depth, ids and cost into the frame buffers, no shading.
   if (options.mode == RenderMode::Visibility) {
     t = Clock::now();
     if (progress) progress->begin("readback", uint64_t(w) * uint64_t(h), "pixels");
@@ -167,55 +366,16 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     out.stats["time.readback"] = seconds_since(t);
   }
 
-  // --- shade (local and full mode): deferred, each visible pixel once
+  // Shade (local and full mode): deferred, each visible pixel once.
   t = Clock::now();
   const bool shade = options.mode != RenderMode::Visibility;
   const std::vector<LightSample> samples =
       shade ? light_samples(scene.lights) : std::vector<LightSample>{};
   const bool shadows = options.mode == RenderMode::Full && !samples.empty();
-  const glm::vec3 eye = scene.camera.eye;
-  // The visible surface at pixel o (covered): position, normals, direction to the eye. The
-  // shadow pass adds the lights with it; the shading kernels do the same float operations.
-  struct Surface {
-    const DrawObject* object;
-    uint32_t primitive;
-    glm::vec3 P, N, V, geometric;
-    bool varies = false;  // textured or vertex-coloured: `own` is its material at P
-    Material own;         // the object's, with the base colour at P as its diffuse
-    const Material& material() const { return varies ? own : *object->material; }
-  };
-  auto surface_at = [&](size_t o) {
-    Surface s;
-    const uint32_t id = target.object(o);
-    s.object = &list.objects[id];
-    s.primitive = target.primitive(o);
-    const TriangleMesh& mesh = *s.object->mesh;
-    const glm::vec3 b = target.barycentric(o);
-    const glm::uvec3& tri = mesh.triangles[s.primitive];
-    const glm::vec3 &p0 = mesh.positions[tri.x], &p1 = mesh.positions[tri.y],
-                    &p2 = mesh.positions[tri.z];
-    s.P = b.x * p0 + b.y * p1 + b.z * p2;
-    s.geometric = glm::normalize(glm::cross(p1 - p0, p2 - p0));
-    const glm::vec3 shading =
-        s.object->smooth ? glm::normalize(b.x * mesh.normals[tri.x] + b.y * mesh.normals[tri.y] +
-                                          b.z * mesh.normals[tri.z])
-                         : s.geometric;
-    s.V = glm::normalize(eye - s.P);
-    s.N = face_viewer(shading, s.geometric, s.V);
-    if (surfaces && surfaces->varies(id)) {
-      // The level of detail the deferred pass sampled at (kept in fb.lod when textured).
-      const float lod = fb.lod.empty() ? 0.0f : fb.lod[o];
-      s.varies = true;
-      s.own = with_diffuse(
-          *s.object->material,
-          base_colour(scene, scene.objects[id], *s.object->material, s.primitive, b.y, b.z, lod));
-    }
-    return s;
-  };
   if (shade) {
     if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
     soft::DeferredShading shading;
-    shading.eye = eye;
+    shading.eye = scene.camera.eye;
     shading.ambient = scene.ambient;
     shading.background = scene.image.background;
     shading.colour = shadows ? soft::ShadedColour::Base : soft::ShadedColour::Local;
@@ -226,122 +386,16 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     out.stats["time.shade"] = seconds_since(t);
   }
 
-  // --- shadows (full mode): a cube of distance maps per light sample, drawn by this z-buffer,
-  // in batches that fit kShadowBatchBytes; each batch then adds its samples' light.
+  // Shadows (full mode): the lights, seen through this z-buffer's shadow cubes.
   if (shadows) {
-    if (options.shadow_map_size < 1)
-      return bad_input(fmt::format("shadow map size {} must be positive", options.shadow_map_size));
-    if (!(options.shadow_bias >= 0.0f) || !std::isfinite(options.shadow_bias))
-      return bad_input(fmt::format("shadow bias {} must be >= 0", options.shadow_bias));
-    t = Clock::now();
-    soft::ShadowSettings settings;
-    settings.size = std::min(options.shadow_map_size, soft::kMaxImageSide);
-    const double texels =
-        6.0 * double(samples.size()) * double(settings.size) * double(settings.size);
-    if (texels > kShadowTexelBudget) {
-      const int fit = int(std::sqrt(kShadowTexelBudget / (6.0 * double(samples.size()))));
-      settings.size = std::max(std::min(settings.size, kShadowMinSize), fit);
-    }
-    if (settings.size < options.shadow_map_size)
-      out.warnings.push_back(
-          fmt::format("shadow maps of {} texels per side for {} light samples ({} requested)",
-                      settings.size, samples.size(), options.shadow_map_size));
-    settings.bias = options.shadow_bias;
-    settings.pcf = options.shadow_pcf;
-    // Near and far only clip: the maps hold distances, so a near plane far below any feature
-    // size (1e-6 of the scene's reach from the lights) costs no precision.
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-    bool any = false;
-    for (const DrawObject& d : list.objects)
-      if (d.mesh)
-        for (const glm::vec3& p : d.mesh->positions) {
-          lo = glm::min(lo, p);
-          hi = glm::max(hi, p);
-          any = true;
-        }
-    float reach = 0.0f;
-    for (const LightSample& ls : samples)
-      reach = std::max(
-          reach, glm::length(glm::max(glm::abs(ls.position - lo), glm::abs(ls.position - hi))));
-    if (!any) reach = 1.0f;
-    reach = std::max(reach, 1e-3f);
-    const float near_plane = 1e-6f * reach, far_plane = 2.0f * reach;
-    settings.projection =
-        glm::dmat4(glm::perspective(glm::radians(90.0f), 1.0f, near_plane, far_plane));
-    const size_t per_sample = 6 * size_t(settings.size) * size_t(settings.size) * sizeof(float);
-    const size_t batch = std::clamp<size_t>(kShadowBatchBytes / per_sample, 1, samples.size());
-    std::optional<DepthTarget> scratch_built;
-    arena.execute([&] {
-      scratch_built.emplace(settings.size, settings.size, near_plane, far_plane, options.hiz,
-                            kernels, /*depth_only=*/true);
-    });
-    DepthTarget& scratch = *scratch_built;
-    std::vector<soft::ShadowCube> cubes(batch);
-    DrawResult shadow_work;
-    double draw_seconds = 0;
-    if (progress) progress->begin("shadows", samples.size(), "light samples");
-    for (size_t first = 0; first < samples.size(); first += batch) {
-      const size_t end = std::min(samples.size(), first + batch);
-      auto t_draw = Clock::now();
-      for (size_t i = first; i < end; ++i)
-        cubes[i - first].build(list, samples[i].position, settings, scratch, arena, shadow_work);
-      draw_seconds += seconds_since(t_draw);
-      arena.execute([&] {
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, fb.pixel_count()),
-                          [&](const tbb::blocked_range<size_t>& r) {
-                            for (size_t o = r.begin(); o != r.end(); ++o) {
-                              if (!target.covered(o)) continue;
-                              const Surface s = surface_at(o);
-                              add_light_samples(
-                                  s.material(), s.P, s.N, s.V, samples, first, end,
-                                  [&](size_t i, const glm::vec3& P, const glm::vec3& L) {
-                                    return cubes[i - first].visibility(P, L, s.geometric, settings);
-                                  },
-                                  fb.color[o]);
-                            }
-                          });
-      });
-      if (progress) progress->advance(end - first);
-    }
-    out.stats["time.shadows"] = seconds_since(t);
-    out.stats["time.shadow_maps"] = draw_seconds;
-    out.stats["shadows.map_size"] = double(settings.size);
-    out.stats["shadows.cubes"] = double(samples.size());
-    out.stats["shadows.triangles_setup"] = double(shadow_work.set_up);
-    out.stats["shadows.fragments"] = double(shadow_work.counters.generated);
-    out.stats["shadows.hiz_blocks_rejected"] = double(shadow_work.counters.blocks_rejected);
-    out.stats["memory.shadow_bytes"] =
-        double(batch * per_sample + scratch.bytes() + shadow_work.peak_chunk_bytes);
+    const VisibleFrame frame{scene, list, target, surfaces ? &*surfaces : nullptr, fb};
+    if (Status lit = add_shadowed_light(frame, samples, options, kernels, arena, fb, out); !lit)
+      return lit.error();
   }
 
-  const soft::TileCounters& sum = drawn.counters;
-  uint64_t covered = 0;
-  for (size_t i = 0; i < fb.pixel_count(); ++i) covered += target.covered(i) ? 1 : 0;
-  out.stats["triangles.submitted"] = double(submitted);
-  out.stats["triangles.clipped"] = double(drawn.clipped);
-  out.stats["triangles.setup"] = double(drawn.set_up);
-  out.stats["fragments.generated"] = double(sum.generated);
-  out.stats["fragments.shaded"] = shade ? double(covered) : 0.0;
-  out.stats["pixels.covered"] = double(covered);
-  out.stats["overdraw"] = covered > 0 ? double(sum.generated) / double(covered) : 0.0;
-  out.stats["blocks.full"] = double(sum.blocks_full);
-  out.stats["hiz.blocks_rejected"] = double(sum.blocks_rejected);
-  out.stats["hiz.triangles_rejected"] = double(sum.triangles_rejected);
-  out.stats["memory.raster_bytes"] = double(target.bytes() + drawn.peak_chunk_bytes);
+  record_draw_stats(drawn, target, submitted, shade, fb, out);
   out.info["hiz"] = options.hiz ? "on" : "off";
-
-  // The warnings do not name the renderer: whoever prints them says whose they are.
-  if (!skipped_csg.empty()) out.warnings.push_back(skipped_csg_warning(skipped_csg));
-  if (options.mode == RenderMode::Full) {
-    if (mirror) out.warnings.push_back("mirror reflection not rendered");
-    if (transparency) out.warnings.push_back("transparency not rendered");
-    if (scene.camera.aperture_radius > 0.0f)
-      out.warnings.push_back("depth of field (aperture) not rendered: pinhole");
-  }
-  if (scene.image.samples_per_pixel > 1)
-    out.warnings.push_back(
-        fmt::format("{} samples per pixel requested; multisampling is not implemented, rendered 1",
-                    scene.image.samples_per_pixel));
+  note_what_is_left_out(scene, options, *prepared, draws, out.warnings);
   return out;
 }
 

@@ -35,13 +35,9 @@ std::vector<std::pair<glm::vec3, float>> scene_points(const Scene& scene) {
       case ObjectType::Sphere:
         points.emplace_back(o.sphere.center, o.sphere.radius);
         break;
-      case ObjectType::Plane: {
-        auto [u, v] = plane_axes(o.plane.normal);
-        float h = o.plane.half_size;
-        for (float su : {-h, h})
-          for (float sv : {-h, h}) points.emplace_back(o.plane.point + su * u + sv * v, 0.0f);
+      case ObjectType::Plane:
+        for (const glm::vec3& p : plane_corners(o.plane)) points.emplace_back(p, 0.0f);
         break;
-      }
       case ObjectType::Csg:
         csg_points(o.csg.get(), points);
         break;

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <string>
 
+#include "rvr/shared/tessellate.h"
+
 namespace rvr {
 namespace {
 
@@ -15,11 +17,6 @@ constexpr uint64_t kBytesPerPixel = 96;
 // Bytes per triangle: the mesh (shared vertices, normals, indices), the GL vertex buffer (3
 // unshared vertices with normal and ids) and the tracer's BVH and leaf-ordered triangles.
 constexpr uint64_t kBytesPerTriangle = 260;
-
-uint64_t sphere_triangles(int segments) {
-  uint64_t rings = uint64_t(std::max(2, segments / 2));
-  return uint64_t(segments) * (2 * rings - 2);
-}
 
 }  // namespace
 
@@ -34,10 +31,10 @@ ResourceEstimate estimate_resources(const Scene& scene, const RenderOptions& opt
         e.triangles += o.mesh.triangle_count();
         break;
       case ObjectType::Sphere:  // the z-buffer draws the tessellation whatever the tracer does
-        e.triangles += sphere_triangles(options.sphere_segments);
+        e.triangles += sphere_triangle_count(options.sphere_segments);
         break;
       case ObjectType::Plane:
-        e.triangles += 2;
+        e.triangles += kPlaneTriangleCount;
         break;
       case ObjectType::Csg:
         break;

@@ -54,7 +54,8 @@ TriangleMesh tessellate_sphere(const Sphere& s, int segments) {
   for (int k = 0; k < segments; ++k)
     mesh.triangles.push_back({south, ring_vertex(rings - 1, k + 1), ring_vertex(rings - 1, k)});
   RVR_CHECK(mesh.positions.size() == size_t(2 + (rings - 1) * segments) &&
-                mesh.triangles.size() == size_t(2 * segments * (rings - 1)),
+                mesh.triangles.size() == size_t(2 * segments * (rings - 1)) &&
+                mesh.triangles.size() == sphere_triangle_count(segments),
             "a UV sphere of ", segments, " longitudes and ", rings, " rings has ",
             2 * segments * (rings - 1), " triangles, not ", mesh.triangles.size());
   RVR_CHECK(ring_vertex(rings - 1, segments - 1) < south, "ring vertices come before the pole");
@@ -62,14 +63,27 @@ TriangleMesh tessellate_sphere(const Sphere& s, int segments) {
 }
 
 TriangleMesh tessellate_plane(const Plane& p) {
-  auto [u, v] = plane_axes(p.normal);
-  float h = p.half_size;
+  const std::array<glm::vec3, 4> corners = plane_corners(p);
   TriangleMesh mesh;
-  mesh.positions = {p.point - h * u - h * v, p.point + h * u - h * v, p.point + h * u + h * v,
-                    p.point - h * u + h * v};
+  mesh.positions.assign(corners.begin(), corners.end());
   // u x v = n, so (u, v) order is counter-clockwise seen from the normal's side.
   mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  RVR_CHECK(mesh.triangles.size() == kPlaneTriangleCount, "a square is ", kPlaneTriangleCount,
+            " triangles");
   return mesh;
+}
+
+std::array<glm::vec3, 4> plane_corners(const Plane& p) {
+  auto [u, v] = plane_axes(p.normal);
+  float h = p.half_size;
+  return {p.point - h * u - h * v, p.point + h * u - h * v, p.point + h * u + h * v,
+          p.point - h * u + h * v};
+}
+
+uint64_t sphere_triangle_count(int segments) {
+  segments = std::max(segments, 3);  // as tessellate_sphere
+  const uint64_t rings = uint64_t(std::max(2, segments / 2));
+  return uint64_t(segments) * (2 * rings - 2);
 }
 
 int sphere_segments_for_triangles(size_t triangles) {

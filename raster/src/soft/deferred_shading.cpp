@@ -115,14 +115,8 @@ class VisibilityRows {
   std::vector<uint8_t> use_primitive_id_;  // per object: its triangle index is the primitive id
 };
 
-}  // namespace
-
-void shade_pixels(const DrawList& list, const DepthTarget& target, const DeferredShading& settings,
-                  const ShadeKernels& kernels, tbb::task_arena& arena, ProgressSink* progress,
-                  FrameBuffers& fb) {
-  const int w = target.width(), h = target.height();
-  allocate_frame(w, h, fb);  // every pixel is written below
-  const VisibilityRows visibility(list, target, settings.cost);
+// The per-object table the kernel reads, built once per frame.
+std::vector<ObjectShading> object_shading(const DrawList& list, const DeferredShading& settings) {
   std::vector<ObjectShading> objects(list.objects.size());
   for (size_t i = 0; i < objects.size(); ++i) {
     const DrawObject& d = list.objects[i];
@@ -133,115 +127,180 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
     s.varies = settings.surfaces && d.material && settings.surfaces->varies(uint32_t(i));
     if (d.material) s.material = shade_material(*d.material, settings.ambient);
   }
-  const SurfaceColours* surfaces = settings.surfaces;
-  if (surfaces && surfaces->textured())
+  return objects;
+}
+
+// What every row's shading shares in one frame.
+struct FrameShading {
+  const DepthTarget& target;
+  const DeferredShading& settings;
+  const ShadeKernels& kernels;
+  const VisibilityRows& visibility;
+  const std::vector<ObjectShading>& objects;
+  const ShadeLights& lights;
+  glm::vec3 eye;
+  FrameBuffers& fb;
+};
+
+// Shades rows of one range: each covered pixel gathered into a batch of kShadeBatch slots
+// (barycentrics, material, triangle), shaded by the kernel when full; uncovered runs get the
+// background. The target marks a pixel nothing covers with the id the frame buffers give the
+// background.
+class RowShader {
+ public:
+  explicit RowShader(const FrameShading& frame) : frame_(frame) {
+    // Flat pixels leave their slots' vertex normals as they were: defined values, not read.
+    std::fill(&batch_.normal[0][0][0], &batch_.normal[0][0][0] + 9 * kShadeBatch, 0.0f);
+  }
+
+  // Row y: its depth, ids and cost, then its runs of background and its covered pixels.
+  void shade_row(int y) {
+    static_assert(kNoId == 0xFFFFFFFFu);
+    const int w = frame_.target.width();
+    const uint32_t* object_of = frame_.target.objects();
+    const size_t row = frame_.fb.index(0, y);
+    frame_.visibility.write(y, frame_.fb);
+    int x = 0;
+    while (x < w) {
+      if (object_of[row + size_t(x)] == kNoId) {
+        int end = x + 1;
+        while (end < w && object_of[row + size_t(end)] == kNoId) ++end;
+        fill_background(row + size_t(x), size_t(end - x));
+        x = end;
+        continue;
+      }
+      add_pixel(row + size_t(x), x, y);
+      ++x;
+    }
+  }
+
+  // Shades the batch gathered so far and writes its pixels' colours and normals.
+  void flush() {
+    if (batch_.count == 0) return;
+    RVR_DCHECK(batch_.count <= kShadeBatch, "flushed when full: ", batch_.count);
+    const int n = batch_.count;
+    pad_batch(batch_, mixed_);
+    batch_.material = mixed_ ? nullptr : &frame_.objects[batch_object_].material;
+    const float eye[3] = {frame_.eye.x, frame_.eye.y, frame_.eye.z};
+    frame_.kernels.shade(batch_, eye, frame_.lights);
+    FrameBuffers& fb = frame_.fb;
+    for (int i = 0; i < n; ++i) {
+      const size_t o = pixel_[i];
+      fb.normal[o] = {batch_.shading_normal[0][i], batch_.shading_normal[1][i],
+                      batch_.shading_normal[2][i]};
+      fb.color[o] = {batch_.colour[0][i], batch_.colour[1][i], batch_.colour[2][i]};
+    }
+    batch_.count = 0;
+    mixed_ = false;
+  }
+
+ private:
+  // Pixels [o, o + n): the background colour and a zero normal.
+  void fill_background(size_t o, size_t n) {
+    fill_vec3(frame_.fb.color.data() + o, n, frame_.settings.background);
+    std::memset(static_cast<void*>(frame_.fb.normal.data() + o), 0,
+                n * sizeof(glm::vec3));  // +0.0f is all zero bits
+  }
+
+  // The covered pixel o (at x, y) into the next slot: barycentrics, material, triangle.
+  void add_pixel(size_t o, int x, int y) {
+    const uint32_t id = frame_.target.objects()[o];
+    const ObjectShading& s = frame_.objects[id];
+    const uint32_t primitive = frame_.target.primitives()[o];
+    RVR_DCHECK(id < frame_.objects.size() && primitive < frame_.objects[id].mesh->triangles.size(),
+               "the z-buffer stores ids of drawn triangles: object ", id, ", primitive ",
+               primitive);
+    const int i = batch_.count++;
+    pixel_[i] = o;
+    if (i == 0)
+      batch_object_ = id;
+    else if (!mixed_ && id != batch_object_)
+      carry_materials(i);
+    const float* barycentric = frame_.target.barycentrics() + 3 * o;
+    for (int a = 0; a < 3; ++a) batch_.bary[a][i] = barycentric[a];
+    if (s.varies) {
+      if (!mixed_) carry_materials(i);
+      put_surface_material(i, o, id, primitive, s, x, y);
+    } else if (mixed_) {
+      put_material(batch_, i, s.material);
+    }
+    put_triangle(i, id, primitive, s);
+    if (batch_.count == kShadeBatch) flush();
+  }
+
+  // From slot i on, each slot carries its material: slots before it get the one they shared.
+  void carry_materials(int i) {
+    mixed_ = true;
+    for (int k = 0; k < i; ++k) put_material(batch_, k, frame_.objects[batch_object_].material);
+  }
+
+  // A textured or vertex-coloured pixel's own material (its base colour at the slot's
+  // barycentrics) and the level of detail it was sampled at.
+  void put_surface_material(int i, size_t o, uint32_t id, uint32_t primitive,
+                            const ObjectShading& s, int x, int y) {
+    const glm::vec3 b(batch_.bary[0][i], batch_.bary[1][i], batch_.bary[2][i]);
+    const SurfaceSample here =
+        frame_.settings.surfaces->at(id, *s.source, primitive, b, x, y, planes_);
+    put_material(batch_, i,
+                 shade_material(with_diffuse(*s.source, here.base), frame_.settings.ambient));
+    if (!frame_.fb.lod.empty()) frame_.fb.lod[o] = here.lod;
+  }
+
+  // The triangle's vertices (and vertex normals if smooth) into slot i; consecutive pixels
+  // mostly show the same triangle, so the last one gathered is kept.
+  void put_triangle(int i, uint32_t id, uint32_t primitive, const ObjectShading& s) {
+    if (id != last_object_ || primitive != last_primitive_) {
+      last_object_ = id;
+      last_primitive_ = primitive;
+      const TriangleMesh& mesh = *s.mesh;
+      const glm::uvec3& tri = mesh.triangles[primitive];
+      for (int c = 0; c < 3; ++c) last_vertex_[c] = mesh.positions[tri[c]];
+      if (s.smooth)
+        for (int c = 0; c < 3; ++c) last_normal_[c] = mesh.normals[tri[c]];
+    }
+    for (int c = 0; c < 3; ++c) put_vec3(batch_.vertex[c], i, last_vertex_[c]);
+    batch_.smooth[i] = s.smooth ? ~0u : 0u;
+    if (s.smooth)
+      for (int c = 0; c < 3; ++c) put_vec3(batch_.normal[c], i, last_normal_[c]);
+  }
+
+  const FrameShading& frame_;
+  ShadeBatch batch_;
+  PlanesCache planes_;
+  size_t pixel_[kShadeBatch];  // frame-buffer index of each slot
+  // The object of every slot so far, while the batch holds one (then batch.material is set at
+  // the flush and the per-slot material arrays are not filled).
+  uint32_t batch_object_ = 0;
+  bool mixed_ = false;
+  uint32_t last_object_ = kNoId, last_primitive_ = kNoId;
+  glm::vec3 last_vertex_[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
+  glm::vec3 last_normal_[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
+};
+
+}  // namespace
+
+void shade_pixels(const DrawList& list, const DepthTarget& target, const DeferredShading& settings,
+                  const ShadeKernels& kernels, tbb::task_arena& arena, ProgressSink* progress,
+                  FrameBuffers& fb) {
+  allocate_frame(target.width(), target.height(), fb);  // every pixel is written below
+  const VisibilityRows visibility(list, target, settings.cost);
+  const std::vector<ObjectShading> objects = object_shading(list, settings);
+  if (settings.surfaces && settings.surfaces->textured())
     fb.lod.assign(fb.pixel_count(), std::numeric_limits<float>::quiet_NaN());
   // The light samples as the kernel reads them (none: the colour is the base).
   const bool lit = settings.colour == ShadedColour::Local && settings.samples;
   const ShadeLightArrays light_arrays(lit ? *settings.samples : std::vector<LightSample>{});
-  const ShadeLights& lights = light_arrays.lights();
-  const float eye[3] = {settings.eye.x, settings.eye.y, settings.eye.z};
-  // The target marks a pixel nothing covers with the id the frame buffers give the background.
-  static_assert(kNoId == 0xFFFFFFFFu);
-  const uint32_t* object_of = target.objects();
-  const uint32_t* primitive_of = target.primitives();
-  const float* barycentrics = target.barycentrics();
-
+  const FrameShading frame{
+      target, settings, kernels, visibility, objects, light_arrays.lights(), settings.eye, fb};
   arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
-      ShadeBatch batch;
-      PlanesCache planes;
-      // Flat pixels leave their slots' vertex normals as they were: defined values, not read.
-      std::fill(&batch.normal[0][0][0], &batch.normal[0][0][0] + 9 * kShadeBatch, 0.0f);
-      size_t pixel[kShadeBatch];  // frame-buffer index of each slot
-      // The object of every slot so far, while the batch holds one (then batch.material is
-      // set at the flush and the per-slot material arrays are not filled).
-      uint32_t batch_object = 0;
-      bool mixed = false;
-      auto flush = [&] {
-        if (batch.count == 0) return;
-        RVR_DCHECK(batch.count <= kShadeBatch, "flushed when full: ", batch.count);
-        const int n = batch.count;
-        pad_batch(batch, mixed);
-        batch.material = mixed ? nullptr : &objects[batch_object].material;
-        kernels.shade(batch, eye, lights);
-        for (int i = 0; i < n; ++i) {
-          const size_t o = pixel[i];
-          fb.normal[o] = {batch.shading_normal[0][i], batch.shading_normal[1][i],
-                          batch.shading_normal[2][i]};
-          fb.color[o] = {batch.colour[0][i], batch.colour[1][i], batch.colour[2][i]};
-        }
-        batch.count = 0;
-        mixed = false;
-      };
-      // The last triangle gathered: consecutive pixels mostly show the same one.
-      uint32_t last_object = kNoId, last_primitive = kNoId;
-      glm::vec3 last_vertex[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
-      glm::vec3 last_normal[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
-      for (int y = r.begin(); y != r.end(); ++y) {
-        const size_t row = fb.index(0, y);
-        visibility.write(y, fb);  // depth, ids and cost of the whole row
-        int x = 0;
-        while (x < w) {
-          if (object_of[row + size_t(x)] == kNoId) {
-            int end = x + 1;
-            while (end < w && object_of[row + size_t(end)] == kNoId) ++end;
-            fill_vec3(fb.color.data() + row + size_t(x), size_t(end - x), settings.background);
-            std::memset(static_cast<void*>(fb.normal.data() + row + size_t(x)), 0,
-                        size_t(end - x) * sizeof(glm::vec3));  // +0.0f is all zero bits
-            x = end;
-            continue;
-          }
-          const size_t o = row + size_t(x);
-          ++x;
-          const uint32_t id = object_of[o];
-          const ObjectShading& s = objects[id];
-          const uint32_t primitive = primitive_of[o];
-          RVR_DCHECK(id < objects.size() && primitive < objects[id].mesh->triangles.size(),
-                     "the z-buffer stores ids of drawn triangles: object ", id, ", primitive ",
-                     primitive);
-
-          const int i = batch.count++;
-          pixel[i] = o;
-          if (i == 0)
-            batch_object = id;
-          else if (!mixed && id != batch_object) {
-            mixed = true;  // from now on each slot carries its material
-            for (int k = 0; k < i; ++k) put_material(batch, k, objects[batch_object].material);
-          }
-          for (int a = 0; a < 3; ++a) batch.bary[a][i] = barycentrics[3 * o + size_t(a)];
-          if (s.varies) {
-            if (!mixed) {
-              mixed = true;
-              for (int k = 0; k < i; ++k) put_material(batch, k, objects[batch_object].material);
-            }
-            const glm::vec3 b(batch.bary[0][i], batch.bary[1][i], batch.bary[2][i]);
-            const SurfaceSample here = surfaces->at(id, *s.source, primitive, b, x - 1, y, planes);
-            put_material(batch, i,
-                         shade_material(with_diffuse(*s.source, here.base), settings.ambient));
-            if (!fb.lod.empty()) fb.lod[o] = here.lod;
-          } else if (mixed) {
-            put_material(batch, i, s.material);
-          }
-          if (id != last_object || primitive != last_primitive) {
-            last_object = id;
-            last_primitive = primitive;
-            const TriangleMesh& mesh = *s.mesh;
-            const glm::uvec3& tri = mesh.triangles[primitive];
-            for (int c = 0; c < 3; ++c) last_vertex[c] = mesh.positions[tri[c]];
-            if (s.smooth)
-              for (int c = 0; c < 3; ++c) last_normal[c] = mesh.normals[tri[c]];
-          }
-          for (int c = 0; c < 3; ++c) put_vec3(batch.vertex[c], i, last_vertex[c]);
-          batch.smooth[i] = s.smooth ? ~0u : 0u;
-          if (s.smooth)
-            for (int c = 0; c < 3; ++c) put_vec3(batch.normal[c], i, last_normal[c]);
-          if (batch.count == kShadeBatch) flush();
-        }
-      }
-      flush();
-      if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));
-    });
+    tbb::parallel_for(tbb::blocked_range<int>(0, target.height()),
+                      [&](const tbb::blocked_range<int>& r) {
+                        RowShader shader(frame);
+                        for (int y = r.begin(); y != r.end(); ++y) shader.shade_row(y);
+                        shader.flush();
+                        if (progress)
+                          progress->advance(uint64_t(r.size()) * uint64_t(target.width()));
+                      });
   });
 }
 

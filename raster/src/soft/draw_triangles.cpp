@@ -112,6 +112,281 @@ ProjectionParams projection_params(int width, int height, const glm::dmat4& view
   return p;
 }
 
+// The tiles a set-up triangle's pixel box overlaps, kept per sub-chunk for the binning's second
+// pass: 8 bytes a triangle to read instead of its 64-byte first line.
+struct TileSpan {
+  uint16_t x0, y0, x1, y1;
+};
+static_assert(kMaxImageSide / kTile <= 65536, "tile indices fit 16 bits");
+
+// What every sub-chunk's setup shares: the kernels, the projection and the viewport.
+struct SetupContext {
+  const FillKernels& kernels;
+  ProjectionParams params;
+  int width, height;
+};
+
+// The triangle (a, b, c of the batch's vertices) clipped or batched: trivially outside the view
+// frustum (`reject`): counted as clipped; crossing the near or a guard plane (`clip`): through
+// the scalar clipper, in order; otherwise it joins the batch as slot batch.count.
+void set_up_one(const SetupContext& ctx, SetupWorker& worker, const TriangleMesh& m,
+                const glm::uvec3& tri, uint32_t object, uint32_t primitive, bool reject, bool clip,
+                SetupTriangles& local, size_t& local_clipped) {
+  if (reject) {
+    ++local_clipped;
+    return;
+  }
+  if (clip) {
+    worker.flush(ctx.kernels, ctx.width, ctx.height, local);
+    worker.setup.add(
+        worker.setup.project(m.positions[tri.x]), worker.setup.project(m.positions[tri.y]),
+        worker.setup.project(m.positions[tri.z]), object, primitive, local, local_clipped);
+    return;
+  }
+  SetupBatch& batch = worker.batch;
+  const int k = batch.count;
+  batch.object[k] = object;
+  batch.primitive[k] = primitive;
+  if (++batch.count == kSetupBatch) worker.flush(ctx.kernels, ctx.width, ctx.height, local);
+}
+
+// Triangles tris[0 .. n) of mesh m (primitives from `primitive0`), whose vertices lie in
+// [lo, lo + span): the range projected at once, then each triangle culled, clipped (scalar
+// path) or batched by vertex index, in order.
+void set_up_range(const SetupContext& ctx, SetupWorker& worker, const TriangleMesh& m,
+                  uint32_t object, const glm::uvec3* tris, size_t n, uint32_t primitive0,
+                  uint32_t lo, uint32_t span, SetupTriangles& local, size_t& local_clipped) {
+  worker.project_range(ctx.kernels, ctx.params, m.positions.data() + lo, span);
+  SetupBatch& batch = worker.batch;
+  batch.vertices = worker.range.arrays();
+  const uint8_t* reject = worker.range_reject.data();
+  const uint8_t* clip = worker.range_clip.data();
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t a = tris[i].x - lo, b = tris[i].y - lo, c = tris[i].z - lo;
+    const int k = batch.count;
+    batch.vertex[0][k] = a;
+    batch.vertex[1][k] = b;
+    batch.vertex[2][k] = c;
+    set_up_one(ctx, worker, m, tris[i], object, primitive0 + uint32_t(i),
+               (reject[a] & reject[b] & reject[c]) != 0, (clip[a] | clip[b] | clip[c]) != 0, local,
+               local_clipped);
+  }
+  worker.flush(ctx.kernels, ctx.width, ctx.height, local);
+}
+
+// Submitted triangles [begin, end), starting in object `object`, through the worker's vertex
+// cache (scattered indices, or several objects): each triangle's projected vertices copied into
+// the batch's own store (a later lookup may evict them), then culled, clipped or batched.
+void set_up_cached(const SetupContext& ctx, SetupWorker& worker, const DrawList& list,
+                   size_t object, size_t begin, size_t end, SetupTriangles& local,
+                   size_t& local_clipped) {
+  SetupBatch& batch = worker.batch;
+  batch.vertices = worker.batch_vertices.arrays();
+  VertexStore& store = worker.batch_vertices;
+  for (size_t g = begin; g < end; ++g) {
+    while (g >= list.first[object + 1]) ++object;
+    const TriangleMesh& m = *list.objects[object].mesh;
+    const uint32_t primitive = uint32_t(g - list.first[object]);
+    const glm::uvec3& tri = m.triangles[primitive];
+    const uint32_t o = uint32_t(object);
+    const int k = batch.count;
+    uint32_t reject = ~0u, clip = 0;
+    for (int v = 0; v < 3; ++v) {
+      const ProjectedVertex& p = worker.vertex(o, tri[v], m.positions[tri[v]]);
+      reject &= p.reject;
+      clip |= p.clip_planes;
+      const uint32_t at = uint32_t(v * kSetupBatch + k);
+      clip |= fits_32_bits(p) ? 0u : kScalarOnly;
+      store.fx[at] = int32_t(p.fx);
+      store.fy[at] = int32_t(p.fy);
+      store.sx[at] = p.sx;
+      store.sy[at] = p.sy;
+      store.w[at] = p.clip.w;
+      store.inv_w[at] = p.inv_w;
+      batch.vertex[v][k] = at;
+    }
+    set_up_one(ctx, worker, m, tri, o, primitive, reject != 0, clip != 0, local, local_clipped);
+  }
+  worker.flush(ctx.kernels, ctx.width, ctx.height, local);
+}
+
+// Submitted triangles [begin, end) set up in order into `local`: one object's compact index
+// range projected in one kernel pass, anything else through the vertex cache. Returns how many
+// were clipped away.
+size_t set_up_sub_chunk(const SetupContext& ctx, SetupWorker& worker, const DrawList& list,
+                        size_t begin, size_t end, SetupTriangles& local) {
+  local.clear();
+  size_t local_clipped = 0;
+  RVR_DCHECK(begin < end && end - begin <= kSubChunk, "sub-chunk [", begin, ", ", end, ")");
+  local.reserve(end - begin);
+  const size_t object =
+      size_t(std::upper_bound(list.first.begin(), list.first.end(), begin) - list.first.begin()) -
+      1;
+  if (end <= list.first[object + 1]) {
+    const TriangleMesh& mesh = *list.objects[object].mesh;
+    const glm::uvec3* tris = mesh.triangles.data() + (begin - list.first[object]);
+    const size_t n = end - begin;
+    uint32_t lo = ~0u, hi = 0;
+    for (size_t i = 0; i < n; ++i)
+      for (int v = 0; v < 3; ++v) {
+        lo = std::min(lo, tris[i][v]);
+        hi = std::max(hi, tris[i][v]);
+      }
+    if (size_t(hi - lo) < kRangePerTriangle * n) {
+      set_up_range(ctx, worker, mesh, uint32_t(object), tris, n,
+                   uint32_t(begin - list.first[object]), lo, hi - lo + 1, local, local_clipped);
+      return local_clipped;
+    }
+  }
+  set_up_cached(ctx, worker, list, object, begin, end, local, local_clipped);
+  return local_clipped;
+}
+
+// The chunked draw's state across chunks: per sub-chunk its set-up triangles, clipped count and
+// tile spans; per tile and sub-chunk the bin counts (then offsets); the bins; per tile its
+// counters.
+class ChunkedDraw {
+ public:
+  ChunkedDraw(const DrawList& list, const glm::dmat4& view_projection, DepthTarget& target,
+              tbb::task_arena& arena)
+      : list_(list),
+        target_(target),
+        arena_(arena),
+        ctx_{target.kernels(), projection_params(target.width(), target.height(), view_projection),
+             target.width(), target.height()},
+        tiles_x_(target.tiles_x()),
+        tile_count_(size_t(target.tiles_x()) * size_t(target.tiles_y())),
+        workers_(TriangleSetup(target.width(), target.height(), view_projection)),
+        sub_out_((kChunk + kSubChunk - 1) / kSubChunk),
+        sub_clipped_(sub_out_.size()),
+        sub_spans_(sub_out_.size()),
+        bin_start_(tile_count_ + 1),
+        counters_(tile_count_) {}
+
+  // Sets up submitted triangles [chunk, chunk_end) in `subs` sub-chunks in parallel, each kept in
+  // order, and counts their tiles while they are still in that core's cache (a pass of its own
+  // read them all back from memory).
+  void set_up(size_t chunk, size_t chunk_end, size_t subs, DrawResult& result) {
+    counts_.assign(subs * tile_count_, 0);
+    arena_.execute([&] {
+      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
+        const size_t begin = chunk + s * kSubChunk, end = std::min(chunk_end, begin + kSubChunk);
+        sub_clipped_[s] = set_up_sub_chunk(ctx_, workers_.local(), list_, begin, end, sub_out_[s]);
+        count_tiles(s);
+      });
+    });
+    for (size_t s = 0; s < subs; ++s) {
+      RVR_CHECK(sub_out_[s].size() < (size_t(1) << DepthTarget::kLocalBits),
+                "a sub-chunk's set-up triangles (clipping makes up to six of one) must fit a bin "
+                "entry's local index: ",
+                sub_out_[s].size());
+      result.clipped += sub_clipped_[s];
+      result.set_up += sub_out_[s].size();
+    }
+  }
+
+  // A counting sort of the chunk's triangles into tiles, in submission order (the counts were
+  // taken in the setup pass): offsets tile by tile, and within a tile sub-chunk by sub-chunk,
+  // then every triangle's entry in each tile it overlaps.
+  void bin(size_t subs) {
+    uint32_t running = 0;
+    for (size_t b = 0; b < tile_count_; ++b) {
+      bin_start_[b] = running;
+      for (size_t s = 0; s < subs; ++s) {
+        uint32_t n = counts_[s * tile_count_ + b];
+        counts_[s * tile_count_ + b] = running;
+        running += n;
+      }
+    }
+    bin_start_[tile_count_] = running;
+    RVR_CHECK(subs <= (size_t(1) << (32 - DepthTarget::kLocalBits)),
+              "a chunk's sub-chunk numbers must fit a bin entry's top bits: ", subs);
+    bin_.resize(running);
+    arena_.execute([&] {
+      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
+        uint32_t* next = &counts_[s * tile_count_];
+        const uint32_t tag = uint32_t(s) << DepthTarget::kLocalBits;
+        const std::vector<TileSpan>& spans = sub_spans_[s];
+        for (size_t i = 0; i < spans.size(); ++i)
+          for_tiles(spans[i], [&](size_t b) { bin_[next[b]++] = tag | uint32_t(i); });
+      });
+    });
+  }
+
+  // The bytes the chunk holds: bins, counts, spans and set-up triangles.
+  size_t chunk_bytes() const {
+    size_t bytes = (bin_.capacity() + counts_.capacity()) * sizeof(uint32_t);
+    for (const auto& spans : sub_spans_) bytes += spans.capacity() * sizeof(TileSpan);
+    for (const auto& v : sub_out_)
+      if (v.capacity() > 0) bytes += HugePageAllocator<SetupTriangle>::bytes_for(v.capacity());
+    return bytes;
+  }
+
+  // Draws the binned triangles, tiles in parallel, each independent of the others. Returns the
+  // fragments generated.
+  uint64_t raster() {
+    std::atomic<uint64_t> fragments{0};
+    arena_.execute([&] {
+      tbb::parallel_for(size_t(0), tile_count_, [&](size_t b) {
+        if (bin_start_[b + 1] == bin_start_[b]) return;
+        const uint64_t before = counters_[b].generated;
+        target_.draw_tile(int(b % size_t(tiles_x_)), int(b / size_t(tiles_x_)), sub_out_.data(),
+                          bin_.data() + bin_start_[b], bin_start_[b + 1] - bin_start_[b],
+                          counters_[b]);
+        fragments.fetch_add(counters_[b].generated - before, std::memory_order_relaxed);
+      });
+    });
+    return fragments.load();
+  }
+
+  // Every tile's counters summed.
+  TileCounters counters() const {
+    TileCounters sum;
+    for (const TileCounters& c : counters_) {
+      sum.generated += c.generated;
+      sum.blocks_rejected += c.blocks_rejected;
+      sum.triangles_rejected += c.triangles_rejected;
+      sum.blocks_full += c.blocks_full;
+    }
+    return sum;
+  }
+
+ private:
+  template <class Fn>
+  void for_tiles(const TileSpan& span, Fn&& fn) const {
+    for (int ty = span.y0; ty <= span.y1; ++ty)
+      for (int tx = span.x0; tx <= span.x1; ++tx) fn(size_t(ty) * size_t(tiles_x_) + size_t(tx));
+  }
+
+  // Sub-chunk s's tile spans and its counts per tile.
+  void count_tiles(size_t s) {
+    uint32_t* c = &counts_[s * tile_count_];
+    std::vector<TileSpan>& spans = sub_spans_[s];
+    spans.resize(sub_out_[s].size());
+    for (size_t i = 0; i < spans.size(); ++i) {
+      const SetupTriangle& st = sub_out_[s][i];
+      RVR_DCHECK(st.x0 <= st.x1 && st.y0 <= st.y1 && st.x1 < ctx_.width && st.y1 < ctx_.height,
+                 "setup keeps only triangles with an on-screen pixel box");
+      spans[i] = {uint16_t(st.x0 / kTile), uint16_t(st.y0 / kTile), uint16_t(st.x1 / kTile),
+                  uint16_t(st.y1 / kTile)};
+      for_tiles(spans[i], [&](size_t b) { ++c[b]; });
+    }
+  }
+
+  const DrawList& list_;
+  DepthTarget& target_;
+  tbb::task_arena& arena_;
+  const SetupContext ctx_;
+  const int tiles_x_;
+  const size_t tile_count_;
+  tbb::enumerable_thread_specific<SetupWorker> workers_;
+  std::vector<SetupTriangles> sub_out_;
+  std::vector<size_t> sub_clipped_;
+  std::vector<std::vector<TileSpan>> sub_spans_;
+  std::vector<uint32_t> counts_, bin_start_, bin_;
+  std::vector<TileCounters> counters_;
+};
+
 }  // namespace
 
 DrawList make_draw_list(std::vector<DrawObject> objects) {
@@ -128,228 +403,24 @@ DrawList make_draw_list(std::vector<DrawObject> objects) {
 DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projection,
                           DepthTarget& target, tbb::task_arena& arena, ProgressSink* progress) {
   DrawResult result;
+  ChunkedDraw draw(list, view_projection, target, arena);
   const size_t submitted = list.triangles();
-  const size_t tile_count = size_t(target.tiles_x()) * size_t(target.tiles_y());
-  const int tiles_x = target.tiles_x();
-  const int width = target.width(), height = target.height();
-  const FillKernels& kernels = target.kernels();
-  const TriangleSetup prototype(target.width(), target.height(), view_projection);
-  tbb::enumerable_thread_specific<SetupWorker> workers(prototype);
-  std::vector<SetupTriangles> sub_out((kChunk + kSubChunk - 1) / kSubChunk);
-  std::vector<size_t> sub_clipped(sub_out.size());
-  std::vector<uint32_t> counts, bin_start(tile_count + 1), bin;
-  std::vector<TileCounters> counters(tile_count);
-  // The tiles a set-up triangle's pixel box overlaps, kept per sub-chunk for the binning's
-  // second pass: 8 bytes a triangle to read instead of its 64-byte first line.
-  struct TileSpan {
-    uint16_t x0, y0, x1, y1;
-  };
-  static_assert(kMaxImageSide / kTile <= 65536, "tile indices fit 16 bits");
-  std::vector<std::vector<TileSpan>> sub_spans(sub_out.size());
-  auto for_tiles = [&](const TileSpan& span, auto&& fn) {
-    for (int ty = span.y0; ty <= span.y1; ++ty)
-      for (int tx = span.x0; tx <= span.x1; ++tx) fn(size_t(ty) * size_t(tiles_x) + size_t(tx));
-  };
-  const ProjectionParams params = projection_params(width, height, view_projection);
-  // Triangles tris[0 .. n) of mesh m (primitives from `primitive0`), whose vertices lie in
-  // [lo, lo + span): the range projected at once, then each triangle culled, clipped (scalar
-  // path) or batched by vertex index, in order.
-  auto set_up_range = [&](SetupWorker& worker, const TriangleMesh& m, uint32_t object,
-                          const glm::uvec3* tris, size_t n, uint32_t primitive0, uint32_t lo,
-                          uint32_t span, SetupTriangles& local, size_t& local_clipped) {
-    worker.project_range(kernels, params, m.positions.data() + lo, span);
-    SetupBatch& batch = worker.batch;
-    batch.vertices = worker.range.arrays();
-    const uint8_t* reject = worker.range_reject.data();
-    const uint8_t* clip = worker.range_clip.data();
-    for (size_t i = 0; i < n; ++i) {
-      const uint32_t a = tris[i].x - lo, b = tris[i].y - lo, c = tris[i].z - lo;
-      const int k = batch.count;
-      batch.vertex[0][k] = a;
-      batch.vertex[1][k] = b;
-      batch.vertex[2][k] = c;
-      if (reject[a] & reject[b] & reject[c]) {  // trivially outside the view frustum
-        ++local_clipped;
-        continue;
-      }
-      const uint32_t primitive = primitive0 + uint32_t(i);
-      if (clip[a] | clip[b] | clip[c]) {  // the scalar clipper, in order
-        worker.flush(kernels, width, height, local);
-        worker.setup.add(worker.setup.project(m.positions[tris[i].x]),
-                         worker.setup.project(m.positions[tris[i].y]),
-                         worker.setup.project(m.positions[tris[i].z]), object, primitive, local,
-                         local_clipped);
-        continue;
-      }
-      batch.object[k] = object;
-      batch.primitive[k] = primitive;
-      if (++batch.count == kSetupBatch) worker.flush(kernels, width, height, local);
-    }
-    worker.flush(kernels, width, height, local);
-  };
   for (size_t chunk = 0; chunk < submitted; chunk += kChunk) {
     const size_t chunk_end = std::min(submitted, chunk + kChunk);
     const size_t subs = (chunk_end - chunk + kSubChunk - 1) / kSubChunk;
-    // --- setup: transform, cull, clip; sub-chunks in parallel, kept in order
     auto t = Clock::now();
-    counts.assign(subs * tile_count, 0);
-    arena.execute([&] {
-      auto set_up_sub_chunk = [&](size_t s) {
-        SetupWorker& worker = workers.local();
-        SetupTriangles& local = sub_out[s];
-        local.clear();
-        size_t local_clipped = 0;
-        const size_t begin = chunk + s * kSubChunk, end = std::min(chunk_end, begin + kSubChunk);
-        RVR_DCHECK(begin < end && end - begin <= kSubChunk, "sub-chunk [", begin, ", ", end, ")");
-        local.reserve(end - begin);
-        size_t object = size_t(std::upper_bound(list.first.begin(), list.first.end(), begin) -
-                               list.first.begin()) -
-                        1;
-        SetupBatch& batch = worker.batch;
-        // One object and a compact index range: project the range in one kernel pass.
-        const TriangleMesh& first_mesh = *list.objects[object].mesh;
-        if (end <= list.first[object + 1]) {
-          const glm::uvec3* tris = first_mesh.triangles.data() + (begin - list.first[object]);
-          const size_t n = end - begin;
-          uint32_t lo = ~0u, hi = 0;
-          for (size_t i = 0; i < n; ++i)
-            for (int v = 0; v < 3; ++v) {
-              lo = std::min(lo, tris[i][v]);
-              hi = std::max(hi, tris[i][v]);
-            }
-          if (size_t(hi - lo) < kRangePerTriangle * n) {
-            set_up_range(worker, first_mesh, uint32_t(object), tris, n,
-                         uint32_t(begin - list.first[object]), lo, hi - lo + 1, local,
-                         local_clipped);
-            sub_clipped[s] = local_clipped;
-            return;
-          }
-        }
-        batch.vertices = worker.batch_vertices.arrays();
-        VertexStore& store = worker.batch_vertices;
-        for (size_t g = begin; g < end; ++g) {
-          while (g >= list.first[object + 1]) ++object;
-          const TriangleMesh& m = *list.objects[object].mesh;
-          const uint32_t primitive = uint32_t(g - list.first[object]);
-          const glm::uvec3& tri = m.triangles[primitive];
-          const uint32_t o = uint32_t(object);
-          // The vertices straight into the batch's own copy (a later lookup may evict them).
-          const int k = batch.count;
-          uint32_t reject = ~0u, clip = 0;
-          for (int v = 0; v < 3; ++v) {
-            const ProjectedVertex& p = worker.vertex(o, tri[v], m.positions[tri[v]]);
-            reject &= p.reject;
-            clip |= p.clip_planes;
-            const uint32_t at = uint32_t(v * kSetupBatch + k);
-            clip |= fits_32_bits(p) ? 0u : kScalarOnly;
-            store.fx[at] = int32_t(p.fx);
-            store.fy[at] = int32_t(p.fy);
-            store.sx[at] = p.sx;
-            store.sy[at] = p.sy;
-            store.w[at] = p.clip.w;
-            store.inv_w[at] = p.inv_w;
-            batch.vertex[v][k] = at;
-          }
-          if (reject) {  // trivially outside the view frustum
-            ++local_clipped;
-            continue;
-          }
-          if (clip) {  // crosses the near or a guard plane: the scalar clipper, in order
-            worker.flush(kernels, width, height, local);
-            worker.setup.add(
-                worker.setup.project(m.positions[tri.x]), worker.setup.project(m.positions[tri.y]),
-                worker.setup.project(m.positions[tri.z]), o, primitive, local, local_clipped);
-            continue;
-          }
-          batch.object[k] = o;
-          batch.primitive[k] = primitive;
-          if (++batch.count == kSetupBatch) worker.flush(kernels, width, height, local);
-        }
-        worker.flush(kernels, width, height, local);
-        sub_clipped[s] = local_clipped;
-      };
-      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
-        set_up_sub_chunk(s);
-        // The binning's counts, while the sub-chunk's triangles are still in this core's cache
-        // (a pass of its own read them all back from memory).
-        uint32_t* c = &counts[s * tile_count];
-        std::vector<TileSpan>& spans = sub_spans[s];
-        spans.resize(sub_out[s].size());
-        for (size_t i = 0; i < spans.size(); ++i) {
-          const SetupTriangle& st = sub_out[s][i];
-          RVR_DCHECK(st.x0 <= st.x1 && st.y0 <= st.y1 && st.x1 < width && st.y1 < height,
-                     "setup keeps only triangles with an on-screen pixel box");
-          spans[i] = {uint16_t(st.x0 / kTile), uint16_t(st.y0 / kTile), uint16_t(st.x1 / kTile),
-                      uint16_t(st.y1 / kTile)};
-          for_tiles(spans[i], [&](size_t b) { ++c[b]; });
-        }
-      });
-    });
-    for (size_t s = 0; s < subs; ++s) {
-      RVR_CHECK(sub_out[s].size() < (size_t(1) << DepthTarget::kLocalBits),
-                "a sub-chunk's set-up triangles (clipping makes up to six of one) must fit a bin "
-                "entry's local index: ",
-                sub_out[s].size());
-      result.clipped += sub_clipped[s];
-      result.set_up += sub_out[s].size();
-    }
+    draw.set_up(chunk, chunk_end, subs, result);  // transform, cull, clip; count tiles
     result.setup_seconds += seconds_since(t);
-
-    // --- bin: a counting sort of the chunk's triangles into tiles, in submission order (the
-    // counts were taken in the setup pass)
     t = Clock::now();
-    // Offsets: tile by tile, and within a tile sub-chunk by sub-chunk (submission order).
-    uint32_t running = 0;
-    for (size_t b = 0; b < tile_count; ++b) {
-      bin_start[b] = running;
-      for (size_t s = 0; s < subs; ++s) {
-        uint32_t n = counts[s * tile_count + b];
-        counts[s * tile_count + b] = running;
-        running += n;
-      }
-    }
-    bin_start[tile_count] = running;
-    RVR_CHECK(subs <= (size_t(1) << (32 - DepthTarget::kLocalBits)),
-              "a chunk's sub-chunk numbers must fit a bin entry's top bits: ", subs);
-    bin.resize(running);
-    arena.execute([&] {
-      tbb::parallel_for(size_t(0), subs, [&](size_t s) {
-        uint32_t* next = &counts[s * tile_count];
-        const uint32_t tag = uint32_t(s) << DepthTarget::kLocalBits;
-        const std::vector<TileSpan>& spans = sub_spans[s];
-        for (size_t i = 0; i < spans.size(); ++i)
-          for_tiles(spans[i], [&](size_t b) { bin[next[b]++] = tag | uint32_t(i); });
-      });
-    });
+    draw.bin(subs);
     result.bin_seconds += seconds_since(t);
-    size_t chunk_bytes = (bin.capacity() + counts.capacity()) * sizeof(uint32_t);
-    for (const auto& spans : sub_spans) chunk_bytes += spans.capacity() * sizeof(TileSpan);
-    for (const auto& v : sub_out)
-      if (v.capacity() > 0)
-        chunk_bytes += HugePageAllocator<SetupTriangle>::bytes_for(v.capacity());
-    result.peak_chunk_bytes = std::max(result.peak_chunk_bytes, chunk_bytes);
-
-    // --- raster: tiles in parallel, each independent of the others
+    result.peak_chunk_bytes = std::max(result.peak_chunk_bytes, draw.chunk_bytes());
     t = Clock::now();
-    std::atomic<uint64_t> fragments{0};
-    arena.execute([&] {
-      tbb::parallel_for(size_t(0), tile_count, [&](size_t b) {
-        if (bin_start[b + 1] == bin_start[b]) return;
-        const uint64_t before = counters[b].generated;
-        target.draw_tile(int(b % size_t(tiles_x)), int(b / size_t(tiles_x)), sub_out.data(),
-                         bin.data() + bin_start[b], bin_start[b + 1] - bin_start[b], counters[b]);
-        fragments.fetch_add(counters[b].generated - before, std::memory_order_relaxed);
-      });
-    });
+    const uint64_t fragments = draw.raster();
     result.raster_seconds += seconds_since(t);
-    if (progress) progress->advance(chunk_end - chunk, fragments.load());
+    if (progress) progress->advance(chunk_end - chunk, fragments);
   }
-  for (const TileCounters& c : counters) {
-    result.counters.generated += c.generated;
-    result.counters.blocks_rejected += c.blocks_rejected;
-    result.counters.triangles_rejected += c.triangles_rejected;
-    result.counters.blocks_full += c.blocks_full;
-  }
+  result.counters = draw.counters();
   return result;
 }
 

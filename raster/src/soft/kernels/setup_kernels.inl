@@ -87,154 +87,190 @@ void project_vertices(const ProjectionParams& p, const float* xyz, size_t count,
   }
 }
 
-int setup_batch(const SetupBatch& in, int width, int height, SetupTriangle* out) {
-  const int n = in.count;
-  constexpr int B = kSetupBatch;
-  const VertexArrays& vs = in.vertices;
+// A batch's triangles in SoA, lane k for triangle k of the batch (the fixed-point part) and lane
+// r for survivor r (the double-precision part). Fixed point in 32 bits: guard-band coordinates
+// and their differences fit (setup_triangle.h).
+struct BatchLanes {
+  static constexpr int B = kSetupBatch;
   // Vertices in emit's order (1 and 2 swapped for negative area), pixel boxes, top-left edges.
-  // Fixed point in 32 bits: guard-band coordinates and their differences fit (setup_triangle.h).
   alignas(64) int32_t x[3][B], y[3][B];
   alignas(64) int32_t swapped[B], live[B];
   alignas(64) int32_t bx0[B], by0[B], bx1[B], by1[B];
   alignas(64) int32_t top_left[3][B];
+  // The survivors, in order: their lane k, screen positions in emit's vertex order,
+  // f[v][j] = (barycentric j of vertex v) / w_v = (v is vertex j) ? 1/w : 0, the smallest w.
+  alignas(64) int index[B];
+  alignas(64) double sx[3][B], sy[3][B], f[3][3][B], w_min[B];
+  // Their perspective planes, hi-z bound and whether emit keeps them.
+  alignas(64) double qa[3][B], qb[3][B], min_depth[B];
+  alignas(64) int64_t ok[B];
+};
+
+// Each triangle oriented (two-sided: either winding), with its pixel box (emit's first_centre /
+// last_centre, clamped to the viewport); live if it has area and the box is not empty.
+void orient_and_box(const SetupBatch& in, int width, int height, BatchLanes& l) {
+  const VertexArrays& vs = in.vertices;
+  const int n = in.count;
   for (int k = 0; k < n; ++k) {
     const uint32_t a = in.vertex[0][k], b = in.vertex[1][k], c = in.vertex[2][k];
     const int32_t ax = vs.fx[a], bx = vs.fx[b], cx = vs.fx[c];
     const int32_t ay = vs.fy[a], by = vs.fy[b], cy = vs.fy[c];
     const int64_t area = int64_t(bx - ax) * int64_t(cy - ay) - int64_t(by - ay) * int64_t(cx - ax);
-    const bool swap = area < 0;  // two-sided: either winding, oriented here
+    const bool swap = area < 0;
     const int32_t x1 = swap ? cx : bx, x2 = swap ? bx : cx;
     const int32_t y1 = swap ? cy : by, y2 = swap ? by : cy;
-    x[0][k] = ax, x[1][k] = x1, x[2][k] = x2;
-    y[0][k] = ay, y[1][k] = y1, y[2][k] = y2;
-    swapped[k] = swap;
+    l.x[0][k] = ax, l.x[1][k] = x1, l.x[2][k] = x2;
+    l.y[0][k] = ay, l.y[1][k] = y1, l.y[2][k] = y2;
+    l.swapped[k] = swap;
     const int32_t min_x = ax < x1 ? (ax < x2 ? ax : x2) : (x1 < x2 ? x1 : x2);
     const int32_t max_x = ax > x1 ? (ax > x2 ? ax : x2) : (x1 > x2 ? x1 : x2);
     const int32_t min_y = ay < y1 ? (ay < y2 ? ay : y2) : (y1 < y2 ? y1 : y2);
     const int32_t max_y = ay > y1 ? (ay > y2 ? ay : y2) : (y1 > y2 ? y1 : y2);
-    // emit's first_centre / last_centre.
     const int32_t fx0 = (min_x + int32_t(kSub / 2 - 1)) >> kSubBits;
     const int32_t fy0 = (min_y + int32_t(kSub / 2 - 1)) >> kSubBits;
     const int32_t lx1 = (max_x - int32_t(kSub / 2)) >> kSubBits;
     const int32_t ly1 = (max_y - int32_t(kSub / 2)) >> kSubBits;
-    bx0[k] = fx0 > 0 ? fx0 : 0;
-    by0[k] = fy0 > 0 ? fy0 : 0;
-    bx1[k] = lx1 < width - 1 ? lx1 : width - 1;
-    by1[k] = ly1 < height - 1 ? ly1 : height - 1;
-    live[k] = area != 0 && bx0[k] <= bx1[k] && by0[k] <= by1[k];
+    l.bx0[k] = fx0 > 0 ? fx0 : 0;
+    l.by0[k] = fy0 > 0 ? fy0 : 0;
+    l.bx1[k] = lx1 < width - 1 ? lx1 : width - 1;
+    l.by1[k] = ly1 < height - 1 ? ly1 : height - 1;
+    l.live[k] = area != 0 && l.bx0[k] <= l.bx1[k] && l.by0[k] <= l.by1[k];
   }
-  // Top-left edges, and a box of at most four centres tested with the rasterizer's own edge
-  // functions (candidate c at column a, row b of the box: 1xN, 2x1, 2x2, Nx1 boxes).
+}
+
+// Top-left edges, and a box of at most four centres tested with the rasterizer's own edge
+// functions (candidate c at column a, row b of the box: 1xN, 2x1, 2x2, Nx1 boxes): a small box
+// holding no centre is not live.
+void edges_and_small_boxes(int n, BatchLanes& l) {
   for (int k = 0; k < n; ++k) {
     int32_t edx[3], edy[3];
     int64_t bias[3];
     for (int i = 0; i < 3; ++i) {
       const int nx = i == 2 ? 0 : i + 1;
-      edx[i] = x[nx][k] - x[i][k];
-      edy[i] = y[nx][k] - y[i][k];
+      edx[i] = l.x[nx][k] - l.x[i][k];
+      edy[i] = l.y[nx][k] - l.y[i][k];
       const bool tl = (edy[i] == 0 && edx[i] > 0) || edy[i] < 0;
-      top_left[i][k] = tl;
+      l.top_left[i][k] = tl;
       bias[i] = tl ? 0 : 1;
     }
-    const int32_t wx = bx1[k] - bx0[k] + 1, wy = by1[k] - by0[k] + 1;
+    const int32_t wx = l.bx1[k] - l.bx0[k] + 1, wy = l.by1[k] - l.by0[k] + 1;
     const int32_t box = wx * wy;
     bool covers = false;
     for (int32_t c = 0; c < 4; ++c) {
       const int32_t a = wx == 1 ? 0 : (wx == 2 ? (c & 1) : c);
       const int32_t b = wx == 1 ? c : (wx == 2 ? (c >> 1) : 0);
-      const int32_t px = (bx0[k] + a) * int32_t(kSub) + int32_t(kSub / 2);
-      const int32_t py = (by0[k] + b) * int32_t(kSub) + int32_t(kSub / 2);
+      const int32_t px = (l.bx0[k] + a) * int32_t(kSub) + int32_t(kSub / 2);
+      const int32_t py = (l.by0[k] + b) * int32_t(kSub) + int32_t(kSub / 2);
       bool inside = c < box;
       for (int i = 0; i < 3; ++i)
-        inside &= int64_t(edx[i]) * int64_t(py - y[i][k]) -
-                      int64_t(edy[i]) * int64_t(px - x[i][k]) - bias[i] >=
+        inside &= int64_t(edx[i]) * int64_t(py - l.y[i][k]) -
+                      int64_t(edy[i]) * int64_t(px - l.x[i][k]) - bias[i] >=
                   0;
       covers |= inside;
     }
-    live[k] &= box > 4 || covers;
+    l.live[k] &= box > 4 || covers;
   }
-  // The survivors, in order, gathered for the double-precision part: screen positions in emit's
-  // vertex order, f[v][j] = (barycentric j of vertex v) / w_v = (v is vertex j) ? 1/w : 0.
-  alignas(64) int index[B];
+}
+
+// The live triangles, in order, gathered for the double-precision part. Returns their count.
+int gather_survivors(const SetupBatch& in, BatchLanes& l) {
+  const VertexArrays& vs = in.vertices;
+  const int n = in.count;
   int m = 0;
   for (int k = 0; k < n; ++k) {
-    index[m] = k;
-    m += int(live[k] != 0);
+    l.index[m] = k;
+    m += int(l.live[k] != 0);
   }
-  alignas(64) double sx[3][B], sy[3][B], f[3][3][B], w_min[B];
   for (int r = 0; r < m; ++r) {
-    const int k = index[r];
+    const int k = l.index[r];
     const uint32_t vertex[3] = {in.vertex[0][k], in.vertex[1][k], in.vertex[2][k]};
-    const int order[3] = {0, swapped[k] ? 2 : 1, swapped[k] ? 1 : 2};
+    const int order[3] = {0, l.swapped[k] ? 2 : 1, l.swapped[k] ? 1 : 2};
     for (int v = 0; v < 3; ++v) {
-      sx[v][r] = vs.sx[vertex[order[v]]];
-      sy[v][r] = vs.sy[vertex[order[v]]];
-      for (int j = 0; j < 3; ++j) f[v][j][r] = order[v] == j ? vs.inv_w[vertex[j]] : 0.0;
+      l.sx[v][r] = vs.sx[vertex[order[v]]];
+      l.sy[v][r] = vs.sy[vertex[order[v]]];
+      for (int j = 0; j < 3; ++j) l.f[v][j][r] = order[v] == j ? vs.inv_w[vertex[j]] : 0.0;
     }
     // std::min({w0, w1, w2}) in emit's (input) order.
     const double w0 = vs.w[vertex[0]], w1 = vs.w[vertex[1]], w2 = vs.w[vertex[2]];
     double wm = w0;
     if (w1 < wm) wm = w1;
     if (w2 < wm) wm = w2;
-    w_min[r] = wm;
+    l.w_min[r] = wm;
   }
-  alignas(64) double qa[3][B], qb[3][B], min_depth[B];
-  alignas(64) int64_t ok[B];
+  return m;
+}
+
+// Survivors' perspective planes (the barycentrics over w as planes in screen space) and hi-z
+// bound; ok: emit keeps them.
+void planes_and_depth_bound(int m, BatchLanes& l) {
   for (int r = 0; r < m; ++r) {
-    const double dx1 = sx[1][r] - sx[0][r], dy1 = sy[1][r] - sy[0][r];
-    const double dx2 = sx[2][r] - sx[0][r], dy2 = sy[2][r] - sy[0][r];
+    const double dx1 = l.sx[1][r] - l.sx[0][r], dy1 = l.sy[1][r] - l.sy[0][r];
+    const double dx2 = l.sx[2][r] - l.sx[0][r], dy2 = l.sy[2][r] - l.sy[0][r];
     const double det = dx1 * dy2 - dx2 * dy1;
     const double abs_det = std::fabs(det);
     // emit drops !(|det| > 0) || !isfinite(det) (bitwise &: no branch in the vector loop).
-    ok[r] = int64_t(abs_det > 0.0) & int64_t(abs_det <= DBL_MAX);
-#define RVR_PLANES(j)                                               \
-  {                                                                 \
-    const double f0 = f[0][j][r], f1 = f[1][j][r], f2 = f[2][j][r]; \
-    qa[j][r] = ((f1 - f0) * dy2 - (f2 - f0) * dy1) / det;           \
-    qb[j][r] = ((f2 - f0) * dx1 - (f1 - f0) * dx2) / det;           \
+    l.ok[r] = int64_t(abs_det > 0.0) & int64_t(abs_det <= DBL_MAX);
+#define RVR_PLANES(j)                                                     \
+  {                                                                       \
+    const double f0 = l.f[0][j][r], f1 = l.f[1][j][r], f2 = l.f[2][j][r]; \
+    l.qa[j][r] = ((f1 - f0) * dy2 - (f2 - f0) * dy1) / det;               \
+    l.qb[j][r] = ((f2 - f0) * dx1 - (f1 - f0) * dx2) / det;               \
   }
     RVR_PLANES(0)
     RVR_PLANES(1)
     RVR_PLANES(2)
 #undef RVR_PLANES
     // std::max(longest2, e) over the edges, from 0.
-    const double e0 = (sx[1][r] - sx[0][r]) * (sx[1][r] - sx[0][r]) +
-                      (sy[1][r] - sy[0][r]) * (sy[1][r] - sy[0][r]);
-    const double e1 = (sx[2][r] - sx[1][r]) * (sx[2][r] - sx[1][r]) +
-                      (sy[2][r] - sy[1][r]) * (sy[2][r] - sy[1][r]);
-    const double e2 = (sx[0][r] - sx[2][r]) * (sx[0][r] - sx[2][r]) +
-                      (sy[0][r] - sy[2][r]) * (sy[0][r] - sy[2][r]);
+    const double e0 = (l.sx[1][r] - l.sx[0][r]) * (l.sx[1][r] - l.sx[0][r]) +
+                      (l.sy[1][r] - l.sy[0][r]) * (l.sy[1][r] - l.sy[0][r]);
+    const double e1 = (l.sx[2][r] - l.sx[1][r]) * (l.sx[2][r] - l.sx[1][r]) +
+                      (l.sy[2][r] - l.sy[1][r]) * (l.sy[2][r] - l.sy[1][r]);
+    const double e2 = (l.sx[0][r] - l.sx[2][r]) * (l.sx[0][r] - l.sx[2][r]) +
+                      (l.sy[0][r] - l.sy[2][r]) * (l.sy[0][r] - l.sy[2][r]);
     double longest2 = 0.0 < e0 ? e0 : 0.0;
     longest2 = longest2 < e1 ? e1 : longest2;
     longest2 = longest2 < e2 ? e2 : longest2;
     const double altitude = abs_det / std::sqrt(longest2);
-    const double bound = w_min[r] / (1.0 + 4.0 * kSnapDistance / altitude);
-    min_depth[r] = altitude > 0 ? bound : 0.0;
+    const double bound = l.w_min[r] / (1.0 + 4.0 * kSnapDistance / altitude);
+    l.min_depth[r] = altitude > 0 ? bound : 0.0;
   }
+}
+
+// The kept survivors written out in order. Returns how many.
+int write_survivors(const SetupBatch& in, int m, const BatchLanes& l, SetupTriangle* out) {
   int written = 0;
   for (int r = 0; r < m; ++r) {
-    if (!ok[r]) continue;
-    const int k = index[r];
+    if (!l.ok[r]) continue;
+    const int k = l.index[r];
     SetupTriangle& t = out[written++];
     for (int i = 0; i < 3; ++i) {
-      t.x[i] = x[i][k];
-      t.y[i] = y[i][k];
-      t.top_left[i] = top_left[i][k] != 0;
-      t.q0[i] = f[0][i][r];
-      t.qa[i] = qa[i][r];
-      t.qb[i] = qb[i][r];
+      t.x[i] = l.x[i][k];
+      t.y[i] = l.y[i][k];
+      t.top_left[i] = l.top_left[i][k] != 0;
+      t.q0[i] = l.f[0][i][r];
+      t.qa[i] = l.qa[i][r];
+      t.qb[i] = l.qb[i][r];
     }
-    t.ox = sx[0][r];
-    t.oy = sy[0][r];
-    t.x0 = bx0[k];
-    t.y0 = by0[k];
-    t.x1 = bx1[k];
-    t.y1 = by1[k];
-    t.min_depth = min_depth[r];
+    t.ox = l.sx[0][r];
+    t.oy = l.sy[0][r];
+    t.x0 = l.bx0[k];
+    t.y0 = l.by0[k];
+    t.x1 = l.bx1[k];
+    t.y1 = l.by1[k];
+    t.min_depth = l.min_depth[r];
     t.object = in.object[k];
     t.primitive = in.primitive[k];
   }
   return written;
+}
+
+int setup_batch(const SetupBatch& in, int width, int height, SetupTriangle* out) {
+  BatchLanes lanes;
+  orient_and_box(in, width, height, lanes);
+  edges_and_small_boxes(in.count, lanes);
+  const int survivors = gather_survivors(in, lanes);
+  planes_and_depth_bound(survivors, lanes);
+  return write_survivors(in, survivors, lanes, out);
 }
 
 }  // namespace
