@@ -96,11 +96,11 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
   }
 
   phase("", "compare");
-  return compare_rendered(scene, std::move(result.renderers), compare);
+  return compare_rendered(scene, std::move(result.renderers), compare, options);
 }
 
 CompareResult compare_rendered(const Scene& scene, std::vector<ComparedRenderer> rendered,
-                               const CompareOptions& compare) {
+                               const CompareOptions& compare, const RenderOptions& options) {
   CompareResult result;
   result.renderers = std::move(rendered);
   for (ComparedRenderer& r : result.renderers) {

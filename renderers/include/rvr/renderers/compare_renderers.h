@@ -73,8 +73,10 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
 
 // The comparing half of compare_renderers, over renders already made (each with its name,
 // seconds and output; at least two, all of the scene's size): their images and cost pictures,
-// every pair and the warnings.
+// every pair and the warnings. `options` are the renders' own (their sphere tessellation names
+// the facets the mismatch classes look at).
 CompareResult compare_rendered(const Scene& scene, std::vector<ComparedRenderer> rendered,
-                               const CompareOptions& compare = {});
+                               const CompareOptions& compare = {},
+                               const RenderOptions& options = {});
 
 }  // namespace rvr
