@@ -149,6 +149,7 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
 
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
+      if (is_cancelled(progress)) return;  // the rows left are skipped
       ShadeBatch batch;
       PlanesCache planes;
       // Flat pixels leave their slots' vertex normals as they were: defined values, not read.

@@ -188,6 +188,7 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
     worker.flush(kernels, width, height, local);
   };
   for (size_t chunk = 0; chunk < submitted; chunk += kChunk) {
+    if (is_cancelled(progress)) break;  // the caller returns cancelled_error()
     const size_t chunk_end = std::min(submitted, chunk + kChunk);
     const size_t subs = (chunk_end - chunk + kSubChunk - 1) / kSubChunk;
     // --- setup: transform, cull, clip; sub-chunks in parallel, kept in order
