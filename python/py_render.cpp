@@ -160,10 +160,10 @@ void bind_render(py::module_& m) {
         "(visibility, local, full) on THREADS worker threads (0: every core). Other keyword "
         "options are the command line's of the same names: accel, spheres, sphere_segments, "
         "triangle_test, max_depth, seed, gl, shadow_map_size, shadow_bias, shadow_pcf, hiz, "
-        "depth_format. The GIL is released while rendering; Ctrl-C raises KeyboardInterrupt at "
-        "once (the render is abandoned and finishes in the background).");
-  py::module_::import("atexit").attr("register")(
-      py::cpp_function([] { wait_for_abandoned_renders(); }));
+        "depth_format. The GIL is released while rendering; Ctrl-C cancels the render (it stops "
+        "at its next tile or chunk) and raises KeyboardInterrupt.");
+  m.def("_running_renders", &running_renders,
+        "Render threads still running: 0 outside rvr.render, also after a KeyboardInterrupt.");
 }
 
 }  // namespace rvr::python

@@ -2,12 +2,13 @@
 
 #include <pybind11/pybind11.h>
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
-#include <vector>
 
+#include "rvr/shared/progress.h"
 #include "rvr/shared/timer.h"
 
 namespace py = pybind11;
@@ -18,15 +19,17 @@ namespace {
 // How often the waiting thread looks at Python's signals.
 constexpr std::chrono::milliseconds kSignalPoll{20};
 
+std::atomic<int> g_running{0};
+
 struct RenderJob {
   std::shared_ptr<const Scene> scene;
   std::unique_ptr<Renderer> renderer;
   RenderOptions options;
+  ProgressSink own_sink;  // cancelled on a signal when the caller gave none
   RenderResultWithTime result;
   std::mutex mutex;
   std::condition_variable finished;
   bool done = false;
-  std::thread thread;  // joined by whoever holds the job last: the caller, or the exit hook
 
   void run() {
     const auto start = std::chrono::steady_clock::now();
@@ -53,48 +56,54 @@ struct RenderJob {
   }
 };
 
-std::mutex g_abandoned_mutex;
-std::vector<std::shared_ptr<RenderJob>> g_abandoned;
+// The render thread, joined (without the GIL) however the caller leaves.
+class RenderThread {
+ public:
+  explicit RenderThread(RenderJob& job) : thread_([&job] { job.run(); }) { ++g_running; }
+  RenderThread(const RenderThread&) = delete;
+  RenderThread& operator=(const RenderThread&) = delete;
+  ~RenderThread() {
+    py::gil_scoped_release release;
+    thread_.join();
+    --g_running;
+  }
 
-void abandon(std::shared_ptr<RenderJob> job) {
-  std::lock_guard lock(g_abandoned_mutex);
-  g_abandoned.push_back(std::move(job));
-}
+ private:
+  std::thread thread_;
+};
 
 }  // namespace
 
 RenderResultWithTime render_interruptibly(std::shared_ptr<const Scene> scene,
                                           std::unique_ptr<Renderer> renderer,
                                           const RenderOptions& options) {
-  auto job = std::make_shared<RenderJob>();
-  job->scene = std::move(scene);
-  job->renderer = std::move(renderer);
-  job->options = options;
-  job->thread = std::thread([raw = job.get()] { raw->run(); });
-  for (;;) {
-    bool done = false;
-    {
-      py::gil_scoped_release release;
-      done = job->wait_for(kSignalPoll);
-    }
-    if (done) break;
-    if (PyErr_CheckSignals() != 0) {
-      abandon(job);
-      throw py::error_already_set();
+  RenderJob job;
+  job.scene = std::move(scene);
+  job.renderer = std::move(renderer);
+  job.options = options;
+  if (!job.options.progress) job.options.progress = &job.own_sink;
+  {
+    RenderThread thread(job);
+    for (;;) {
+      bool done = false;
+      {
+        py::gil_scoped_release release;
+        done = job.wait_for(kSignalPoll);
+      }
+      if (done) break;
+      if (PyErr_CheckSignals() != 0) {
+        // The exception is pending; the render stops at its next tile, and the thread's
+        // destructor waits for it before the exception leaves.
+        job.options.progress->cancel();
+        throw py::error_already_set();
+      }
     }
   }
-  job->thread.join();
-  return std::move(job->result);
+  return std::move(job.result);
 }
 
-void wait_for_abandoned_renders() {
-  std::vector<std::shared_ptr<RenderJob>> jobs;
-  {
-    std::lock_guard lock(g_abandoned_mutex);
-    jobs.swap(g_abandoned);
-  }
-  py::gil_scoped_release release;
-  for (const auto& job : jobs) job->thread.join();
+int running_renders() {
+  return g_running.load();
 }
 
 }  // namespace rvr::python

@@ -1,7 +1,7 @@
 // A render run on a thread of its own while the calling Python thread waits without the GIL,
-// looking at Python's signals every few milliseconds: Ctrl-C raises KeyboardInterrupt at once.
-// The renderers have no way to be stopped part way, so an interrupted render is abandoned: it
-// finishes on its thread, its result dropped, and the interpreter waits for it at exit.
+// looking at Python's signals every few milliseconds. When a signal handler raises (Ctrl-C:
+// KeyboardInterrupt), the render is cancelled through its ProgressSink, which the renderers look
+// at per tile or chunk; the thread is joined and the exception raised: nothing is left running.
 #pragma once
 
 #include <memory>
@@ -18,12 +18,13 @@ struct RenderResultWithTime {
 };
 
 // Renders `scene` with `renderer` and `options`; called with the GIL held. Throws
-// pybind11::error_already_set when a signal handler raised (KeyboardInterrupt).
+// pybind11::error_already_set when a signal handler raised (KeyboardInterrupt), after the
+// render has stopped. `options.progress`, when set, is the sink cancelled; else one of its own.
 RenderResultWithTime render_interruptibly(std::shared_ptr<const Scene> scene,
                                           std::unique_ptr<Renderer> renderer,
                                           const RenderOptions& options);
 
-// Waits (without the GIL) for every abandoned render to finish; registered with atexit.
-void wait_for_abandoned_renders();
+// Render threads started and not yet joined (0 whenever no call is inside render_interruptibly).
+int running_renders();
 
 }  // namespace rvr::python

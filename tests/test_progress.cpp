@@ -1,7 +1,7 @@
-// Progress on long work: what the renderers count, the line the command line draws from it, and
-// rvr itself run under a pseudo-terminal (a bar, a rate and a time left, erased at the end), with
-// stderr redirected (nothing but the summary), with --quiet and TERM=dumb (nothing), and failing
-// after the bar was drawn (one clean "error:" line).
+// Progress on long work: what the renderers count, cancelling them part way, the line the command
+// line draws from it, and rvr itself run under a pseudo-terminal (a bar, a rate and a time left,
+// erased at the end), with stderr redirected (nothing but the summary), with --quiet and TERM=dumb
+// (nothing), and failing after the bar was drawn (one clean "error:" line).
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <poll.h>
@@ -10,9 +10,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +25,7 @@
 #include <vector>
 
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/progress.h"
 #include "rvr/shared/scene_loader.h"
 #include "terminal_progress.h"
@@ -158,6 +161,60 @@ TEST(ProgressSink, EveryRendererAndRasterOnEglDrawsTheSameWhenWatched) {
                                          plain.stats["rays.reflection"] +
                                          plain.stats["rays.refraction"]);
     }
+  }
+}
+
+// Cancelling from another thread once the render's work has begun: after its first counted unit
+// (a tile, a chunk, rows), or for the GL z-buffer, which looks between passes and has one pass
+// here, in its setup or upload, before that pass. Every renderer of the table returns
+// ErrorKind::Cancelled, its work left undone. The time from the cancel to the return is bounded
+// by a quarter of the same render run to its end, measured here on this machine, so the bound
+// holds however loaded it is.
+TEST(ProgressSink, CancelFromAnotherThreadStopsEveryRendererPartWay) {
+  using Clock = std::chrono::steady_clock;
+  Scene scene = load_scene("builtin:soup:200000").value();
+  scene.image.width = 1024;
+  scene.image.height = 768;
+  for (const RendererChoice& c : renderer_choices()) {
+    if (c.variant) continue;
+    RendererConfig config{GlBackend::OsMesa};
+    RenderOptions options;
+    options.mode = RenderMode::Local;
+    c.apply(config, options);
+    const std::string& label = c.name;
+    std::unique_ptr<Renderer> renderer = c.info->create(config).value();
+
+    const Clock::time_point full_start = Clock::now();
+    ASSERT_TRUE(renderer->render(scene, options).ok()) << label;
+    const double full_seconds = std::chrono::duration<double>(Clock::now() - full_start).count();
+
+    ProgressSink sink;
+    options.progress = &sink;
+    std::atomic<bool> returned{false};
+    Clock::time_point cancelled_at{};
+    std::thread canceller([&] {
+      while (!returned.load()) {
+        const ProgressSnapshot s = sink.snapshot();
+        if (s.done > 0 || s.phase == "setup" || s.phase == "upload") {
+          cancelled_at = Clock::now();
+          sink.cancel();
+          return;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      }
+    });
+    Expected<RenderOutput> out = renderer->render(scene, options);
+    const Clock::time_point returned_at = Clock::now();
+    returned.store(true);
+    canceller.join();
+    ASSERT_TRUE(sink.cancelled()) << label << ": finished before its work was seen to begin";
+    ASSERT_FALSE(out.ok()) << label << ": rendered to the end although cancelled";
+    EXPECT_EQ(out.error().kind, ErrorKind::Cancelled) << label;
+    EXPECT_EQ(out.error().message, "cancelled") << label;
+    const double stop_seconds = std::chrono::duration<double>(returned_at - cancelled_at).count();
+    EXPECT_LT(stop_seconds, full_seconds / 4) << label << ": full render " << full_seconds << " s";
+    std::printf("%-12s full %.3f s, cancel to return %.3f s\n", label.c_str(), full_seconds,
+                stop_seconds);
   }
 }
 

@@ -9,6 +9,7 @@
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/check.h"
 #include "rvr/shared/image_sample.h"
+#include "rvr/shared/progress.h"
 #include "rvr/shared/timer.h"
 
 namespace rvr {
@@ -59,6 +60,7 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   Expected<RenderOutput> zbuffer = rasterizer_->render(scene, visibility_options);
   const double zbuffer_seconds = seconds_since(t_zbuffer);
   if (!zbuffer) return zbuffer.error();
+  if (is_cancelled(options.progress)) return cancelled_error();  // between z-buffer and trace
   const FrameBuffers& ids = zbuffer->buffers;
   RVR_CHECK(ids.width == scene.image.width && ids.height == scene.image.height &&
                 ids.object_id.size() == ids.pixel_count() &&
@@ -84,6 +86,7 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
     FrameBuffers& fb = o.buffers;
     std::vector<glm::vec3> sum(fb.pixel_count(), glm::vec3(0.0f));
     for (int k = 0; k < spp; ++k) {
+      if (is_cancelled(options.progress)) return cancelled_error();  // per accumulation pass
       visibility_options.image_sample =
           image_sample(scene.camera, options.seed, k, spp, options.mode == RenderMode::Full);
       auto t_pass = Clock::now();

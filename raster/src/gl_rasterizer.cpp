@@ -917,6 +917,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
       progress->begin("render");
   }
   for (size_t b = 0; b < batches; ++b) {
+    if (is_cancelled(progress)) return cancelled_error();
     const size_t first = b * shadows.batch, end = std::min(samples.size(), first + shadows.batch);
     if (shadows.enabled) {
       auto ts = Clock::now();
@@ -1142,6 +1143,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
           : camera_projection,
       depth_format};
   RVR_TRY(scene_passes(pass, msaa, out));
+  if (is_cancelled(progress)) return cancelled_error();
 
   if (options.cost_aov) {
     if (progress) progress->begin("cost");

@@ -236,6 +236,7 @@ Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSamp
   ProgressSink* const progress = options.progress;
   if (progress) progress->begin("shadows", samples.size(), "light samples");
   for (size_t first = 0; first < samples.size(); first += batch) {
+    if (is_cancelled(progress)) return cancelled_error();
     const size_t end = std::min(samples.size(), first + batch);
     auto t_draw = Clock::now();
     for (size_t i = first; i < end; ++i)
@@ -350,6 +351,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   // The fraction in triangles, the speed in fragments.
   if (progress) progress->begin("draw", submitted, "triangles", "fragments");
   const DrawResult drawn = soft::draw_triangles(list, view_projection, target, arena, progress);
+  if (is_cancelled(progress)) return cancelled_error();
   out.stats["time.setup"] += drawn.setup_seconds;
   out.stats["time.bin"] = drawn.bin_seconds;
   out.stats["time.raster"] = drawn.raster_seconds;
@@ -383,6 +385,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     shading.cost = options.cost_aov;
     shading.surfaces = surfaces ? &*surfaces : nullptr;
     soft::shade_pixels(list, target, shading, shade_kernels(isa), arena, progress, fb);
+    if (is_cancelled(progress)) return cancelled_error();
     out.stats["time.shade"] = seconds_since(t);
   }
 

@@ -818,6 +818,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   if (progress) progress->begin("trace", uint64_t(w) * uint64_t(h), "pixels", "rays");
   const RayCounters total =
       for_each_tile(w, h, options.threads, [&](int x0, int y0, int x1, int y1, RayCounters& local) {
+        if (is_cancelled(progress)) return;  // the tiles left are skipped
         const auto t_tile = Clock::now();
         const uint64_t rays_before = local.rays();
         TileOutput tile;
@@ -835,6 +836,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
           progress->advance(uint64_t(x1 - x0) * uint64_t(y1 - y0), local.rays() - rays_before);
         local.busy_seconds += seconds_since(t_tile);
       });
+  if (is_cancelled(progress)) return cancelled_error();
   const double render_seconds = seconds_since(t_render);
   out.stats["time.render"] = render_seconds;
   // The frame's time divided as the threads' time divides: until the primary hits are known

@@ -295,6 +295,7 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, target.height()),
                       [&](const tbb::blocked_range<int>& r) {
+                        if (is_cancelled(progress)) return;  // the rows left are skipped
                         RowShader shader(frame);
                         for (int y = r.begin(); y != r.end(); ++y) shader.shade_row(y);
                         shader.flush();

@@ -406,6 +406,7 @@ DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projectio
   ChunkedDraw draw(list, view_projection, target, arena);
   const size_t submitted = list.triangles();
   for (size_t chunk = 0; chunk < submitted; chunk += kChunk) {
+    if (is_cancelled(progress)) break;  // the caller returns cancelled_error()
     const size_t chunk_end = std::min(submitted, chunk + kChunk);
     const size_t subs = (chunk_end - chunk + kSubChunk - 1) / kSubChunk;
     auto t = Clock::now();

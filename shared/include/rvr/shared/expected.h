@@ -7,8 +7,9 @@
 
 namespace rvr {
 
-// Exit status the CLI uses for an error (see docs/cli.md).
-enum class ErrorKind { BadInput = 2, Internal = 3 };
+// Exit status the CLI uses for an error (see docs/cli.md). Cancelled: the work was asked to stop
+// part way (ProgressSink::cancel) and returned no result; 130 is a shell's status for Ctrl-C.
+enum class ErrorKind { BadInput = 2, Internal = 3, Cancelled = 130 };
 
 struct Error {
   // Without the "error: " prefix, e.g. "scenes/bad.json: objects[3].radius: must be > 0, got -1".
@@ -21,6 +22,9 @@ inline Error bad_input(std::string message) {
 }
 inline Error internal_error(std::string message) {
   return Error{std::move(message), ErrorKind::Internal};
+}
+inline Error cancelled_error() {
+  return Error{"cancelled", ErrorKind::Cancelled};
 }
 
 // A value or an Error (std::expected is C++23).

@@ -4,6 +4,12 @@
 //   if (ProgressSink* p = options.progress) p->begin("trace", pixels, "pixels", "rays");
 //   ... per finished tile or chunk (never per ray):
 //   if (ProgressSink* p = options.progress) p->advance(tile_pixels, tile_rays);
+//
+// The sink also carries a request to stop: cancel() from any thread; a renderer looks at
+// cancelled() where it advances (one relaxed load per tile or chunk), skips the work left and
+// returns cancelled_error() instead of a partial image.
+//
+//   if (is_cancelled(options.progress)) return;  // in the tile loop: the tiles left are skipped
 #pragma once
 
 #include <atomic>
@@ -45,11 +51,22 @@ class ProgressSink {
   }
   ProgressSnapshot snapshot() const;
 
+  // Asks the work reporting here to stop as soon as it next looks; never undone (begin() keeps
+  // it). Relaxed: the flag orders nothing else, the renderer's own joins publish its results.
+  void cancel() noexcept { cancelled_.store(true, std::memory_order_relaxed); }
+  bool cancelled() const noexcept { return cancelled_.load(std::memory_order_relaxed); }
+
  private:
   mutable std::mutex mutex_;  // guards the strings and the start time, never taken by advance
   std::string phase_, unit_, rate_unit_;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::atomic<uint64_t> total_{0}, done_{0}, rate_done_{0};
+  std::atomic<bool> cancelled_{false};
 };
+
+// True when `sink` (may be null: nobody watching, nobody can cancel) was asked to stop.
+inline bool is_cancelled(const ProgressSink* sink) noexcept {
+  return sink && sink->cancelled();
+}
 
 }  // namespace rvr
