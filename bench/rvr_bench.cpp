@@ -116,6 +116,18 @@ class FrameRenderer {
   std::unique_ptr<PreparedRenderer> prepared_;
 };
 
+// The timed loop: one frame rendered untimed first (warming caches), then a frame per
+// iteration, its phase times added to `phases`; returns the last frame.
+RenderOutput time_frames(benchmark::State& state, FrameRenderer& renderer, PhaseTimes& phases) {
+  RenderOutput out = renderer.frame();
+  for (auto _ : state) {
+    out = renderer.frame();
+    benchmark::DoNotOptimize(out.buffers.color.data());
+    phases.add(out);
+  }
+  return out;
+}
+
 // Every renderer of the table, each followed by its variants of one kind, if any: the sweeps
 // that vary an early rejection include the renderers without it.
 std::vector<RendererChoice> choices_with(std::optional<VariantOf> of) {
@@ -142,13 +154,8 @@ void time_frames(benchmark::State& state, const std::string& renderer_name, cons
   options.cost_aov = cost_aov;
   options.threads = threads;
   FrameRenderer renderer(renderer_name, scene, options);
-  RenderOutput out = renderer.frame();
   PhaseTimes phases;
-  for (auto _ : state) {
-    out = renderer.frame();
-    benchmark::DoNotOptimize(out.buffers.color.data());
-    phases.add(out);
-  }
+  RenderOutput out = time_frames(state, renderer, phases);
   add_counters(state, out, double(scene.image.width) * scene.image.height);
   phases.report(state);
   if (auto it = out.stats.find("memory.raster_bytes"); it != out.stats.end())
@@ -182,13 +189,8 @@ void BM_Texture(benchmark::State& state, std::string renderer_name, TextureLod l
   options.mode = RenderMode::Local;
   options.texture_lod = lod;
   FrameRenderer renderer(renderer_name, scene, options);
-  RenderOutput out = renderer.frame();
   PhaseTimes phases;
-  for (auto _ : state) {
-    out = renderer.frame();
-    benchmark::DoNotOptimize(out.buffers.color.data());
-    phases.add(out);
-  }
+  RenderOutput out = time_frames(state, renderer, phases);
   add_counters(state, out, double(scene.image.width) * scene.image.height);
   phases.report(state);
   float max_lod = 0.0f;
