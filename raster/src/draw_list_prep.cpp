@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/tessellate.h"
 
 namespace rvr {
@@ -84,6 +85,8 @@ Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
     if (Status checked = check_mesh(*p.mesh, o.name); !checked) return checked.error();
     p.smooth = p.mesh->smooth();
   }
+  RVR_CHECK(prepared.objects.size() == scene.objects.size(),
+            "one prepared entry per scene object, so its index is the object id");
   return prepared;
 }
 

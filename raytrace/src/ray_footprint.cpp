@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/surface_colour.h"
 
 namespace rvr {
@@ -36,6 +37,7 @@ glm::vec3 unit_derivative(const glm::vec3& D, const glm::vec3& dD) {
 
 HitFootprint footprint_at_hit(const RayFootprint& ray, const glm::vec3& direction, float t,
                               const glm::vec3& N) {
+  RVR_DCHECK(t >= 0.0f, "a hit lies ahead of its ray: t = ", t);
   HitFootprint h;
   h.cone_width = ray.cone_width + ray.cone_spread * t * glm::length(direction);
   h.cone_spread = ray.cone_spread;

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "rvr/shared/check.h"
+
 namespace rvr {
 
 bool textured(const Scene& scene, const Object& object) {
@@ -19,12 +21,18 @@ bool varies_in_colour(const Scene& scene, const Object& object) {
 glm::vec2 triangle_uv(const TriangleMesh& mesh, const Material& m, uint32_t triangle, float b1,
                       float b2) {
   const glm::uvec3 t = mesh.triangles[triangle];
+  RVR_DCHECK(mesh.uvs.size() == mesh.positions.size() && t.x < mesh.uvs.size() &&
+                 t.y < mesh.uvs.size() && t.z < mesh.uvs.size(),
+             "uvs are per position (the loaders check the counts)");
   const glm::vec2 uv = (1.0f - b1 - b2) * mesh.uvs[t.x] + b1 * mesh.uvs[t.y] + b2 * mesh.uvs[t.z];
   return m.uv_transform.apply(uv);
 }
 
 glm::vec3 triangle_colour(const TriangleMesh& mesh, uint32_t triangle, float b1, float b2) {
   const glm::uvec3 t = mesh.triangles[triangle];
+  RVR_DCHECK(mesh.colours.size() == mesh.positions.size() && t.x < mesh.colours.size() &&
+                 t.y < mesh.colours.size() && t.z < mesh.colours.size(),
+             "vertex colours are per position (the loaders check the counts)");
   return (1.0f - b1 - b2) * mesh.colours[t.x] + b1 * mesh.colours[t.y] + b2 * mesh.colours[t.z];
 }
 
@@ -48,6 +56,7 @@ glm::vec3 base_colour(const Scene& scene, const Object& object, const Material& 
   if (object.type != ObjectType::Triangles) return colour;
   if (textured(scene, object)) {
     const Texture& tex = scene.textures[size_t(m.texture)];
+    RVR_DCHECK(triangle < object.mesh.triangles.size(), "the hit triangle is the object's");
     colour *= sample_texture(tex, triangle_uv(object.mesh, m, triangle, b1, b2), lod);
   }
   if (object.mesh.coloured()) colour *= triangle_colour(object.mesh, triangle, b1, b2);

@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/scene.h"
 
 namespace rvr {
@@ -79,15 +80,21 @@ std::pair<int, float> linear_taps(float coord, int size, TextureWrap wrap) {
 }  // namespace
 
 MipChain build_mip_chain(TextureLevel level0) {
+  RVR_CHECK(level0.width > 0 && level0.height > 0 &&
+                level0.texels.size() == size_t(level0.width) * size_t(level0.height),
+            "a texture's level 0 holds width x height texels: ", level0.width, "x", level0.height,
+            ", ", level0.texels.size());
   MipChain chain;
   chain.levels.push_back(std::move(level0));
   while (chain.levels.back().width > 1 || chain.levels.back().height > 1)
     chain.levels.push_back(reduce(chain.levels.back()));
+  RVR_CHECK(chain.levels.size() <= 32, "a mip chain halves a side of at most 2^31 texels");
   return chain;
 }
 
 glm::vec3 sample_bilinear(const TextureLevel& level, TextureWrap wrap_u, TextureWrap wrap_v,
                           glm::vec2 uv) {
+  RVR_DCHECK(level.width > 0 && level.height > 0, "a texture level has texels");
   auto [x, fx] = linear_taps(uv.x, level.width, wrap_u);
   auto [y, fy] = linear_taps(uv.y, level.height, wrap_v);
   const int x0 = wrap_index(x, level.width, wrap_u), x1 = wrap_index(x + 1, level.width, wrap_u);
@@ -99,6 +106,7 @@ glm::vec3 sample_bilinear(const TextureLevel& level, TextureWrap wrap_u, Texture
 
 glm::vec3 sample_trilinear(const MipChain& mips, TextureWrap wrap_u, TextureWrap wrap_v,
                            glm::vec2 uv, float lod) {
+  RVR_DCHECK(!mips.levels.empty(), "a texture sampled has a level 0");
   if (std::isnan(lod)) lod = 0.0f;
   lod = std::clamp(lod, 0.0f, mips.max_lod());
   const int level = int(std::floor(lod));
