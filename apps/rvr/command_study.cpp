@@ -25,7 +25,7 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "cpu_probe.h"
-#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/environment.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
@@ -83,10 +83,9 @@ study::MachineInfo machine_info() {
   m.cpu = cpu_model();
   m.threads = std::thread::hardware_concurrency();
   m.kernels = describe_isa_choice();
-  m.versions = {{"rvr", kVersion},
-                {"embree", embree_version()},
-                {"tbb", tbb_version()},
-                {"compiler", __VERSION__}};
+  const TracerLibraries tracer = tracer_libraries();
+  m.versions = {
+      {"rvr", kVersion}, {"embree", tracer.embree}, {"tbb", tracer.tbb}, {"compiler", __VERSION__}};
   return m;
 }
 
