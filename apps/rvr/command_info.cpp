@@ -11,6 +11,7 @@
 #include "rvr/renderers/environment.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"
+#include "rvr/shared/gl_backend.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/isa.h"
 

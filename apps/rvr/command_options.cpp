@@ -21,6 +21,7 @@
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/texture.h"
 #include "rvr/shared/timer.h"
 
 namespace rvr::cli {

@@ -190,7 +190,7 @@ void print(const json& v, int indent, std::string& out) {
     out += v.is_array() ? "[\n" : "{\n";
     size_t i = 0;
     for (auto it = v.begin(); it != v.end(); ++it, ++i) {
-      out.append(size_t(indent + 2), ' ');
+      out.append(size_t(indent) + 2, ' ');
       if (v.is_object()) out += json(it.key()).dump() + ": ";
       print(*it, indent + 2, out);
       out += i + 1 < v.size() ? ",\n" : "\n";
