@@ -477,6 +477,7 @@ std::vector<RayPacket> make_tiles(const Scene& scene, std::vector<std::vector<in
     for (int x0 = 0; x0 < 1024; x0 += 8) {
       RayPacket p = primary.packet(x0, y0, 8, 8);
       std::vector<int> index;
+      index.reserve(64);
       for (int k = 0; k < 64; ++k) index.push_back((y0 + k / 8) * 1024 + x0 + k % 8);
       tiles.push_back(p);
       ray_index.push_back(index);
