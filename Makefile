@@ -141,17 +141,21 @@ format:
 	clang-format -i $$(git ls-files '*.cpp' '*.h')
 
 # clang-tidy 14 (.clang-tidy: bugprone-*, performance-*, readability-function-size at 120 lines,
-# less the checks listed there as noise) over every project translation unit in the build's
-# compile_commands.json; any finding fails. LINT_FILES narrows it (a regular expression on paths).
-LINT_FILES ?= $(CURDIR)/(apps|shared|raster|raytrace|hybrid|renderers|study|image_codec)/
-# Then include-what-you-use on apps/rvr (tools/iwyu.imp maps glm's, nlohmann's, CLI11's and
-# libstdc++'s internal headers to their public ones): any include to add or remove fails.
+# less the checks listed there as noise) over the project's translation units in the build's
+# compile_commands.json, chosen by tools/lint_files.py: the paths matching LINT_FILES and not
+# LINT_EXCLUDE (regular expressions; LINT_EXCLUDE empty: none left out). Any finding fails.
+LINT_FILES ?= $(CURDIR)/(apps|shared|raster|raytrace|hybrid|renderers|study|image_codec|bench)/
+LINT_EXCLUDE ?=
+# Then include-what-you-use on LINT_IWYU_DIRS (tools/iwyu.imp maps glm's, nlohmann's, CLI11's
+# and libstdc++'s internal headers to their public ones): any include to add or remove fails.
+LINT_IWYU_DIRS ?= apps/rvr
 lint: build
-	run-clang-tidy-14 -p $(BUILD_DIR) -j $(JOBS) -quiet '$(LINT_FILES)'
-	iwyu_tool -p $(BUILD_DIR) -j $(JOBS) apps/rvr -- -Xiwyu --no_fwd_decls -Xiwyu --cxx17ns \
+	run-clang-tidy-14 -p $(BUILD_DIR) -j $(JOBS) -quiet \
+		$$(/usr/bin/python3 tools/lint_files.py $(BUILD_DIR)/compile_commands.json '$(LINT_FILES)' '$(LINT_EXCLUDE)')
+	iwyu_tool -p $(BUILD_DIR) -j $(JOBS) $(LINT_IWYU_DIRS) -- -Xiwyu --no_fwd_decls -Xiwyu --cxx17ns \
 		-Xiwyu --mapping_file=$(CURDIR)/tools/iwyu.imp > $(BUILD_DIR)/iwyu.txt 2>&1 || true
 	@if grep -q 'should \(add\|remove\) these lines' $(BUILD_DIR)/iwyu.txt; then \
-		cat $(BUILD_DIR)/iwyu.txt; echo "lint: include-what-you-use asks for changes in apps/rvr"; exit 1; fi
+		cat $(BUILD_DIR)/iwyu.txt; echo "lint: include-what-you-use asks for changes in $(LINT_IWYU_DIRS)"; exit 1; fi
 
 clean:
 	rm -rf $(BUILD_DIR) $(SANITIZE_DIR) $(FUZZ_DIR) rvr-out

@@ -28,6 +28,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -181,7 +182,7 @@ double texel_bytes_per_pixel(const FrameBuffers& fb, float max_lod) {
 }
 
 // builtin:textured with one renderer and level-of-detail rule.
-void BM_Texture(benchmark::State& state, std::string renderer_name, TextureLod lod) {
+void BM_Texture(benchmark::State& state, const std::string& renderer_name, TextureLod lod) {
   Scene scene = builtin("textured");
   scene.image.width = 640;
   scene.image.height = 480;
@@ -211,8 +212,8 @@ constexpr FrameSweep kFrameSweep{"BM_Frame", RenderMode::Local, true};
 constexpr FrameSweep kVisibilitySweep{"BM_Visibility", RenderMode::Visibility, false};
 
 // A frame of the sweep with one renderer: <scene>:<n> at width x width * 3/4.
-void BM_Frame(benchmark::State& state, FrameSweep sweep, std::string renderer_name,
-              std::string scene_name) {
+void BM_Frame(benchmark::State& state, FrameSweep sweep, const std::string& renderer_name,
+              const std::string& scene_name) {
   Scene scene = builtin(scene_name + ":" + std::to_string(state.range(0)));
   scene.image.width = int(state.range(1));
   scene.image.height = int(state.range(1) * 3 / 4);
@@ -220,7 +221,7 @@ void BM_Frame(benchmark::State& state, FrameSweep sweep, std::string renderer_na
 }
 
 // Parallel scaling of our own loops: the same frame with 1 and with 2 worker threads.
-void BM_Threads(benchmark::State& state, std::string renderer_name) {
+void BM_Threads(benchmark::State& state, const std::string& renderer_name) {
   Scene scene = builtin("tessphere:100000");
   scene.image.width = 1024;
   scene.image.height = 768;
@@ -230,7 +231,8 @@ void BM_Threads(benchmark::State& state, std::string renderer_name) {
 // occluders:N, N quads one behind another, submitted front to back (hi-z skips the hidden ones)
 // or, with back_to_front, rearmost first (every quad is nearer than what is there: nothing to
 // skip).
-void BM_DepthComplexity(benchmark::State& state, std::string renderer_name, bool back_to_front) {
+void BM_DepthComplexity(benchmark::State& state, const std::string& renderer_name,
+                        bool back_to_front) {
   Scene scene =
       builtin((back_to_front ? "occluders_back:" : "occluders:") + std::to_string(state.range(0)));
   scene.image.width = 512;
@@ -268,7 +270,7 @@ void effect_scene(const std::string& effect, Scene& scene, RenderOptions& option
 }
 
 // The tracer on cornell with exactly one effect switched on.
-void BM_Effects(benchmark::State& state, std::string effect) {
+void BM_Effects(benchmark::State& state, const std::string& effect) {
   Scene scene;
   RenderOptions options;
   effect_scene(effect, scene, options);
@@ -284,7 +286,8 @@ void BM_Effects(benchmark::State& state, std::string effect) {
 // The same frames with another renderer of the table (the hybrid: the z-buffer finds the
 // primary hits, the tracer does the effect), built afresh each frame as the tracer's are. The
 // split of its time: zbuffer_ms (visibility passes) and trace_ms (hits rebuilt, shading, rays).
-void BM_EffectsWith(benchmark::State& state, std::string renderer_name, std::string effect) {
+void BM_EffectsWith(benchmark::State& state, const std::string& renderer_name,
+                    const std::string& effect) {
   Scene scene;
   RenderOptions options;
   effect_scene(effect, scene, options);
@@ -416,8 +419,8 @@ TraceCheck check_against_embree(const std::vector<TraceAnswer>& answers,
 // chosen for this CPU), bvh2 (the binary tree) or embree (rtcIntersect1), over the same rays.
 // Before timing, every answer is checked against Embree's and the traversal counted (the timed
 // loop counts nothing).
-void BM_Trace(benchmark::State& state, std::string accel, std::string rays_kind,
-              std::string scene_name) {
+void BM_Trace(benchmark::State& state, const std::string& accel, const std::string& rays_kind,
+              const std::string& scene_name) {
   std::string name = scene_name + ":" + std::to_string(state.range(0));
   const Scene& scene = builtin(name);
   TraceGeometry geometry(scene, SphereMode::Analytic, 64, accel_kind(accel),
@@ -476,6 +479,7 @@ std::vector<RayPacket> make_tiles(const Scene& scene, std::vector<std::vector<in
     for (int x0 = 0; x0 < 1024; x0 += 8) {
       RayPacket p = primary.packet(x0, y0, 8, 8);
       std::vector<int> index;
+      index.reserve(64);
       for (int k = 0; k < 64; ++k) index.push_back((y0 + k / 8) * 1024 + x0 + k % 8);
       tiles.push_back(p);
       ray_index.push_back(index);
@@ -487,7 +491,8 @@ std::vector<RayPacket> make_tiles(const Scene& scene, std::vector<std::vector<in
 // Primary rays, one thread, as packets: bvh (our packet traversal of the wide BVH) or embree
 // (rtcIntersect8 or rtcIntersect16, its native width on this CPU), over the same 8x8 tiles.
 // Answers are checked against Embree's single-ray ones first.
-void BM_TracePacket(benchmark::State& state, std::string accel, std::string scene_name) {
+void BM_TracePacket(benchmark::State& state, const std::string& accel,
+                    const std::string& scene_name) {
   std::string name = scene_name + ":" + std::to_string(state.range(0));
   const Scene& scene = builtin(name);
   TraceGeometry geometry(scene, SphereMode::Analytic, 64, accel_kind(accel));
@@ -544,7 +549,7 @@ void BM_TracePacket(benchmark::State& state, std::string accel, std::string scen
 // binned-SAH binary tree collapsed to the wide BVH and its triangle blocks), bvh2 (the binary
 // tree alone), embree_medium (Embree's binned SAH, the same kind of tree as ours) and
 // embree_high (with spatial splits; what the embree renderer uses).
-void BM_Build(benchmark::State& state, std::string accel) {
+void BM_Build(benchmark::State& state, const std::string& accel) {
   tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   const Scene& scene = builtin("soup:" + std::to_string(state.range(0)));
   double nodes = 0, sah = 0, bytes = 0;
@@ -573,6 +578,16 @@ void BM_Build(benchmark::State& state, std::string accel) {
 }
 
 // One frame sweep: <family>/<renderer>/<scene>/<n>/<width>.
+// A benchmark's name: its parts joined by '/' ("BM_Trace/bvh/primary/soup").
+std::string bench_name(std::initializer_list<std::string> parts) {
+  std::string name;
+  for (const std::string& part : parts) {
+    if (!name.empty()) name += '/';
+    name += part;
+  }
+  return name;
+}
+
 void register_frame_sweep(const FrameSweep& sweep) {
   auto add = [&](const std::string& r, const std::string& s, long n, long w) {
     benchmark::RegisterBenchmark((sweep.family + ("/" + r + "/" + s)).c_str(), BM_Frame, sweep, r,
@@ -614,25 +629,25 @@ void register_all() {
         ->UseRealTime();
     // Beside the tracer's: the hybrids (GL's z-buffer, softraster's) on the same frames.
     for (std::string h : {"hybrid", "hybrid_soft"})
-      benchmark::RegisterBenchmark(("BM_Effects/" + h + "/" + e).c_str(), BM_EffectsWith, h, e)
+      benchmark::RegisterBenchmark(bench_name({"BM_Effects", h, e}).c_str(), BM_EffectsWith, h, e)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
   }
   for (std::string a : {"bvh", "bvh2", "embree"})
     for (std::string rays : {"primary", "random"}) {
-      benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/tessphere").c_str(), BM_Trace,
+      benchmark::RegisterBenchmark(bench_name({"BM_Trace", a, rays, "tessphere"}).c_str(), BM_Trace,
                                    a, rays, std::string("tessphere"))
           ->Arg(100000)
           ->Unit(benchmark::kMillisecond);
-      benchmark::RegisterBenchmark(("BM_Trace/" + a + "/" + rays + "/soup").c_str(), BM_Trace, a,
+      benchmark::RegisterBenchmark(bench_name({"BM_Trace", a, rays, "soup"}).c_str(), BM_Trace, a,
                                    rays, std::string("soup"))
           ->Arg(1000000)
           ->Unit(benchmark::kMillisecond);
     }
   for (std::string a : {"bvh", "embree"})
     for (std::string scene : {"tessphere", "soup"})
-      benchmark::RegisterBenchmark(("BM_TracePacket/" + a + "/" + scene).c_str(), BM_TracePacket, a,
-                                   scene)
+      benchmark::RegisterBenchmark(bench_name({"BM_TracePacket", a, scene}).c_str(), BM_TracePacket,
+                                   a, scene)
           ->Arg(scene == "soup" ? 1000000 : 100000)
           ->Unit(benchmark::kMillisecond);
   // Textures: the z-buffers' own level of detail, the tracers' three.

@@ -7,15 +7,12 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
 #include "report.h"
 #include "report_input.h"
-#include "rvr/raster/gl_rasterizer.h"
-#include "rvr/raytrace/ray_tracer.h"
 #include "rvr/renderers/compare_renderers.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"

@@ -8,10 +8,10 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "cpu_probe.h"
-#include "rvr/raster/gl_rasterizer.h"
-#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/environment.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"
+#include "rvr/shared/gl_backend.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/isa.h"
 
@@ -33,11 +33,12 @@ int run_info(const std::string& gl_name) {
   std::printf(" (RVR_ISA=");
   for (Isa isa : kAllIsas) std::printf("%s%s", isa == kAllIsas[0] ? "" : "|", to_string(isa));
   std::printf(" forces one)\n");
-  std::printf("embree: %s\nopenimageio: %s\ntbb: %s\n", embree_version().c_str(),
-              openimageio_version().c_str(), tbb_version().c_str());
+  const TracerLibraries tracer = tracer_libraries();
+  std::printf("embree: %s\nopenimageio: %s\ntbb: %s\n", tracer.embree.c_str(),
+              openimageio_version().c_str(), tracer.tbb.c_str());
   CommonOptions gl_choice;
   gl_choice.gl = gl_name;
-  Expected<GlInfo> gl = query_gl_info(gl_backend(gl_choice));
+  Expected<GlInfo> gl = query_renderer_gl(gl_backend(gl_choice));
   if (!gl) fail(gl.error());
   for (const std::string& w : gl->warnings) std::printf("gl warning: %s\n", w.c_str());
   std::printf("gl backend: %s\nGL_VERSION: %s\nGL_RENDERER: %s\nGL_VENDOR: %s\nGLSL: %s\n",

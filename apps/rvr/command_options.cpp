@@ -14,14 +14,15 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "one_of.h"
-#include "rvr/raster/gl_rasterizer.h"
 #include "rvr/shared/expected.h"
+#include "rvr/shared/gl_backend.h"
 #include "rvr/shared/isa.h"
 #include "rvr/shared/limits.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
 #include "rvr/shared/scene_for_render.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/texture.h"
 #include "rvr/shared/timer.h"
 
 namespace rvr::cli {

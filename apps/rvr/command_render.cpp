@@ -10,14 +10,13 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
 #include "render_stats.h"
 #include "report.h"
-#include "rvr/raster/gl_rasterizer.h"
-#include "rvr/raytrace/ray_tracer.h"
 #include "rvr/renderers/compare_renderers.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/image_io.h"
@@ -33,8 +32,11 @@ int run_render(const RenderArgs& a) {
   std::vector<std::string> outputs{a.out};
   if (!stats_to_stdout && !a.stats.empty()) outputs.push_back(a.stats);
   const std::string base = std::filesystem::path(a.out).replace_extension().string();
-  for (const std::string& aov : a.aovs)
-    outputs.push_back(base + "." + aov + (aov == "cost" ? ".png" : ".exr"));
+  for (const std::string& aov : a.aovs) {
+    std::string name = base;
+    name.append(".").append(aov).append(aov == "cost" ? ".png" : ".exr");
+    outputs.push_back(std::move(name));
+  }
   if (std::count(a.aovs.begin(), a.aovs.end(), "cost")) outputs.push_back(base + ".cost.exr");
   refuse_overwriting_inputs({a.common.scene}, outputs);
   TerminalProgress progress(progress_wanted(a.common.quiet));

@@ -26,7 +26,7 @@
 #include "commands.h"
 #include "study_setup.h"
 #include "cpu_probe.h"
-#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/environment.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "rvr/raster/gl_rasterizer.h"
 #include "rvr/shared/compare.h"
+#include "rvr/shared/gl_backend.h"
 #include "rvr/shared/limits.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"

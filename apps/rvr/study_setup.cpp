@@ -4,7 +4,7 @@
 #include <thread>
 
 #include "cpu_probe.h"
-#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/renderers/environment.h"
 #include "rvr/shared/isa.h"
 
 namespace rvr {
@@ -25,9 +25,10 @@ study::MachineInfo machine_info(const std::string& version) {
   m.cpu = cli::cpu_model();
   m.threads = std::thread::hardware_concurrency();
   m.kernels = describe_isa_choice();
+  const TracerLibraries tracer = tracer_libraries();
   m.versions = {{"rvr", version},
-                {"embree", embree_version()},
-                {"tbb", tbb_version()},
+                {"embree", tracer.embree},
+                {"tbb", tracer.tbb},
                 {"compiler", __VERSION__}};
   return m;
 }

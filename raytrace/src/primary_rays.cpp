@@ -31,7 +31,7 @@ RayPacket PrimaryRays::packet(int x0, int y0, int w, int h) const {
   packet.count = w * h;
   const float* column = column_.data() + x0;
   for (int j = 0; j < h; ++j) {
-    const float row = row_[size_t(y0 + j)];
+    const float row = row_[size_t(y0) + size_t(j)];
     for (int a = 0; a < 3; ++a) {
       // (forward + right * column) + up * row, as glm adds the vec3 terms; vectorizes along i.
       const float forward = frame_.forward[a], right = frame_.right[a], up_row = frame_.up[a] * row;

@@ -153,6 +153,7 @@ Scene spheres() {
   Scene s = base_scene("spheres");
   add_floor(s, {0.6f, 0.6f, 0.55f}, {0, 0, 0}, 8.0f);
   const int n = 5;
+  const int centre = n / 2;  // the grid's middle row and column stand at the origin
   for (int j = 0; j < n; ++j) {
     for (int i = 0; i < n; ++i) {
       float hue = float(i * n + j) / float(n * n);
@@ -160,7 +161,7 @@ Scene spheres() {
       uint32_t m = add_material(s, "ball" + std::to_string(i * n + j), colour, glm::vec3(0.4f),
                                 16.0f + 8.0f * float(i));
       add_sphere(s, "sphere " + std::to_string(i) + "," + std::to_string(j), m,
-                 {float(i - n / 2) * 1.1f, 0.45f, float(j - n / 2) * 1.1f}, 0.45f);
+                 {float(i - centre) * 1.1f, 0.45f, float(j - centre) * 1.1f}, 0.45f);
     }
   }
   look_at(s, {0.0f, 4.0f, 7.5f}, {0.0f, 0.3f, 0.0f}, 45.0f, 0.1f, 100.0f);

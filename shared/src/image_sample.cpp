@@ -33,8 +33,9 @@ ImageSample image_sample(const Camera& camera, uint64_t seed, int k, int spp, bo
   s.jx = uniform(state);
   s.jy = uniform(state);
   if (k < m * m) {
-    s.jx = (float(k % m) + s.jx) / float(m);
-    s.jy = (float(k / m) + s.jy) / float(m);
+    const int column = k % m, row = k / m;  // sample k's stratum of the m x m grid
+    s.jx = (float(column) + s.jx) / float(m);
+    s.jy = (float(row) + s.jy) / float(m);
   }
   if (thin_lens && camera.aperture_radius > 0.0f) {
     const float pi = 3.14159265358979f;

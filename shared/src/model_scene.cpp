@@ -229,7 +229,7 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
                     "normals",
                     repaired, repaired == 1 ? "" : "s"));
   }
-  for (std::string& w : scene.warnings) w = path + ": " + w;
+  for (std::string& w : scene.warnings) w.insert(0, path + ": ");
   return scene;
 }
 

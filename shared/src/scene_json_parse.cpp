@@ -111,7 +111,7 @@ std::string syntax_message(const std::string& raw, bool whitespace_only, bool* t
       context = msg.substr(0, dash);
       msg = msg.substr(dash + 3);
     }
-  } else if (size_t colon = msg.find("]"); colon != std::string::npos) {
+  } else if (size_t colon = msg.find(']'); colon != std::string::npos) {
     msg = msg.substr(colon + 2);
   }
   if (msg.rfind("unexpected ", 0) == 0) {

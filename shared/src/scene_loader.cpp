@@ -512,7 +512,8 @@ class Reader {
     if (scene_.objects.size() == before) {
       fail(fp, quote_json(file) + ": all triangles are degenerate (zero area)");
     }
-    for (const std::string& w : model.warnings) scene_.warnings.push_back(label + ": " + w);
+    for (const std::string& w : model.warnings)
+      scene_.warnings.emplace_back(label + ": ").append(w);
     if (model.skipped_primitives > 0) {
       scene_.warnings.push_back(
           fmt::format("{}: ignored {} point/line primitives", label, model.skipped_primitives));

@@ -190,7 +190,7 @@ void print(const json& v, int indent, std::string& out) {
     out += v.is_array() ? "[\n" : "{\n";
     size_t i = 0;
     for (auto it = v.begin(); it != v.end(); ++it, ++i) {
-      out.append(size_t(indent + 2), ' ');
+      out.append(size_t(indent) + 2, ' ');
       if (v.is_object()) out += json(it.key()).dump() + ": ";
       print(*it, indent + 2, out);
       out += i + 1 < v.size() ? ",\n" : "\n";
@@ -256,6 +256,58 @@ std::string ply(const TriangleMesh& mesh, const std::string& path) {
   return out;
 }
 
+// The scene's lights as the file's "lights" array.
+json lights_json(const std::vector<Light>& scene_lights) {
+  json lights = json::array();
+  for (size_t i = 0; i < scene_lights.size(); ++i) {
+    const Light& l = scene_lights[i];
+    std::string path = fmt::format("lights[{}]", i);
+    if (l.type == LightType::Point) {
+      lights.push_back({{"type", "point"},
+                        {"position", vec(l.position, path + ".position")},
+                        {"intensity", vec(l.intensity, path + ".intensity")}});
+    } else {
+      lights.push_back({{"type", "area"},
+                        {"corner", vec(l.corner, path + ".corner")},
+                        {"edge_u", vec(l.edge_u, path + ".edge_u")},
+                        {"edge_v", vec(l.edge_v, path + ".edge_v")},
+                        {"intensity", vec(l.intensity, path + ".intensity")},
+                        {"samples", l.samples}});
+    }
+  }
+  return lights;
+}
+
+// A one-triangle flat mesh as a "triangle" object: its vertices, and uvs and colours when it
+// has them.
+json triangle_members(json j, const TriangleMesh& mesh, const std::string& path) {
+  j["type"] = "triangle";
+  json verts = json::array();
+  for (int k = 0; k < 3; ++k) {
+    uint32_t v = mesh.triangles[0][k];
+    if (v >= mesh.positions.size()) fail(path + ": a vertex index is out of range");
+    verts.push_back(vec(mesh.positions[v], fmt::format("{}.vertices[{}]", path, k)));
+  }
+  j["vertices"] = std::move(verts);
+  if (mesh.textured() || mesh.coloured()) {
+    json uvs = json::array(), colours = json::array();
+    for (int k = 0; k < 3; ++k) {
+      uint32_t v = mesh.triangles[0][k];
+      if (mesh.textured()) {
+        if (v >= mesh.uvs.size()) fail(path + ": uvs and positions differ in number");
+        uvs.push_back(vec2(mesh.uvs[v], fmt::format("{}.uvs[{}]", path, k)));
+      }
+      if (mesh.coloured()) {
+        if (v >= mesh.colours.size()) fail(path + ": colours and positions differ in number");
+        colours.push_back(vec(mesh.colours[v], fmt::format("{}.colors[{}]", path, k)));
+      }
+    }
+    if (mesh.textured()) j["uvs"] = std::move(uvs);
+    if (mesh.coloured()) j["colors"] = std::move(colours);
+  }
+  return j;
+}
+
 SceneDocument write(const Scene& scene, const std::string& mesh_prefix,
                     const std::string& document_folder) {
   SceneDocument doc;
@@ -303,24 +355,7 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix,
   }
   root["materials"] = std::move(materials);
 
-  json lights = json::array();
-  for (size_t i = 0; i < scene.lights.size(); ++i) {
-    const Light& l = scene.lights[i];
-    std::string path = fmt::format("lights[{}]", i);
-    if (l.type == LightType::Point) {
-      lights.push_back({{"type", "point"},
-                        {"position", vec(l.position, path + ".position")},
-                        {"intensity", vec(l.intensity, path + ".intensity")}});
-    } else {
-      lights.push_back({{"type", "area"},
-                        {"corner", vec(l.corner, path + ".corner")},
-                        {"edge_u", vec(l.edge_u, path + ".edge_u")},
-                        {"edge_v", vec(l.edge_v, path + ".edge_v")},
-                        {"intensity", vec(l.intensity, path + ".intensity")},
-                        {"samples", l.samples}});
-    }
-  }
-  root["lights"] = std::move(lights);
+  root["lights"] = lights_json(scene.lights);
 
   json objects = json::array();
   for (size_t i = 0; i < scene.objects.size(); ++i) {
@@ -345,31 +380,7 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix,
         const TriangleMesh& mesh = o.mesh;
         if (mesh.triangles.empty()) fail(path + ": a mesh with no triangles");
         if (mesh.triangles.size() == 1 && !mesh.smooth()) {
-          j["type"] = "triangle";
-          json verts = json::array();
-          for (int k = 0; k < 3; ++k) {
-            uint32_t v = mesh.triangles[0][k];
-            if (v >= mesh.positions.size()) fail(path + ": a vertex index is out of range");
-            verts.push_back(vec(mesh.positions[v], fmt::format("{}.vertices[{}]", path, k)));
-          }
-          j["vertices"] = std::move(verts);
-          if (mesh.textured() || mesh.coloured()) {
-            json uvs = json::array(), colours = json::array();
-            for (int k = 0; k < 3; ++k) {
-              uint32_t v = mesh.triangles[0][k];
-              if (mesh.textured()) {
-                if (v >= mesh.uvs.size()) fail(path + ": uvs and positions differ in number");
-                uvs.push_back(vec2(mesh.uvs[v], fmt::format("{}.uvs[{}]", path, k)));
-              }
-              if (mesh.coloured()) {
-                if (v >= mesh.colours.size())
-                  fail(path + ": colours and positions differ in number");
-                colours.push_back(vec(mesh.colours[v], fmt::format("{}.colors[{}]", path, k)));
-              }
-            }
-            if (mesh.textured()) j["uvs"] = std::move(uvs);
-            if (mesh.coloured()) j["colors"] = std::move(colours);
-          }
+          j = triangle_members(std::move(j), mesh, path);
         } else {
           std::string file = fmt::format("{}.mesh{}.ply", mesh_prefix, i);
           j["type"] = "mesh";

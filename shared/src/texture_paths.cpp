@@ -121,7 +121,7 @@ std::string percent_decoded(const std::string& p) {
 // The path as written, then with each name matched regardless of case.
 fs::path find_as_written(const std::string& p, const fs::path& base) {
   if (windows_absolute(p)) return {};
-  const fs::path written = fs::path(p).is_absolute() ? fs::path(p) : base / p;
+  fs::path written = fs::path(p).is_absolute() ? fs::path(p) : base / p;
   if (is_file(written)) return written;
   if (fs::path(p).is_relative()) return match_case_insensitively(base, fs::path(p));
   return {};

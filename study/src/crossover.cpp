@@ -85,6 +85,7 @@ std::vector<int> significant_signs(const std::vector<std::vector<double>>& repli
   std::vector<int> signs(points, 0);
   for (size_t i = 0; i < points; ++i) {
     std::vector<double> di;
+    di.reserve(replicates.size());
     for (const auto& d : replicates) di.push_back(d[i]);
     Interval ci = percentile_interval(di);
     signs[i] = ci.high < 0 ? -1 : (ci.low > 0 ? +1 : 0);

@@ -31,6 +31,7 @@ std::vector<Interval> bootstrap_intervals(const CostModel& model,
                                           const BootstrapOptions& boot) {
   Rng rng(boot.seed);
   std::vector<double> measured;
+  measured.reserve(points.size());
   for (const Measurement& p : points) measured.push_back(typical_seconds(p));
   std::vector<std::vector<double>> draws(use.size());
   for (int r = 0; r < boot.replicates; ++r) {
@@ -40,6 +41,7 @@ std::vector<Interval> bootstrap_intervals(const CostModel& model,
     for (size_t j = 0; j < use.size(); ++j) draws[j].push_back((*c)[j]);
   }
   std::vector<Interval> intervals;
+  intervals.reserve(draws.size());
   for (const auto& d : draws) intervals.push_back(percentile_interval(d));
   return intervals;
 }
@@ -90,6 +92,7 @@ ModelFit fit_model(const CostModel& model, const std::vector<Measurement>& point
   f.fixed_pixels = shared_pixels(points);
   std::vector<bool> use = identifiable_terms(model, points);
   std::vector<double> medians;
+  medians.reserve(points.size());
   for (const Measurement& p : points) medians.push_back(typical_seconds(p));
   size_t used = 0;
   for (bool u : use) used += u;
@@ -153,6 +156,7 @@ std::vector<CostModel> candidate_models(const CostModel& textbook,
 ModelFit fit_chosen_model(const CostModel& textbook, const std::vector<Measurement>& points,
                           const BootstrapOptions& boot, const FitThresholds& limits) {
   std::vector<double> medians;
+  medians.reserve(points.size());
   for (const Measurement& p : points) medians.push_back(typical_seconds(p));
   CostModel widest = textbook;
   widest.edges = true;

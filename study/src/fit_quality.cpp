@@ -60,6 +60,7 @@ FitQuality fit_quality(const CostModel& cost_model, const std::vector<Measuremen
                        const std::vector<bool>& use) {
   FitQuality q = leave_one_out(cost_model, points, medians, use);
   std::vector<double> model;
+  model.reserve(points.size());
   for (const Measurement& p : points)
     model.push_back(predict(cost_model, coefficients, p.pixels, p.n));
   q.r2 = weighted_r2(medians, model);

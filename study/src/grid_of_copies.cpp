@@ -38,7 +38,8 @@ Expected<Scene> grid_of_copies(const Scene& base, size_t copies) {
   for (const Object& o : base.objects)
     if (!copied(o)) out.objects.push_back(o);
   for (size_t k = 0; k < copies; ++k) {
-    glm::vec3 offset(spacing * float(k % columns), spacing * float(k / columns), 0.0f);
+    const size_t column = k % columns, row = k / columns;
+    glm::vec3 offset(spacing * float(column), spacing * float(row), 0.0f);
     for (const Object& o : base.objects)
       if (copied(o)) out.objects.push_back(k == 0 ? o : translated(o, offset, k));
   }

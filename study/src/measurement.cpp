@@ -59,7 +59,7 @@ double hd_median(std::vector<double> values, const std::vector<double>& weights)
   return total;
 }
 
-double hd_median(std::vector<double> values) {
+double hd_median(const std::vector<double>& values) {
   return hd_median(values, hd_weights(values.size()));
 }
 

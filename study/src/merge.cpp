@@ -140,6 +140,7 @@ std::vector<std::string> source_notes(const std::vector<const StudySource*>& sou
       by_note[note].push_back(s->name);
     }
   std::vector<std::string> out;
+  out.reserve(order.size());
   for (const std::string& note : order) out.push_back(join(by_note[note]) + ": " + note);
   return out;
 }
@@ -181,6 +182,7 @@ Expected<StudyResult> pool(const std::vector<const StudySource*>& sources) {
     if (Status added = points.add(*s); !added) return added.error();
   r.points = points.sorted(r);
   std::vector<std::string> names;
+  names.reserve(sources.size());
   for (const StudySource* s : sources) names.push_back(s->name);
   r.notes.push_back(fmt::format("merged from {} stud{}: {}", sources.size(),
                                 sources.size() > 1 ? "ies" : "y", join(names)));

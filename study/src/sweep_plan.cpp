@@ -81,10 +81,13 @@ std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured) {
 
 std::vector<PlannedPoint> planned_points(const Family& family, int width) {
   std::vector<PlannedPoint> plan;
-  std::vector<size_t> ns = log_spaced(family.low, family.high, family.points);
+  const std::vector<size_t> ns = log_spaced(family.low, family.high, family.points);
+  const std::vector<size_t> pixel_ns = pixel_sweep_ns(ns);
+  const std::vector<int> widths = pixel_sweep_widths(width);
+  plan.reserve(ns.size() + pixel_ns.size() * widths.size());
   for (size_t n : ns) plan.push_back({n, width});
-  for (size_t n : pixel_sweep_ns(ns))
-    for (int narrower : pixel_sweep_widths(width)) plan.push_back({n, narrower});
+  for (size_t n : pixel_ns)
+    for (int narrower : widths) plan.push_back({n, narrower});
   return plan;
 }
 

@@ -83,7 +83,8 @@ class DepthTarget {
     const uint32_t* fragments = fragments_.data() + size_t(y) * size_t(width_);
     const uint32_t* rejects = block_rejects_.data() + size_t(y / kBlock) * size_t(blocks_x_);
     for (int x0 = 0; x0 < width_; x0 += kBlock) {
-      const float reject = float(rejects[x0 / kBlock]) / float(kBlock * kBlock);
+      const int block_x = x0 / kBlock;
+      const float reject = float(rejects[block_x]) / float(kBlock * kBlock);
       const int x1 = x0 + kBlock < width_ ? x0 + kBlock : width_;
       for (int x = x0; x < x1; ++x) out[x] = float(fragments[x]) + reject;
     }

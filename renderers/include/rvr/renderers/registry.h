@@ -7,9 +7,9 @@
 #include <string>
 #include <vector>
 
-#include "rvr/raster/gl_rasterizer.h"
 #include "rvr/renderers/prepared_renderer.h"
 #include "rvr/shared/expected.h"
+#include "rvr/shared/gl_backend.h"
 #include "rvr/shared/renderer.h"
 
 namespace rvr {

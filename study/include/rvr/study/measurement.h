@@ -40,7 +40,7 @@ double median_seconds(const Measurement& m);
 // (n+1)/2) mass over [(i−1)/n, i/n]). The study fits and compares this, not the sample median:
 // the bootstrap of a sample median of 5 repetitions is some 35% too wide in variance (its 95%
 // intervals held the truth 99% of the time in test_study), that of this estimate ~8%.
-double hd_median(std::vector<double> values);
+double hd_median(const std::vector<double>& values);
 
 // hd_median's weights for n values, and the estimate from them (values in any order).
 std::vector<double> hd_weights(size_t n);
