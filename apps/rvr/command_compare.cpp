@@ -1,9 +1,7 @@
 // rvr compare: the compared renderers' images, the difference pictures, metrics.json and
 // report.html.
-#include <algorithm>
 #include <cstdio>
 #include <functional>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>

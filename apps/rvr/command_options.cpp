@@ -16,14 +16,12 @@
 #include "one_of.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/gl_backend.h"
-#include "rvr/shared/isa.h"
 #include "rvr/shared/limits.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
 #include "rvr/shared/scene_for_render.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/texture.h"
-#include "rvr/shared/timer.h"
 
 namespace rvr::cli {
 

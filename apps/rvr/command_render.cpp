@@ -1,14 +1,8 @@
 // rvr render: one renderer, one image, its AOVs and --stats.
-#include <sys/resource.h>
-
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <glm/glm.hpp>
-#include <map>
 #include <memory>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -16,8 +10,6 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "render_stats.h"
-#include "report.h"
-#include "rvr/renderers/compare_renderers.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/renderer.h"

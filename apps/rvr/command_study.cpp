@@ -13,20 +13,15 @@
 #include <filesystem>
 #include <functional>
 #include <initializer_list>
-#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <system_error>
-#include <thread>
 #include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
-#include "study_setup.h"
-#include "cpu_probe.h"
-#include "rvr/renderers/environment.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
@@ -39,6 +34,7 @@
 #include "rvr/study/study_json.h"
 #include "rvr/study/study_markdown.h"
 #include "rvr/study/sweep_plan.h"
+#include "study_setup.h"
 #include "terminal_progress.h"
 
 namespace {

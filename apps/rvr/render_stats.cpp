@@ -3,6 +3,8 @@
 #include <sys/resource.h>
 
 #include <cmath>
+#include <glm/glm.hpp>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <vector>
 

@@ -1,6 +1,14 @@
 #include "report_input.h"
 
+#include <stddef.h>
+
 #include <algorithm>
+#include <map>
+#include <memory>
+
+#include "rvr/shared/compare.h"
+#include "rvr/shared/mismatch_classes.h"
+#include "rvr/shared/renderer.h"
 
 namespace rvr {
 

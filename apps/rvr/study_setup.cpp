@@ -1,6 +1,7 @@
 #include "study_setup.h"
 
 #include <algorithm>
+#include <map>
 #include <thread>
 
 #include "cpu_probe.h"
@@ -26,10 +27,8 @@ study::MachineInfo machine_info(const std::string& version) {
   m.threads = std::thread::hardware_concurrency();
   m.kernels = describe_isa_choice();
   const TracerLibraries tracer = tracer_libraries();
-  m.versions = {{"rvr", version},
-                {"embree", tracer.embree},
-                {"tbb", tracer.tbb},
-                {"compiler", __VERSION__}};
+  m.versions = {
+      {"rvr", version}, {"embree", tracer.embree}, {"tbb", tracer.tbb}, {"compiler", __VERSION__}};
   return m;
 }
 

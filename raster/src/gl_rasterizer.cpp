@@ -1165,7 +1165,8 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
     generated += double(fb.cost[i]);
     covered += fb.object_id[i] != kNoId ? 1 : 0;
   }
-  out.stats["triangles.submitted"] = double(vertices.size() / 3);
+  const size_t triangles_submitted = vertices.size() / 3;  // three vertices each, no index
+  out.stats["triangles.submitted"] = double(triangles_submitted);
   if (options.cost_aov) {  // counted by the cost pass only
     out.stats["fragments.generated"] = generated;
     out.stats["overdraw"] = covered > 0 ? generated / double(covered) : 0.0;
