@@ -267,7 +267,8 @@ inline std::string glb(const GltfExtras& e) {
   return s;
 }
 
-// 3DS (3D Studio) of the cube with one material of diffuse colour (r, g, b) bytes.
+// 3DS (3D Studio, whose z is up) of the cube with one material of diffuse colour (r, g, b)
+// bytes.
 inline std::string chunk3ds(uint16_t id, const std::string& body) {
   std::string s;
   put<uint16_t>(s, id);
@@ -275,7 +276,9 @@ inline std::string chunk3ds(uint16_t id, const std::string& body) {
   return s + body;
 }
 
-inline std::string cube_3ds(uint8_t r, uint8_t g, uint8_t b) {
+// `size`: the box's extent along the file's x, y and z (the unit cube by default).
+inline std::string cube_3ds(uint8_t r, uint8_t g, uint8_t b,
+                            const std::array<float, 3>& size = {1.0f, 1.0f, 1.0f}) {
   std::string rgb;
   put<uint8_t>(rgb, r);
   put<uint8_t>(rgb, g);
@@ -284,8 +287,10 @@ inline std::string cube_3ds(uint8_t r, uint8_t g, uint8_t b) {
                                               chunk3ds(0xA020, chunk3ds(0x0011, rgb)));
   std::string verts;
   put<uint16_t>(verts, 8);
-  for (int v = 0; v < 8; ++v)
-    for (float c : cube_vertex(v)) put<float>(verts, c);
+  for (int v = 0; v < 8; ++v) {
+    auto p = cube_vertex(v);
+    for (int k = 0; k < 3; ++k) put<float>(verts, p[k] * size[k]);
+  }
   auto tris = cube_triangles();
   std::string faces, group = std::string("paint\0", 6);
   put<uint16_t>(faces, uint16_t(tris.size()));
@@ -424,6 +429,71 @@ inline std::string ascii_stl_cube_with_stated_normals(bool degenerate_facet) {
   return s + "endsolid stated\n";
 }
 
+// ASCII FBX 7.4, Y up, of one triangle (0, 0, 0), (0, 0, 2s), (0, s, 0) (facing -x) and a camera
+// "shot" at
+// (-5s, 0.5s, s) looking along +x (Assimp's FBX camera convention: its node's +x) with near
+// plane 0.1s and far plane 100s, all in file units. `unit_scale_factor`: GlobalSettings'
+// UnitScaleFactor (centimetres per file unit) as written, no such line when empty (FBX's
+// default: 1, centimetres).
+inline std::string fbx_triangle_and_camera(float s, const std::string& unit_scale_factor) {
+  std::string unit = unit_scale_factor.empty() ? ""
+                                               : "\t\tP: \"UnitScaleFactor\", \"double\", "
+                                                 "\"Number\", \"\"," +
+                                                     unit_scale_factor + "\n";
+  return R"FBX(; FBX 7.4.0 project file
+FBXHeaderExtension:  {
+	FBXHeaderVersion: 1003
+	FBXVersion: 7400
+	Creator: "rvr test"
+}
+GlobalSettings:  {
+	Version: 1000
+	Properties70:  {
+		P: "UpAxis", "int", "Integer", "",1
+		P: "UpAxisSign", "int", "Integer", "",1
+)FBX" + unit +
+         R"FBX(	}
+}
+Objects:  {
+	Geometry: 1000, "Geometry::tri", "Mesh" {
+		Vertices: *9 {
+			a: 0,0,0,0,0,)FBX" +
+         num(2 * s) + ",0," + num(s) + R"FBX(,0
+		}
+		PolygonVertexIndex: *3 {
+			a: 0,1,-3
+		}
+		GeometryVersion: 124
+	}
+	Model: 2000, "Model::tri", "Mesh" {
+		Version: 232
+	}
+	NodeAttribute: 5000, "NodeAttribute::shot", "Camera" {
+		TypeFlags: "Camera"
+		Properties70:  {
+			P: "NearPlane", "double", "Number", "",)FBX" +
+         num(0.1f * s) + R"FBX(
+			P: "FarPlane", "double", "Number", "",)FBX" +
+         num(100.0f * s) + R"FBX(
+		}
+	}
+	Model: 6000, "Model::shot", "Camera" {
+		Version: 232
+		Properties70:  {
+			P: "Lcl Translation", "Lcl Translation", "", "A",)FBX" +
+         num(-5.0f * s) + "," + num(0.5f * s) + "," + num(s) + R"FBX(
+		}
+	}
+}
+Connections:  {
+	C: "OO",2000,0
+	C: "OO",1000,2000
+	C: "OO",6000,0
+	C: "OO",5000,6000
+}
+)FBX";
+}
+
 // Collada 1.4 with a camera and no geometry (`light`: a point light too); Assimp's Collada
 // reader puts a placeholder skeleton mesh around the nodes of such a file.
 inline std::string dae_camera_only(bool light) {
@@ -459,6 +529,35 @@ inline std::string gltf_camera_only() {
   return R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
   "nodes": [{"camera": 0, "translation": [0.5, 0.5, 5]}],
   "cameras": [{"type": "perspective", "perspective": {"yfov": 0.7, "znear": 0.1, "zfar": 100}}]})";
+}
+
+// Every model file of the corpus as a bare model file would come (name, bytes), each once,
+// and the files they need beside them (`paint.mtl`); CorpusFile::model says which is which.
+struct CorpusFile {
+  std::string name, bytes;
+  bool model = true;
+};
+inline std::vector<CorpusFile> every_file() {
+  GltfExtras lit;
+  lit.camera = true;
+  lit.light = true;
+  GltfExtras textured;
+  textured.texture = true;  // on a mesh without texture coordinates: a warning
+  return {{"paint.mtl", "newmtl paint\nKd 0.9 0.15 0.1\nKs 0.5 0.5 0.5\nNs 40\n", false},
+          {"cube.obj", obj_cube("mtllib paint.mtl\n", "paint")},
+          {"bare.obj", obj_cube("", "")},
+          {"cube.ply", blender_ply_cube(250, 250, 250)},
+          {"binary.stl", binary_stl_cube()},
+          {"ascii.stl", ascii_stl_cube()},
+          {"stated.stl", ascii_stl_cube_with_stated_normals(true)},
+          {"cube.off", off_cube_with_comments()},
+          {"cube.gltf", gltf_json(GltfExtras{}, false)},
+          {"textured.gltf", gltf_json(textured, false)},
+          {"lit.glb", glb(lit)},
+          {"cube.3ds", cube_3ds(255, 255, 255)},
+          {"tall.3ds", cube_3ds(200, 120, 40, {1.0f, 2.0f, 3.0f})},
+          {"cube.dae", dae_cube(DaeExtras{})},
+          {"cm.fbx", fbx_triangle_and_camera(100.0f, "")}};
 }
 
 }  // namespace corpus

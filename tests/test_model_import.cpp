@@ -10,6 +10,7 @@
 
 #include <assimp/Importer.hpp>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <glm/glm.hpp>
 #include <glm/gtc/constants.hpp>
@@ -400,11 +401,11 @@ TEST_F(ModelFiles, UpZTurnsTheModelSoItsZIsUp) {
   expect_near3(rvr::load_scene(p, o)->objects.at(0).mesh.positions.at(2), {0, 1, 2}, 0.0f);
 }
 
-// An ASCII FBX 7.4 saying it is Z-up (GlobalSettings UpAxis 2, UpAxisSign 1), with the
-// viewport camera "Producer Perspective" of FBX 6 exporters as a model of its own, and a
-// camera the user placed, "shot", at (-5, 0.5, 1) looking along its node's +x (Assimp's FBX
-// camera convention). Assimp reads both cameras and the axes into the scene's metadata
-// without applying them. rvr takes "shot", not the viewport camera, and turns the model
+// An ASCII FBX 7.4 in metres (UnitScaleFactor 100) saying it is Z-up (GlobalSettings UpAxis 2,
+// UpAxisSign 1), with the viewport camera "Producer Perspective" of FBX 6 exporters as a model of
+// its own, and a camera the user placed, "shot", at (-5, 0.5, 1) looking along its node's +x
+// (Assimp's FBX camera convention). Assimp reads both cameras and the axes into the scene's
+// metadata without applying them. rvr takes "shot", not the viewport camera, and turns the model
 // (x, y, z) -> (x, z, -y): the triangle's (0, 1, 2) to (0, 2, -1), the eye to (-5, 1, -0.5).
 TEST_F(ModelFiles, FbxUpAxisFromItsMetadataAndItsViewportCameraSkipped) {
   std::string p = write("cam.fbx", R"FBX(; FBX 7.4.0 project file
@@ -422,7 +423,7 @@ GlobalSettings:  {
 		P: "FrontAxisSign", "int", "Integer", "",-1
 		P: "CoordAxis", "int", "Integer", "",0
 		P: "CoordAxisSign", "int", "Integer", "",1
-		P: "UnitScaleFactor", "double", "Number", "",1
+		P: "UnitScaleFactor", "double", "Number", "",100
 		P: "DefaultCamera", "KString", "", "", "Producer Perspective"
 	}
 }
@@ -484,6 +485,96 @@ Connections:  {
   rvr::Scene as_read = rvr::load_scene(p, o).value();
   expect_near3(as_read.objects.at(0).mesh.positions.at(2), {0, 1, 2}, 0.0f);
   expect_near3(as_read.camera.eye, {-5, 0.5f, 1}, 1e-5f);
+}
+
+// FBX units: positions in UnitScaleFactor centimetres per unit (centimetres when the file does
+// not say), which Assimp reports and does not apply. The same scene written in centimetres
+// (no UnitScaleFactor line), in inches (2.54) and in metres (100): the triangle's corners
+// (0, 0, 2s) and (0, s, 0) are (0, 0, 2) m and (0, 1, 0) m, the camera's eye (-5, 0.5, 1) m, near
+// 0.1 m and far 100 m in every one; as a mesh object of a scene file too.
+TEST_F(ModelFiles, FbxUnitScaleFactorGivesMetres) {
+  struct Case {
+    std::string name, factor;
+    float metres_per_unit;
+  };
+  for (const Case& c :
+       {Case{"cm.fbx", "", 0.01f}, Case{"inch.fbx", "2.54", 0.0254f}, Case{"m.fbx", "100", 1.0f}}) {
+    SCOPED_TRACE(c.name);
+    std::string p =
+        write(c.name, corpus::fbx_triangle_and_camera(1.0f / c.metres_per_unit, c.factor));
+    rvr::Expected<rvr::Scene> loaded = rvr::load_scene(p);
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    const rvr::Scene& s = *loaded;
+    const std::vector<glm::vec3>& v = s.objects.at(0).mesh.positions;
+    ASSERT_EQ(v.size(), 3u);
+    expect_near3(v[0], {0, 0, 0}, 1e-6f);
+    expect_near3(v[1], {0, 0, 2}, 1e-5f);
+    expect_near3(v[2], {0, 1, 0}, 1e-5f);
+    expect_near3(s.camera.eye, {-5, 0.5f, 1}, 1e-4f);
+    expect_near3(glm::normalize(s.camera.target - s.camera.eye), {1, 0, 0}, 1e-6f);
+    EXPECT_NEAR(s.camera.near, 0.1f, 1e-6f);
+    EXPECT_NEAR(s.camera.far, 100.0f, 1e-3f);
+    EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+    for (const char* material : {"", R"(,"material":"from_file")"}) {
+      SCOPED_TRACE(material);
+      auto o = rvr::parse_scene(R"({"camera":{"eye":[3,3,3],"target":[0,0,0],"up":[0,1,0]},)"
+                                R"("objects":[{"type":"mesh","file":")" +
+                                    c.name + "\"" + material + "}]}",
+                                "t.json", dir_.string());
+      ASSERT_TRUE(o.ok()) << o.error().message;
+      glm::vec3 high(-1e9f);
+      for (const glm::vec3& q : o->objects.at(0).mesh.positions) high = glm::max(high, q);
+      expect_near3(high, {0, 1, 2}, 1e-5f);
+    }
+  }
+}
+
+// A Z-up 3DS file (3D Studio's z is up; Assimp turns it to +y as it reads): a box 1 along the
+// file's x, 2 along y and 3 along z stands upright with --up auto, its tall axis (3) along +y,
+// and the file's y along z: extents (1, 3, 2).
+TEST_F(ModelFiles, ThreeDsIsZUpAndStandsUpright) {
+  std::string p = write("tall.3ds", corpus::cube_3ds(200, 200, 200, {1.0f, 2.0f, 3.0f}));
+  rvr::Scene s = rvr::load_scene(p).value();
+  glm::vec3 low(1e9f), high(-1e9f);
+  for (const rvr::Object& o : s.objects) {
+    for (const glm::vec3& q : o.mesh.positions) {
+      low = glm::min(low, q);
+      high = glm::max(high, q);
+    }
+  }
+  expect_near3(high - low, {1, 3, 2}, 1e-5f);
+  EXPECT_EQ(s.camera.up, glm::vec3(0, 1, 0));
+}
+
+// The automatic exposure on every model file of the corpus, rendered by softraster at 160x120
+// with the file's own camera and lights where it has them: under 1 % of the model's pixels
+// have a linear colour above 1 in any channel.
+TEST_F(ModelFiles, AutomaticExposureClipsUnderOnePercentOfEveryCorpusModel) {
+  std::vector<std::string> files;
+  for (const corpus::CorpusFile& f : corpus::every_file()) {
+    std::string p = write(f.name, f.bytes);
+    if (f.model) files.push_back(p);
+  }
+  auto renderer = rvr::make_renderer("softraster").value();
+  for (const std::string& p : files) {
+    SCOPED_TRACE(p);
+    rvr::SceneOverrides o;
+    o.width = 160;
+    o.height = 120;
+    rvr::Expected<rvr::Scene> s = rvr::load_scene(p, o);
+    ASSERT_TRUE(s.ok()) << s.error().message;
+    rvr::FrameBuffers b = renderer->render(*s, {}).value().buffers;
+    size_t model = 0, clipped = 0;
+    for (size_t i = 0; i < b.color.size(); ++i) {
+      if (b.object_id[i] == rvr::kNoId) continue;
+      ++model;
+      clipped += b.color[i].r > 1.0f || b.color[i].g > 1.0f || b.color[i].b > 1.0f;
+    }
+    EXPECT_GT(model, 100u);
+    EXPECT_LT(clipped * 100, model) << clipped << " of " << model << " pixels clip";
+    std::printf("%-40s %zu of %zu model pixels clip\n", fs::path(p).filename().c_str(), clipped,
+                model);
+  }
 }
 
 // The automatic exposure: a white cube (diffuse 1, from an MTL) under the default key light
@@ -708,6 +799,36 @@ TEST_F(ModelFiles, ModelContentIsRecognisedWhateverTheExtension) {
   EXPECT_EQ(s->triangle_count(), 12u);
 }
 
+// The normals of the cube written by corpus::ascii_stl_cube_with_stated_normals as rvr should
+// shade it: each facet whose stated normal contradicts the winding with the cube's outward
+// normal, the others with their stated normal, normalised.
+void expect_stl_normals_honest(const rvr::TriangleMesh& mesh) {
+  const auto tris = corpus::cube_triangles();
+  ASSERT_EQ(mesh.triangles.size(), tris.size());
+  ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
+  // Each loaded triangle is the cube triangle with the same corners, in the same order.
+  size_t matched = 0;
+  for (const glm::uvec3& lt : mesh.triangles) {
+    for (size_t t = 0; t < tris.size(); ++t) {
+      bool same = true;
+      for (int k = 0; k < 3; ++k) {
+        auto c = corpus::cube_vertex(tris[t][k]);
+        same = same && mesh.positions[lt[k]] == glm::vec3(c[0], c[1], c[2]);
+      }
+      if (!same) continue;
+      ++matched;
+      SCOPED_TRACE("facet " + std::to_string(t));
+      auto out = corpus::cube_outward_normal(tris[t]);
+      auto stated = corpus::stated_facet_normal(t);
+      glm::vec3 want = corpus::facet_normal_kind(t) == 'k'
+                           ? glm::normalize(glm::vec3(stated[0], stated[1], stated[2]))
+                           : glm::vec3(out[0], out[1], out[2]);
+      for (int k = 0; k < 3; ++k) expect_near3(mesh.normals[lt[k]], want, 1e-6f);
+    }
+  }
+  EXPECT_EQ(matched, tris.size());
+}
+
 // STL facet normals against the winding: facets 0-2 state a tilted outward normal reversed, 3-4 a
 // zero normal, the rest an outward normal tilted by 0.25 (corpus::stated_facet_normal). Assimp
 // hands every stated normal on as it is (the oracle, checked first); rvr shades the five that
@@ -734,27 +855,7 @@ TEST_F(ModelFiles, StlFacetNormalsThatContradictTheWindingAreReplaced) {
   ASSERT_EQ(s.objects.size(), 1u);
   const rvr::TriangleMesh& mesh = s.objects[0].mesh;
   ASSERT_EQ(mesh.triangles.size(), tris.size());
-  // Each loaded triangle is the cube triangle with the same corners, in the same order.
-  size_t matched = 0;
-  for (const glm::uvec3& lt : mesh.triangles) {
-    for (size_t t = 0; t < tris.size(); ++t) {
-      bool same = true;
-      for (int k = 0; k < 3; ++k) {
-        auto c = corpus::cube_vertex(tris[t][k]);
-        same = same && mesh.positions[lt[k]] == glm::vec3(c[0], c[1], c[2]);
-      }
-      if (!same) continue;
-      ++matched;
-      SCOPED_TRACE("facet " + std::to_string(t));
-      auto out = corpus::cube_outward_normal(tris[t]);
-      auto stated = corpus::stated_facet_normal(t);
-      glm::vec3 want = corpus::facet_normal_kind(t) == 'k'
-                           ? glm::normalize(glm::vec3(stated[0], stated[1], stated[2]))
-                           : glm::vec3(out[0], out[1], out[2]);
-      for (int k = 0; k < 3; ++k) expect_near3(mesh.normals[lt[k]], want, 1e-6f);
-    }
-  }
-  EXPECT_EQ(matched, tris.size());
+  expect_stl_normals_honest(mesh);
   std::string all;
   for (const std::string& w : s.warnings) all += w + "\n";
   EXPECT_NE(all.find(p + ": 5 facets have normals that contradict the winding (3 pointing "
@@ -762,6 +863,33 @@ TEST_F(ModelFiles, StlFacetNormalsThatContradictTheWindingAreReplaced) {
             std::string::npos)
       << all;
   EXPECT_NE(all.find(p + ": dropped 1 degenerate triangle"), std::string::npos) << all;
+}
+
+// The same STL file as a mesh object of a scene file: with `smooth: true` (the file's normals
+// kept) the facets that contradict the winding are shaded with their geometric normal and the
+// scene carries the warning, naming the object; with `smooth: false` no stated normal is used,
+// so there is nothing to replace and no such warning.
+TEST_F(ModelFiles, StlFacetNormalsAreCheckedAsAMeshObjectOfASceneFile) {
+  write("stated.stl", corpus::ascii_stl_cube_with_stated_normals(false));
+  auto scene_with = [&](const char* smooth) {
+    return rvr::parse_scene(R"({"camera":{"eye":[3,3,3],"target":[0,0,0],"up":[0,1,0]},)"
+                            R"("objects":[{"name":"part","type":"mesh","file":"stated.stl",)"
+                            R"("smooth":)" +
+                                std::string(smooth) + "}]}",
+                            "t.json", dir_.string());
+  };
+  rvr::Expected<rvr::Scene> smooth = scene_with("true");
+  ASSERT_TRUE(smooth.ok()) << smooth.error().message;
+  ASSERT_EQ(smooth->objects.size(), 1u);
+  expect_stl_normals_honest(smooth->objects[0].mesh);
+  ASSERT_EQ(smooth->warnings.size(), 1u);
+  EXPECT_EQ(smooth->warnings[0],
+            "objects[0] (part): 5 facets have normals that contradict the winding (3 pointing "
+            "against it, 2 zero or non-finite): shaded with the facets' geometric normals");
+  rvr::Expected<rvr::Scene> flat = scene_with("false");
+  ASSERT_TRUE(flat.ok()) << flat.error().message;
+  EXPECT_TRUE(flat->objects.at(0).mesh.normals.empty());
+  EXPECT_TRUE(flat->warnings.empty()) << flat->warnings.front();
 }
 
 // A file with a camera (and a light) and no geometry: Assimp's Collada reader makes a

@@ -803,12 +803,62 @@ glm::vec3 metadata_up(const aiScene* ai) {
   return up;
 }
 
+// The length of one FBX unit in metres: GlobalSettings' UnitScaleFactor is in centimetres (1,
+// centimetres, when the file does not say), which Assimp (5.2) reports in the scene's metadata
+// as a float or a double and does not apply. An unusable factor (zero, negative, non-finite)
+// counts as the default with a warning.
+float fbx_metres_per_unit(const aiScene* ai, std::vector<std::string>& warnings) {
+  double factor = 1.0;
+  float as_float = 0.0f;
+  if (ai->mMetaData && !ai->mMetaData->Get("UnitScaleFactor", factor)) {
+    factor = ai->mMetaData->Get("UnitScaleFactor", as_float) ? double(as_float) : 1.0;
+  }
+  if (!std::isfinite(factor) || factor <= 0.0) {
+    warnings.push_back(fmt::format(
+        "the file's UnitScaleFactor ({}) is unusable; read in centimetres, the FBX default",
+        factor));
+    factor = 1.0;
+  }
+  return float(factor * 0.01);
+}
+
+// Scales the whole file (meshes, cameras, lights) by `metres_per_unit` through its root
+// node's transform, as Assimp applies Collada's <unit>: positions come out in metres, and a
+// camera's near and far scale with its node's transform (read_camera).
+void apply_units(const aiScene* ai, float metres_per_unit) {
+  if (!ai->mRootNode || metres_per_unit == 1.0f) return;
+  aiMatrix4x4 scale;
+  aiMatrix4x4::Scaling(aiVector3D(metres_per_unit), scale);
+  ai->mRootNode->mTransformation = scale * ai->mRootNode->mTransformation;
+}
+
+std::string lower_extension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+// The warning for STL facets whose normals were replaced (replace_contradicting_facet_normals);
+// empty when there were none.
+std::string facet_normals_warning(size_t opposite, size_t zero) {
+  const size_t n = opposite + zero;
+  if (n == 0) return {};
+  return fmt::format(
+      "{} facet{} normals that contradict the winding ({} pointing against it, {} zero or "
+      "non-finite): shaded with the facets' geometric normals",
+      n, n == 1 ? " has" : "s have", opposite, zero);
+}
+
 TriangleMesh import_mesh_here(const fs::path& full, const std::string& file,
-                              const std::string& path, bool smooth, size_t* skipped_primitives) {
+                              const std::string& path, bool smooth, size_t* skipped_primitives,
+                              std::vector<std::string>* warnings) {
   Assimp::Importer importer;
   const aiScene* raw = read_checked(importer, full, file, path);
   const bool placeholder = placeholder_meshes(raw);
   const std::vector<std::string> contents = other_contents(raw);
+  const std::string ext = lower_extension(full);
+  if (ext == ".fbx") apply_units(raw, fbx_metres_per_unit(raw, *warnings));
   unsigned flags =
       aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices;
   if (smooth) flags |= aiProcess_GenSmoothNormals;  // ignored where the file has normals
@@ -823,6 +873,12 @@ TriangleMesh import_mesh_here(const fs::path& full, const std::string& file,
     append_mesh(mesh, ai, m, smooth, uv_set, true, file, path, skipped_primitives);
   }
   if (mesh.triangles.empty()) fail_no_triangles(contents, *skipped_primitives, file, path);
+  // Smooth shading keeps the file's normals: an STL file's facet normals are checked first.
+  size_t opposite_normals = 0, zero_normals = 0;
+  if (ext == ".stl") replace_contradicting_facet_normals(mesh, &opposite_normals, &zero_normals);
+  if (std::string w = facet_normals_warning(opposite_normals, zero_normals); !w.empty()) {
+    warnings->push_back(std::move(w));
+  }
   return mesh;
 }
 
@@ -835,9 +891,8 @@ ImportedModel import_model_here(const fs::path& full, const std::string& file,
   const std::vector<std::string> contents = other_contents(raw);
   // Cameras and lights hang off nodes, whose transforms PreTransformVertices removes: read
   // them first.
-  std::string ext = full.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lower_extension(full);
+  if (ext == ".fbx") apply_units(raw, fbx_metres_per_unit(raw, model.warnings));
   read_camera(raw, ext == ".gltf" || ext == ".glb", ext == ".fbx", model);
   read_lights(raw, model);
   // Only FBX: Assimp (5.2) reports the axes of FBX alone, and applies Collada's itself.
@@ -886,12 +941,8 @@ ImportedModel import_model_here(const fs::path& full, const std::string& file,
         without_uvs.size() == 1 ? "" : "es", names, without_uvs.size() == 1 ? "s" : "ve"));
   }
   if (model.parts.empty()) fail_no_triangles(contents, model.skipped_primitives, file, path);
-  if (opposite_normals + zero_normals > 0) {
-    size_t n = opposite_normals + zero_normals;
-    model.warnings.push_back(fmt::format(
-        "{} facet{} normals that contradict the winding ({} pointing against it, {} zero or "
-        "non-finite): shaded with the facets' geometric normals",
-        n, n == 1 ? " has" : "s have", opposite_normals, zero_normals));
+  if (std::string w = facet_normals_warning(opposite_normals, zero_normals); !w.empty()) {
+    model.warnings.push_back(std::move(w));
   }
   return model;
 }
@@ -951,16 +1002,18 @@ std::string import_isolated(const std::function<std::string()>& body, const std:
 }  // namespace
 
 TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
-                         const std::string& path, bool smooth, size_t* skipped_primitives) {
+                         const std::string& path, bool smooth, size_t* skipped_primitives,
+                         std::vector<std::string>* warnings) {
   fs::path full = resolve(file, base_dir, path);
   std::string bytes = import_isolated(
       [&] {
         size_t skipped = 0;
-        TriangleMesh mesh = import_mesh_here(full, file, path, smooth, &skipped);
-        return encode(mesh, skipped);
+        std::vector<std::string> found;
+        TriangleMesh mesh = import_mesh_here(full, file, path, smooth, &skipped, &found);
+        return encode(mesh, skipped, found);
       },
       file, path);
-  return decode_mesh(bytes, skipped_primitives);
+  return decode_mesh(bytes, skipped_primitives, warnings);
 }
 
 ImportedModel import_model(const std::string& file, const std::string& base_dir,

@@ -13,9 +13,12 @@
 namespace rvr::scene_load {
 
 // `file` relative to `base_dir`; `path` is the JSON path for errors. Faces that are not
-// triangles are counted in `skipped_primitives`. All of the file's meshes in one.
+// triangles are counted in `skipped_primitives`; what else was repaired or assumed (STL facet
+// normals that contradict the winding, an unusable FBX unit) is added to `warnings`. All of
+// the file's meshes in one, in metres where the file states its unit (Collada, FBX).
 TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
-                         const std::string& path, bool smooth, size_t* skipped_primitives);
+                         const std::string& path, bool smooth, size_t* skipped_primitives,
+                         std::vector<std::string>* warnings);
 
 // A material's base-colour texture as the model file names it, before it is found and read.
 struct ModelTexture {

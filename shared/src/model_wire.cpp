@@ -157,17 +157,23 @@ EmbeddedImage get_image(Reader& r) {
 
 }  // namespace
 
-std::string encode(const TriangleMesh& mesh, size_t skipped_primitives) {
+std::string encode(const TriangleMesh& mesh, size_t skipped_primitives,
+                   const std::vector<std::string>& warnings) {
   Writer w;
   put(w, mesh);
   w.pod(uint64_t(skipped_primitives));
+  w.pod(uint64_t(warnings.size()));
+  for (const std::string& s : warnings) w.text(s);
   return w.take();
 }
 
-TriangleMesh decode_mesh(const std::string& bytes, size_t* skipped_primitives) {
+TriangleMesh decode_mesh(const std::string& bytes, size_t* skipped_primitives,
+                         std::vector<std::string>* warnings) {
   Reader r(bytes);
   TriangleMesh mesh = get_mesh(r);
   *skipped_primitives += size_t(r.pod<uint64_t>());
+  uint64_t warning_count = r.pod<uint64_t>();
+  for (uint64_t i = 0; i < warning_count; ++i) warnings->push_back(r.text());
   r.expect_end();
   return mesh;
 }

@@ -3,15 +3,19 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "mesh_import.h"
 
 namespace rvr::scene_load {
 
-std::string encode(const TriangleMesh& mesh, size_t skipped_primitives);
+std::string encode(const TriangleMesh& mesh, size_t skipped_primitives,
+                   const std::vector<std::string>& warnings);
 std::string encode(const ImportedModel& model);
 // Throw std::runtime_error on bytes that are not what encode() wrote.
-TriangleMesh decode_mesh(const std::string& bytes, size_t* skipped_primitives);
+// decode_mesh adds to `skipped_primitives` and appends to `warnings`.
+TriangleMesh decode_mesh(const std::string& bytes, size_t* skipped_primitives,
+                         std::vector<std::string>* warnings);
 ImportedModel decode_model(const std::string& bytes);
 
 }  // namespace rvr::scene_load

@@ -450,7 +450,9 @@ class Reader {
         return;
       }
       size_t skipped = 0, dropped = 0, repaired = 0;
-      o.mesh = import_mesh(file, base_dir_, fp, smooth, &skipped);
+      std::vector<std::string> file_warnings;
+      o.mesh = import_mesh(file, base_dir_, fp, smooth, &skipped, &file_warnings);
+      for (const std::string& w : file_warnings) scene_.warnings.push_back(label + ": " + w);
       read_vertex_values(v, path, o.mesh, " of " + quote_json(file) + " as loaded");
       size_t total = o.mesh.triangles.size();
       finish_mesh(o.mesh, t, path, &dropped, &repaired);
