@@ -354,6 +354,96 @@ class Reader {
     for (size_t i = 0; i < v.size(); ++i) read_object(v[i], i);
   }
 
+  // The object's "material": sets o.material, or returns true for "from_file" (a mesh keeps its
+  // file's own materials).
+  bool read_object_material(const json& v, const std::string& path, const std::string& type,
+                            Object& o) {
+    const json* m = find(v, "material");
+    if (!m) return false;
+    std::string mp = key_path(path, "material");
+    const std::string& name = string(*m, mp);
+    if (name == kFromFile) {
+      if (type != "mesh") {
+        fail(mp, "\"from_file\" keeps a mesh file's own materials: only for mesh objects");
+      }
+      return true;
+    }
+    auto it = material_index_.find(name);
+    if (it == material_index_.end()) {
+      std::vector<std::string> known;
+      for (const auto& [k, idx] : material_index_) known.push_back(k);
+      std::string s = suggestion(name, known);
+      fail(mp, "unknown material " + quote_json(name) +
+                   (s.empty() ? "" : " (did you mean '" + s + "'?)"));
+    }
+    o.material = it->second;
+    return false;
+  }
+
+  // A "triangle" object: its three vertices (and their uvs and colours).
+  void read_triangle_object(const json& v, const std::string& path, const Transform& t, Object& o) {
+    o.type = ObjectType::Triangles;
+    std::string vp = key_path(path, "vertices");
+    const json& verts = require(v, path, "vertices");
+    if (!verts.is_array() || verts.size() != 3) {
+      fail(vp, "must be an array of 3 vertices, got " + describe(verts));
+    }
+    for (size_t k = 0; k < 3; ++k) o.mesh.positions.push_back(vec3(verts[k], index_path(vp, k)));
+    o.mesh.triangles.emplace_back(0, 1, 2);
+    read_vertex_values(v, path, o.mesh, "");
+    size_t dropped = 0, repaired = 0;
+    finish_mesh(o.mesh, t, path, &dropped, &repaired);
+    if (dropped > 0) fail(vp, "the triangle is degenerate (zero area)");
+  }
+
+  // A "mesh" object read from its file into o, with the loader's warnings; false when it was
+  // "material": "from_file" and its parts were appended to the scene already.
+  bool read_mesh_object(const json& v, const std::string& path, const Transform& t, bool from_file,
+                        const std::string& label, Object& o) {
+    o.type = ObjectType::Triangles;
+    std::string fp = key_path(path, "file");
+    const std::string& file = string(require(v, path, "file"), fp);
+    bool smooth = false;
+    if (const json* s = find(v, "smooth")) smooth = boolean(*s, key_path(path, "smooth"));
+    if (from_file) {
+      for (const char* k : {"uvs", "colors"}) {
+        if (find(v, k)) {
+          fail(key_path(path, k),
+               "is not allowed with \"material\": \"from_file\" (the "
+               "file's own are kept)");
+        }
+      }
+      read_mesh_from_file(o, file, fp, t, label);
+      return false;
+    }
+    size_t skipped = 0, dropped = 0, repaired = 0;
+    std::vector<std::string> file_warnings;
+    o.mesh = import_mesh(file, base_dir_, fp, smooth, &skipped, &file_warnings);
+    for (const std::string& w : file_warnings)
+      scene_.warnings.push_back(fmt::format("{}: {}", label, w));
+    read_vertex_values(v, path, o.mesh, fmt::format(" of {} as loaded", quote_json(file)));
+    size_t total = o.mesh.triangles.size();
+    finish_mesh(o.mesh, t, path, &dropped, &repaired);
+    if (o.mesh.triangles.empty()) {
+      fail(fp,
+           fmt::format("{}: all {} triangles are degenerate (zero area)", quote_json(file), total));
+    }
+    if (skipped > 0) {
+      scene_.warnings.push_back(
+          fmt::format("{}: ignored {} point/line primitives", label, skipped));
+    }
+    if (dropped > 0) {
+      scene_.warnings.push_back(fmt::format("{}: dropped {} degenerate triangle{}", label, dropped,
+                                            dropped == 1 ? "" : "s"));
+    }
+    if (repaired > 0) {
+      scene_.warnings.push_back(
+          fmt::format("{}: replaced {} zero or non-finite vertex normal{} by face normals", label,
+                      repaired, repaired == 1 ? "" : "s"));
+    }
+    return true;
+  }
+
   // Appends the object to the scene: one, or for a mesh with "material": "from_file" one per
   // material of the file.
   void read_object(const json& v, size_t index) {
@@ -384,29 +474,7 @@ class Reader {
     Object o;
     o.name = type + "#" + std::to_string(index);
     if (const json* n = find(v, "name")) o.name = string(*n, key_path(path, "name"));
-    bool from_file = false;
-    if (const json* m = find(v, "material")) {
-      std::string mp = key_path(path, "material");
-      const std::string& name = string(*m, mp);
-      if (name == kFromFile) {
-        if (type != "mesh") {
-          fail(mp, "\"from_file\" keeps a mesh file's own materials: only for mesh objects");
-        }
-        from_file = true;
-      }
-      auto it = material_index_.find(name);
-      if (from_file) {
-        // the file's materials, read below
-      } else if (it == material_index_.end()) {
-        std::vector<std::string> known;
-        for (const auto& [k, idx] : material_index_) known.push_back(k);
-        std::string s = suggestion(name, known);
-        fail(mp, "unknown material " + quote_json(name) +
-                     (s.empty() ? "" : " (did you mean '" + s + "'?)"));
-      } else {
-        o.material = it->second;
-      }
-    }
+    const bool from_file = read_object_material(v, path, type, o);
     Transform t;
     if (const json* tr = find(v, "transform"))
       t = parse_transform(*tr, key_path(path, "transform"));
@@ -420,59 +488,9 @@ class Reader {
       o.type = ObjectType::Plane;
       o.plane = read_plane(v, path, t);
     } else if (type == "triangle") {
-      o.type = ObjectType::Triangles;
-      std::string vp = key_path(path, "vertices");
-      const json& verts = require(v, path, "vertices");
-      if (!verts.is_array() || verts.size() != 3) {
-        fail(vp, "must be an array of 3 vertices, got " + describe(verts));
-      }
-      for (size_t k = 0; k < 3; ++k) o.mesh.positions.push_back(vec3(verts[k], index_path(vp, k)));
-      o.mesh.triangles.emplace_back(0, 1, 2);
-      read_vertex_values(v, path, o.mesh, "");
-      size_t dropped = 0, repaired = 0;
-      finish_mesh(o.mesh, t, path, &dropped, &repaired);
-      if (dropped > 0) fail(vp, "the triangle is degenerate (zero area)");
+      read_triangle_object(v, path, t, o);
     } else if (type == "mesh") {
-      o.type = ObjectType::Triangles;
-      std::string fp = key_path(path, "file");
-      const std::string& file = string(require(v, path, "file"), fp);
-      bool smooth = false;
-      if (const json* s = find(v, "smooth")) smooth = boolean(*s, key_path(path, "smooth"));
-      if (from_file) {
-        for (const char* k : {"uvs", "colors"}) {
-          if (find(v, k)) {
-            fail(key_path(path, k),
-                 "is not allowed with \"material\": \"from_file\" (the "
-                 "file's own are kept)");
-          }
-        }
-        read_mesh_from_file(o, file, fp, t, label);
-        return;
-      }
-      size_t skipped = 0, dropped = 0, repaired = 0;
-      std::vector<std::string> file_warnings;
-      o.mesh = import_mesh(file, base_dir_, fp, smooth, &skipped, &file_warnings);
-      for (const std::string& w : file_warnings) scene_.warnings.push_back(label + ": " + w);
-      read_vertex_values(v, path, o.mesh, " of " + quote_json(file) + " as loaded");
-      size_t total = o.mesh.triangles.size();
-      finish_mesh(o.mesh, t, path, &dropped, &repaired);
-      if (o.mesh.triangles.empty()) {
-        fail(fp, fmt::format("{}: all {} triangles are degenerate (zero area)", quote_json(file),
-                             total));
-      }
-      if (skipped > 0) {
-        scene_.warnings.push_back(
-            fmt::format("{}: ignored {} point/line primitives", label, skipped));
-      }
-      if (dropped > 0) {
-        scene_.warnings.push_back(fmt::format("{}: dropped {} degenerate triangle{}", label,
-                                              dropped, dropped == 1 ? "" : "s"));
-      }
-      if (repaired > 0) {
-        scene_.warnings.push_back(
-            fmt::format("{}: replaced {} zero or non-finite vertex normal{} by face normals", label,
-                        repaired, repaired == 1 ? "" : "s"));
-      }
+      if (!read_mesh_object(v, path, t, from_file, label, o)) return;
     } else {  // csg
       o.type = ObjectType::Csg;
       o.csg = read_csg_inner(v, path, 1, t);
