@@ -305,6 +305,43 @@ TEST(SoftrasterSetup, EveryProjectionKernelProjectsAsTriangleSetupDoes) {
   EXPECT_GT(scalar_only, 0u);
 }
 
+// A vertex whose projection is not finite (a coordinate the projection overflows, or NaN) has no
+// screen position: a triangle with one is dropped and counted as clipped, whichever of the
+// scalar paths (unclipped, or crossing the near plane) it would otherwise take. Its neighbours
+// made of finite vertices are set up as usual.
+TEST(SoftrasterSetup, TrianglesWithANonFiniteVertexAreDropped) {
+  const int width = 64, height = 48;
+  const glm::dmat4 view_projection =
+      glm::dmat4(glm::perspective(0.9f, float(width) / float(height), 0.1f, 500.0f)) *
+      glm::dmat4(glm::lookAt(glm::vec3(0.0f, 0.0f, 4.0f), glm::vec3(0.0f), glm::vec3(0, 1, 0)));
+  soft::TriangleSetup setup(width, height, view_projection);
+  const float inf = std::numeric_limits<float>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const soft::ProjectedVertex a = setup.project({-1, -1, 0}), b = setup.project({1, -1, 0});
+  const soft::ProjectedVertex c = setup.project({0, 1, 0});
+  const soft::ProjectedVertex behind = setup.project({0, 1, 10});  // behind the eye: clipped
+  ASSERT_EQ(a.clip_planes | b.clip_planes | c.clip_planes, 0u);
+  ASSERT_NE(behind.clip_planes, 0u);
+  soft::SetupTriangles out;
+  size_t clipped = 0;
+  setup.add(a, b, c, 0, 0, out, clipped);
+  ASSERT_EQ(out.size(), 1u);
+  ASSERT_EQ(clipped, 0u);
+  setup.add(a, b, behind, 0, 1, out, clipped);  // clipped, and something remains
+  ASSERT_GT(out.size(), 1u);
+  ASSERT_EQ(clipped, 1u);
+  const size_t before = out.size();
+  for (const glm::vec3 bad : {glm::vec3(nan, 0, 0), glm::vec3(inf, 1, 0), glm::vec3(0, -inf, 0),
+                              glm::vec3(inf, inf, inf), glm::vec3(0, 0, -inf)}) {
+    const soft::ProjectedVertex v = setup.project(bad);
+    clipped = 0;
+    setup.add(a, b, v, 0, 2, out, clipped);
+    setup.add(v, behind, c, 0, 3, out, clipped);
+    EXPECT_EQ(out.size(), before) << bad.x << " " << bad.y << " " << bad.z;
+    EXPECT_EQ(clipped, 2u);
+  }
+}
+
 // SetupTriangle keeps fixed-point vertices in 32 bits: enough for anything inside the guard band
 // (clipping keeps screen positions within kGuardPixels / 2 + width / 2 pixels). A triangle
 // reaching far left is clipped at the guard plane (scalar path); one reaching just inside it is

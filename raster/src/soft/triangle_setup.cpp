@@ -1,8 +1,10 @@
 #include "soft/triangle_setup.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <iterator>
+#include <limits>
 #include <utility>
 
 #include "rvr/shared/check.h"
@@ -21,6 +23,16 @@ inline int64_t round_half_away(double x) {
   if (fraction >= 0.5) ++i;
   if (fraction <= -0.5) --i;
   return i;
+}
+
+// A vertex the rasterizer can place: finite clip coordinates and, where it is not clipped, a
+// finite screen position. Others (coordinates overflowing the projection) have no position, and
+// a triangle with one is dropped.
+bool placeable(const ProjectedVertex& v) {
+  const glm::dvec4& c = v.clip;
+  if (!(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w)))
+    return false;
+  return v.clip_planes != 0 || (std::isfinite(v.sx) && std::isfinite(v.sy));
 }
 
 }  // namespace
@@ -59,6 +71,12 @@ ProjectedVertex TriangleSetup::project(const glm::vec3& p) const {
     // Viewport with y flipped: row 0 is the top.
     v.sx = (k.x / k.w * 0.5 + 0.5) * width_;
     v.sy = (0.5 - k.y / k.w * 0.5) * height_;
+    if (!std::isfinite(v.sx) || !std::isfinite(v.sy)) {
+      // Not placeable: a fixed point outside every range, so that the batch path hands the
+      // triangle to add(), which drops it.
+      v.fx = v.fy = std::numeric_limits<int64_t>::min();
+      return v;
+    }
     v.fx = round_half_away(v.sx * double(kSub));
     v.fy = round_half_away(v.sy * double(kSub));
     RVR_DCHECK(std::abs(v.fx) < (int64_t(1) << 28) && std::abs(v.fy) < (int64_t(1) << 28),
@@ -72,7 +90,7 @@ void TriangleSetup::add(const ProjectedVertex& a, const ProjectedVertex& b,
                         const ProjectedVertex& c, uint32_t object, uint32_t primitive,
                         SetupTriangles& out, size_t& clipped) {
   // Trivial reject against the view frustum; then clip only where a plane is crossed.
-  if (a.reject & b.reject & c.reject) {
+  if ((a.reject & b.reject & c.reject) || !placeable(a) || !placeable(b) || !placeable(c)) {
     ++clipped;
     return;
   }

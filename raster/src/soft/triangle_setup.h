@@ -23,7 +23,7 @@ constexpr int kMaxImageSide = 1 << 15;
 struct ProjectedVertex {
   glm::dvec4 clip;
   double sx = 0, sy = 0;     // screen position, y down
-  int64_t fx = 0, fy = 0;    // the same in fixed point
+  int64_t fx = 0, fy = 0;    // the same in fixed point (INT64_MIN: not finite)
   double inv_w = 0;          // 1 / clip.w
   uint32_t reject = 0;       // bit p: outside frustum plane p (all three: the triangle is culled)
   uint32_t clip_planes = 0;  // bit p: outside near or guard plane p (any: the triangle is clipped)
