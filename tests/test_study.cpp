@@ -41,6 +41,7 @@
 #include "rvr/study/study_json.h"
 #include "rvr/study/study_markdown.h"
 #include "rvr/study/sweep_plan.h"
+#include "loglog_chart.h"
 
 using namespace rvr;
 using namespace rvr::study;
@@ -1088,4 +1089,38 @@ TEST(StudyRun, ShardsMeasureEveryPlannedPointOnce) {
   ASSERT_TRUE(whole.ok());
   EXPECT_FALSE(whole->shard.has_value());
   EXPECT_GT(whole->points.size(), 2 * planned.size()) << "the whole adds points near crossovers";
+}
+
+// A model with no positive time over a chart's x range cannot be drawn on a log axis: the chart
+// says so in its place (a label naming the renderer), while a model positive somewhere is drawn
+// as a path over the positive part only.
+TEST(StudyChart, AModelWithNoPositiveTimeIsSaidNotSilentlyLeftOut) {
+  ChartSpec spec;
+  spec.id = "c";
+  spec.title = "t";
+  spec.x_label = "N";
+  spec.y_label = "s";
+  spec.swept_low = 10;
+  spec.swept_high = 1e4;
+  ChartSeries below, crossing;
+  below.name = "below";
+  below.colour = "#111";
+  below.points = {{10, 1e-3, 1e-3, 1e-3, ""}, {1e4, 2e-3, 2e-3, 2e-3, ""}};
+  below.model = [](double x) { return 1e-3 - 1e-6 * x - 1e-2; };  // negative everywhere
+  crossing = below;
+  crossing.name = "crossing";
+  crossing.fits = true;
+  crossing.model = [](double x) { return 1e-6 * x - 1e-4; };  // positive above x = 100
+  spec.series = {below, crossing};
+  const std::string svg = loglog_chart_svg(spec);
+  auto count = [&](const std::string& what) {
+    size_t n = 0;
+    for (size_t at = svg.find(what); at != std::string::npos; at = svg.find(what, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("class=\"model-label model-not-positive\""), 1u) << svg;
+  EXPECT_EQ(count("below: model not positive over this range (does not fit)"), 1u);
+  EXPECT_EQ(count("<path class=\"model no-fit\" data-renderer=\"below\""), 0u);
+  EXPECT_EQ(count("<path class=\"model fits\" data-renderer=\"crossing\""), 1u);
+  EXPECT_EQ(count("crossing: model not positive"), 0u);
 }

@@ -211,7 +211,8 @@ std::string crossing_svg(const Frame& f, const ChartCrossing& c, int index, doub
 }
 
 // The model's curve over the whole x axis, broken where it is not a positive time; dashed and
-// labelled when the model does not fit, the label `row` lines above the curve's end.
+// labelled when the model does not fit, the label `row` lines above the curve's end. A model
+// with no positive time on the axis is a label in the chart's corner, `row` lines down.
 std::string curve_svg(const Frame& f, const ChartSeries& s, int row) {
   std::string d;
   bool pen_down = false;
@@ -230,7 +231,12 @@ std::string curve_svg(const Frame& f, const ChartSeries& s, int row) {
     pen_down = true;
     if (y >= Frame::top() + 10 && y <= Frame::bottom()) label_x = f.px(x), label_y = y;
   }
-  if (d.empty()) return "";
+  if (d.empty())  // no positive time anywhere on the axis: said, rather than silently absent
+    return fmt::format(
+        "<text class=\"model-label model-not-positive\" x=\"{:.1f}\" y=\"{:.1f}\" "
+        "fill=\"{}\">{}: model not positive over this range{}</text>",
+        Frame::left() + 8, Frame::top() + 14 + 15 * row, s.colour, escape_html(s.name),
+        s.fits ? "" : " (does not fit)");
   std::string o = fmt::format(
       "<path class=\"model {}\" data-renderer=\"{}\" d=\"{}\" stroke=\"{}\"{}><title>{} model{}"
       "</title></path>",

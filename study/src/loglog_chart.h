@@ -42,7 +42,8 @@ struct ChartSpec {
 
 // The chart as an <svg class="study-chart"> element: decades ticked and labelled 10^k, the
 // points as circle.mark (with a line.spread each) in a g.series per series, the models as
-// path.model, the crossings as g.crossover with rect.ci-band and line.crossover-line.
+// path.model (or text.model-not-positive where a model has no positive time on the x axis), the
+// crossings as g.crossover with rect.ci-band and line.crossover-line.
 std::string loglog_chart_svg(const ChartSpec& spec);
 
 }  // namespace rvr::study

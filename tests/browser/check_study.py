@@ -42,7 +42,8 @@ PAGE_PROBE = r"""
         models: Array.from(g.querySelectorAll('path.model')).map(p => ({
           fits: p.classList.contains('fits'),
           dashed: (p.getAttribute('stroke-dasharray') || '') !== '',
-          length: p.getTotalLength()}))})),
+          length: p.getTotalLength()})),
+        notPositive: g.querySelectorAll('text.model-not-positive').length})),
       crossovers: Array.from(svg.querySelectorAll('g.crossover')).map(g => ({
         measured: g.dataset.measured === 'true',
         bands: g.querySelectorAll('rect.ci-band').length,
@@ -133,6 +134,10 @@ def chart_problems(study, scene, label, chart, counts, crossovers):
                              for c in fit.get("coefficients", {}).values())
         if fitted:
             models = s["models"]
+            # A model that does not fit may predict no positive time over this chart's range
+            # (a negative slope from noise): the chart must then say so in place of the curve.
+            if not models and not fit["fits"] and s["notPositive"] == 1:
+                continue
             if len(models) != 1 or models[0]["length"] <= 0:
                 problems.append(f"{where}: {name}'s model curve is missing or not drawn")
             elif models[0]["fits"] != fit["fits"] or models[0]["dashed"] == fit["fits"]:
