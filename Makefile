@@ -146,15 +146,16 @@ format:
 # LINT_EXCLUDE (regular expressions; LINT_EXCLUDE empty: none left out). Any finding fails.
 LINT_FILES ?= $(CURDIR)/(apps|shared|raster|raytrace|hybrid|renderers|study|image_codec|bench)/
 LINT_EXCLUDE ?=
-# Then include-what-you-use on LINT_IWYU_DIRS (tools/iwyu.imp maps glm's, nlohmann's, CLI11's
-# and libstdc++'s internal headers to their public ones): any include to add or remove fails.
-LINT_IWYU_DIRS ?= apps/rvr
+# Then include-what-you-use on LINT_IWYU_DIRS (tools/iwyu.imp maps the libraries' and libstdc++'s
+# internal headers to their public ones): any include to add or remove fails, and so does iwyu
+# failing on a file (a fatal error or an assertion leaves the file unchecked).
+LINT_IWYU_DIRS ?= apps shared raster raytrace hybrid renderers study image_codec bench python
 lint: build
 	run-clang-tidy-14 -p $(BUILD_DIR) -j $(JOBS) -quiet \
 		$$(/usr/bin/python3 tools/lint_files.py $(BUILD_DIR)/compile_commands.json '$(LINT_FILES)' '$(LINT_EXCLUDE)')
 	iwyu_tool -p $(BUILD_DIR) -j $(JOBS) $(LINT_IWYU_DIRS) -- -Xiwyu --no_fwd_decls -Xiwyu --cxx17ns \
 		-Xiwyu --mapping_file=$(CURDIR)/tools/iwyu.imp > $(BUILD_DIR)/iwyu.txt 2>&1 || true
-	@if grep -q 'should \(add\|remove\) these lines' $(BUILD_DIR)/iwyu.txt; then \
+	@if grep -q 'should \(add\|remove\) these lines\|fatal error\|Assertion failed' $(BUILD_DIR)/iwyu.txt; then \
 		cat $(BUILD_DIR)/iwyu.txt; echo "lint: include-what-you-use asks for changes in $(LINT_IWYU_DIRS)"; exit 1; fi
 
 clean:

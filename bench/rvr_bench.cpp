@@ -28,6 +28,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <glm/glm.hpp>
 #include <initializer_list>
 #include <map>
 #include <memory>
@@ -38,13 +42,23 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/raytrace/bvh.h"
+#include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/raytrace/trace_geometry.h"
+#include "rvr/raytrace/wide_bvh.h"
+#include "rvr/raytrace/wide_bvh_layout.h"
+#include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/camera.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/isa.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/texture.h"
 
 using namespace rvr;
 

@@ -1,5 +1,8 @@
 #include "errors.h"
 
+#include <Python.h>
+#include <pybind11/pybind11.h>
+
 #include "bindings.h"
 
 namespace rvr::python {

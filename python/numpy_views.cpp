@@ -1,5 +1,7 @@
 #include "numpy_views.h"
 
+#include <utility>
+
 namespace py = pybind11;
 
 namespace rvr::python {

@@ -1,16 +1,24 @@
 // rvr.compare and rvr.diff: `rvr compare`'s metrics.json for two renders, `rvr diff` for two
 // image files, through the libraries the command line uses.
-#include <pybind11/stl.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>  // IWYU pragma: keep (type casters for std containers)
 
+#include <array>
+#include <memory>
 #include <optional>
+#include <string>
 
 #include "bindings.h"
 #include "errors.h"
 #include "py_render.h"
+#include "render_stats.h"
+#include "report.h"
 #include "report_input.h"
 #include "rvr/renderers/compare_renderers.h"
 #include "rvr/shared/compare.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/renderer.h"
 
 namespace py = pybind11;
 

@@ -2,12 +2,18 @@
 // GIL released.
 #include "py_render.h"
 
-#include <pybind11/stl.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>  // IWYU pragma: keep (type casters for std containers)
+#include <stdint.h>
+#include <unistd.h>
 
-#include <cstdio>
+#include <array>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <glm/glm.hpp>
+#include <utility>
+#include <variant>
+#include <vector>
 
 #include "bindings.h"
 #include "errors.h"
@@ -16,6 +22,7 @@
 #include "render_job.h"
 #include "render_kwargs.h"
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/limits.h"
 

@@ -1,15 +1,25 @@
 // rvr.Scene and rvr.scenes(): scenes loaded through the command line's loader.
 #include "py_scene.h"
 
-#include <pybind11/stl.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>  // IWYU pragma: keep (type casters for std containers)
 
+#include <array>
+#include <cmath>
 #include <filesystem>
+#include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "bindings.h"
 #include "errors.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/image_sample.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/renderer.h"
 #include "rvr/shared/scene_for_render.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/scene_writer.h"

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <memory>
-#include <string>
 
 #include "rvr/shared/limits.h"
 #include "rvr/shared/scene.h"

@@ -1,17 +1,29 @@
 // rvr.study: `rvr study`'s sweep, fits and conclusions, returned as the study.json document.
 // The study runs on a thread of its own; Ctrl-C sets the study's own cancel hook (polled between
 // frames), the thread is joined and KeyboardInterrupt raised.
-#include <pybind11/stl.h>
+#include <Python.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>  // IWYU pragma: keep (type casters for std containers)
+#include <stdint.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
+#include <exception>
+#include <functional>
+#include <string>
 #include <thread>
+#include <variant>
+#include <vector>
 
 #include "bindings.h"
 #include "errors.h"
 #include "render_kwargs.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/renderer.h"
 #include "rvr/study/renderer_frames.h"
 #include "rvr/study/run_study.h"
+#include "rvr/study/study.h"
 #include "rvr/study/study_json.h"
 #include "study_setup.h"
 

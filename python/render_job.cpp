@@ -1,12 +1,17 @@
 #include "render_job.h"
 
+#include <Python.h>
 #include <pybind11/pybind11.h>
 
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <exception>
 #include <mutex>
+#include <new>
+#include <string>
 #include <thread>
+#include <utility>
 
 #include "rvr/shared/progress.h"
 #include "rvr/shared/timer.h"

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <variant>
 
 #include "rvr/shared/expected.h"
 #include "rvr/shared/renderer.h"

@@ -1,9 +1,14 @@
 #include "render_kwargs.h"
 
+#include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <map>
+#include <optional>
+#include <utility>
 
 #include "errors.h"
+#include "rvr/shared/gl_backend.h"
 
 namespace py = pybind11;
 

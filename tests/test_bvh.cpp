@@ -2,17 +2,34 @@
 // every SIMD kernel this CPU can run, and the binary one. Ties at equal t go to the lowest
 // primitive index in all three, so hits agree to the bit, primitive included.
 #include <gtest/gtest.h>
+#include <stdint.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <functional>
+#include <glm/glm.hpp>
+#include <initializer_list>
+#include <memory>
+#include <optional>
 #include <random>
+#include <string>
 #include <tuple>
+#include <vector>
 
+#include "rvr/raytrace/bvh.h"
+#include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/trace_geometry.h"
+#include "rvr/raytrace/wide_bvh.h"
+#include "rvr/raytrace/wide_bvh_layout.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/isa.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/texture.h"
 
 using namespace rvr;
 

@@ -2,6 +2,8 @@
 // the condition, the caller's message and file:line; a kept one costs nothing visible.
 #include <gtest/gtest.h>
 
+#include <memory>
+
 #include "rvr/shared/check.h"
 
 namespace {

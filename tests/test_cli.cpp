@@ -9,19 +9,25 @@
 
 #include <algorithm>
 #include <chrono>
+#include <compare>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
 #include <string>
 #include <thread>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "model_corpus.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/html_escape.h"
 #include "rvr/shared/image_io.h"
 

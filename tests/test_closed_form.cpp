@@ -6,16 +6,30 @@
 // the expected values, so a wrong term shared by the C++ and the GLSL fails here even though
 // every renderer agrees with every other.
 #include <gtest/gtest.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <functional>
+#include <glm/glm.hpp>
+#include <initializer_list>
 #include <map>
+#include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "closed_form_oracle.h"
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/gl_backend.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/tessellate.h"
 
 namespace rvr {

@@ -6,17 +6,23 @@
 // from its definition (window z = f (d - n) / (d (f - n)); d24: round(z * (2^24 - 1)); d32f:
 // float(z); reversed: float(n (f - d) / (d (f - n)))), at the analytic depths of the two planes.
 #include <gtest/gtest.h>
+#include <stddef.h>
 
 #include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
+#include <initializer_list>
+#include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
-#include "rvr/shared/camera.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
 #include "scene_builders.h"

@@ -5,15 +5,21 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <fstream>  // IWYU pragma: keep (std::ifstream/ofstream: iwyu takes <iosfwd> for them)
+#include <initializer_list>
 #include <iterator>
 #include <set>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "fuzz/fuzz_common.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/scene.h"
 
 namespace fs = std::filesystem;
 

@@ -1,5 +1,6 @@
 // Image I/O (OpenImageIO, atomic writes, AOVs) and the comparison metrics.
 #include <gtest/gtest.h>
+#include <stdint.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -7,14 +8,20 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <glm/glm.hpp>
+#include <initializer_list>
 #include <limits>
 #include <random>
-#include <sstream>
 #include <string>
+#include <system_error>
+#include <utility>
 #include <vector>
 
 #include "rvr/shared/compare.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/mismatch_classes.h"
 
 namespace fs = std::filesystem;
 using namespace rvr;

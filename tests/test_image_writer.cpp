@@ -4,18 +4,23 @@
 // bit. The reference is the library rvr wrote with before the light writer existed, not the
 // code under test.
 #include <gtest/gtest.h>
+#include <stdint.h>
 #include <unistd.h>
 
-#include <cmath>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
 
 namespace fs = std::filesystem;

@@ -1,10 +1,17 @@
 // Ray-primitive tests against analytic answers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <glm/glm.hpp>
+#include <initializer_list>
 #include <random>
+#include <string>
 
 #include "rvr/raytrace/intersect.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/tessellate.h"
+#include "rvr/shared/texture.h"
 
 using namespace rvr;
 

@@ -6,17 +6,33 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstring>
+#include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
+#include <initializer_list>
 #include <limits>
+#include <map>
+#include <memory>
+#include <optional>
 #include <random>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/isa.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "soft/fill_dispatch.h"
+#include "soft/fill_kernel.h"
+#include "soft/setup_kernel.h"
+#include "soft/setup_triangle.h"
 #include "soft/triangle_setup.h"
 
 using namespace rvr;

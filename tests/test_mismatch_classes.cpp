@@ -5,13 +5,16 @@
 // pixels, so a point (X, Y, -Z) projects to pixel position (8 (X/Z + 1), 8 (1 - Y/Z)): a square
 // of half-size Z/2 at depth Z covers pixels 4..11 in x and y, its outline on pixel boundaries.
 #include <gtest/gtest.h>
+#include <stddef.h>
 
-#include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <initializer_list>
+#include <utility>
 #include <vector>
 
 #include "rvr/shared/compare.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
 #include "rvr/shared/mismatch_classes.h"
 #include "rvr/shared/scene.h"

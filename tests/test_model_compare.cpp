@@ -5,20 +5,25 @@
 // corpus and of scenes/models through both z-buffers, with the loader's warnings in metrics.json.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
+#include <array>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <glm/glm.hpp>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
-#include <sstream>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "model_corpus.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 
 namespace fs = std::filesystem;

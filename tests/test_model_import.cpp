@@ -6,21 +6,32 @@
 #include <assimp/scene.h>
 #include <gtest/gtest.h>
 #include <sys/resource.h>
-#include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <assimp/Importer.hpp>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <glm/glm.hpp>
 #include <glm/gtc/constants.hpp>
+#include <initializer_list>
+#include <memory>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "model_corpus.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/camera.h"
 #include "rvr/shared/camera_framing.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
+#include "rvr/shared/image_sample.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 
 namespace fs = std::filesystem;

@@ -4,20 +4,28 @@
 // as exporters write them. Expected values are the ones written into the files: texels are the
 // PNG's bytes decoded by the closed form of sRGB, bottom row first; uvs and colours per vertex.
 #include <gtest/gtest.h>
+#include <stddef.h>
+#include <stdint.h>
 
+#include <array>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <glm/glm.hpp>
-#include <sstream>
+#include <initializer_list>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "model_corpus.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/scene_writer.h"
 #include "rvr/shared/surface_colour.h"
+#include "rvr/shared/texture.h"
 
 namespace fs = std::filesystem;
 namespace corpus = rvr::test::corpus;

@@ -2,10 +2,23 @@
 // every mode, and a mesh of degenerate triangles and zero-length normals that the loader would
 // have dropped or refused (a hand-built scene reaches the renderers without it).
 #include <gtest/gtest.h>
+#include <stddef.h>
 
+#include <algorithm>
 #include <cmath>
+#include <glm/glm.hpp>
+#include <initializer_list>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "scene_builders.h"
 

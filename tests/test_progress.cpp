@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <poll.h>
+#include <signal.h>
 #include <sys/ioctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,15 +19,21 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
-#include <sstream>
+#include <string>
 #include <thread>
-#include <utility>
 #include <vector>
 
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/gl_backend.h"
 #include "rvr/shared/progress.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "terminal_progress.h"
 

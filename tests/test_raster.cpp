@@ -4,14 +4,27 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <limits>
+#include <map>
+#include <memory>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/shared/camera.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/gl_backend.h"
+#include "rvr/shared/image_sample.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/tessellate.h"

@@ -5,8 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <glm/glm.hpp>
+#include <initializer_list>
+#include <memory>
 
 #include "ray_footprint.h"
+#include "rvr/shared/texture.h"
 
 using namespace rvr;
 

@@ -3,16 +3,26 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
+#include <iterator>
 #include <limits>
+#include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <system_error>
+#include <vector>
 
 #include "base64.h"
 #include "report.h"
+#include "rvr/shared/compare.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/mismatch_classes.h"
 
 namespace fs = std::filesystem;
 using namespace rvr;
@@ -271,11 +281,10 @@ TEST_F(ReportDir, HtmlIsSelfContained) {
   // Warnings are shown, escaped.
   EXPECT_NE(h.find("csg objects skipped: &lt;1&gt; &amp; &quot;more&quot;"), std::string::npos);
   EXPECT_EQ(h.find("<1>"), std::string::npos);
-  for (const char* word :
-       {"id_agreement", "covered_fraction", "mismatch_classes.occlusion", "max_rel_error",
-        "psnr_db", "ssim", "time.render", "time.build", "diff.png", "id_mismatch.png",
-        "depth_diff.png", "mismatch_classes.png", "raytrace: nearly all &lt;background&gt;",
-        "depth_precision: both hit"})
+  for (const char* word : {"id_agreement", "covered_fraction", "mismatch_classes.occlusion",
+                           "max_rel_error", "psnr_db", "ssim", "time.render", "time.build",
+                           "diff.png", "id_mismatch.png", "depth_diff.png", "mismatch_classes.png",
+                           "raytrace: nearly all &lt;background&gt;", "depth_precision: both hit"})
     EXPECT_NE(h.find(word), std::string::npos) << word;
   EXPECT_NE(h.find("</html>"), std::string::npos);
 }

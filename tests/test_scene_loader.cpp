@@ -3,20 +3,34 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
+#include <fstream>  // IWYU pragma: keep (std::ifstream/ofstream: iwyu takes <iosfwd> for them)
 #include <glm/glm.hpp>
+#include <initializer_list>
+#include <memory>
+#include <optional>
+#include <sstream>
 #include <string>
+#include <system_error>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/scene_writer.h"
+#include "rvr/shared/texture.h"
 
 namespace fs = std::filesystem;
 using rvr::Expected;

@@ -3,16 +3,26 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/glm.hpp>
+#include <initializer_list>
+#include <memory>
 #include <string>
+#include <variant>
 #include <vector>
 
+#include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/scene_writer.h"
+#include "rvr/shared/texture.h"
 
 namespace fs = std::filesystem;
 using namespace rvr;

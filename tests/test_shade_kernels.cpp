@@ -4,7 +4,11 @@
 // cases, so an image cannot depend on the kernel, and softraster and the tracer compute the same
 // colour for the same surface point.
 #include <gtest/gtest.h>
+#include <stdint.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <glm/glm.hpp>
 #include <limits>
@@ -13,7 +17,9 @@
 #include <string>
 #include <vector>
 
+#include "rvr/shared/expected.h"
 #include "rvr/shared/isa.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/shade_batch.h"
 #include "rvr/shared/shade_kernel.h"
 #include "rvr/shared/shading.h"

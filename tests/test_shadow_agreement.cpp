@@ -1,18 +1,29 @@
 // Shadow maps (raster) against shadow rays (tracer) on the Cornell box: whether each pixel is
 // lit, partly lit or shadowed by the area light must agree almost everywhere.
 #include <gtest/gtest.h>
+#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <glm/glm.hpp>
 #include <initializer_list>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "closed_form_oracle.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/image_sample.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 
 namespace rvr {

@@ -1,17 +1,31 @@
 // SoftRasterizer: the top-left fill rule, near-plane clipping, orientation, determinism across
 // thread counts, agreement with the GL rasterizer and the ray tracer, and the cost AOV.
 #include <gtest/gtest.h>
+#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <glm/glm.hpp>
-#include <limits>
+#include <initializer_list>
+#include <map>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/image_sample.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/mismatch_classes.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "scene_builders.h"
 #include "visibility_frame.h"

@@ -2,11 +2,14 @@
 // 8-bit images were always written): every float of the pow branch, and the linear branch and
 // the ends sampled. Any differing float would change the bytes of every PNG rvr writes.
 #include <gtest/gtest.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
+#include <memory>
 
 #include "rvr/shared/srgb.h"
 

@@ -14,20 +14,29 @@
 // - no interval band drawn for a crossover: MarksTheCrossoverWithItsInterval.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <stddef.h>
+#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <glm/glm.hpp>
+#include <initializer_list>
 #include <limits>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
 #include "rvr/shared/camera.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/texture.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/cost_model.h"
@@ -35,8 +44,10 @@
 #include "rvr/study/fit.h"
 #include "rvr/study/grid_of_copies.h"
 #include "rvr/study/least_squares.h"
+#include "rvr/study/measurement.h"
 #include "rvr/study/merge.h"
 #include "rvr/study/run_study.h"
+#include "rvr/study/study.h"
 #include "rvr/study/study_html.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/study_markdown.h"

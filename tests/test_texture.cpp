@@ -7,8 +7,12 @@
 
 #include <cmath>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <limits>
+#include <memory>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "rvr/shared/scene.h"
 #include "rvr/shared/texture.h"

@@ -9,18 +9,29 @@
 #include <cmath>
 #include <cstdlib>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "closed_form_oracle.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/shared/compare.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/gl_backend.h"
+#include "rvr/shared/image_sample.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
+#include "rvr/shared/texture.h"
 
 namespace rvr {
 namespace {

@@ -1,16 +1,36 @@
 // The tracer's images checked against geometry worked out by hand: shadows, mirrors, CSG,
 // and the same bytes whatever the thread count.
 #include <gtest/gtest.h>
+#include <stdint.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstring>
+#include <glm/glm.hpp>
+#include <initializer_list>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/raytrace/trace_geometry.h"
+#include "rvr/raytrace/wide_bvh_layout.h"
 #include "rvr/shared/camera.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/shading.h"
+#include "rvr/shared/texture.h"
 #include "scene_builders.h"
 
 using namespace rvr;

@@ -1,13 +1,25 @@
 // Refraction, depth of field and soft shadows against closed-form optics.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <glm/glm.hpp>
+#include <initializer_list>
+#include <map>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
-#include "rvr/raytrace/intersect.h"
+#include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/camera.h"
-#include "rvr/shared/shading.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "scene_builders.h"
 
 using namespace rvr;

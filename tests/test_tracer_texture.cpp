@@ -5,16 +5,30 @@
 // bilinearly with --texture-lod none; a vertex-coloured triangle interpolated per pixel, seen
 // directly and in a mirror.
 #include <gtest/gtest.h>
+#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <glm/glm.hpp>
+#include <initializer_list>
+#include <memory>
 #include <optional>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
+#include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/surface_colour.h"
+#include "rvr/shared/texture.h"
 #include "scene_builders.h"
 
 using namespace rvr;

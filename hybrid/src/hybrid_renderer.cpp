@@ -1,14 +1,25 @@
 #include "rvr/hybrid/hybrid_renderer.h"
 
+#include <stddef.h>
+
 #include <chrono>
+#include <glm/glm.hpp>
+#include <map>
+#include <optional>
+#include <span>
 #include <string>
+#include <utility>
+#include <variant>
 #include <vector>
 
+#include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/shared/check.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_sample.h"
+#include "rvr/shared/isa.h"
 #include "rvr/shared/progress.h"
 #include "rvr/shared/timer.h"
 

@@ -4,6 +4,8 @@
 // name. Anything else (alpha, which OpenImageIO un-premultiplies in PNG; unnamed EXR channels)
 // is declined and goes to OpenImageIO. Exceptions and libpng's longjmp never cross the C
 // boundary.
+#include <ImfCompression.h>
+#include <ImfPixelType.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
@@ -18,7 +20,7 @@
 #include <exception>
 #include <set>
 #include <string>
-#include <vector>
+#include <utility>
 
 #include "rvr/image_codec/image_writer_abi.h"
 

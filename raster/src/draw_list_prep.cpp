@@ -2,8 +2,10 @@
 #include "draw_list_prep.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
 #include <algorithm>
+#include <glm/glm.hpp>
 
 #include "rvr/shared/check.h"
 #include "rvr/shared/tessellate.h"

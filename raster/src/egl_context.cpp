@@ -8,16 +8,18 @@
 // makes an X11 display object. We need ten functions, looked up with dlsym.
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
+#include <EGL/eglplatform.h>
 #include <dlfcn.h>
 #include <fmt/format.h>
-#include <glad/gl.h>
 
-#include <cstdlib>
+#include <memory>
 #include <string>
 #include <type_traits>
+#include <utility>
 
 #include "gl_check.h"
 #include "gl_context.h"
+#include "rvr/shared/expected.h"
 
 namespace rvr {
 

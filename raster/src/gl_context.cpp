@@ -5,6 +5,7 @@
 #include <cassert>
 #include <cstdlib>
 #include <string_view>
+#include <variant>
 
 #include "gl_check.h"
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "rvr/raster/gl_rasterizer.h"
 #include "rvr/shared/expected.h"
+#include "rvr/shared/gl_backend.h"
 
 namespace rvr {
 

@@ -1,8 +1,11 @@
 #include "gl_program.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
 #include <string>
+
+#include "gl_check.h"
 
 namespace rvr {
 

@@ -1,7 +1,8 @@
 // Shader compilation and linking; failures carry the driver's info log.
 #pragma once
 
-#include "gl_check.h"
+#include <glad/gl.h>
+
 #include "rvr/shared/expected.h"
 
 namespace rvr {

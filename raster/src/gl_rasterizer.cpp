@@ -1,22 +1,28 @@
 #include "rvr/raster/gl_rasterizer.h"
 
 #include <fmt/format.h>
+#include <glad/gl.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <initializer_list>
 #include <limits>
+#include <map>
 #include <memory>
 #include <new>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "draw_list_prep.h"
@@ -25,8 +31,11 @@
 #include "gl_program.h"
 #include "gl_shaders.h"
 #include "rvr/shared/camera.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_sample.h"
+#include "rvr/shared/progress.h"
 #include "rvr/shared/surface_colour.h"
+#include "rvr/shared/texture.h"
 #include "rvr/shared/timer.h"
 
 namespace rvr {

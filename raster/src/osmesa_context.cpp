@@ -10,12 +10,15 @@
 #include <fmt/format.h>
 
 #include <cstdlib>
+#include <memory>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "gl_check.h"
 #include "gl_context.h"
+#include "rvr/shared/expected.h"
 
 namespace rvr {
 

@@ -1,27 +1,31 @@
 #include "rvr/raster/soft_rasterizer.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
-#include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <map>
 #include <new>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "draw_list_prep.h"
 #include "rvr/shared/camera.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_sample.h"
+#include "rvr/shared/isa.h"
+#include "rvr/shared/progress.h"
 #include "rvr/shared/shade_kernel.h"
 #include "rvr/shared/shading.h"
 #include "rvr/shared/surface_colour.h"
@@ -29,9 +33,11 @@
 #include "soft/deferred_shading.h"
 #include "soft/draw_triangles.h"
 #include "soft/fill_dispatch.h"
+#include "soft/fill_kernel.h"
 #include "soft/shadow_cube.h"
 #include "soft/surface_texture.h"
 #include "soft/tile_raster.h"
+#include "soft/triangle_setup.h"
 
 namespace rvr {
 

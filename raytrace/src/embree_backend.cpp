@@ -3,12 +3,17 @@
 #include <embree3/rtcore.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <glm/glm.hpp>
 #include <limits>
+#include <memory>
 #include <vector>
 
+#include "rvr/raytrace/bvh.h"
 #include "rvr/shared/check.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 

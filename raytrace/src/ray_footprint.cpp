@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "rvr/shared/check.h"
 #include "rvr/shared/surface_colour.h"

@@ -1,9 +1,11 @@
 #include "rvr/raytrace/trace_geometry.h"
 
-#include <algorithm>
 #include <cmath>
+#include <initializer_list>
+#include <type_traits>
 
 #include "embree_backend.h"
+#include "rvr/raytrace/traversal_kernels.h"
 #include "rvr/shared/check.h"
 #include "rvr/shared/tessellate.h"
 

@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <glm/glm.hpp>
+#include <memory>
+#include <string>
 
 #include "rvr/shared/check.h"
 

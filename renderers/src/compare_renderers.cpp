@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/mismatch_classes.h"
 #include "rvr/shared/timer.h"
 

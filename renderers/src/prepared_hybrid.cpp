@@ -1,5 +1,7 @@
 #include "prepared_hybrid.h"
 
+#include <variant>
+
 #include "prepared_over_geometry.h"
 
 namespace rvr {

@@ -6,6 +6,10 @@
 
 #include "rvr/hybrid/hybrid_renderer.h"
 #include "rvr/renderers/prepared_renderer.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/gl_backend.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 

@@ -1,6 +1,11 @@
 #include "rvr/renderers/prepared_renderer.h"
 
+#include <memory>
+#include <type_traits>
+#include <utility>
+
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 

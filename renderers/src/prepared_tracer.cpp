@@ -1,5 +1,7 @@
 #include "prepared_tracer.h"
 
+#include <variant>
+
 #include "prepared_over_geometry.h"
 #include "rvr/raytrace/ray_tracer.h"
 

@@ -4,6 +4,9 @@
 #include <memory>
 
 #include "rvr/renderers/prepared_renderer.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 

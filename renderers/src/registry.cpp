@@ -5,6 +5,8 @@
 
 #include <memory>
 #include <set>
+#include <utility>
+#include <variant>
 
 #include "prepared_hybrid.h"
 #include "prepared_tracer.h"

@@ -1,14 +1,24 @@
 // The built-in scenes: small, deterministic, and chosen to stress one axis each
 // (cornell: everything; spheres: analytic shapes; occluders: depth complexity; soup and
 // tessphere: triangle count).
+#include <stddef.h>
+
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <memory>
 #include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
 
+#include "rvr/shared/expected.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/shared/tessellate.h"
+#include "rvr/shared/texture.h"
 
 namespace rvr {
 namespace {

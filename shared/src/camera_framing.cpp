@@ -2,7 +2,11 @@
 #include "rvr/shared/camera_framing.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
+#include <utility>
+#include <vector>
 
 #include "rvr/shared/tessellate.h"
 

@@ -5,7 +5,7 @@
 
 #include <cstdio>
 #include <cstdlib>
-#include <sstream>
+#include <sstream>  // IWYU pragma: keep (std::ostringstream; iwyu takes <ostream> for it)
 #include <string>
 
 namespace rvr::detail {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <exception>
+#include <glm/glm.hpp>
 #include <limits>
 #include <span>
 #include <string>

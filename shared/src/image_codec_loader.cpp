@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <climits>
+#include <initializer_list>
 #include <mutex>
 #include <string>
 

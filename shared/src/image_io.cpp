@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -17,15 +19,19 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <glm/glm.hpp>
 #include <limits>
 #include <memory>
 #include <span>
 #include <string>
 #include <system_error>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "image_codec_loader.h"
+#include "rvr/image_codec/image_codec_abi.h"
+#include "rvr/image_codec/image_writer_abi.h"
 #include "rvr/shared/check.h"
 #include "rvr/shared/srgb.h"
 

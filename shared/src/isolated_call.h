@@ -7,7 +7,6 @@
 // the parent, not a crash.
 #pragma once
 
-#include <cstdint>
 #include <functional>
 #include <string>
 

@@ -4,11 +4,13 @@
 #pragma once
 
 #include <cstddef>
+#include <glm/glm.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "rvr/shared/scene.h"
+#include "rvr/shared/texture.h"
 
 namespace rvr::scene_load {
 

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 

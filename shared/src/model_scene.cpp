@@ -2,12 +2,20 @@
 // a framing camera and default lights where it has none or where asked, turned so that its up
 // is +y, and an automatic exposure (docs/scene-format.md).
 #include <fmt/format.h>
+#include <stddef.h>
+#include <stdint.h>
 
 #include <algorithm>
 #include <assimp/Importer.hpp>
+#include <cctype>
+#include <chrono>
 #include <cmath>
+#include <exception>
 #include <filesystem>
+#include <glm/glm.hpp>
+#include <initializer_list>
 #include <new>
+#include <optional>
 #include <set>
 #include <string>
 #include <utility>
@@ -16,6 +24,8 @@
 #include "mesh_import.h"
 #include "mesh_repair.h"
 #include "rvr/shared/camera_framing.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "scene_json_errors.h"
 #include "scene_textures.h"

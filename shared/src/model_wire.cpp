@@ -4,8 +4,13 @@
 
 #include <cstdint>
 #include <cstring>
+#include <glm/glm.hpp>
+#include <optional>
 #include <stdexcept>
 #include <type_traits>
+#include <utility>
+
+#include "rvr/shared/texture.h"
 
 namespace rvr::scene_load {
 namespace {

@@ -2,10 +2,13 @@
 // (isolated_call.h) and back. Private to shared/src.
 #pragma once
 
+#include <stddef.h>
+
 #include <string>
 #include <vector>
 
 #include "mesh_import.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr::scene_load {
 

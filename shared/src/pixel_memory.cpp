@@ -2,6 +2,8 @@
 
 #include <cstdlib>
 #include <deque>
+#include <iterator>
+#include <memory>
 #include <mutex>
 #include <new>
 

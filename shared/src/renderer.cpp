@@ -1,5 +1,6 @@
 #include "rvr/shared/renderer.h"
 
+#include <initializer_list>
 #include <optional>
 #include <string>
 

@@ -1,6 +1,7 @@
 #include "rvr/shared/scene_for_render.h"
 
 #include <chrono>
+#include <variant>
 
 #include "rvr/shared/isa.h"
 #include "rvr/shared/timer.h"

@@ -2,9 +2,13 @@
 #include "scene_json_errors.h"
 
 #include <fmt/format.h>
+#include <stdint.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 namespace rvr::scene_load {
 

@@ -3,7 +3,10 @@
 // Private to shared/src.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
+#include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <unordered_set>
 #include <utility>

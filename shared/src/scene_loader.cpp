@@ -23,19 +23,27 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
-#include <limits>
+#include <initializer_list>
 #include <map>
+#include <memory>
 #include <new>
-#include <stdexcept>
+#include <nlohmann/json.hpp>
+#include <system_error>
+#include <utility>
+#include <variant>
 
 #include "json_fields.h"
 #include "mesh_import.h"
 #include "mesh_repair.h"
 #include "rvr/shared/camera_framing.h"
+#include "rvr/shared/texture.h"
 #include "scene_json_errors.h"
 #include "scene_json_parse.h"
 #include "scene_textures.h"

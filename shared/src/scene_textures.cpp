@@ -2,10 +2,12 @@
 #include "scene_textures.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
-#include <filesystem>
-#include <functional>
+#include <cstdint>
+#include <utility>
 
+#include "rvr/shared/expected.h"
 #include "scene_json_errors.h"
 #include "texture_images.h"
 #include "texture_paths.h"

@@ -4,6 +4,8 @@
 // and the materials that use it render with their colour alone. Private to shared/src.
 #pragma once
 
+#include <stdint.h>
+
 #include <map>
 #include <memory>
 #include <string>
@@ -12,6 +14,7 @@
 
 #include "mesh_import.h"
 #include "rvr/shared/scene.h"
+#include "rvr/shared/texture.h"
 
 namespace rvr::scene_load {
 

@@ -5,18 +5,23 @@
 #include <fmt/format.h>
 
 #include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <filesystem>
+#include <glm/glm.hpp>
 #include <limits>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <stdexcept>
+#include <system_error>
+#include <utility>
 
-#include "rvr/shared/scene_loader.h"
+#include "rvr/shared/texture.h"
 
 namespace rvr {
 namespace {

@@ -1,5 +1,8 @@
 #include "rvr/shared/shade_batch.h"
 
+#include <stddef.h>
+#include <stdint.h>
+
 #include <limits>
 
 #include "rvr/shared/check.h"

@@ -1,3 +1,4 @@
+#include "rvr/shared/isa.h"
 #include "rvr/shared/shade_kernel.h"
 
 namespace rvr {

@@ -6,6 +6,8 @@
 // lookup takes that value or the next.
 #include "rvr/shared/srgb.h"
 
+#include <stddef.h>
+
 #include <algorithm>
 #include <array>
 #include <bit>

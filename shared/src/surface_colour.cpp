@@ -1,8 +1,13 @@
 #include "rvr/shared/surface_colour.h"
 
+#include <stddef.h>
+
 #include <cmath>
+#include <memory>
+#include <vector>
 
 #include "rvr/shared/check.h"
+#include "rvr/shared/texture.h"
 
 namespace rvr {
 

@@ -1,15 +1,17 @@
 // Texture images to mip chains (texture_images.h).
 #include "texture_images.h"
 
-#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <glm/glm.hpp>
+#include <utility>
 #include <vector>
 
 #include "rvr/shared/srgb.h"

@@ -1,11 +1,16 @@
 // Texture paths resolved as modelling tools resolve them (texture_paths.h).
 #include "texture_paths.h"
 
+#include <stddef.h>
+
 #include <algorithm>
 #include <cctype>
+#include <chrono>
 #include <deque>
 #include <filesystem>
+#include <initializer_list>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 namespace rvr::scene_load {

@@ -2,14 +2,22 @@
 #include "rvr/study/conclusions.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <map>
+#include <memory>
+#include <optional>
 #include <set>
+#include <type_traits>
 
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
+#include "rvr/study/crossover.h"
+#include "rvr/study/fit.h"
 #include "rvr/study/study_markdown.h"
 
 namespace rvr::study {

@@ -1,11 +1,17 @@
 // Crossovers of measured curves and their bootstrap intervals (see crossover.h).
 #include "rvr/study/crossover.h"
 
+#include <stddef.h>
+
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
+#include <memory>
+#include <utility>
 
 #include "rvr/shared/check.h"
+#include "rvr/study/cost_model.h"
 
 namespace rvr::study {
 namespace {

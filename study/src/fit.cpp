@@ -3,9 +3,10 @@
 
 #include <fmt/format.h>
 
-#include <cmath>
 #include <limits>
+#include <memory>
 #include <set>
+#include <utility>
 
 #include "rvr/study/fit_quality.h"
 #include "rvr/study/least_squares.h"

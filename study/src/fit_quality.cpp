@@ -1,10 +1,14 @@
 // R², the largest relative residual and the leave-one-out error of a fit (see fit_quality.h).
 #include "rvr/study/fit_quality.h"
 
+#include <stddef.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
+#include "rvr/shared/expected.h"
 #include "rvr/study/fit.h"
 
 namespace rvr::study {

@@ -1,10 +1,11 @@
 // N copies of a scene's geometry in a grid (see grid_of_copies.h).
 #include "rvr/study/grid_of_copies.h"
 
+#include <algorithm>
 #include <cmath>
 #include <glm/glm.hpp>
 #include <string>
-#include <utility>
+#include <vector>
 
 #include "rvr/shared/camera_framing.h"
 

@@ -2,6 +2,7 @@
 #include "html_text.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
 #include <cctype>
 

@@ -1,8 +1,11 @@
 // Weighted least squares by Householder QR (see least_squares.h).
 #include "rvr/study/least_squares.h"
 
+#include <stddef.h>
+
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 
 #include "rvr/shared/check.h"

@@ -2,12 +2,15 @@
 #include "loglog_chart.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "html_text.h"
+#include "rvr/shared/html_escape.h"
 
 namespace rvr::study {
 namespace {

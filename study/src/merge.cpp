@@ -2,16 +2,26 @@
 #include "rvr/study/merge.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <compare>
 #include <map>
+#include <memory>
+#include <optional>
 #include <set>
 #include <tuple>
+#include <type_traits>
+#include <utility>
 
+#include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
+#include "rvr/study/crossover.h"
+#include "rvr/study/measurement.h"
 #include "rvr/study/study_markdown.h"
+#include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 namespace {

@@ -2,11 +2,15 @@
 #include "rvr/study/prediction_checks.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <initializer_list>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/crossover.h"

@@ -1,11 +1,26 @@
 // FrameSource over the renderer table (see renderer_frames.h).
 #include "rvr/study/renderer_frames.h"
 
-#include <chrono>
+#include <stddef.h>
 
+#include <chrono>
+#include <initializer_list>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/study/grid_of_copies.h"
+#include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 namespace {

@@ -6,13 +6,16 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
 #include <limits>
 #include <set>
 #include <tuple>
+#include <utility>
 
 #include "rvr/renderers/registry.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
+#include "rvr/study/measurement.h"
 #include "rvr/study/prediction_checks.h"
 #include "rvr/study/sweep_plan.h"
 

@@ -2,15 +2,22 @@
 #include "rvr/study/study_html.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <iterator>
 #include <map>
 #include <set>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "html_text.h"
 #include "loglog_chart.h"
+#include "rvr/shared/html_escape.h"
+#include "rvr/study/bootstrap.h"
 #include "rvr/study/cost_model.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"

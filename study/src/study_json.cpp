@@ -2,7 +2,19 @@
 #include "rvr/study/study_json.h"
 
 #include <cmath>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "rvr/study/bootstrap.h"
+#include "rvr/study/cost_model.h"
+#include "rvr/study/crossover.h"
+#include "rvr/study/fit.h"
+#include "rvr/study/measurement.h"
+#include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 namespace {

@@ -2,16 +2,25 @@
 // repetitions. The conclusions in the file are computed from these, so they are checked for
 // their type only and left for conclude() to compute again.
 #include <fmt/format.h>
+#include <stddef.h>
+#include <stdint.h>
 
 #include <algorithm>
-#include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
-#include <sstream>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
 #include "rvr/study/conclusions.h"
+#include "rvr/study/measurement.h"
+#include "rvr/study/study.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/sweep_plan.h"
 

@@ -4,6 +4,10 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <map>
+#include <vector>
+
+#include "rvr/study/bootstrap.h"
 
 namespace rvr::study {
 namespace {

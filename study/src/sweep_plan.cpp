@@ -7,8 +7,12 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <iterator>
+#include <system_error>
+#include <utility>
 
 #include "rvr/shared/check.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 
 namespace rvr::study {

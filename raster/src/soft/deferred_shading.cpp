@@ -8,10 +8,10 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <memory>
 
 #include "rvr/shared/check.h"
 #include "rvr/shared/shade_batch.h"
-#include "rvr/shared/shading.h"
 #include "rvr/shared/surface_colour.h"
 
 namespace rvr::soft {

@@ -6,10 +6,17 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdint>
+#include <initializer_list>
+#include <memory>
+#include <utility>
 
 #include "rvr/shared/check.h"
 #include "rvr/shared/timer.h"
+#include "soft/fill_kernel.h"
+#include "soft/huge_page_allocator.h"
 #include "soft/setup_kernel.h"
+#include "soft/setup_triangle.h"
 #include "soft/triangle_setup.h"
 
 namespace rvr::soft {

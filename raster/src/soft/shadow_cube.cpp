@@ -1,5 +1,7 @@
 #include "soft/shadow_cube.h"
 
+#include <stddef.h>
+
 #include <algorithm>
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>

@@ -6,11 +6,14 @@
 // optional 3x3 percentage-closer filtering within a face.
 #pragma once
 
+#include <tbb/task_arena.h>
+
 #include <array>
 #include <glm/glm.hpp>
 #include <vector>
 
 #include "soft/draw_triangles.h"
+#include "soft/tile_raster.h"
 
 namespace rvr::soft {
 

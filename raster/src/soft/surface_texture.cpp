@@ -1,7 +1,10 @@
 #include "soft/surface_texture.h"
 
+#include <stddef.h>
+
 #include <cmath>
 #include <limits>
+#include <memory>
 
 #include "rvr/shared/surface_colour.h"
 #include "rvr/shared/texture.h"

@@ -5,10 +5,11 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <array>
+#include <cstddef>
 #include <limits>
 
 #include "rvr/shared/check.h"
+#include "soft/triangle_setup.h"
 
 namespace rvr::soft {
 

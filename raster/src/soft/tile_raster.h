@@ -6,13 +6,16 @@
 // in all of its blocks) is not rasterized there at all.
 #pragma once
 
+#include <stddef.h>
+
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <limits>
 #include <vector>
 
 #include "rvr/shared/framebuffers.h"
 #include "soft/fill_kernel.h"
-#include "soft/triangle_setup.h"
+#include "soft/setup_triangle.h"
 
 namespace rvr::soft {
 

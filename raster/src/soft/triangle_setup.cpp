@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <utility>
 
 #include "rvr/shared/check.h"

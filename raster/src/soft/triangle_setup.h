@@ -4,12 +4,13 @@
 // the same bytes whichever path a triangle takes.
 #pragma once
 
-#include <cmath>
+#include <stddef.h>
+
+#include <algorithm>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "rvr/shared/scene.h"
 #include "soft/setup_triangle.h"
 
 namespace rvr::soft {

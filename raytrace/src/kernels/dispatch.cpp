@@ -1,4 +1,6 @@
 #include "rvr/raytrace/traversal_kernels.h"
+#include "rvr/raytrace/wide_bvh_layout.h"
+#include "rvr/shared/isa.h"
 
 namespace rvr {
 

@@ -1,6 +1,7 @@
 // The shading kernels compiled for avx2 (flags in the top-level CMakeLists.txt).
 #define RVR_KERNEL_NS isa_avx2
 #define RVR_KERNEL_NAME "avx2"
+#include "rvr/shared/shade_kernel.h"
 #include "shade_kernels.inl"
 
 namespace rvr {

@@ -1,6 +1,7 @@
 // The shading kernels compiled for avx512 (flags in the top-level CMakeLists.txt).
 #define RVR_KERNEL_NS isa_avx512
 #define RVR_KERNEL_NAME "avx512"
+#include "rvr/shared/shade_kernel.h"
 #include "shade_kernels.inl"
 
 namespace rvr {

@@ -1,6 +1,7 @@
 // The shading kernels compiled for sse (flags in the top-level CMakeLists.txt).
 #define RVR_KERNEL_NS isa_sse
 #define RVR_KERNEL_NAME "sse"
+#include "rvr/shared/shade_kernel.h"
 #include "shade_kernels.inl"
 
 namespace rvr {

@@ -7,9 +7,11 @@
 #include <memory>
 #include <string>
 
-#include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raytrace/trace_geometry.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/gl_backend.h"
 #include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 

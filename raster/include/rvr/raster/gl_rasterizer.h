@@ -8,6 +8,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/shared/gl_backend.h"
 #include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 
@@ -26,6 +27,7 @@ class GlRasterizer : public Renderer {
 
  private:
   struct Impl;
+
   std::unique_ptr<Impl> impl_;  // the GL context and resources, created on first render
 };
 

@@ -9,6 +9,7 @@
 
 #include "rvr/shared/expected.h"
 #include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 

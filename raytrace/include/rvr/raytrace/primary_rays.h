@@ -5,6 +5,9 @@
 // division per ray.
 #pragma once
 
+#include <stddef.h>
+
+#include <glm/glm.hpp>
 #include <vector>
 
 #include "rvr/raytrace/intersect.h"

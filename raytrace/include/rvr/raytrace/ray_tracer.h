@@ -8,7 +8,9 @@
 
 #include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/trace_geometry.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 

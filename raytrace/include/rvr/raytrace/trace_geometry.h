@@ -9,7 +9,11 @@
 // primitive, u, v); full surface data is computed once, for that hit only.
 #pragma once
 
+#include <stddef.h>
+
+#include <cmath>
 #include <cstdint>
+#include <glm/glm.hpp>
 #include <memory>
 #include <optional>
 #include <string>
@@ -18,9 +22,11 @@
 
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
-#include "rvr/raytrace/traversal_kernels.h"
 #include "rvr/raytrace/wide_bvh.h"
-#include "rvr/shared/camera.h"
+#include "rvr/raytrace/wide_bvh_layout.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
+#include "rvr/shared/isa.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
 
@@ -31,6 +37,7 @@ constexpr uint32_t kNoPrimitive = 0xFFFFFFFFu;
 // Embree's device and scene when Embree answers the queries (embree_backend.cpp); opaque here so
 // no Embree type leaks into this header.
 struct EmbreeBackend;
+
 struct EmbreeBackendDeleter {
   void operator()(EmbreeBackend* backend) const;
 };

@@ -5,6 +5,8 @@
 // (simd_kernels.h).
 #pragma once
 
+#include <stddef.h>
+
 #include <cstdint>
 #include <vector>
 

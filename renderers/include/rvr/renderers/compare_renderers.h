@@ -2,6 +2,8 @@
 // is compared pixel by pixel, and the pictures of the comparison are made.
 #pragma once
 
+#include <stddef.h>
+
 #include <functional>
 #include <string>
 #include <vector>
@@ -10,7 +12,9 @@
 #include "rvr/shared/compare.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
+#include "rvr/shared/mismatch_classes.h"
 #include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 

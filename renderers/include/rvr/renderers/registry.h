@@ -11,6 +11,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/shared/gl_backend.h"
 #include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 
 namespace rvr {
 

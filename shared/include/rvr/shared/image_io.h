@@ -2,6 +2,8 @@
 // and is renamed into place, so a failed run never leaves a half-written file.
 #pragma once
 
+#include <stddef.h>
+
 #include <string>
 #include <vector>
 

@@ -3,7 +3,6 @@
 // out-of-memory kill. Each limit has a default and a CLI flag to raise it.
 #pragma once
 
-#include <cstddef>
 #include <cstdint>
 
 #include "rvr/shared/expected.h"

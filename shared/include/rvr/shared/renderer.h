@@ -3,7 +3,6 @@
 
 #include <cstdint>
 #include <map>
-#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +13,7 @@
 #include "rvr/shared/isa.h"
 #include "rvr/shared/progress.h"
 #include "rvr/shared/scene.h"
+#include "rvr/shared/texture.h"
 
 namespace rvr {
 

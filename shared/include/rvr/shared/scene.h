@@ -2,6 +2,8 @@
 // (materials by index, meshes in world space, defaults applied).
 #pragma once
 
+#include <stddef.h>
+
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <memory>

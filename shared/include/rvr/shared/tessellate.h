@@ -4,6 +4,8 @@
 // (camera framing).
 #pragma once
 
+#include <stddef.h>
+
 #include <array>
 #include <cstdint>
 #include <glm/glm.hpp>

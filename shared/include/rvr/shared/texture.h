@@ -6,6 +6,8 @@
 // the same filter and only its level of detail is its own.
 #pragma once
 
+#include <stddef.h>
+
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <memory>

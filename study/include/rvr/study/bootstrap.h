@@ -3,6 +3,8 @@
 // then the timing noise of each point, never which points were swept.
 #pragma once
 
+#include <stddef.h>
+
 #include <cstdint>
 #include <vector>
 

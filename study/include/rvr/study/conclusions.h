@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "rvr/study/bootstrap.h"
+#include "rvr/study/cost_model.h"
+#include "rvr/study/measurement.h"
 #include "rvr/study/study.h"
 
 namespace rvr::study {

@@ -14,6 +14,8 @@
 //          become smaller than the rasterizer's blocks (flatter)
 #pragma once
 
+#include <stddef.h>
+
 #include <string>
 #include <vector>
 

@@ -2,6 +2,8 @@
 // intervals from the bootstrap over repetitions, and whether the model fits at all.
 #pragma once
 
+#include <stddef.h>
+
 #include <string>
 #include <vector>
 

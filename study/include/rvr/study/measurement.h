@@ -1,6 +1,8 @@
 // One measured point of a study: a renderer's frame of one scene size, timed several times.
 #pragma once
 
+#include <stddef.h>
+
 #include <map>
 #include <string>
 #include <vector>

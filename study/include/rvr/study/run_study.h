@@ -12,6 +12,8 @@
 // crossovers.
 #pragma once
 
+#include <stddef.h>
+
 #include <cstdint>
 #include <functional>
 #include <map>

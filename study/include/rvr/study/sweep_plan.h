@@ -3,6 +3,8 @@
 // cost of a point predicted from those measured.
 #pragma once
 
+#include <stddef.h>
+
 #include <map>
 #include <string>
 #include <vector>
