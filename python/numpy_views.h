@@ -12,13 +12,14 @@
 namespace rvr::python {
 
 // `shape` (rows, columns[, channels]) over `data`, C order; `owner` is kept alive by the array.
+// `elements`: how many T the buffer holds (the shape must not reach past them).
 template <class T>
-pybind11::array_t<T> view(std::shared_ptr<const void> owner, const T* data,
+pybind11::array_t<T> view(std::shared_ptr<const void> owner, const T* data, size_t elements,
                           const std::vector<pybind11::ssize_t>& shape);
 
-extern template pybind11::array_t<float> view(std::shared_ptr<const void>, const float*,
+extern template pybind11::array_t<float> view(std::shared_ptr<const void>, const float*, size_t,
                                               const std::vector<pybind11::ssize_t>&);
-extern template pybind11::array_t<int32_t> view(std::shared_ptr<const void>, const int32_t*,
+extern template pybind11::array_t<int32_t> view(std::shared_ptr<const void>, const int32_t*, size_t,
                                                 const std::vector<pybind11::ssize_t>&);
 
 }  // namespace rvr::python

@@ -98,36 +98,42 @@ void bind_render_class(py::module_& m) {
       .def_property_readonly(
           "color",
           [=](const PyRender& r) {
-            return view(owner(r), &buffers(r).color.data()->x, shape(r, 3));
+            return view(owner(r), &buffers(r).color.data()->x, 3 * buffers(r).color.size(),
+                        shape(r, 3));
           },
           "H x W x 3 float32, linear RGB.")
       .def_property_readonly(
           "depth",
-          [=](const PyRender& r) { return view(owner(r), buffers(r).depth.data(), shape(r)); },
+          [=](const PyRender& r) {
+            return view(owner(r), buffers(r).depth.data(), buffers(r).depth.size(), shape(r));
+          },
           "H x W float32 view-axis depth, +inf on background.")
       .def_property_readonly(
           "object_id",
           [=](const PyRender& r) {
             return view(owner(r), reinterpret_cast<const int32_t*>(buffers(r).object_id.data()),
-                        shape(r));
+                        buffers(r).object_id.size(), shape(r));
           },
           "H x W int32 index into the scene's objects, -1 on background.")
       .def_property_readonly(
           "primitive_id",
           [=](const PyRender& r) {
             return view(owner(r), reinterpret_cast<const int32_t*>(buffers(r).primitive_id.data()),
-                        shape(r));
+                        buffers(r).primitive_id.size(), shape(r));
           },
           "H x W int32 triangle index in the object (0 for analytic shapes), -1 on background.")
       .def_property_readonly(
           "normal",
           [=](const PyRender& r) {
-            return view(owner(r), &buffers(r).normal.data()->x, shape(r, 3));
+            return view(owner(r), &buffers(r).normal.data()->x, 3 * buffers(r).normal.size(),
+                        shape(r, 3));
           },
           "H x W x 3 float32 world-space shading normal facing the viewer, 0 on background.")
       .def_property_readonly(
           "cost",
-          [=](const PyRender& r) { return view(owner(r), buffers(r).cost.data(), shape(r)); },
+          [=](const PyRender& r) {
+            return view(owner(r), buffers(r).cost.data(), buffers(r).cost.size(), shape(r));
+          },
           "H x W float32 work per pixel (nodes visited and tests, or fragments).")
       .def_property_readonly(
           "stats", [](const PyRender& r) { return json_loads(r.result->stats_json); },

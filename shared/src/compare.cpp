@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <exception>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <limits>
 #include <span>
 #include <string>
@@ -396,6 +397,12 @@ DiffVerdict diff_verdict(const ImageDiff& diff, const DiffThresholds& t) {
 Image diff_heat_map(const Image& a, const Image& b, float scale) {
   const int w = a.width, h = a.height;
   const int channels = std::min(a.channels, b.channels);
+  for (const Image* image : {&a, &b})
+    RVR_DCHECK(image->pixels.size() == size_t(std::max(image->width, 0)) *
+                                           size_t(std::max(image->height, 0)) *
+                                           size_t(std::max(image->channels, 0)),
+               "an image's pixels fill its size: ", image->pixels.size(), " for ", image->width,
+               "x", image->height, "x", image->channels);
   std::vector<float> v(size_t(std::max(w, 0)) * std::max(h, 0), 0.0f);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {

@@ -24,6 +24,8 @@ namespace {
 // The texels of level k that texel i of level k+1 averages along one axis: [2i, 2i + 2), and
 // the last one also takes the odd texel left over ([2i, 2i + 3)).
 std::pair<int, int> reduced_span(int i, int size, int reduced) {
+  RVR_DCHECK(i >= 0 && i < reduced && reduced == std::max(1, size / 2), "texel ", i,
+             " of a level of ", reduced, " halving ", size);
   int first = std::min(2 * i, size - 1);
   int end = std::min(2 * i + 2, size);
   if (i == reduced - 1) end = size;
@@ -50,6 +52,7 @@ TextureLevel reduce(const TextureLevel& from) {
 
 // A texel index wrapped into [0, size) as GL wraps the integer coordinates of LINEAR.
 int wrap_index(int i, int size, TextureWrap wrap) {
+  RVR_DCHECK(size > 0, "a texture side holds texels: ", size);
   switch (wrap) {
     case TextureWrap::ClampToEdge:
       return std::clamp(i, 0, size - 1);

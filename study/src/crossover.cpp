@@ -89,6 +89,9 @@ std::vector<std::vector<double>> replicate_ratios(const std::vector<Measurement>
 std::vector<int> significant_signs(const std::vector<std::vector<double>>& replicates,
                                    size_t points) {
   std::vector<int> signs(points, 0);
+  for (const auto& d : replicates)
+    RVR_DCHECK(d.size() == points, "a replicate holds one ratio per point: ", d.size(), " of ",
+               points);
   for (size_t i = 0; i < points; ++i) {
     std::vector<double> di;
     di.reserve(replicates.size());
@@ -106,6 +109,9 @@ std::vector<int> significant_signs(const std::vector<std::vector<double>>& repli
 std::vector<Crossing> significant_crossings(const std::vector<double>& log_n,
                                             const std::vector<double>& d,
                                             const std::vector<int>& signs) {
+  RVR_CHECK(signs.size() == d.size() && log_n.size() == d.size(),
+            "one sign and one position per ratio: ", signs.size(), ", ", log_n.size(), ", ",
+            d.size());
   std::vector<Crossing> out;
   size_t last = signs.size();  // the previous significant point
   for (size_t j = 0; j < signs.size(); ++j) {
@@ -129,6 +135,8 @@ std::vector<double> replicate_positions(const std::vector<std::vector<double>>& 
                                         const std::vector<double>& log_n, const Crossing& c) {
   std::vector<double> positions;
   for (const std::vector<double>& d : replicates) {
+    RVR_DCHECK(!d.empty() && d.size() == log_n.size(),
+               "a replicate's ratios at every point: ", d.size(), " of ", log_n.size());
     double best = kInf, best_distance = kInf;
     for (const Crossing& x : crossings(log_n, d))
       if (x.a_faster_below == c.a_faster_below && std::fabs(x.log_n - c.log_n) < best_distance) {

@@ -20,6 +20,8 @@ void weighted_system(const Matrix& x, const std::vector<double>& y, const std::v
                      const std::vector<size_t>& cols, Matrix& a, std::vector<double>& b,
                      std::vector<double>& scale) {
   scale.assign(cols.size(), 0.0);
+  for (size_t c : cols)
+    RVR_DCHECK(x.empty() || c < x[0].size(), "a used column exists: ", c, " of ", x[0].size());
   for (const auto& row : x)
     for (size_t j = 0; j < cols.size(); ++j) scale[j] = std::max(scale[j], std::fabs(row[cols[j]]));
   for (double& s : scale) s = s > 0 ? s : 1.0;
@@ -36,6 +38,8 @@ void weighted_system(const Matrix& x, const std::vector<double>& y, const std::v
 // (nearly) dependent on the ones before it.
 bool householder(Matrix& a, std::vector<double>& b) {
   const size_t m = a.size(), k = a[0].size();
+  RVR_DCHECK(m >= k && b.size() == m, "QR of a tall system: ", m, " rows, ", k, " columns, ",
+             b.size(), " targets");
   std::vector<double> column_norm(k, 0.0);
   for (size_t j = 0; j < k; ++j)
     for (size_t i = 0; i < m; ++i) column_norm[j] += a[i][j] * a[i][j];
