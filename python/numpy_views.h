@@ -5,6 +5,7 @@
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <stddef.h>
 
 #include <memory>
 #include <vector>
