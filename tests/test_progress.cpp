@@ -175,8 +175,8 @@ TEST(ProgressSink, EveryRendererAndRasterOnEglDrawsTheSameWhenWatched) {
 // (a tile, a chunk, rows), or for the GL z-buffer, which looks between passes and has one pass
 // here, in its setup or upload, before that pass. Every renderer of the table returns
 // ErrorKind::Cancelled, its work left undone. The time from the cancel to the return is bounded
-// by a quarter of the same render run to its end, measured here on this machine, so the bound
-// holds however loaded it is.
+// by a quarter of the time the same render takes when this test runs it to its end, so the bound
+// scales with however loaded the machine is.
 TEST(ProgressSink, CancelFromAnotherThreadStopsEveryRendererPartWay) {
   using Clock = std::chrono::steady_clock;
   Scene scene = load_scene("builtin:soup:200000").value();
