@@ -39,7 +39,7 @@ constexpr std::chrono::milliseconds kSignalPoll{20};
 Expected<study::StudyResult> run_interruptibly(const study::StudyRequest& request) {
   std::atomic<bool> cancelled{false}, done{false};
   study::StudyHooks hooks;
-  hooks.prepare = study::renderer_frames(request);
+  hooks.start_session = study::in_process_sessions(request);
   hooks.cancelled = [&] { return cancelled.load(); };
   Expected<study::StudyResult> result = internal_error("study not run");
   std::thread worker([&] {

@@ -27,13 +27,13 @@
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/isa.h"
 #include "rvr/study/merge.h"
-#include "rvr/study/renderer_frames.h"
 #include "rvr/study/run_study.h"
 #include "rvr/study/study.h"
 #include "rvr/study/study_html.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/study_markdown.h"
 #include "rvr/study/sweep_plan.h"
+#include "study_processes.h"
 #include "study_setup.h"
 #include "terminal_progress.h"
 
@@ -83,9 +83,18 @@ study::StudyRequest request_of(const StudyArgs& a) {
   r.mode = parse_mode(a.mode);
   r.budget_seconds = a.budget;
   r.repetitions = a.repetitions;
+  r.sessions = a.processes;
+  r.noise_threshold = a.noise_threshold;
   r.seed = a.seed;
   if (!a.shard.empty()) r.shard = take(study::parse_shard(a.shard));
   return r;
+}
+
+// A study that concludes nothing says why (study.md does too) and exits 1.
+int no_conclusion_status(const study::StudyResult& result) {
+  if (result.no_conclusion.empty()) return 0;
+  std::fprintf(stderr, "rvr study: no conclusion: %s\n", result.no_conclusion.c_str());
+  return 1;
 }
 
 void write_study(const std::string& dir, const study::StudyResult& result,
@@ -113,7 +122,8 @@ int run_merge(const StudyArgs& a, const std::string& command_line) {
     write_study(a.out_dir, groups[0].study, markdown);
     std::printf("%s\nwrote %s/{study.json,study.md,study.html}\n", markdown.c_str(),
                 a.out_dir.c_str());
-    return 0;
+    std::fflush(stdout);
+    return no_conclusion_status(groups[0].study);
   }
   for (const study::MachineGroup& g : groups)
     write_study(a.out_dir + "/" + g.slug, g.study, study::study_markdown(g.study));
@@ -143,7 +153,12 @@ void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
       ->check(CLI::IsMember({"visibility", "local", "full"}));
   cmd->add_option("--budget", a.budget, "seconds the sweep may take (default 300)");
   cmd->add_option("--repetitions", a.repetitions,
-                  "frames timed per renderer and point (>= 5, default 5)");
+                  "rounds timed per run: frames per renderer in each process (>= 3, default 5)");
+  cmd->add_option("--processes", a.processes,
+                  "runs per point, each in a fresh process (>= 3, default 3)");
+  cmd->add_option("--noise-threshold", a.noise_threshold,
+                  "the smallest difference called one renderer faster: a ratio of 1 + this "
+                  "(default 0.03)");
   cmd->add_option("--seed", a.seed, "seed of the interleaving order and the bootstrap");
   cmd->add_flag("-q,--quiet", a.quiet, "no progress line");
   CLI::Option* shard =
@@ -154,8 +169,8 @@ void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
       "--merge", a.merge,
       "study folders to pool instead of sweeping: same machine type and mode pooled, others "
       "compared (comparison.md)");
-  for (const char* sweep_only :
-       {"scenes", "--renderers", "--width", "--mode", "--budget", "--repetitions", "--seed"})
+  for (const char* sweep_only : {"scenes", "--renderers", "--width", "--mode", "--budget",
+                                 "--repetitions", "--processes", "--noise-threshold", "--seed"})
     merge->excludes(cmd->get_option(sweep_only));
   merge->excludes(shard);
   cmd->add_option("-o,--output", a.out_dir, "output folder: study.json, study.md, study.html")
@@ -168,7 +183,7 @@ int run_study(const StudyArgs& a, const std::string& command_line) {
   study::StudyRequest request = request_of(a);
   TerminalProgress progress(progress_wanted(a.quiet));
   study::StudyHooks hooks;
-  hooks.prepare = study::renderer_frames(request);
+  hooks.start_session = process_sessions(own_executable(), request.renderers, request.mode);
   hooks.on_progress = [&](const std::string& what) { progress.begin(what, "measure"); };
   study::StudyResult result;
   {
@@ -183,12 +198,22 @@ int run_study(const StudyArgs& a, const std::string& command_line) {
   progress.stop();
   std::printf("%s\nwrote %s/{study.json,study.md,study.html}\n", markdown.c_str(),
               a.out_dir.c_str());
-  if (!result.interrupted) return 0;
   std::fflush(stdout);
-  std::fprintf(
-      stderr, "rvr study: interrupted; wrote %s/{study.json,study.md,study.html} from %zu points\n",
-      a.out_dir.c_str(), result.points.size());
-  return 130;
+  if (result.interrupted) {
+    std::fprintf(
+        stderr,
+        "rvr study: interrupted; wrote %s/{study.json,study.md,study.html} from %zu points\n",
+        a.out_dir.c_str(), result.points.size());
+    return 130;
+  }
+  return no_conclusion_status(result);
+}
+
+void add_study_worker_command(CLI::App& app, StudyWorkerArgs& a, CLI::App*& cmd) {
+  cmd = app.add_subcommand("study-worker", "a session process of rvr study (internal)");
+  cmd->group("");  // not listed: rvr study starts it
+  cmd->add_option("-r,--renderers", a.renderers)->delimiter(',')->required();
+  cmd->add_option("--mode", a.mode)->check(CLI::IsMember({"visibility", "local", "full"}));
 }
 
 }  // namespace rvr::cli

@@ -105,6 +105,8 @@ struct StudyArgs {
   std::string mode = "local";
   double budget = 300;
   int repetitions = 5;
+  int processes = 3;             // --processes: runs per point, each in a fresh process
+  double noise_threshold = 0.03;  // --noise-threshold
   uint64_t seed = 1;
   std::string shard;               // --shard I/N
   std::vector<std::string> merge;  // --merge DIR...: study folders to pool instead of a sweep
@@ -114,5 +116,12 @@ struct StudyArgs {
 
 void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd);
 int run_study(const StudyArgs& a, const std::string& command_line);
+
+// `rvr study-worker`: a study's session process (study_processes.h); not for users, hidden.
+struct StudyWorkerArgs {
+  std::vector<std::string> renderers;
+  std::string mode = "local";
+};
+void add_study_worker_command(CLI::App& app, StudyWorkerArgs& a, CLI::App*& cmd);
 
 }  // namespace rvr::cli

@@ -15,6 +15,7 @@
 
 #include "cli_exit.h"
 #include "commands.h"
+#include "study_processes.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/expected.h"
@@ -163,6 +164,9 @@ int run(int argc, char** argv) {
   StudyArgs study;
   CLI::App* study_cmd = nullptr;
   add_study_command(app, study, study_cmd);
+  StudyWorkerArgs study_worker;
+  CLI::App* study_worker_cmd = nullptr;
+  add_study_worker_command(app, study_worker, study_worker_cmd);
 
   try {
     app.parse(argc, argv);
@@ -183,6 +187,8 @@ int run(int argc, char** argv) {
   if (scenes_cmd->parsed()) return run_scenes(scenes);
   if (info_cmd->parsed()) return run_info(info_gl);
   if (study_cmd->parsed()) return run_study(study, join_args(argc, argv));
+  if (study_worker_cmd->parsed())
+    return run_study_worker(study_worker.renderers, study_worker.mode);
   return 2;
 }
 

@@ -31,18 +31,73 @@ double Rng::normal() {
   return std::sqrt(-2.0 * std::log(u)) * std::cos(2.0 * M_PI * v);
 }
 
-std::vector<double> resample_medians(const std::vector<Measurement>& points, Rng& rng) {
-  std::vector<double> medians;
-  medians.reserve(points.size());
-  std::vector<double> draw, weights;
-  for (const Measurement& p : points) {
-    draw.clear();
-    for (size_t k = 0; k < p.seconds.size(); ++k)
-      draw.push_back(p.seconds[rng.below(p.seconds.size())]);
-    if (weights.size() != draw.size()) weights = hd_weights(draw.size());
-    medians.push_back(hd_median(draw, weights));
-  }
-  return medians;
+namespace {
+
+// hd_median of `values` drawn with replacement from `from`.
+double resample_hd_median(const std::vector<double>& from, Rng& rng, std::vector<double>& draw) {
+  draw.clear();
+  for (size_t k = 0; k < from.size(); ++k) draw.push_back(from[rng.below(from.size())]);
+  return hd_median(draw);
+}
+
+}  // namespace
+
+double resample_time(const Measurement& m, Rng& rng) {
+  std::vector<const Run*> runs = timed_runs(m);
+  if (runs.empty()) return 0.0;
+  std::vector<double> draw;
+  double log_sum = 0;
+  for (size_t k = 0; k < runs.size(); ++k)
+    log_sum += std::log(resample_hd_median(runs[rng.below(runs.size())]->seconds, rng, draw));
+  return std::exp(log_sum / double(runs.size()));
+}
+
+std::vector<double> resample_times(const std::vector<Measurement>& points, Rng& rng) {
+  std::vector<double> out;
+  out.reserve(points.size());
+  for (const Measurement& p : points) out.push_back(resample_time(p, rng));
+  return out;
+}
+
+PairedRatios paired_ratios(const Measurement& a, const Measurement& b) {
+  PairedRatios p;
+  for (const Run& ra : a.runs)
+    for (const Run& rb : b.runs) {
+      if (ra.session != rb.session) continue;
+      const size_t rounds = std::min(ra.seconds.size(), rb.seconds.size());
+      std::vector<double> logs;
+      logs.reserve(rounds);
+      for (size_t k = 0; k < rounds; ++k) logs.push_back(std::log(ra.seconds[k] / rb.seconds[k]));
+      if (!logs.empty()) p.runs.push_back(std::move(logs));
+      break;
+    }
+  return p;
+}
+
+double ratio_estimate(const PairedRatios& p) {
+  if (p.runs.empty()) return std::numeric_limits<double>::quiet_NaN();
+  double sum = 0;
+  for (const std::vector<double>& run : p.runs) sum += hd_median(run);
+  return sum / double(p.runs.size());
+}
+
+double resample_ratio(const PairedRatios& p, Rng& rng) {
+  if (p.runs.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> draw;
+  double sum = 0;
+  for (size_t k = 0; k < p.runs.size(); ++k)
+    sum += resample_hd_median(p.runs[rng.below(p.runs.size())], rng, draw);
+  return sum / double(p.runs.size());
+}
+
+double variance(const std::vector<double>& values) {
+  if (values.size() < 2) return 0.0;
+  double mean = 0;
+  for (double v : values) mean += v;
+  mean /= double(values.size());
+  double ss = 0;
+  for (double v : values) ss += (v - mean) * (v - mean);
+  return ss / double(values.size() - 1);
 }
 
 double quantile(std::vector<double> values, double q) {

@@ -23,15 +23,33 @@
 namespace rvr::study {
 namespace {
 
-// In every note conclude() adds: a pair tied within the noise.
-constexpr const char* kTieWords = "are within the timing noise of each other";
+// In every note conclude() adds: a pair tied within the noise, a comparison with too few points,
+// a model fitted to busy times.
+constexpr const char* kTieWords = "are within the noise threshold of each other";
+constexpr const char* kFewWords = "nothing is concluded along";
+constexpr const char* kBusyFitWords = "fitted to times measured while the machine was busy";
+constexpr const char* kNoConclusionWords = "the study concludes nothing";
 
 std::vector<Measurement> points_of(const StudyResult& r, const std::string& renderer,
                                    const std::string& scene) {
   std::vector<Measurement> out;
   for (const Measurement& m : r.points)
-    if (m.renderer == renderer && m.scene == scene && !m.busy) out.push_back(m);
+    if (m.renderer == renderer && m.scene == scene && !m.runs.empty()) out.push_back(m);
   return out;
+}
+
+// The points a renderer's model is fitted to: those with a quiet run, unless too few have one
+// (then all, and a note says the absolute times are a busy machine's).
+std::vector<Measurement> fit_points(StudyResult& r, const std::string& renderer,
+                                    const std::string& scene, size_t enough) {
+  std::vector<Measurement> all = points_of(r, renderer, scene), quiet;
+  for (const Measurement& m : all)
+    if (!m.busy()) quiet.push_back(m);
+  if (quiet.size() >= enough || quiet.size() == all.size()) return quiet;
+  r.notes.push_back(fmt::format(
+      "{} on {}: {} (only {} of {} points had a quiet run): its costs are overstated", renderer,
+      scene, kBusyFitWords, quiet.size(), all.size()));
+  return all;
 }
 
 // The points along the family's axis: those at the study's full image size.
@@ -56,7 +74,7 @@ std::vector<Measurement> along_pixels(const StudyResult& r, const std::string& r
 std::vector<double> pixel_sweep_columns(const StudyResult& r, const std::string& scene) {
   std::map<double, std::set<double>> widths;
   for (const Measurement& m : r.points)
-    if (m.scene == scene && !m.busy) widths[m.scene_n].insert(m.pixels);
+    if (m.scene == scene && !m.runs.empty()) widths[m.scene_n].insert(m.pixels);
   std::vector<double> out;
   for (const auto& [n, w] : widths)
     if (w.size() > 1) out.push_back(n);
@@ -82,9 +100,11 @@ void fit_models(StudyResult& r, const BootstrapOptions& boot) {
     m.name = name;
     m.loop_order = short_name(order_of(name));
     m.form = model_form_of(name);
-    for (const std::string& scene : r.scenes)
-      m.fits[scene] =
-          fit_chosen_model(textbook_model(m.form, r.axes[scene]), points_of(r, name, scene), boot);
+    for (const std::string& scene : r.scenes) {
+      const CostModel textbook = textbook_model(m.form, r.axes[scene]);
+      const size_t enough = coefficient_names(textbook).size() + 2;
+      m.fits[scene] = fit_chosen_model(textbook, fit_points(r, name, scene, enough), boot);
+    }
     r.models.push_back(m);
   }
 }
@@ -118,34 +138,50 @@ void add_extrapolated(StudyResult& r, const Dominance& d) {
   r.crossovers.push_back(c);
 }
 
+// The notes of a comparison that concludes nothing: tied, or too few points.
+void comparison_notes(StudyResult& r, const CurveComparison& c) {
+  const Comparison& x = c.comparison;
+  const std::string along =
+      x.axis == kPixelsAxis
+          ? fmt::format("the pixel count at {} {}", format_number(x.n), r.axes[x.scene])
+          : fmt::format("{} at {}×{}", x.axis, r.width, r.height);
+  if (!x.inconclusive.empty())
+    r.notes.push_back(fmt::format("{}: for {} and {}, {} {}: {}", x.scene, x.a, x.b, kFewWords,
+                                  along, x.inconclusive));
+  else if (c.tie)
+    r.notes.push_back(fmt::format("{}: {} and {} {} ({:.0f}%) along {}, at every point measured",
+                                  x.scene, x.a, x.b, kTieWords, 100 * r.noise_threshold, along));
+}
+
+void add_comparison(StudyResult& r, const CurveComparison& c, bool extrapolate) {
+  if (c.comparison.points.empty()) return;
+  r.comparisons.push_back(c.comparison);
+  for (const Crossover& x : c.crossovers) r.crossovers.push_back(x);
+  if (c.dominance) {
+    r.dominance.push_back(*c.dominance);
+    if (extrapolate) add_extrapolated(r, *c.dominance);
+  }
+  comparison_notes(r, c);
+}
+
 // Every pair the study compares, along N at the full width and along the pixel count at each N
 // of the pixel sweep.
 void compare_pairs(StudyResult& r, const BootstrapOptions& boot) {
+  const CompareOptions options{boot, r.noise_threshold};
   for (const std::string& scene : r.scenes)
     for (size_t i = 0; i < r.renderers.size(); ++i)
       for (size_t j = i + 1; j < r.renderers.size(); ++j) {
         const std::string &a = r.renderers[i], &b = r.renderers[j];
         if (!compared_pair(a, b)) continue;
-        CurveComparison c =
-            compare_curves(along_n(r, a, scene), along_n(r, b, scene), r.axes[scene], boot);
-        for (const Crossover& x : c.crossovers) r.crossovers.push_back(x);
-        if (c.dominance) {
-          r.dominance.push_back(*c.dominance);
-          add_extrapolated(r, *c.dominance);
-        }
-        if (c.tie)
-          r.notes.push_back(fmt::format("{}: {} and {} {} at every {} measured", scene, a, b,
-                                        kTieWords, r.axes[scene]));
-        for (double n : pixel_sweep_columns(r, scene)) {
-          CurveComparison p = compare_curves(along_pixels(r, a, scene, n),
-                                             along_pixels(r, b, scene, n), kPixelsAxis, boot);
-          for (const Crossover& x : p.crossovers) r.crossovers.push_back(x);
-          if (p.dominance) r.dominance.push_back(*p.dominance);
-          if (p.tie)
-            r.notes.push_back(fmt::format(
-                "{} with {} {}: {} and {} {} at every pixel count measured", scene,
-                format_number(along_pixels(r, a, scene, n)[0].n), r.axes[scene], a, b, kTieWords));
-        }
+        add_comparison(r,
+                       compare_curves(along_n(r, a, scene), along_n(r, b, scene), r.axes[scene],
+                                      options),
+                       true);
+        for (double n : pixel_sweep_columns(r, scene))
+          add_comparison(r,
+                         compare_curves(along_pixels(r, a, scene, n), along_pixels(r, b, scene, n),
+                                        kPixelsAxis, options),
+                         false);
       }
 }
 
@@ -233,10 +269,21 @@ double loglog_slope(const std::vector<Measurement>& points, double from, double 
 }
 
 bool is_conclusion_note(const std::string& note) {
-  return note.find(kTieWords) != std::string::npos;
+  for (const char* words : {kTieWords, kFewWords, kBusyFitWords, kNoConclusionWords})
+    if (note.find(words) != std::string::npos) return true;
+  return false;
 }
 
 namespace {
+
+// Every repetition's seconds of one phase, over the point's timed runs.
+std::vector<double> phase_seconds(const Measurement& m, const std::string& phase) {
+  std::vector<double> out;
+  for (const Run* run : timed_runs(m))
+    if (auto it = run->phases.find(phase); it != run->phases.end())
+      out.insert(out.end(), it->second.begin(), it->second.end());
+  return out;
+}
 
 // The hybrids' z-buffer/trace split at the smallest and largest N at full width.
 void phase_splits(StudyResult& r) {
@@ -244,17 +291,42 @@ void phase_splits(StudyResult& r) {
     for (const std::string& scene : r.scenes) {
       std::vector<Measurement> p = along_n(r, name, scene);
       std::erase_if(p, [](const Measurement& m) {
-        return !m.phases.count("zbuffer") || !m.phases.count("trace");
+        return phase_seconds(m, "zbuffer").empty() || phase_seconds(m, "trace").empty();
       });
       if (p.empty()) continue;
       auto by_n = [](const Measurement& x, const Measurement& y) { return x.n < y.n; };
       for (const Measurement* m : {&*std::min_element(p.begin(), p.end(), by_n),
                                    &*std::max_element(p.begin(), p.end(), by_n)}) {
-        const double z = median(m->phases.at("zbuffer")), t = median(m->phases.at("trace"));
+        const double z = median(phase_seconds(*m, "zbuffer")),
+                     t = median(phase_seconds(*m, "trace"));
         r.splits.push_back({name, scene, m->n, m->pixels, z, t, z + t > 0 ? z / (z + t) : 0});
         if (p.size() == 1) break;
       }
     }
+}
+
+// Why nothing is concluded, when nothing is: no comparison found a crossover, a dominance or a
+// tie, and no model fits.
+std::string no_conclusion_reason(const StudyResult& r) {
+  if (!r.crossovers.empty() || !r.dominance.empty()) return "";
+  for (const RendererModels& m : r.models)
+    for (const auto& [scene, f] : m.fits)
+      if (f.fits) return "";
+  size_t ties = 0;
+  for (const std::string& note : r.notes) ties += note.find(kTieWords) != std::string::npos;
+  if (ties > 0) return "";
+  size_t points = 0, busy = 0;
+  for (const Measurement& m : r.points) points += 1, busy += m.busy();
+  if (points == 0)
+    return "no point was measured: the budget or an interruption stopped the sweep before its "
+           "first point";
+  std::string why = fmt::format(
+      "{} measurements at {} points, too few for a comparison ({} points along an axis) or "
+      "a model",
+      points, points / std::max<size_t>(r.renderers.size(), 1), kMinComparedPoints);
+  if (busy > 0)
+    why += fmt::format("; {} of them measured only while the machine was busy", busy);
+  return why + ": give the study a larger --budget";
 }
 
 }  // namespace
@@ -265,6 +337,9 @@ void conclude(StudyResult& result, const BootstrapOptions& boot) {
   scaling(result);
   unit_costs(result);
   phase_splits(result);
+  result.no_conclusion = no_conclusion_reason(result);
+  if (!result.no_conclusion.empty())
+    result.notes.push_back(std::string(kNoConclusionWords) + ": " + result.no_conclusion);
 }
 
 }  // namespace rvr::study

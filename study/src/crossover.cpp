@@ -1,229 +1,307 @@
-// Crossovers of measured curves and their bootstrap intervals (see crossover.h).
+// Comparisons of two renderers along an axis (see crossover.h).
 #include "rvr/study/crossover.h"
 
+#include <fmt/format.h>
 #include <stddef.h>
 
 #include <algorithm>
+#include <boost/math/distributions/students_t.hpp>
 #include <cmath>
 #include <initializer_list>
 #include <limits>
-#include <memory>
+#include <numeric>
 #include <utility>
 
 #include "rvr/shared/check.h"
 #include "rvr/study/cost_model.h"
+#include "rvr/study/trend.h"
 
 namespace rvr::study {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // The value of the swept axis at a point: its pixel count on the "pixels" axis, else its N.
 double axis_value(const Measurement& m, const std::string& axis) {
   return axis == kPixelsAxis ? m.pixels : m.n;
 }
 
-// a's and b's points at the axis values both have, in increasing axis value.
-void matched(const std::vector<Measurement>& a, const std::vector<Measurement>& b,
-             const std::string& axis, std::vector<Measurement>& ma, std::vector<Measurement>& mb) {
+// a's and b's points at the axis values both have and with a session in common, paired, in
+// increasing axis value.
+struct Matched {
+  std::vector<double> at, log_at;
+  std::vector<PairedRatios> ratios;
+  std::vector<double> d;  // each pair's log ratio estimate
+};
+
+Matched matched(const std::vector<Measurement>& a, const std::vector<Measurement>& b,
+                const std::string& axis) {
+  std::vector<std::pair<double, PairedRatios>> found;
   for (const Measurement& p : a)
     for (const Measurement& q : b)
       if (p.n == q.n && p.pixels == q.pixels) {
-        ma.push_back(p);
-        mb.push_back(q);
+        PairedRatios r = paired_ratios(p, q);
+        if (!r.runs.empty()) found.push_back({axis_value(p, axis), std::move(r)});
       }
-  std::vector<size_t> idx(ma.size());
-  for (size_t i = 0; i < idx.size(); ++i) idx[i] = i;
-  std::sort(idx.begin(), idx.end(),
-            [&](size_t i, size_t j) { return axis_value(ma[i], axis) < axis_value(ma[j], axis); });
-  std::vector<Measurement> sa, sb;
-  for (size_t i : idx) {
-    sa.push_back(ma[i]);
-    sb.push_back(mb[i]);
+  std::sort(found.begin(), found.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  Matched m;
+  for (auto& [at, r] : found) {
+    if (!m.at.empty() && at == m.at.back()) continue;  // one point per axis value
+    m.at.push_back(at);
+    m.log_at.push_back(std::log(at));
+    m.d.push_back(ratio_estimate(r));
+    m.ratios.push_back(std::move(r));
   }
-  ma = std::move(sa);
-  mb = std::move(sb);
+  return m;
 }
 
-struct Crossing {
-  double log_n;
-  bool a_faster_below;
+// The bootstrap of the trend: per replicate, every point's log ratio redrawn hierarchically
+// (runs, then rounds) plus the noise between points (normal, sd `point_noise`), then the trend.
+// replicates[r][j] is replicate r's trend at point j.
+std::vector<std::vector<double>> trend_replicates(const Matched& m, const Trend& trend,
+                                                  double point_noise, Rng& rng, int count) {
+  std::vector<std::vector<double>> out;
+  out.reserve(size_t(count));
+  std::vector<double> y(m.d.size());
+  for (int r = 0; r < count; ++r) {
+    for (size_t i = 0; i < y.size(); ++i)
+      y[i] = resample_ratio(m.ratios[i], rng) + point_noise * rng.normal();
+    out.push_back(trend.apply(y));
+  }
+  return out;
+}
+
+// The variance of each point's log ratio over hierarchical resamples of its own runs.
+std::vector<double> run_variances(const Matched& m, Rng& rng, int count) {
+  std::vector<double> out;
+  std::vector<double> draws(static_cast<size_t>(count));
+  for (const PairedRatios& p : m.ratios) {
+    for (double& d : draws) d = resample_ratio(p, rng);
+    out.push_back(variance(draws));
+  }
+  return out;
+}
+
+// Point j's values over the replicates.
+std::vector<double> column(const std::vector<std::vector<double>>& replicates, size_t j) {
+  std::vector<double> out;
+  out.reserve(replicates.size());
+  for (const std::vector<double>& r : replicates) out.push_back(r[j]);
+  return out;
+}
+
+// For each point: the p-value that its trend is within ±delta of 0 (two one-sided t tests,
+// doubled), and the side it lies on; Holm-adjusted over the points.
+void judge_points(const std::vector<double>& trend, const std::vector<double>& sd, double delta,
+                  double dof, std::vector<PointComparison>& points) {
+  boost::math::students_t t(dof);
+  std::vector<double> p(trend.size(), 1.0);
+  std::vector<int> side(trend.size(), 0);
+  for (size_t j = 0; j < trend.size(); ++j) {
+    if (!(sd[j] > 0)) {  // no spread at all: beyond the threshold or not, exactly
+      p[j] = std::fabs(trend[j]) > delta ? 0.0 : 1.0;
+    } else {
+      const double below = boost::math::cdf(boost::math::complement(t, (-delta - trend[j]) / sd[j]));
+      const double above = boost::math::cdf(boost::math::complement(t, (trend[j] - delta) / sd[j]));
+      p[j] = std::min(1.0, 2 * std::min(below, above));
+    }
+    side[j] = trend[j] < 0 ? -1 : +1;
+  }
+  std::vector<double> adjusted = holm_adjusted(p);
+  for (size_t j = 0; j < points.size(); ++j) {
+    points[j].p = adjusted[j];
+    points[j].faster = adjusted[j] <= kFamilyAlpha ? side[j] : 0;
+  }
+}
+
+// A maximal run of significant points of one side, in the order of the significant points
+// alone (points within the noise between them do not break it).
+struct Stretch {
+  int side = 0;
+  size_t first = 0, last = 0;  // point indices
+  size_t count = 0;
+  bool two_in_a_row = false;  // two of its points are neighbours in the sweep
 };
 
-// Every sign change of d = log(t_a / t_b) over the points, in log n.
-std::vector<Crossing> crossings(const std::vector<double>& log_n, const std::vector<double>& d) {
-  RVR_CHECK(log_n.size() == d.size(), "one ratio per point: ", d.size(), " ratios at ",
-            log_n.size(), " points");
-  std::vector<Crossing> out;
-  for (size_t i = 0; i + 1 < d.size(); ++i) {
-    if ((d[i] < 0) == (d[i + 1] < 0) || d[i] == 0) continue;
-    double f = d[i] / (d[i] - d[i + 1]);
-    out.push_back({log_n[i] + f * (log_n[i + 1] - log_n[i]), d[i] < 0});
-  }
-  return out;
-}
-
-std::vector<double> log_ratios(const std::vector<double>& ta, const std::vector<double>& tb) {
-  RVR_CHECK(ta.size() == tb.size(), "both renderers timed at the same points: ", ta.size(), " and ",
-            tb.size());
-  std::vector<double> d;
-  for (size_t i = 0; i < ta.size(); ++i) d.push_back(std::log(ta[i] / tb[i]));
-  return d;
-}
-
-// Each replicate's log ratios d = log(t_a / t_b) at the matched points.
-std::vector<std::vector<double>> replicate_ratios(const std::vector<Measurement>& a,
-                                                  const std::vector<Measurement>& b,
-                                                  const BootstrapOptions& boot) {
-  Rng rng(boot.seed);
-  std::vector<std::vector<double>> out;
-  for (int r = 0; r < boot.replicates; ++r) {
-    std::vector<double> ta = resample_medians(a, rng), tb = resample_medians(b, rng);
-    out.push_back(log_ratios(ta, tb));
-  }
-  return out;
-}
-
-// Which renderer each point shows faster beyond its timing noise: −1 (a), +1 (b), or 0 when the
-// 95% interval of d over the replicates holds 0 (a tie).
-std::vector<int> significant_signs(const std::vector<std::vector<double>>& replicates,
-                                   size_t points) {
-  std::vector<int> signs(points, 0);
-  for (const auto& d : replicates)
-    RVR_DCHECK(d.size() == points, "a replicate holds one ratio per point: ", d.size(), " of ",
-               points);
-  for (size_t i = 0; i < points; ++i) {
-    std::vector<double> di;
-    di.reserve(replicates.size());
-    for (const auto& d : replicates) di.push_back(d[i]);
-    Interval ci = percentile_interval(di);
-    signs[i] = ci.high < 0 ? -1 : (ci.low > 0 ? +1 : 0);
-  }
-  return signs;
-}
-
-// The crossings of the measured curves that the noise cannot explain: one for every pair of
-// consecutive significant points of opposite signs, placed at the measured sign change between
-// them (the geometric middle of the first and last when ties between them change sign more
-// than once).
-std::vector<Crossing> significant_crossings(const std::vector<double>& log_n,
-                                            const std::vector<double>& d,
-                                            const std::vector<int>& signs) {
-  RVR_CHECK(signs.size() == d.size() && log_n.size() == d.size(),
-            "one sign and one position per ratio: ", signs.size(), ", ", log_n.size(), ", ",
-            d.size());
-  std::vector<Crossing> out;
-  size_t last = signs.size();  // the previous significant point
-  for (size_t j = 0; j < signs.size(); ++j) {
-    if (signs[j] == 0) continue;
-    if (last != signs.size() && signs[j] != signs[last]) {
-      std::vector<double> sub_n(log_n.begin() + long(last), log_n.begin() + long(j) + 1);
-      std::vector<double> sub_d(d.begin() + long(last), d.begin() + long(j) + 1);
-      std::vector<Crossing> raw = crossings(sub_n, sub_d);
-      double x = raw.empty() ? 0.5 * (log_n[last] + log_n[j])
-                             : 0.5 * (raw.front().log_n + raw.back().log_n);
-      out.push_back({x, signs[last] < 0});
+std::vector<Stretch> stretches(const std::vector<PointComparison>& points) {
+  std::vector<Stretch> out;
+  for (size_t j = 0; j < points.size(); ++j) {
+    if (points[j].faster == 0) continue;
+    if (out.empty() || out.back().side != points[j].faster) {
+      out.push_back({points[j].faster, j, j, 1, false});
+      continue;
     }
-    last = j;
+    Stretch& s = out.back();
+    s.two_in_a_row = s.two_in_a_row || s.last + 1 == j;
+    s.last = j;
+    ++s.count;
   }
-  return out;
+  std::erase_if(out, [](const Stretch& s) { return !s.two_in_a_row; });
+  // Stretches of one side left next to each other once the others are gone are one.
+  std::vector<Stretch> merged;
+  for (const Stretch& s : out) {
+    if (!merged.empty() && merged.back().side == s.side) {
+      merged.back().last = s.last;
+      merged.back().count += s.count;
+    } else {
+      merged.push_back(s);
+    }
+  }
+  return merged;
 }
 
-// The replicates' positions of the crossing `c`: the nearest of each replicate's crossings of
-// the same direction, or ±inf when a replicate has none (one renderer faster everywhere).
+// The replicates' positions of a crossing at log value `log_x` where the trend goes from side
+// `from` to the other: each replicate's crossing of that direction nearest it, or ±inf when a
+// replicate has none (one renderer faster everywhere in it).
 std::vector<double> replicate_positions(const std::vector<std::vector<double>>& replicates,
-                                        const std::vector<double>& log_n, const Crossing& c) {
+                                        const std::vector<double>& log_at, double log_x,
+                                        int from) {
   std::vector<double> positions;
+  positions.reserve(replicates.size());
   for (const std::vector<double>& d : replicates) {
-    RVR_DCHECK(!d.empty() && d.size() == log_n.size(),
-               "a replicate's ratios at every point: ", d.size(), " of ", log_n.size());
-    double best = kInf, best_distance = kInf;
-    for (const Crossing& x : crossings(log_n, d))
-      if (x.a_faster_below == c.a_faster_below && std::fabs(x.log_n - c.log_n) < best_distance) {
-        best_distance = std::fabs(x.log_n - c.log_n);
-        best = std::exp(x.log_n);
-      }
-    if (best_distance == kInf) {
-      // a faster everywhere: a crossing where a stops being faster lies above the range.
-      bool a_everywhere = d.front() < 0;
-      best = a_everywhere == c.a_faster_below ? kInf : -kInf;
+    double best = kNaN, best_distance = kInf;
+    for (size_t i = 0; i + 1 < d.size(); ++i) {
+      const bool crosses = from < 0 ? (d[i] < 0 && d[i + 1] >= 0) : (d[i] > 0 && d[i + 1] <= 0);
+      if (!crosses) continue;
+      const double x = zero_crossing(log_at, d, i, i + 1);
+      if (std::fabs(x - log_x) < best_distance) best_distance = std::fabs(x - log_x), best = x;
     }
-    positions.push_back(best);
+    if (std::isnan(best)) {
+      // The side `from` everywhere: its crossing lies above the range; the other everywhere:
+      // below it.
+      const bool from_everywhere = from < 0 ? d.front() < 0 : d.front() > 0;
+      positions.push_back(from_everywhere ? kInf : -kInf);
+    } else {
+      positions.push_back(std::exp(best));
+    }
   }
   return positions;
 }
 
-// The renderer faster wherever the difference is beyond the noise, and its smallest lead
-// there; nullopt when no point is.
-std::optional<Dominance> dominance(const std::vector<Measurement>& a,
-                                   const std::vector<Measurement>& b, const std::vector<double>& d,
-                                   const std::vector<int>& signs, const std::string& axis) {
-  size_t first = 0;
-  while (first < signs.size() && signs[first] == 0) ++first;
-  if (first == signs.size()) return std::nullopt;
-  Dominance dom;
-  bool a_faster = signs[first] < 0;
-  dom.faster = a_faster ? a[0].renderer : b[0].renderer;
-  dom.slower = a_faster ? b[0].renderer : a[0].renderer;
-  dom.min_ratio = kInf;
-  for (size_t i = 0; i < d.size(); ++i)
-    if (signs[i] != 0 && std::exp(std::fabs(d[i])) < dom.min_ratio) {
-      dom.min_ratio = std::exp(std::fabs(d[i]));
-      dom.at = axis_value(a[i], axis);
+// The trend's ratio of the slower over the faster at point j.
+double lead(const PointComparison& p) {
+  return p.faster < 0 ? 1.0 / p.trend : p.trend;
+}
+
+Dominance dominance_of(const Comparison& c, int side) {
+  Dominance d;
+  d.faster = side < 0 ? c.a : c.b;
+  d.slower = side < 0 ? c.b : c.a;
+  d.scene = c.scene;
+  d.axis = c.axis;
+  d.pixels = c.pixels;
+  d.n = c.n;
+  d.range_low = c.points.front().at;
+  d.range_high = c.points.back().at;
+  d.points = c.points.size();
+  d.min_ratio = kInf;
+  d.significant_low = kInf;
+  d.significant_high = 0;
+  for (const PointComparison& p : c.points) {
+    if (p.faster == side) {
+      ++d.significant;
+      d.significant_low = std::min(d.significant_low, p.at);
+      d.significant_high = std::max(d.significant_high, p.at);
+      if (lead(p) < d.min_ratio) d.min_ratio = lead(p), d.at = p.at;
     }
-  return dom;
+    const double slower_over_faster = side < 0 ? 1.0 / p.ratio : p.ratio;
+    if (slower_over_faster < 1) {
+      d.contrary.push_back(p.at);
+      d.contrary_ratios.push_back(1.0 / slower_over_faster);
+    }
+  }
+  return d;
 }
 
 }  // namespace
 
-CurveComparison compare_curves(const std::vector<Measurement>& a_in,
-                               const std::vector<Measurement>& b_in, const std::string& axis,
-                               const BootstrapOptions& boot) {
-  CurveComparison out;
-  std::vector<Measurement> a, b;
-  matched(a_in, b_in, axis, a, b);
-  if (a.empty()) return out;
-  const bool pixels_axis = axis == kPixelsAxis;
-  const double low = axis_value(a.front(), axis), high = axis_value(a.back(), axis);
-  std::vector<double> log_n, ta, tb;
-  for (size_t i = 0; i < a.size(); ++i) {
-    log_n.push_back(std::log(axis_value(a[i], axis)));
-    ta.push_back(typical_seconds(a[i]));
-    tb.push_back(typical_seconds(b[i]));
+std::vector<double> holm_adjusted(const std::vector<double>& p) {
+  std::vector<size_t> order(p.size());
+  std::iota(order.begin(), order.end(), size_t(0));
+  std::stable_sort(order.begin(), order.end(), [&](size_t i, size_t j) { return p[i] < p[j]; });
+  std::vector<double> out(p.size());
+  double running = 0;
+  for (size_t k = 0; k < order.size(); ++k) {
+    running = std::max(running, std::min(1.0, double(order.size() - k) * p[order[k]]));
+    out[order[k]] = running;
   }
-  std::vector<double> d = log_ratios(ta, tb);
-  std::vector<std::vector<double>> replicates = replicate_ratios(a, b, boot);
-  std::vector<int> signs = significant_signs(replicates, a.size());
-  for (const Crossing& c : significant_crossings(log_n, d, signs)) {
+  return out;
+}
+
+CurveComparison compare_curves(const std::vector<Measurement>& a,
+                               const std::vector<Measurement>& b, const std::string& axis,
+                               const CompareOptions& options) {
+  CurveComparison out;
+  Comparison& c = out.comparison;
+  if (a.empty() || b.empty()) return out;
+  const bool pixels_axis = axis == kPixelsAxis;
+  c.a = a[0].renderer;
+  c.b = b[0].renderer;
+  c.scene = a[0].scene;
+  c.axis = axis;
+  c.pixels = pixels_axis ? 0 : a[0].pixels;
+  c.n = pixels_axis ? a[0].n : 0;
+  const Matched m = matched(a, b, axis);
+  for (size_t i = 0; i < m.at.size(); ++i)
+    c.points.push_back({m.at[i], std::exp(m.d[i]), kNaN, {kNaN, kNaN}, 1.0, 0});
+  if (m.at.size() < kMinComparedPoints) {
+    c.inconclusive = fmt::format(
+        "only {} points measured by both: at least {} are needed to tell a trend from the noise "
+        "between points",
+        m.at.size(), kMinComparedPoints);
+    return out;
+  }
+  const Trend trend(m.log_at);
+  Rng rng(options.boot.seed);
+  const int count = std::max(options.boot.replicates, 100);
+  const std::vector<double> v = run_variances(m, rng, count);
+  const double mean_v = std::accumulate(v.begin(), v.end(), 0.0) / double(v.size());
+  c.point_noise = std::sqrt(std::max(0.0, trend.residual_variance(m.d) - mean_v));
+  c.dof = trend.residual_dof();
+  const std::vector<double> t = trend.apply(m.d);
+  const std::vector<std::vector<double>> replicates =
+      trend_replicates(m, trend, c.point_noise, rng, count);
+  std::vector<double> sd;
+  for (size_t j = 0; j < t.size(); ++j) {
+    std::vector<double> col = column(replicates, j);
+    sd.push_back(std::sqrt(variance(col)));
+    Interval ci = percentile_interval(col);
+    c.points[j].trend = std::exp(t[j]);
+    c.points[j].ci95 = {std::exp(ci.low), std::exp(ci.high)};
+  }
+  judge_points(t, sd, std::log1p(options.noise_threshold), c.dof, c.points);
+  const std::vector<Stretch> found = stretches(c.points);
+  for (size_t k = 0; k + 1 < found.size(); ++k) {
+    const Stretch &lo = found[k], &hi = found[k + 1];
     Crossover x;
-    x.a = a[0].renderer;
-    x.b = b[0].renderer;
-    x.scene = a[0].scene;
+    x.a = c.a;
+    x.b = c.b;
+    x.scene = c.scene;
     x.axis = axis;
-    x.value = std::exp(c.log_n);
-    x.ci95 = percentile_interval(replicate_positions(replicates, log_n, c));
-    x.pixels = pixels_axis ? 0 : a[0].pixels;
-    x.n = pixels_axis ? a[0].n : 0;
-    x.a_faster_below = c.a_faster_below;
-    x.range_low = low;
-    x.range_high = high;
+    const double log_x = zero_crossing(m.log_at, t, lo.last, hi.first);
+    x.value = std::exp(log_x);
+    x.ci95 = percentile_interval(replicate_positions(replicates, m.log_at, log_x, lo.side));
+    x.pixels = c.pixels;
+    x.n = c.n;
+    x.a_faster_below = lo.side < 0;
+    x.range_low = m.at.front();
+    x.range_high = m.at.back();
+    x.below_points = lo.count;
+    x.above_points = hi.count;
+    x.below_ratio = lead(c.points[lo.last]);
+    x.above_ratio = lead(c.points[hi.first]);
     out.crossovers.push_back(x);
   }
-  if (out.crossovers.empty()) {
-    std::optional<Dominance> found = dominance(a, b, d, signs, axis);
-    if (!found) {
-      out.tie = true;
-      return out;
-    }
-    Dominance dom = *found;
-    dom.scene = a[0].scene;
-    dom.axis = axis;
-    dom.pixels = pixels_axis ? 0 : a[0].pixels;
-    dom.n = pixels_axis ? a[0].n : 0;
-    dom.range_low = low;
-    dom.range_high = high;
-    out.dominance = dom;
+  if (!out.crossovers.empty()) return out;
+  size_t faster_a = 0, faster_b = 0;
+  for (const PointComparison& p : c.points) (p.faster < 0 ? faster_a : faster_b) += p.faster != 0;
+  if (faster_a + faster_b == 0) {
+    out.tie = true;
+    return out;
   }
+  out.dominance = dominance_of(c, faster_a >= faster_b ? -1 : +1);
   return out;
 }
 

@@ -29,7 +29,8 @@ double shared_pixels(const std::vector<Measurement>& points) {
 std::vector<Interval> bootstrap_intervals(const CostModel& model,
                                           const std::vector<Measurement>& points,
                                           const std::vector<bool>& use,
-                                          const BootstrapOptions& boot) {
+                                          const BootstrapOptions& boot,
+                                          std::vector<std::vector<double>>& replicates) {
   Rng rng(boot.seed);
   std::vector<double> measured;
   measured.reserve(points.size());
@@ -37,9 +38,10 @@ std::vector<Interval> bootstrap_intervals(const CostModel& model,
   std::vector<std::vector<double>> draws(use.size());
   for (int r = 0; r < boot.replicates; ++r) {
     Expected<std::vector<double>> c =
-        fit_coefficients(model, points, resample_medians(points, rng), use, measured);
+        fit_coefficients(model, points, resample_times(points, rng), use, measured);
     if (!c) continue;
     for (size_t j = 0; j < use.size(); ++j) draws[j].push_back((*c)[j]);
+    replicates.push_back(*c);
   }
   std::vector<Interval> intervals;
   intervals.reserve(draws.size());
@@ -113,7 +115,7 @@ ModelFit fit_model(const CostModel& model, const std::vector<Measurement>& point
     f.verdict = "does not fit: " + c.error().message;
     return f;
   }
-  std::vector<Interval> ci = bootstrap_intervals(model, points, use, boot);
+  std::vector<Interval> ci = bootstrap_intervals(model, points, use, boot, f.replicates);
   for (size_t j = 0; j < use.size(); ++j) {
     f.coefficients[j].value = (*c)[j];
     f.coefficients[j].ci95 = ci[j];
@@ -135,6 +137,30 @@ std::vector<double> coefficient_values(const ModelFit& fit) {
 
 double predict_seconds(const ModelFit& fit, double pixels, double n) {
   return predict(fit.model, coefficient_values(fit), pixels, n);
+}
+
+PredictedRatio predict_ratio(const ModelFit& a, const ModelFit& b, double pixels, double n) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  PredictedRatio out{nan, nan, nan};
+  if (!a.fits || !b.fits) return out;
+  const double ta = predict_seconds(a, pixels, n), tb = predict_seconds(b, pixels, n);
+  if (!(ta > 0 && tb > 0)) return out;
+  out.ratio = ta / tb;
+  std::vector<double> ratios;
+  const size_t count = std::min(a.replicates.size(), b.replicates.size());
+  for (size_t k = 0; k < count; ++k) {
+    const double ra = predict(a.model, a.replicates[k], pixels, n),
+                 rb = predict(b.model, b.replicates[k], pixels, n);
+    if (ra > 0 && rb > 0) ratios.push_back(ra / rb);
+  }
+  // Replicates predicting no positive time count as unbounded either way.
+  for (size_t k = ratios.size(); k < count; ++k)
+    ratios.push_back(k % 2 ? std::numeric_limits<double>::infinity() : 0.0);
+  if (!ratios.empty()) {
+    Interval ci = percentile_interval(ratios);
+    out.low = ci.low, out.high = ci.high;
+  }
+  return out;
 }
 
 std::vector<CostModel> candidate_models(const CostModel& textbook,

@@ -18,10 +18,6 @@ double median(std::vector<double> values) {
   return 0.5 * (lower + upper);
 }
 
-double median_seconds(const Measurement& m) {
-  return median(m.seconds);
-}
-
 namespace {
 
 // ∫ x^(a−1) (1−x)^(a−1) dx over [lo, hi], by Simpson's rule (a ≥ 1: the integrand is smooth).
@@ -60,18 +56,64 @@ double hd_median(std::vector<double> values, const std::vector<double>& weights)
 }
 
 double hd_median(const std::vector<double>& values) {
-  return hd_median(values, hd_weights(values.size()));
+  // The weights depend only on the count: computed once per count and thread (the bootstrap
+  // asks for the same few counts millions of times).
+  thread_local std::vector<std::vector<double>> cache;
+  const size_t n = values.size();
+  if (n >= 256) return hd_median(values, hd_weights(n));
+  if (cache.size() <= n) cache.resize(n + 1);
+  if (cache[n].size() != n) cache[n] = hd_weights(n);
+  return hd_median(values, cache[n]);
+}
+
+bool Measurement::busy() const {
+  if (runs.empty()) return false;
+  for (const Run& r : runs)
+    if (!r.busy) return false;
+  return true;
+}
+
+size_t Measurement::frames() const {
+  size_t count = 0;
+  for (const Run& r : runs) count += r.seconds.size();
+  return count;
+}
+
+std::vector<const Run*> timed_runs(const Measurement& m) {
+  std::vector<const Run*> quiet, all;
+  for (const Run& r : m.runs) {
+    if (r.seconds.empty()) continue;
+    all.push_back(&r);
+    if (!r.busy) quiet.push_back(&r);
+  }
+  return quiet.empty() ? all : quiet;
 }
 
 double typical_seconds(const Measurement& m) {
-  return hd_median(m.seconds);
+  std::vector<const Run*> runs = timed_runs(m);
+  if (runs.empty()) return 0.0;
+  double log_sum = 0;
+  for (const Run* r : runs) log_sum += std::log(hd_median(r->seconds));
+  return std::exp(log_sum / double(runs.size()));
+}
+
+std::vector<double> all_seconds(const Measurement& m) {
+  std::vector<double> out;
+  for (const Run* r : timed_runs(m)) out.insert(out.end(), r->seconds.begin(), r->seconds.end());
+  return out;
+}
+
+double median_seconds(const Measurement& m) {
+  return median(all_seconds(m));
 }
 
 double relative_mad(const Measurement& m) {
-  double med = median(m.seconds);
+  std::vector<double> seconds = all_seconds(m);
+  double med = median(seconds);
   if (med <= 0) return 0.0;
   std::vector<double> deviations;
-  for (double s : m.seconds) deviations.push_back(std::fabs(s - med));
+  deviations.reserve(seconds.size());
+  for (double s : seconds) deviations.push_back(std::fabs(s - med));
   return median(deviations) / med;
 }
 

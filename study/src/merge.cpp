@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include <algorithm>
 #include <cctype>
@@ -66,19 +67,34 @@ size_t index_in(const std::vector<std::string>& list, const std::string& item) {
   return size_t(std::find(list.begin(), list.end(), item) - list.begin());
 }
 
-// Unites the points of the group's studies: a point measured by several keeps every
-// repetition of each, in the order the studies were given, but for those measured while the
-// machine was busy when another study measured it on a quiet one.
+// Unites the points of the group's studies: each study's sessions are the merged study's too
+// (renumbered), so a point measured by several keeps the runs of each as runs of its own, the
+// level where the variation between them arises. A study already held (its run id, or a study
+// merged into it) is refused, and so is a run whose frames are another's to the last digit.
 class PointPool {
  public:
-  Status add(const StudySource& source) {
-    for (const Measurement& m : source.study.points) {
+  Status add(const StudySource& source, StudyResult& merged) {
+    const StudyResult& s = source.study;
+    std::vector<std::string> runs = s.merged_runs;
+    runs.push_back(s.run_id);
+    for (const std::string& id : runs) {
+      auto [it, fresh] = run_sources_.try_emplace(id, source.name);
+      if (!fresh)
+        return bad_input(fmt::format(
+            "{}: holds the measurements of study {}, already merged from {}: a study is merged "
+            "once (is one a merged copy of the other?)",
+            source.name, id, it->second));
+      merged.merged_runs.push_back(id);
+    }
+    const int offset = int(merged.sessions.size());
+    for (const SessionInfo& info : s.sessions) merged.sessions.push_back(info);
+    for (const Measurement& m : s.points) {
       auto key = std::make_tuple(m.renderer, m.scene, m.scene_n, m.width);
       auto [it, fresh] = index_.try_emplace(key, points_.size());
       if (fresh) {
         points_.push_back(m);
+        points_.back().runs.clear();
         first_source_.push_back(source.name);
-        continue;
       }
       Measurement& pooled = points_[it->second];
       if (pooled.n != m.n || pooled.pixels != m.pixels)
@@ -87,15 +103,18 @@ class PointPool {
             "not the same point",
             source.name, m.renderer, m.scene, m.scene_n, m.width, m.n, m.pixels, pooled.n,
             first_source_[it->second], pooled.pixels));
-      repeated_ = true;
-      if (m.busy && !pooled.busy) continue;  // the quiet measurement alone
-      if (pooled.busy && !m.busy) {
-        pooled = m;
-        continue;
+      repeated_ = repeated_ || !fresh;
+      for (const Run& run : m.runs) {
+        for (const Run& held : pooled.runs)
+          if (held.seconds == run.seconds)
+            return bad_input(fmt::format(
+                "{}: {} on {}:{} at width {} has a run whose frame times are those of a run "
+                "already merged from {}: the same measurement twice",
+                source.name, m.renderer, m.scene, m.scene_n, m.width, first_source_[it->second]));
+        pooled.runs.push_back(run);
+        pooled.runs.back().session += offset;
       }
-      pooled.seconds.insert(pooled.seconds.end(), m.seconds.begin(), m.seconds.end());
-      pooled.order.insert(pooled.order.end(), m.order.begin(), m.order.end());
-      pooled.reference_ratio = std::max(pooled.reference_ratio, m.reference_ratio);
+      if (pooled.counters.empty()) pooled.counters = m.counters;
     }
     return ok_status();
   }
@@ -118,6 +137,7 @@ class PointPool {
   std::map<std::tuple<std::string, std::string, double, int>, size_t> index_;
   std::vector<Measurement> points_;
   std::vector<std::string> first_source_;
+  std::map<std::string, std::string> run_sources_;  // run id -> the source that held it
   bool repeated_ = false;
 };
 
@@ -162,6 +182,8 @@ Status pool_request(const std::vector<const StudySource*>& sources, StudyResult&
   r.width = first.width, r.height = first.height;
   r.mode = first.mode;
   r.repetitions = first.repetitions;
+  r.sessions_per_point = first.sessions_per_point;
+  r.noise_threshold = first.noise_threshold;
   r.seed = first.seed;
   r.bootstrap_replicates = first.bootstrap_replicates;
   r.machine = first.machine;
@@ -180,8 +202,23 @@ Status pool_request(const std::vector<const StudySource*>& sources, StudyResult&
     r.budget_seconds += study.budget_seconds;
     if (std::isfinite(study.elapsed_seconds)) r.elapsed_seconds += study.elapsed_seconds;
     r.interrupted = r.interrupted || study.interrupted;
+    if (study.noise_threshold != first.noise_threshold)
+      return bad_input(fmt::format(
+          "{}: noise threshold {}, but {} has {}: studies pooled must judge their points alike",
+          s->name, study.noise_threshold, sources[0]->name, first.noise_threshold));
   }
+  r.system_before = first.system_before;
+  r.system_after = sources.back()->study.system_after;
   return ok_status();
+}
+
+// The run id of a merged study: a hash (FNV-1a) of the run ids it holds, so that merging the same
+// studies gives the same id.
+std::string merged_run_id(const std::vector<std::string>& runs) {
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (const std::string& id : runs)
+    for (char c : id + ";") h = (h ^ uint64_t(static_cast<unsigned char>(c))) * 0x100000001b3ull;
+  return fmt::format("merged-{:016x}", h);
 }
 
 Expected<StudyResult> pool(const std::vector<const StudySource*>& sources) {
@@ -189,7 +226,8 @@ Expected<StudyResult> pool(const std::vector<const StudySource*>& sources) {
   if (Status s = pool_request(sources, r); !s) return s.error();
   PointPool points;
   for (const StudySource* s : sources)
-    if (Status added = points.add(*s); !added) return added.error();
+    if (Status added = points.add(*s, r); !added) return added.error();
+  r.run_id = merged_run_id(r.merged_runs);
   r.points = points.sorted(r);
   std::vector<std::string> names;
   names.reserve(sources.size());
@@ -197,7 +235,8 @@ Expected<StudyResult> pool(const std::vector<const StudySource*>& sources) {
   r.notes.push_back(fmt::format("merged from {} stud{}: {}", sources.size(),
                                 sources.size() > 1 ? "ies" : "y", join(names)));
   if (points.repeated())
-    r.notes.push_back("points measured by more than one study hold the repetitions of each");
+    r.notes.push_back(
+        "points measured by more than one study hold the runs of each, each run one session");
   for (const std::string& note : shard_notes(sources)) r.notes.push_back(note);
   for (const std::string& note : source_notes(sources)) r.notes.push_back(note);
   conclude(r, BootstrapOptions{r.bootstrap_replicates, r.seed});

@@ -1,29 +1,25 @@
 // FrameSource over the renderer table (see renderer_frames.h).
 #include "rvr/study/renderer_frames.h"
 
-#include <stddef.h>
-
 #include <chrono>
 #include <initializer_list>
 #include <map>
-#include <memory>
 #include <optional>
-#include <string>
 #include <utility>
 #include <variant>
-#include <vector>
 
 #include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
 #include "rvr/shared/scene_loader.h"
 #include "rvr/study/grid_of_copies.h"
-#include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
 // Triangles the z-buffers draw for a mesh-only scene; the family's N for any other.
 double axis_value_of(const Scene& scene, const Family& family, size_t n) {
@@ -41,37 +37,47 @@ class RendererFrames : public FrameSource {
   Status add(const std::string& name, const RenderOptions& options) {
     Expected<RendererChoice> choice = find_renderer_choice(name);
     if (!choice) return choice.error();
+    const auto start = std::chrono::steady_clock::now();
     Expected<std::unique_ptr<PreparedRenderer>> p = prepare_renderer(*choice, *scene_, {}, options);
     if (!p) return p.error();
+    prepare_seconds_.push_back(seconds_since(start));
     prepared_.push_back(std::move(*p));
-    // The first frame (thread start, first touch of the frame buffers) is not timed.
+    // The first frame (thread start, first touch of the frame buffers) is not timed; its
+    // counters are every frame's.
     Expected<RenderOutput> first = prepared_.back()->render();
     if (!first) return first.error();
+    std::map<std::string, double> work;
+    for (const auto& [stat, value] : first->stats)
+      if (is_work_counter(stat)) work[stat] = value;
+    counters_.push_back(std::move(work));
     return ok_status();
   }
 
   double axis_value() const override { return axis_; }
   double pixels() const override { return double(scene_->image.width) * scene_->image.height; }
-
-  Expected<double> time_frame(size_t index) override {
-    auto start = std::chrono::steady_clock::now();
-    Expected<RenderOutput> out = prepared_[index]->render();
-    auto end = std::chrono::steady_clock::now();
-    if (!out) return out.error();
-    last_phases_.clear();
-    for (const auto& [stat, phase] :
-         {std::pair{"time.zbuffer", "zbuffer"}, {"time.trace", "trace"}})
-      if (auto it = out->stats.find(stat); it != out->stats.end()) last_phases_[phase] = it->second;
-    return std::chrono::duration<double>(end - start).count();
+  double prepare_seconds(size_t index) const override { return prepare_seconds_.at(index); }
+  std::map<std::string, double> counters(size_t index) const override {
+    return counters_.at(index);
   }
 
-  std::map<std::string, double> last_phases() const override { return last_phases_; }
+  Expected<FrameTime> time_frame(size_t index) override {
+    const auto start = std::chrono::steady_clock::now();
+    Expected<RenderOutput> out = prepared_.at(index)->render();
+    FrameTime t;
+    t.seconds = seconds_since(start);
+    if (!out) return out.error();
+    for (const auto& [stat, phase] :
+         {std::pair{"time.zbuffer", "zbuffer"}, {"time.trace", "trace"}})
+      if (auto it = out->stats.find(stat); it != out->stats.end()) t.phases[phase] = it->second;
+    return t;
+  }
 
  private:
   std::unique_ptr<Scene> scene_;  // before prepared_: they hold references to it
   double axis_;
   std::vector<std::unique_ptr<PreparedRenderer>> prepared_;
-  std::map<std::string, double> last_phases_;
+  std::vector<double> prepare_seconds_;
+  std::vector<std::map<std::string, double>> counters_;
 };
 
 // builtin:<family>:<n>, or n copies of the family's file, at width × width·3/4.
@@ -91,21 +97,45 @@ Expected<Scene> family_scene(const Family& family, size_t n, int width) {
   return grid_of_copies(*base, n);
 }
 
+class InProcessSession : public Session {
+ public:
+  InProcessSession(std::vector<std::string> renderers, RenderMode mode)
+      : renderers_(std::move(renderers)), mode_(mode) {}
+  std::string kind() const override { return "preparation"; }
+  Expected<std::unique_ptr<FrameSource>> prepare(const Family& family, size_t n,
+                                                 int width) override {
+    return prepare_frames(renderers_, mode_, family, n, width);
+  }
+
+ private:
+  std::vector<std::string> renderers_;
+  RenderMode mode_;
+};
+
 }  // namespace
 
-PrepareFrames renderer_frames(const StudyRequest& request) {
-  return [request](const Family& family, size_t n,
-                   int width) -> Expected<std::unique_ptr<FrameSource>> {
-    Expected<Scene> scene = family_scene(family, n, width);
-    if (!scene) return scene.error();
-    double axis = axis_value_of(*scene, family, n);
-    auto frames =
-        std::make_unique<RendererFrames>(std::make_unique<Scene>(std::move(*scene)), axis);
-    RenderOptions options;
-    options.mode = request.mode;
-    for (const std::string& name : request.renderers)
-      if (Status s = frames->add(name, options); !s) return s.error();
-    return std::unique_ptr<FrameSource>(std::move(frames));
+bool is_work_counter(const std::string& stat) {
+  return stat.rfind("time.", 0) != 0 && stat.rfind("memory.", 0) != 0;
+}
+
+Expected<std::unique_ptr<FrameSource>> prepare_frames(const std::vector<std::string>& renderers,
+                                                      RenderMode mode, const Family& family,
+                                                      size_t n, int width) {
+  Expected<Scene> scene = family_scene(family, n, width);
+  if (!scene) return scene.error();
+  double axis = axis_value_of(*scene, family, n);
+  auto frames = std::make_unique<RendererFrames>(std::make_unique<Scene>(std::move(*scene)), axis);
+  RenderOptions options;
+  options.mode = mode;
+  for (const std::string& name : renderers)
+    if (Status s = frames->add(name, options); !s) return s.error();
+  return std::unique_ptr<FrameSource>(std::move(frames));
+}
+
+StartSession in_process_sessions(const StudyRequest& request) {
+  return [renderers = request.renderers,
+          mode = request.mode]() -> Expected<std::unique_ptr<Session>> {
+    return std::unique_ptr<Session>(std::make_unique<InProcessSession>(renderers, mode));
   };
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <random>
 #include <set>
 #include <tuple>
 #include <utility>
@@ -22,13 +23,19 @@
 namespace rvr::study {
 namespace {
 
-// Of the budget share of a scene, where the log-spaced sweep of N must end, and the sweep of
-// the pixel count; the rest is for the points added near crossovers.
+// Of the budget share of a scene, where the log-spaced sweep of N must end (all its sessions
+// counted), and the sweep of the pixel count; the rest is for the points added near crossovers
+// and for busy runs measured again.
 constexpr double kBaseShare = 0.6;
 constexpr double kPixelShare = 0.8;
 constexpr int kRefinementRounds = 3;
-// How long one timing of the reference frame takes at least, in frames in a row.
-constexpr double kReferenceSeconds = 2e-3;
+// Of the whole budget, what the prediction checks keep (when they run).
+constexpr double kCheckShare = 0.15;
+// How long one timing of the reference frame takes at least, in frames in a row: a whole frame
+// at full width touches the frame buffers, so memory contention shows as well as CPU time.
+constexpr double kReferenceSeconds = 10e-3;
+// How long the system probe waits (idle) to see what else uses the CPUs.
+constexpr double kProbeWindow = 0.2;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 Status validate(const StudyRequest& r) {
@@ -42,9 +49,15 @@ Status validate(const StudyRequest& r) {
     return bad_input(fmt::format("--budget: must be > 0 seconds, got {}", r.budget_seconds));
   if (r.width < 16 || r.width > 16384)
     return bad_input(fmt::format("--width: must be in 16 .. 16384, got {}", r.width));
-  // Fewer, and the bootstrap's 95% intervals hold the truth only ~85% of the time (test_study).
-  if (r.repetitions < 5)
-    return bad_input(fmt::format("--repetitions: must be >= 5, got {}", r.repetitions));
+  if (r.repetitions < 3)
+    return bad_input(fmt::format("--repetitions: must be >= 3, got {}", r.repetitions));
+  // Fewer, and the spread between processes cannot be told from that between frames.
+  if (r.sessions < 3)
+    return bad_input(fmt::format("--processes: must be >= 3, got {}", r.sessions));
+  if (!(r.noise_threshold >= 0 && r.noise_threshold < 1))
+    return bad_input(
+        fmt::format("--noise-threshold: must be in 0 .. 1 (a ratio minus 1), got {}",
+                    r.noise_threshold));
   if (r.shard && (r.shard->count < 1 || r.shard->index >= r.shard->count))
     return bad_input(fmt::format("--shard: must be I/N with 0 <= I < N, got {}/{}", r.shard->index,
                                  r.shard->count));
@@ -55,6 +68,43 @@ Status validate(const StudyRequest& r) {
 std::string point_name(const Family& family, size_t n) {
   return family.source.empty() ? fmt::format("N={}", n) : fmt::format("{} copies", n);
 }
+
+// A unique name for one sweep: 16 hex digits from the OS's random source and the clock.
+std::string new_run_id() {
+  std::random_device device;
+  uint64_t bits = (uint64_t(device()) << 32) ^ uint64_t(device());
+  bits ^= uint64_t(std::chrono::system_clock::now().time_since_epoch().count());
+  return fmt::format("{:016x}", bits);
+}
+
+using PointKey = std::pair<size_t, int>;  // scene N, width
+
+// Where measured points go: the sweep's, or the prediction checks'. For each (n, width), the
+// index in `list` of the first renderer's measurement (the others follow in the request's
+// order).
+struct PointSet {
+  std::vector<Measurement>* list = nullptr;
+  std::map<PointKey, size_t> index;
+};
+
+// What the sweep keeps per family.
+struct FamilyState {
+  PointSet points, checks;
+  std::vector<PointKey> first_session_order;  // as measured in the family's first session
+  CostPredictor cost;                         // one run's wall time at full width, by N
+  int reference_frames = 1;                   // frames in a row per reference time
+  double quickest_reference = kInfinity;      // its quickest time in the family so far
+  std::vector<PlannedPoint> plan;
+  size_t plan_offset = 0;  // the index of its first point in the study's plan
+};
+
+// A session opened for one family: the session, its reference frame and what its probe saw.
+struct OpenSession {
+  std::unique_ptr<Session> session;
+  std::unique_ptr<FrameSource> reference;
+  int index = 0;              // into StudyResult::sessions
+  bool other_work = false;    // its system probe saw other work on the CPUs
+};
 
 // The state of one running study.
 class Sweep {
@@ -67,27 +117,43 @@ class Sweep {
             .count();
       };
     }
+    if (!hooks_.probe) hooks_.probe = probe_system;
     start_ = hooks_.now();
   }
 
-  double elapsed() const { return hooks_.now() - start_; }
+  // Seconds of measuring: the time since the start but for what exclude() took out.
+  double elapsed() const { return hooks_.now() - start_ - excluded_; }
+  // Takes `seconds` (the fits between the sweep and the checks) out of the budget's clock.
+  void exclude(double seconds) { excluded_ += seconds; }
   bool cancelled() const { return hooks_.cancelled && hooks_.cancelled(); }
+  // The budget is a limit: past it no frame is started (the run in progress is dropped).
+  bool out_of_time() const { return elapsed() > request_.budget_seconds; }
+  bool stopped() const { return cancelled() || out_of_time(); }
+  SystemSnapshot probe() const {
+    SystemSnapshot s = hooks_.probe(kProbeWindow);
+    s.at = elapsed();
+    return s;
+  }
 
-  Status run_scene(const Family& family, double share_end);
+  Status run_family(const Family& family, double share_end);
+  // The prediction checks' points (prediction_checks.h), each in S fresh sessions, while the
+  // budget lasts; into result.check_points.
+  Status measure_checks(const std::vector<Family>& families);
 
  private:
-  // Measures (n, width) unless it was measured, or it would end past `limit` as predicted from
-  // the points measured at the full width: false then.
-  Expected<bool> try_point(const Family& family, size_t n, int width, double limit,
-                           double share_end);
-  Status measure(const Family& family, size_t n, int width, double deadline);
-  void time_rounds(const Family& family, size_t n, FrameSource& frames, double deadline,
-                   std::vector<Measurement>& points, Status& status);
-  Status start_reference(const Family& family);
-  Expected<double> time_reference();
-  Status measure_busy_points_again(const Family& family, double share_end);
-  Status sweep_n(const Family& family, double limit, double share_end);
-  Status sweep_pixels(const Family& family, double limit, double share_end);
+  Expected<OpenSession> open_session(const Family& family);
+  Expected<double> time_reference(FrameSource& reference);
+  Status measure_run(const Family& family, size_t n, int width, OpenSession& session,
+                     PointSet& into);
+  void time_rounds(const std::string& what, FrameSource& frames, FrameSource& reference,
+                   std::vector<Run>& runs, Status& status);
+  Expected<bool> try_first_run(const Family& family, size_t n, int width, double limit,
+                               OpenSession& session);
+  Status sweep_n(const Family& family, double limit, OpenSession& session);
+  Status sweep_pixels(const Family& family, double limit, OpenSession& session);
+  Status more_sessions(const Family& family, double limit);
+  Status refine_near_crossovers(const Family& family, double share_end);
+  Status measure_busy_runs_again(const Family& family, double share_end);
   std::vector<size_t> crossover_midpoints(const Family& family) const;
   bool in_this_shard(size_t n, int width) const;
   void progress(const std::string& what) const {
@@ -98,50 +164,57 @@ class Sweep {
   StudyHooks hooks_;
   StudyResult& result_;
   Rng rng_;
-  double start_ = 0;
-  std::set<std::tuple<std::string, size_t, int>> measured_;  // family, n, width
-  CostPredictor cost_;                      // of the current family's points at the full width
-  std::unique_ptr<FrameSource> reference_;  // the current family's reference frame
-  int reference_frames_ = 1;                // frames in a row per reference time
-  double quickest_reference_ = kInfinity;   // its quickest time in the family so far
-  double slowest_reference_ = 0;            // its slowest time while measuring one point
-  std::vector<PlannedPoint> plan_;          // the current family's
-  size_t plan_offset_ = 0;                  // the index of its first point in the study's plan
+  double start_ = 0, excluded_ = 0;
+  std::map<std::string, FamilyState> families_;
+  FamilyState* f_ = nullptr;  // the family being measured
+  size_t plan_size_ = 0;      // of the families swept so far
 };
 
-// The reference frame of a family: its smallest point at full width, the first renderer, run
-// often enough in a row to take kReferenceSeconds (a frame of a few microseconds alone would
-// measure the timer and the scheduler); its quickest time starts as the median of five.
-Status Sweep::start_reference(const Family& family) {
-  Expected<std::unique_ptr<FrameSource>> frames =
-      hooks_.prepare(family, family.low, request_.width);
-  if (!frames) return frames.error();
-  reference_ = std::move(*frames);
-  reference_frames_ = 1;
-  Expected<double> one = time_reference();
-  if (!one) return one.error();
-  reference_frames_ = int(std::clamp(std::ceil(kReferenceSeconds / *one), 1.0, 1000.0));
-  quickest_reference_ = kInfinity;  // the single frame above is not a reference time
+// A fresh session: the machine probed, the family's reference frame (its smallest point at
+// full width, the first renderer) prepared in it and timed five times. In the family's first
+// session the reference's frames in a row are chosen to take kReferenceSeconds (a frame of a
+// few microseconds alone would measure the timer and the scheduler).
+Expected<OpenSession> Sweep::open_session(const Family& family) {
+  OpenSession open;
+  SessionInfo info;
+  info.system = probe();
+  info.study = result_.run_id;
+  open.other_work = shows_other_work(info.system);
+  Expected<std::unique_ptr<Session>> session = hooks_.start_session();
+  if (!session) return session.error();
+  open.session = std::move(*session);
+  info.kind = open.session->kind();
+  open.index = int(result_.sessions.size());
+  result_.sessions.push_back(info);
+  Expected<std::unique_ptr<FrameSource>> reference =
+      open.session->prepare(family, family.low, request_.width);
+  if (!reference) return reference.error();
+  open.reference = std::move(*reference);
+  if (f_->quickest_reference == kInfinity) {
+    f_->reference_frames = 1;
+    Expected<FrameTime> one = open.reference->time_frame(0);
+    if (!one) return one.error();
+    f_->reference_frames =
+        int(std::clamp(std::ceil(kReferenceSeconds / one->seconds), 1.0, 1000.0));
+  }
   std::vector<double> times;
   for (int k = 0; k < 5; ++k) {
-    Expected<double> t = time_reference();
+    Expected<double> t = time_reference(*open.reference);
     if (!t) return t.error();
     times.push_back(*t);
   }
-  quickest_reference_ = median(times);
-  return ok_status();
+  f_->quickest_reference = std::min(f_->quickest_reference, median(times));
+  return open;
 }
 
-// The reference frames in a row: their time joins the point's slowest and the study's quickest.
-Expected<double> Sweep::time_reference() {
+// The reference frames in a row, timed together.
+Expected<double> Sweep::time_reference(FrameSource& reference) {
   double total = 0;
-  for (int k = 0; k < reference_frames_; ++k) {
-    Expected<double> t = reference_->time_frame(0);
+  for (int k = 0; k < f_->reference_frames; ++k) {
+    Expected<FrameTime> t = reference.time_frame(0);
     if (!t) return t.error();
-    total += *t;
+    total += t->seconds;
   }
-  slowest_reference_ = std::max(slowest_reference_, total);
-  quickest_reference_ = std::min(quickest_reference_, total);
   return total;
 }
 
@@ -149,77 +222,94 @@ Expected<double> Sweep::time_reference() {
 // point is, unsharded).
 bool Sweep::in_this_shard(size_t n, int width) const {
   if (!request_.shard) return true;
-  for (size_t i = 0; i < plan_.size(); ++i)
-    if (plan_[i].n == n && plan_[i].width == width)
-      return in_shard(plan_offset_ + i, *request_.shard);
+  for (size_t i = 0; i < f_->plan.size(); ++i)
+    if (f_->plan[i].n == n && f_->plan[i].width == width)
+      return in_shard(f_->plan_offset + i, *request_.shard);
   return false;
 }
 
-// Times `request.repetitions` rounds; in each, every renderer once, in a fresh random order.
-// Stops after the fifth round once `deadline` has passed.
-void Sweep::time_rounds(const Family& family, size_t n, FrameSource& frames, double deadline,
-                        std::vector<Measurement>& points, Status& status) {
-  std::vector<size_t> order(points.size());
-  slowest_reference_ = 0;
-  if (Expected<double> t = time_reference(); !t) status = t.error();
-  for (int round = 0; status && round < request_.repetitions; ++round) {
-    if (round >= 5 && elapsed() > deadline) break;
+// `request.repetitions` rounds, in each every renderer once in a fresh random order, with the
+// reference timed before the first and after each; a run's reference_ratio is its slowest
+// reference over the family's quickest. Stops (status ok, runs incomplete) when the study is
+// cancelled or out of time.
+void Sweep::time_rounds(const std::string& what, FrameSource& frames, FrameSource& reference,
+                        std::vector<Run>& runs, Status& status) {
+  std::vector<size_t> order(runs.size());
+  double slowest = 0;
+  auto reference_time = [&] {
+    Expected<double> t = time_reference(reference);
+    if (!t) return status = t.error(), false;
+    slowest = std::max(slowest, *t);
+    f_->quickest_reference = std::min(f_->quickest_reference, *t);
+    return true;
+  };
+  if (!reference_time()) return;
+  for (int round = 0; round < request_.repetitions; ++round) {
     for (size_t i = 0; i < order.size(); ++i) order[i] = i;
     for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng_.below(i)]);
     for (size_t k = 0; k < order.size(); ++k) {
-      progress(fmt::format("{} {} round {}/{} {}", family.name, point_name(family, n), round + 1,
-                           request_.repetitions, request_.renderers[order[k]]));
-      if (cancelled()) return;
-      Expected<double> t = frames.time_frame(order[k]);
+      progress(fmt::format("{} round {}/{} {}", what, round + 1, request_.repetitions,
+                           request_.renderers[order[k]]));
+      if (stopped()) return;
+      Expected<FrameTime> t = frames.time_frame(order[k]);
       if (!t) {
         status = t.error();
         return;
       }
-      points[order[k]].seconds.push_back(*t);
-      points[order[k]].order.push_back(int(k));
-      for (const auto& [phase, seconds] : frames.last_phases())
-        points[order[k]].phases[phase].push_back(seconds);
+      Run& run = runs[order[k]];
+      run.seconds.push_back(t->seconds);
+      run.order.push_back(int(k));
+      for (const auto& [phase, seconds] : t->phases) run.phases[phase].push_back(seconds);
     }
-    if (Expected<double> t = time_reference(); !t) status = t.error();
+    if (!reference_time()) return;
   }
+  for (Run& run : runs) run.reference_ratio = slowest / f_->quickest_reference;
 }
 
-// Measures builtin:<family>:<n> at `width` with every renderer; the points join the result.
-Status Sweep::measure(const Family& family, size_t n, int width, double deadline) {
-  progress(fmt::format("{} {} {}×{}: preparing", family.name, point_name(family, n), width,
-                       width * 3 / 4));
-  Expected<std::unique_ptr<FrameSource>> frames = hooks_.prepare(family, n, width);
+// One run of builtin:<family>:<n> at `width` in `session`, every renderer: added to the
+// family's points (created at the point's first run). A run cut short is dropped.
+Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession& session,
+                          PointSet& into) {
+  const std::string what =
+      fmt::format("{} {} {}×{} session {}", family.name, point_name(family, n), width,
+                  width * 3 / 4, session.index + 1);
+  progress(what + ": preparing");
+  Expected<std::unique_ptr<FrameSource>> frames = session.session->prepare(family, n, width);
   if (!frames) return frames.error();
-  std::vector<Measurement> points;
-  for (const std::string& name : request_.renderers) {
-    Measurement m;
-    m.renderer = name;
-    m.scene = family.name;
-    m.scene_n = double(n);
-    m.n = (*frames)->axis_value();
-    m.pixels = (*frames)->pixels();
-    m.width = width;
-    m.height = width * 3 / 4;
-    points.push_back(m);
+  std::vector<Run> runs(request_.renderers.size());
+  for (size_t i = 0; i < runs.size(); ++i) {
+    runs[i].session = session.index;
+    runs[i].prepare_seconds = (*frames)->prepare_seconds(i);
   }
   Status status = ok_status();
-  time_rounds(family, n, **frames, deadline, points, status);
+  time_rounds(what, **frames, *session.reference, runs, status);
   if (!status) return status;
-  if (cancelled()) return ok_status();  // the point is incomplete: dropped
-  const double ratio = slowest_reference_ / quickest_reference_;
-  for (Measurement& m : points) {
-    m.reference_ratio = ratio;
-    m.busy = ratio > kBusyRatio;
-    result_.points.push_back(std::move(m));
+  if (runs[0].seconds.size() < size_t(request_.repetitions)) return ok_status();  // cut short
+  std::vector<Measurement>& list = *into.list;
+  auto [it, fresh] = into.index.try_emplace({n, width}, list.size());
+  for (size_t i = 0; i < runs.size(); ++i) {
+    runs[i].busy = runs[i].reference_ratio > kBusyRatio || session.other_work;
+    if (fresh) {
+      Measurement m;
+      m.renderer = request_.renderers[i];
+      m.scene = family.name;
+      m.scene_n = double(n);
+      m.n = (*frames)->axis_value();
+      m.pixels = (*frames)->pixels();
+      m.width = width;
+      m.height = width * 3 / 4;
+      m.counters = (*frames)->counters(i);
+      list.push_back(std::move(m));
+    }
+    list[it->second + i].runs.push_back(std::move(runs[i]));
   }
-  measured_.insert({family.name, n, width});
   return ok_status();
 }
 
 // The midpoints (in log N) of every bracket of measured points between which two renderers of
 // different loop orders change places.
 std::vector<size_t> Sweep::crossover_midpoints(const Family& family) const {
-  std::map<size_t, std::map<std::string, double>> t;  // n -> renderer -> median
+  std::map<size_t, std::map<std::string, double>> t;  // n -> renderer -> time
   for (const Measurement& m : result_.points)
     if (m.scene == family.name && m.width == request_.width)
       t[size_t(m.scene_n)][m.renderer] = typical_seconds(m);
@@ -239,23 +329,35 @@ std::vector<size_t> Sweep::crossover_midpoints(const Family& family) const {
   return {mids.begin(), mids.end()};
 }
 
-Expected<bool> Sweep::try_point(const Family& family, size_t n, int width, double limit,
-                                double share_end) {
-  if (measured_.count({family.name, n, width})) return false;
+// A point's first run, in the family's first session, unless it was measured, or all of its
+// sessions would end past `limit` as predicted from the points measured at the full width:
+// false then.
+Expected<bool> Sweep::try_first_run(const Family& family, size_t n, int width, double limit,
+                                    OpenSession& session) {
+  if (f_->points.index.count({n, width})) return false;
+  // The sessions still to come repeat every point measured so far, and this one.
+  double committed = 0;
+  for (PointKey p : f_->first_session_order) committed += f_->cost.predict(p.first);
+  const double sessions_left = double(request_.sessions - 1);
   // A narrower frame costs no more than the full-width one the prediction is made from.
-  if (!cost_.empty() && elapsed() + cost_.predict(n) > limit) return false;
+  if (!f_->cost.empty() &&
+      elapsed() + f_->cost.predict(n) * double(request_.sessions) + sessions_left * committed >
+          limit)
+    return false;
   double before = elapsed();
-  if (Status s = measure(family, n, width, share_end); !s) return s.error();
-  if (width == request_.width) cost_.add(n, elapsed() - before);
+  if (Status s = measure_run(family, n, width, session, f_->points); !s) return s.error();
+  if (!f_->points.index.count({n, width})) return false;  // cut short
+  if (width == request_.width) f_->cost.add(n, elapsed() - before);
+  f_->first_session_order.push_back({n, width});
   return true;
 }
 
 // The log-spaced sweep of N at the full width, stopped where a point would end past `limit`.
-Status Sweep::sweep_n(const Family& family, double limit, double share_end) {
+Status Sweep::sweep_n(const Family& family, double limit, OpenSession& session) {
   for (size_t n : log_spaced(family.low, family.high, family.points)) {
-    if (cancelled()) return ok_status();
+    if (stopped()) return ok_status();
     if (!in_this_shard(n, request_.width)) continue;
-    Expected<bool> done = try_point(family, n, request_.width, limit, share_end);
+    Expected<bool> done = try_first_run(family, n, request_.width, limit, session);
     if (!done) return done.error();
     if (!*done) {
       result_.notes.push_back(
@@ -269,20 +371,20 @@ Status Sweep::sweep_n(const Family& family, double limit, double share_end) {
 
 // The pixel count swept at the smallest, the middle and the largest N measured, so that the
 // per-pixel terms can be told from the constant ones.
-Status Sweep::sweep_pixels(const Family& family, double limit, double share_end) {
+Status Sweep::sweep_pixels(const Family& family, double limit, OpenSession& session) {
   std::vector<size_t> measured;
-  for (const auto& [name, n, width] : measured_)
-    if (name == family.name && width == request_.width) measured.push_back(n);
+  for (const auto& [point, index] : f_->points.index)
+    if (point.second == request_.width) measured.push_back(point.first);
   std::sort(measured.begin(), measured.end());
   // A shard takes the pixel sweep at the N planned: the other shards measure the rest of them.
   if (request_.shard) measured = log_spaced(family.low, family.high, family.points);
   for (size_t n : pixel_sweep_ns(measured))
     for (int width : pixel_sweep_widths(request_.width)) {
-      if (cancelled()) return ok_status();
+      if (stopped()) return ok_status();
       if (!in_this_shard(n, width)) continue;
-      Expected<bool> done = try_point(family, n, width, limit, share_end);
+      Expected<bool> done = try_first_run(family, n, width, limit, session);
       if (!done) return done.error();
-      if (!*done && !measured_.count({family.name, n, width})) {
+      if (!*done && !f_->points.index.count({n, width})) {
         result_.notes.push_back(fmt::format(
             "{}: the pixel sweep stopped at {}, {} wide (it would have overrun the budget)",
             family.name, point_name(family, n), width));
@@ -292,67 +394,166 @@ Status Sweep::sweep_pixels(const Family& family, double limit, double share_end)
   return ok_status();
 }
 
-// The points of the family measured while the machine was busy, measured again (the busy ones
-// replaced) while the share lasts; those still busy are said in the notes.
-Status Sweep::measure_busy_points_again(const Family& family, double share_end) {
-  std::set<std::pair<size_t, int>> busy;
-  for (const Measurement& m : result_.points)
-    if (m.scene == family.name && m.busy) busy.insert({size_t(m.scene_n), m.width});
-  size_t again = 0;
-  for (auto [n, width] : busy) {
-    if (cancelled() || elapsed() + cost_.predict(n) > share_end) break;
-    auto same_point = [&, n = n, width = width](const Measurement& m) {
-      return m.scene == family.name && size_t(m.scene_n) == n && m.width == width;
-    };
-    std::vector<Measurement> before;
-    for (const Measurement& m : result_.points)
-      if (same_point(m)) before.push_back(m);
-    std::erase_if(result_.points, same_point);
-    measured_.erase({family.name, n, width});
-    if (Status s = measure(family, n, width, share_end); !s) return s;
-    if (!measured_.count({family.name, n, width})) {  // cancelled: the first measurement stays
-      for (Measurement& m : before) result_.points.push_back(std::move(m));
-      break;
+// Sessions 2 … S: every point of the first session measured again, in a fresh random order.
+Status Sweep::more_sessions(const Family& family, double limit) {
+  size_t skipped = 0;
+  for (int s = 1; s < request_.sessions; ++s) {
+    if (stopped()) return ok_status();
+    Expected<OpenSession> session = open_session(family);
+    if (!session) return session.error();
+    std::vector<PointKey> order = f_->first_session_order;
+    for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng_.below(i)]);
+    for (PointKey p : order) {
+      if (stopped()) return ok_status();
+      if (elapsed() + f_->cost.predict(p.first) > limit) {
+        ++skipped;
+        continue;
+      }
+      if (Status st = measure_run(family, p.first, p.second, *session, f_->points); !st) return st;
     }
-    ++again;
   }
-  if (again > 0)
+  if (skipped > 0)
     result_.notes.push_back(fmt::format(
-        "{}: {} {} measured while the machine was busy with something else {} "
-        "measured again",
-        family.name, again, again == 1 ? "point" : "points", again == 1 ? "was" : "were"));
-  size_t still = 0;
-  double worst = 0;
-  for (const Measurement& m : result_.points)
-    if (m.scene == family.name && m.busy) ++still, worst = std::max(worst, m.reference_ratio);
-  if (still > 0)
-    result_.notes.push_back(fmt::format(
-        "{}: {} measurements were taken while the machine was busy with something else (the "
-        "reference frame up to {:.1f}× slower than its quickest) and are left out of the fits "
-        "and crossovers: run the study on a quiet machine",
-        family.name, still, worst));
+        "{}: {} runs of points already measured were left out (they would have overrun the "
+        "budget): those points were measured in fewer than {} sessions",
+        family.name, skipped, request_.sessions));
   return ok_status();
 }
 
-// The sweep of N up to kBaseShare of the scene's share, of the pixel count up to kPixelShare,
-// then points near crossovers, then busy points again.
-Status Sweep::run_scene(const Family& family, double share_end) {
+// Up to kRefinementRounds rounds: points at the midpoints of brackets where two renderers change
+// places, each measured in S fresh sessions, as the share allows.
+Status Sweep::refine_near_crossovers(const Family& family, double share_end) {
+  for (int round = 0; round < kRefinementRounds; ++round) {
+    std::vector<size_t> mids;
+    double cost = 0;
+    for (size_t mid : crossover_midpoints(family))
+      if (!f_->points.index.count({mid, request_.width})) {
+        const double one = double(request_.sessions) * f_->cost.predict(mid);
+        if (elapsed() + cost + one > share_end) continue;
+        mids.push_back(mid);
+        cost += one;
+      }
+    if (mids.empty()) return ok_status();
+    for (int s = 0; s < request_.sessions; ++s) {
+      if (stopped()) return ok_status();
+      Expected<OpenSession> session = open_session(family);
+      if (!session) return session.error();
+      for (size_t i = mids.size(); i > 1; --i) std::swap(mids[i - 1], mids[rng_.below(i)]);
+      for (size_t mid : mids) {
+        if (stopped()) return ok_status();
+        if (Status st = measure_run(family, mid, request_.width, *session, f_->points); !st)
+          return st;
+      }
+    }
+  }
+  return ok_status();
+}
+
+// The family's runs measured while the machine was busy, measured again in a fresh session
+// while the share lasts: a quiet run replaces the busy one. Notes say how many and what is left.
+Status Sweep::measure_busy_runs_again(const Family& family, double share_end) {
+  std::vector<std::pair<PointKey, int>> busy;  // point, session of the busy run
+  for (const auto& [point, index] : f_->points.index)
+    for (const Run& run : result_.points[index].runs)
+      if (run.busy) busy.push_back({point, run.session});
+  size_t replaced = 0;
+  if (!busy.empty() && !stopped() &&
+      elapsed() + f_->cost.predict(busy[0].first.first) < share_end) {
+    Expected<OpenSession> session = open_session(family);
+    if (!session) return session.error();
+    for (auto [point, busy_session] : busy) {
+      if (stopped() || elapsed() + f_->cost.predict(point.first) > share_end) break;
+      const size_t first = f_->points.index.at(point);
+      const size_t before = result_.points[first].runs.size();
+      if (Status s = measure_run(family, point.first, point.second, *session, f_->points); !s)
+        return s;
+      if (result_.points[first].runs.size() == before) break;  // cut short
+      if (result_.points[first].runs.back().busy) continue;    // busy again: both kept
+      for (size_t i = 0; i < request_.renderers.size(); ++i)
+        std::erase_if(result_.points[first + i].runs,
+                      [&](const Run& r) { return r.session == busy_session && r.busy; });
+      ++replaced;
+    }
+  }
+  if (replaced > 0)
+    result_.notes.push_back(fmt::format(
+        "{}: {} {} measured while the machine was busy with something else {} measured again",
+        family.name, replaced, replaced == 1 ? "run" : "runs", replaced == 1 ? "was" : "were"));
+  size_t still = 0, points = 0;
+  double worst = 0;
+  for (const auto& [point, index] : f_->points.index) {
+    bool any = false;
+    for (const Run& run : result_.points[index].runs)
+      if (run.busy) ++still, any = true, worst = std::max(worst, run.reference_ratio);
+    points += any;
+  }
+  if (still > 0)
+    result_.notes.push_back(fmt::format(
+        "{}: {} runs at {} points were measured while the machine was busy with something else "
+        "(the reference frame up to {:.1f}× slower than its quickest, or other work seen by the "
+        "system probe): their paired ratios count, with the spread they have; their absolute "
+        "times are fitted only where no quiet run of the point exists",
+        family.name, still, points, worst));
+  return ok_status();
+}
+
+// The first session sweeps N up to kBaseShare of the scene's share and the pixel count up to
+// kPixelShare (every session to come counted); sessions 2 … S repeat those points; then points
+// near crossovers, then busy runs again.
+Status Sweep::run_family(const Family& family, double share_end) {
   const double share_start = elapsed();
   const double length = share_end - share_start;
-  cost_ = CostPredictor();
-  plan_offset_ += plan_.size();
-  plan_ = planned_points(family, request_.width);
-  if (Status s = start_reference(family); !s) return s;
-  if (Status s = sweep_n(family, share_start + kBaseShare * length, share_end); !s) return s;
-  if (Status s = sweep_pixels(family, share_start + kPixelShare * length, share_end); !s) return s;
+  f_ = &families_[family.name];
+  f_->points.list = &result_.points;
+  f_->checks.list = &result_.check_points;
+  f_->plan = planned_points(family, request_.width);
+  f_->plan_offset = plan_size_;
+  plan_size_ += f_->plan.size();
+  {
+    Expected<OpenSession> first = open_session(family);
+    if (!first) return first.error();
+    if (Status s = sweep_n(family, share_start + kBaseShare * length, *first); !s) return s;
+    if (Status s = sweep_pixels(family, share_start + kPixelShare * length, *first); !s) return s;
+  }
+  if (Status s = more_sessions(family, share_start + kPixelShare * length); !s) return s;
   // A shard adds none near crossovers: where they go depends on the other shards' points.
-  for (int round = 0; round < (request_.shard ? 0 : kRefinementRounds); ++round)
-    for (size_t mid : crossover_midpoints(family)) {
-      if (cancelled()) return ok_status();
-      Expected<bool> done = try_point(family, mid, request_.width, share_end, share_end);
-      if (!done) return done.error();
+  if (!request_.shard)
+    if (Status s = refine_near_crossovers(family, share_end); !s) return s;
+  return measure_busy_runs_again(family, share_end);
+}
+
+Status Sweep::measure_checks(const std::vector<Family>& families) {
+  const std::vector<CheckPoint> plan = plan_checks(result_);
+  size_t skipped = 0;
+  for (int s = 0; s < request_.sessions; ++s)
+    for (const Family& family : families) {
+      std::vector<PointKey> points;
+      for (const CheckPoint& p : plan)
+        if (p.scene == family.name &&
+            std::find(points.begin(), points.end(), PointKey{p.scene_n, p.width}) == points.end())
+          points.push_back({p.scene_n, p.width});
+      if (points.empty() || stopped()) continue;
+      f_ = &families_[family.name];
+      Expected<OpenSession> session = open_session(family);
+      if (!session) return session.error();
+      for (size_t i = points.size(); i > 1; --i) std::swap(points[i - 1], points[rng_.below(i)]);
+      for (PointKey p : points) {
+        if (stopped()) break;
+        // Every session of the checks is to come: the point's share of what is left.
+        if (elapsed() + f_->cost.predict(p.first) * double(request_.sessions - s) >
+            request_.budget_seconds) {
+          ++skipped;
+          continue;
+        }
+        if (Status st = measure_run(family, p.first, p.second, *session, f_->checks); !st)
+          return st;
+      }
     }
-  return measure_busy_points_again(family, share_end);
+  if (skipped > 0)
+    result_.notes.push_back(fmt::format(
+        "{} runs of the prediction checks were left out: they would have overrun the budget",
+        skipped));
+  return ok_status();
 }
 
 }  // namespace
@@ -366,9 +567,12 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   result.mode = to_string(request.mode);
   result.budget_seconds = request.budget_seconds;
   result.repetitions = request.repetitions;
+  result.sessions_per_point = request.sessions;
+  result.noise_threshold = request.noise_threshold;
   result.seed = request.seed;
   result.bootstrap_replicates = request.bootstrap_replicates;
   result.shard = request.shard;
+  result.run_id = new_run_id();
   if (request.shard)
     result.notes.push_back(fmt::format(
         "shard {}/{}: only the planned points whose index is {} mod {} were measured, none near "
@@ -376,28 +580,40 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
         "study --merge pools the shards",
         request.shard->index, request.shard->count, request.shard->index, request.shard->count));
   Sweep sweep(request, hooks, result);
+  result.system_before = sweep.probe();
+  const bool checks = request.check_predictions && !request.shard;
+  const double sweep_budget = request.budget_seconds * (checks ? 1 - kCheckShare : 1.0);
   std::vector<Family> families;
   for (size_t i = 0; i < request.scenes.size(); ++i) {
     Family family = *find_family(request.scenes[i]);
     families.push_back(family);
     result.scenes.push_back(family.name);
     result.axes[family.name] = family.axis;
-    double left = request.budget_seconds - sweep.elapsed();
+    double left = sweep_budget - sweep.elapsed();
     double share_end = sweep.elapsed() + left / double(request.scenes.size() - i);
-    if (Status s = sweep.run_scene(family, share_end); !s) return s.error();
-    if (sweep.cancelled()) break;
+    if (sweep.stopped()) continue;
+    if (Status s = sweep.run_family(family, share_end); !s) return s.error();
   }
   if (sweep.cancelled()) {
     result.interrupted = true;
     result.notes.push_back(
         "the study was interrupted: it is concluded from the points measured "
         "before the interruption");
+  } else if (sweep.out_of_time()) {
+    result.notes.push_back(fmt::format(
+        "the budget of {:.0f} s ran out during the sweep: the run being measured was dropped",
+        request.budget_seconds));
+  }
+  BootstrapOptions boot{request.bootstrap_replicates, request.seed};
+  const double before_fits = sweep.elapsed();
+  conclude(result, boot);
+  sweep.exclude(sweep.elapsed() - before_fits);
+  if (!result.interrupted && checks && !sweep.stopped() && !result.crossovers.empty()) {
+    if (Status s = sweep.measure_checks(families); !s) return s.error();
+    evaluate_checks(result, CompareOptions{boot, request.noise_threshold});
   }
   result.elapsed_seconds = sweep.elapsed();
-  BootstrapOptions boot{request.bootstrap_replicates, request.seed};
-  conclude(result, boot);
-  if (!result.interrupted && request.check_predictions && !request.shard)
-    if (Status s = check_predictions(request, hooks, families, result); !s) return s.error();
+  result.system_after = sweep.probe();
   return result;
 }
 

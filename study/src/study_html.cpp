@@ -151,12 +151,14 @@ ChartPoint chart_point(const Measurement& m, double x, const std::string& what) 
   ChartPoint p;
   p.x = x;
   p.typical = typical_seconds(m);
-  const auto [lo, hi] = std::minmax_element(m.seconds.begin(), m.seconds.end());
-  p.low = lo == m.seconds.end() ? p.typical : *lo;
-  p.high = hi == m.seconds.end() ? p.typical : *hi;
-  p.tooltip = fmt::format("{}, {}: {} ms (fastest {}, slowest {}; {} repetitions)", m.renderer,
-                          what, format_number(1e3 * p.typical), format_number(1e3 * p.low),
-                          format_number(1e3 * p.high), m.seconds.size());
+  const std::vector<double> seconds = all_seconds(m);
+  const auto [lo, hi] = std::minmax_element(seconds.begin(), seconds.end());
+  p.low = lo == seconds.end() ? p.typical : *lo;
+  p.high = hi == seconds.end() ? p.typical : *hi;
+  p.tooltip = fmt::format("{}, {}: {} ms (fastest {}, slowest {}; {} repetitions in {} runs)",
+                          m.renderer, what, format_number(1e3 * p.typical),
+                          format_number(1e3 * p.low), format_number(1e3 * p.high),
+                          seconds.size(), m.runs.size());
   return p;
 }
 
@@ -374,9 +376,14 @@ std::string conclusions_html(const StudyResult& r, const std::string& scene) {
   for (const PredictionCheck& c : r.checks)
     if (c.scene == scene)
       items += fmt::format("<li class=\"check-sentence {}\">Checked after the fit: {}</li>\n",
-                           c.holds ? "holds" : "fails", html_with_powers(check_sentence(c)));
-  if (items.empty()) return "<p>No pair of loop orders was measured.</p>\n";
-  return "<ul class=\"conclusions\">\n" + items + "</ul>\n";
+                           c.verdict, html_with_powers(check_sentence(c)));
+  for (const Comparison& c : r.comparisons)
+    if (c.scene == scene && !c.inconclusive.empty())
+      items += fmt::format("<li class=\"inconclusive\">{} and {} along {}: nothing concluded: {}</li>\n",
+                           escape_html(c.a), escape_html(c.b), escape_html(c.axis),
+                           html_with_powers(c.inconclusive));
+  if (items.empty()) return "";
+  return "<h3>Conclusions</h3>\n<ul class=\"conclusions\">\n" + items + "</ul>\n";
 }
 
 // One scene family, the `index`th: its charts, its crossovers and its models.
@@ -398,7 +405,7 @@ std::string scene_section(const StudyResult& r, size_t index, const Colours& col
                                                     "log-log. ",
                                                     format_number(n), axis)) +
                            kMarksCaption);
-  o += "<h3>Crossovers</h3>\n" + conclusions_html(r, scene);
+  o += conclusions_html(r, scene);
   o += "<h3>Cost models</h3>\n" + models_table(r, scene, colours);
   return o + "</section>\n";
 }
@@ -409,12 +416,17 @@ std::string header_html(const StudyResult& r) {
   for (const std::string& s : r.scenes) scenes += (scenes.empty() ? "" : ", ") + s;
   std::string o = fmt::format("<h1>rvr study: {}</h1>\n", escape_html(scenes));
   if (!r.command.empty()) o += "<pre class=\"cmd\">" + escape_html(r.command) + "</pre>\n";
-  o += fmt::format(
-      "<p>{}×{}, {} mode; {} repetitions per point, interleaved in random order; Harrell–Davis "
-      "medians; 95% intervals from {} bootstrap replicates over the repetitions (seed {}). "
-      "{:.0f} s of a {:.0f} s budget.</p>\n",
-      r.width, r.height, escape_html(r.mode), r.repetitions, r.bootstrap_replicates, r.seed,
-      r.elapsed_seconds, r.budget_seconds);
+  o += "<p class=\"scope\"><b>Scope.</b> " + html_with_powers(scope_text(r)) + "</p>\n";
+  o += "<p class=\"method\"><b>Method.</b> " + html_with_powers(method_text(r)) + "</p>\n";
+  if (!r.no_conclusion.empty())
+    o += "<div class=\"warn no-conclusion\"><b>No conclusion:</b> " +
+         html_with_powers(r.no_conclusion) + ".</div>\n";
+  const std::vector<std::string> headline = headline_sentences(r);
+  if (!headline.empty()) {
+    o += "<h2>Where the pixel-major loop overtakes the triangle-major one</h2>\n<ul class=\"headline\">";
+    for (const std::string& h : headline) o += "<li>" + html_with_powers(h) + "</li>";
+    o += "</ul>\n";
+  }
   if (r.interrupted)
     o += "<div class=\"warn interrupted\"><b>Interrupted:</b> the sweep was stopped before its "
          "end; everything below is from the points measured until then.</div>\n";

@@ -15,6 +15,7 @@
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
 #include "rvr/study/sweep_plan.h"
+#include "rvr/study/system_probe.h"
 
 namespace rvr::study {
 namespace {
@@ -73,13 +74,62 @@ json crossovers_json(const StudyResult& r) {
                    {"n", c.n},
                    {"a_faster_below", c.a_faster_below},
                    {"measured", c.measured},
-                   {"range", json::array({c.range_low, c.range_high})}});
+                   {"range", json::array({c.range_low, c.range_high})},
+                   {"below", {{"points", c.below_points}, {"ratio", number(c.below_ratio)}}},
+                   {"above", {{"points", c.above_points}, {"ratio", number(c.above_ratio)}}},
+                   {"contradicted", c.contradicted}});
+  return out;
+}
+
+json comparisons_json(const StudyResult& r) {
+  json out = json::array();
+  for (const Comparison& c : r.comparisons) {
+    json points = json::array();
+    for (const PointComparison& p : c.points)
+      points.push_back({{"at", p.at},
+                        {"ratio", number(p.ratio)},
+                        {"trend", number(p.trend)},
+                        {"ci95", interval(p.ci95)},
+                        {"p", number(p.p)},
+                        {"faster", p.faster < 0 ? json(c.a) : p.faster > 0 ? json(c.b) : json(nullptr)}});
+    out.push_back({{"a", c.a},
+                   {"b", c.b},
+                   {"scene", c.scene},
+                   {"axis", c.axis},
+                   {"pixels", c.pixels},
+                   {"n", c.n},
+                   {"point_noise", number(c.point_noise)},
+                   {"dof", number(c.dof)},
+                   {"inconclusive", c.inconclusive.empty() ? json(nullptr) : json(c.inconclusive)},
+                   {"points", points}});
+  }
+  return out;
+}
+
+json system_json(const SystemSnapshot& s) {
+  return {{"at", number(s.at)},
+          {"known", s.known},
+          {"cpus", s.cpus},
+          {"load", json::array({number(s.load1), number(s.load5), number(s.load15)})},
+          {"other_busy", number(s.other_busy)},
+          {"steal", number(s.steal)},
+          {"mhz", s.mhz > 0 ? json(s.mhz) : json(nullptr)},
+          {"governor", s.governor.empty() ? json(nullptr) : json(s.governor)}};
+}
+
+json sessions_json(const StudyResult& r) {
+  json out = json::array();
+  for (const SessionInfo& s : r.sessions)
+    out.push_back({{"kind", s.kind}, {"study", s.study}, {"system", system_json(s.system)}});
   return out;
 }
 
 void conclusions_json(const StudyResult& r, json& doc) {
   json dominance = json::array();
-  for (const Dominance& d : r.dominance)
+  for (const Dominance& d : r.dominance) {
+    json contrary = json::array();
+    for (size_t k = 0; k < d.contrary.size(); ++k)
+      contrary.push_back({{"at", d.contrary[k]}, {"ratio", number(d.contrary_ratios[k])}});
     dominance.push_back({{"faster", d.faster},
                          {"slower", d.slower},
                          {"scene", d.scene},
@@ -88,7 +138,13 @@ void conclusions_json(const StudyResult& r, json& doc) {
                          {"at", d.at},
                          {"pixels", d.pixels},
                          {"n", d.n},
-                         {"range", json::array({d.range_low, d.range_high})}});
+                         {"range", json::array({d.range_low, d.range_high})},
+                         {"significant", d.significant},
+                         {"points", d.points},
+                         {"significant_range",
+                          json::array({number(d.significant_low), number(d.significant_high)})},
+                         {"contrary", contrary}});
+  }
   json scaling = json::array();
   for (const ScalingExponent& s : r.scaling)
     scaling.push_back({{"renderer", s.renderer},
@@ -107,18 +163,26 @@ void conclusions_json(const StudyResult& r, json& doc) {
                      {"ns_per_triangle", number(c.ns_per_triangle)},
                      {"ns_per_ray", number(c.ns_per_ray)}});
   json checks = json::array();
+  auto name_or_null = [](const std::string& s) { return s.empty() ? json(nullptr) : json(s); };
   for (const PredictionCheck& c : r.checks)
     checks.push_back({{"a", c.a},
                       {"b", c.b},
                       {"scene", c.scene},
                       {"axis", c.axis},
                       {"crossover", number(c.crossover)},
+                      {"extrapolated", c.extrapolated},
                       {"at", number(c.at)},
                       {"pixels", c.pixels},
-                      {"predicted_faster", c.predicted_faster},
-                      {"measured_faster", c.measured_faster},
+                      {"n", c.n},
+                      {"predicted_faster", name_or_null(c.predicted_faster)},
+                      {"measured_faster", name_or_null(c.measured_faster)},
                       {"ratio", number(c.ratio)},
-                      {"holds", c.holds}});
+                      {"ratio_ci95", interval(c.ratio_ci95)},
+                      {"p", number(c.p)},
+                      {"predicted_ratio", number(c.predicted_ratio)},
+                      {"predicted_ci95", interval(c.predicted_ci95)},
+                      {"verdict", c.verdict},
+                      {"why", c.why}});
   doc["checks"] = checks;
   json splits = json::array();
   for (const PhaseSplit& s : r.splits)
@@ -135,21 +199,33 @@ void conclusions_json(const StudyResult& r, json& doc) {
   doc["costs"] = costs;
 }
 
-json phases_json(const Measurement& m) {
-  json out = json::object();
-  for (const auto& [phase, seconds] : m.phases) {
-    json values = json::array();
-    for (double s : seconds) values.push_back(number(s));
-    out[phase] = values;
+json numbers(const std::vector<double>& values) {
+  json out = json::array();
+  for (double v : values) out.push_back(number(v));
+  return out;
+}
+
+json runs_json(const Measurement& m) {
+  json out = json::array();
+  for (const Run& run : m.runs) {
+    json phases = json::object();
+    for (const auto& [phase, seconds] : run.phases) phases[phase] = numbers(seconds);
+    out.push_back({{"session", run.session},
+                   {"prepare_seconds", number(run.prepare_seconds)},
+                   {"seconds", numbers(run.seconds)},
+                   {"order", run.order},
+                   {"phases", phases},
+                   {"reference_ratio", number(run.reference_ratio)},
+                   {"busy", run.busy}});
   }
   return out;
 }
 
-json points_json(const StudyResult& r) {
+json points_json(const std::vector<Measurement>& points) {
   json out = json::array();
-  for (const Measurement& m : r.points) {
-    json seconds = json::array();
-    for (double s : m.seconds) seconds.push_back(number(s));
+  for (const Measurement& m : points) {
+    json counters = json::object();
+    for (const auto& [name, value] : m.counters) counters[name] = number(value);
     out.push_back({{"renderer", m.renderer},
                    {"scene", m.scene},
                    {"scene_n", m.scene_n},
@@ -157,14 +233,12 @@ json points_json(const StudyResult& r) {
                    {"width", m.width},
                    {"height", m.height},
                    {"pixels", m.pixels},
-                   {"seconds", seconds},
-                   {"order", m.order},
+                   {"counters", counters},
+                   {"runs", runs_json(m)},
+                   {"seconds", number(typical_seconds(m))},
                    {"median", number(median_seconds(m))},
-                   {"hd_median", number(typical_seconds(m))},
                    {"relative_mad", number(relative_mad(m))},
-                   {"reference_ratio", number(m.reference_ratio)},
-                   {"phases", phases_json(m)},
-                   {"busy", m.busy}});
+                   {"busy", m.busy()}});
   }
   return out;
 }
@@ -184,21 +258,31 @@ std::string study_json(const StudyResult& r) {
               {"budget_seconds", r.budget_seconds},
               {"elapsed_seconds", number(r.elapsed_seconds)},
               {"repetitions", r.repetitions},
+              {"sessions_per_point", r.sessions_per_point},
+              {"noise_threshold", r.noise_threshold},
               {"seed", r.seed},
+              {"run_id", r.run_id},
+              {"merged_runs", r.merged_runs},
               {"bootstrap_replicates", r.bootstrap_replicates},
               {"machine",
                {{"cpu", r.machine.cpu},
                 {"threads", r.machine.threads},
                 {"kernels", r.machine.kernels},
                 {"versions", r.machine.versions}}},
+              {"system_before", system_json(r.system_before)},
+              {"system_after", system_json(r.system_after)},
+              {"sessions", sessions_json(r)},
               {"renderers", renderers_json(r)},
+              {"comparisons", comparisons_json(r)},
               {"crossovers", crossovers_json(r)},
+              {"no_conclusion", r.no_conclusion.empty() ? json(nullptr) : json(r.no_conclusion)},
               {"notes", r.notes},
               {"interrupted", r.interrupted},
               {"shard", r.shard ? json{{"index", r.shard->index}, {"count", r.shard->count}}
                                 : json(nullptr)}};
   conclusions_json(r, doc);
-  doc["points"] = points_json(r);
+  doc["points"] = points_json(r.points);
+  doc["check_points"] = points_json(r.check_points);
   return doc.dump(2) + "\n";
 }
 

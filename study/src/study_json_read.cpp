@@ -131,16 +131,22 @@ class Fields {
 };
 
 const std::vector<std::string> kTopKeys = {
-    "format",          "command",     "scenes",     "renderer_order",
-    "width",           "height",      "mode",       "budget_seconds",
-    "elapsed_seconds", "repetitions", "seed",       "bootstrap_replicates",
-    "machine",         "renderers",   "crossovers", "dominance",
-    "scaling",         "costs",       "checks",     "notes",
-    "interrupted",     "shard",       "points",     "splits"};
+    "format",        "command",         "scenes",          "renderer_order",
+    "width",         "height",          "mode",            "budget_seconds",
+    "elapsed_seconds", "repetitions",   "sessions_per_point", "noise_threshold",
+    "seed",          "run_id",          "merged_runs",     "bootstrap_replicates",
+    "machine",       "system_before",   "system_after",    "sessions",
+    "renderers",     "comparisons",     "crossovers",      "no_conclusion",
+    "dominance",     "scaling",         "costs",           "checks",
+    "notes",         "interrupted",     "shard",           "points",
+    "check_points",  "splits"};
 const std::vector<std::string> kPointKeys = {
-    "renderer",  "scene",        "scene_n",         "n",     "width",
-    "height",    "pixels",       "seconds",         "order", "median",
-    "hd_median", "relative_mad", "reference_ratio", "busy",  "phases"};
+    "renderer", "scene",  "scene_n", "n",      "width",        "height", "pixels",
+    "counters", "runs",   "seconds", "median", "relative_mad", "busy"};
+const std::vector<std::string> kRunKeys = {"session", "prepare_seconds", "seconds", "order",
+                                           "phases",  "reference_ratio", "busy"};
+const std::vector<std::string> kSystemKeys = {"at",         "known", "cpus", "load",
+                                              "other_busy", "steal", "mhz",  "governor"};
 
 // A family is a built-in (its axis fixed) or a file grown by copies (axis "triangles").
 void read_scenes(const Fields& top, StudyResult& r) {
@@ -189,6 +195,49 @@ void read_machine(const Fields& top, StudyResult& r) {
   }
 }
 
+SystemSnapshot read_system(const json& v, const std::string& path) {
+  Fields f(v, path, kSystemKeys);
+  SystemSnapshot s;
+  s.at = f.number_or_nan("at");
+  s.known = f.boolean("known");
+  s.cpus = int(f.whole("cpus", 0, 1u << 20));
+  const json& load = f.array("load");
+  if (load.size() != 3) fail(f.path("load"), "must hold 3 load averages, got " + describe(load));
+  double* loads[] = {&s.load1, &s.load5, &s.load15};
+  for (size_t k = 0; k < 3; ++k)
+    *loads[k] = load[k].is_null() ? 0.0 : Fields::number_at(load[k], index_path(f.path("load"), k), 0);
+  s.other_busy = f.number_or_nan("other_busy");
+  s.steal = f.number_or_nan("steal");
+  if (!f.at("mhz").is_null()) s.mhz = f.number("mhz", 0);
+  if (!f.at("governor").is_null()) s.governor = f.string("governor");
+  return s;
+}
+
+void read_sessions(const Fields& top, StudyResult& r) {
+  const json& sessions = top.array("sessions");
+  for (size_t i = 0; i < sessions.size(); ++i) {
+    const std::string path = index_path("sessions", i);
+    Fields f(sessions[i], path, {"kind", "study", "system"});
+    SessionInfo s;
+    s.kind = f.string("kind");
+    if (s.kind != "process" && s.kind != "preparation")
+      fail(f.path("kind"), "must be \"process\" or \"preparation\", got " + describe(f.at("kind")));
+    s.study = f.string("study");
+    s.system = read_system(f.at("system"), f.path("system"));
+    r.sessions.push_back(s);
+  }
+}
+
+std::vector<std::string> strings_of(const Fields& top, const char* key) {
+  const json& list = top.array(key);
+  std::vector<std::string> out;
+  for (size_t i = 0; i < list.size(); ++i) {
+    if (!list[i].is_string()) fail(index_path(key, i), "must be a string, got " + describe(list[i]));
+    out.push_back(list[i].get<std::string>());
+  }
+  return out;
+}
+
 void read_request(const Fields& top, StudyResult& r) {
   if (top.string("format") != kStudyFormat)
     fail("format", fmt::format("must be \"{}\", got {}", kStudyFormat, describe(top.at("format"))));
@@ -204,9 +253,18 @@ void read_request(const Fields& top, StudyResult& r) {
   if (!(r.budget_seconds > 0)) fail("budget_seconds", "must be > 0");
   r.elapsed_seconds = top.number_or_nan("elapsed_seconds");
   r.repetitions = int(top.whole("repetitions", 1, 1u << 20));
+  r.sessions_per_point = int(top.whole("sessions_per_point", 1, 1u << 20));
+  r.noise_threshold = top.number("noise_threshold", 0);
+  if (!(r.noise_threshold < 1)) fail("noise_threshold", "must be below 1");
   r.seed = top.whole("seed", 0, std::numeric_limits<uint64_t>::max());
+  r.run_id = top.string("run_id");
+  if (r.run_id.empty()) fail("run_id", "must not be empty");
+  r.merged_runs = strings_of(top, "merged_runs");
   r.bootstrap_replicates = int(top.whole("bootstrap_replicates", 1, 1u << 24));
   read_machine(top, r);
+  r.system_before = read_system(top.at("system_before"), "system_before");
+  r.system_after = read_system(top.at("system_after"), "system_after");
+  read_sessions(top, r);
   const json& notes = top.array("notes");
   for (size_t i = 0; i < notes.size(); ++i) {
     if (!notes[i].is_string())
@@ -228,11 +286,12 @@ void read_request(const Fields& top, StudyResult& r) {
 // The conclusions are computed again from the points: only their type is checked.
 void check_conclusions(const Fields& top) {
   top.object("renderers");
-  for (const char* key : {"crossovers", "dominance", "scaling", "costs"}) top.array(key);
   // Prediction checks tested the crossovers of the study as it was: not carried to one
-  // concluded again. Studies written before them have none.
-  if (top.has("checks")) top.array("checks");
-  if (top.has("splits")) top.array("splits");
+  // concluded again, and neither are the points they measured.
+  for (const char* key : {"comparisons", "crossovers", "dominance", "scaling", "costs", "checks",
+                          "splits", "check_points"})
+    top.array(key);
+  if (!top.at("no_conclusion").is_null()) top.string("no_conclusion");
 }
 
 std::vector<double> seconds_of(const json& values, const std::string& path) {
@@ -242,6 +301,33 @@ std::vector<double> seconds_of(const json& values, const std::string& path) {
   for (size_t k = 0; k < values.size(); ++k)
     out.push_back(Fields::number_at(values[k], index_path(path, k), 0));
   return out;
+}
+
+Run read_run(const json& v, const std::string& path, const StudyResult& r) {
+  Fields f(v, path, kRunKeys);
+  Run run;
+  run.session = int(f.whole("session", 0, 1u << 30));
+  if (size_t(run.session) >= r.sessions.size())
+    fail(f.path("session"), fmt::format("must index sessions (0 .. {}), got {}",
+                                        int(r.sessions.size()) - 1, run.session));
+  run.prepare_seconds = f.number("prepare_seconds", 0);
+  run.seconds = seconds_of(f.at("seconds"), f.path("seconds"));
+  const json& order = f.array("order");
+  if (order.size() != run.seconds.size())
+    fail(f.path("order"), fmt::format("must have one entry per round ({}), got {}",
+                                      run.seconds.size(), order.size()));
+  for (size_t k = 0; k < order.size(); ++k)
+    run.order.push_back(int(Fields::whole_at(order[k], index_path(f.path("order"), k), 0, 1u << 20)));
+  for (const auto& item : f.object("phases").items()) {
+    const std::string where = f.path("phases") + "." + item.key();
+    run.phases[item.key()] = seconds_of(item.value(), where);
+    if (run.phases[item.key()].size() != run.seconds.size())
+      fail(where, fmt::format("must have one entry per round ({}), got {}", run.seconds.size(),
+                              run.phases[item.key()].size()));
+  }
+  run.reference_ratio = f.number_or_nan("reference_ratio");
+  run.busy = f.boolean("busy");
+  return run;
 }
 
 Measurement read_point(const json& v, const std::string& path, const StudyResult& r) {
@@ -258,25 +344,19 @@ Measurement read_point(const json& v, const std::string& path, const StudyResult
   m.height = int(p.whole("height", 1, 1u << 20));
   m.pixels = p.number("pixels", 0);
   if (!(m.pixels > 0)) fail(p.path("pixels"), "must be > 0");
-  m.seconds = seconds_of(p.at("seconds"), p.path("seconds"));
-  const json& order = p.array("order");
-  if (order.size() != m.seconds.size())
-    fail(p.path("order"), fmt::format("must have one entry per repetition ({}), got {}",
-                                      m.seconds.size(), order.size()));
-  for (size_t k = 0; k < order.size(); ++k)
-    m.order.push_back(int(Fields::whole_at(order[k], index_path(p.path("order"), k), 0, 1u << 20)));
-  for (const char* derived : {"median", "hd_median", "relative_mad"}) p.at(derived);
-  // Studies written before the reference frame have neither: measured as if quiet.
-  if (p.has("reference_ratio")) m.reference_ratio = p.number_or_nan("reference_ratio");
-  if (p.has("busy")) m.busy = p.boolean("busy");
-  if (p.has("phases"))
-    for (const auto& item : p.object("phases").items()) {
-      const std::string where = p.path("phases") + "." + item.key();
-      m.phases[item.key()] = seconds_of(item.value(), where);
-      if (m.phases[item.key()].size() != m.seconds.size())
-        fail(where, fmt::format("must have one entry per repetition ({}), got {}", m.seconds.size(),
-                                m.phases[item.key()].size()));
-    }
+  for (const auto& item : p.object("counters").items())
+    m.counters[item.key()] =
+        Fields::number_at(item.value(), p.path("counters") + "." + item.key(), 0);
+  const json& runs = p.array("runs");
+  if (runs.empty()) fail(p.path("runs"), "must hold at least one run");
+  for (size_t k = 0; k < runs.size(); ++k) {
+    m.runs.push_back(read_run(runs[k], index_path(p.path("runs"), k), r));
+    for (size_t j = 0; j < k; ++j)
+      if (m.runs[j].session == m.runs[k].session)
+        fail(index_path(p.path("runs"), k) + ".session",
+             fmt::format("session {} already has a run at this point", m.runs[k].session));
+  }
+  for (const char* derived : {"seconds", "median", "relative_mad", "busy"}) p.at(derived);
   return m;
 }
 

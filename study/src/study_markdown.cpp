@@ -3,11 +3,13 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <vector>
 
 #include "rvr/study/bootstrap.h"
+#include "rvr/study/conclusions.h"
 
 namespace rvr::study {
 namespace {
@@ -32,62 +34,135 @@ std::string where_text(const StudyResult& r, const std::string& scene, const std
   return fmt::format("at {}×{} on {}", r.width, r.height, scene);
 }
 
-std::string header(const StudyResult& r) {
-  std::string scenes;
-  for (const std::string& s : r.scenes) scenes += (scenes.empty() ? "" : ", ") + s;
-  std::string text = "# rvr study\n\n";
-  text += fmt::format(
-      "{} at {}×{}, {} mode; {} repetitions per point, interleaved in random "
-      "order; Harrell–Davis medians; 95% intervals from {} bootstrap replicates over the "
-      "repetitions. {:.0f} s of a {:.0f} s budget.\n\n",
-      scenes, r.width, r.height, r.mode, r.repetitions, r.bootstrap_replicates, r.elapsed_seconds,
-      r.budget_seconds);
-  text += fmt::format("Machine: {}, {} threads; kernels: {}.\n", r.machine.cpu, r.machine.threads,
-                      r.machine.kernels);
-  for (const std::string& note : r.notes) text += "\nNote: " + note + ".\n";
+std::string join(const std::vector<std::string>& words) {
+  std::string out;
+  for (const std::string& w : words) out += (out.empty() ? "" : ", ") + w;
+  return out;
+}
+
+// The sentences of one section, as a Markdown list under its heading; nothing when empty.
+std::string section(const std::string& heading, const std::string& intro,
+                    const std::vector<std::string>& sentences) {
+  if (sentences.empty()) return "";
+  std::string text = "\n## " + heading + "\n\n" + (intro.empty() ? "" : intro + "\n\n");
+  for (const std::string& s : sentences) text += "- " + s + "\n";
   return text;
 }
 
-std::string scaling_section(const StudyResult& r) {
-  std::string text = "\n## Scaling (log-log slope per decade)\n\n";
-  for (const ScalingExponent& s : r.scaling)
-    text +=
-        s.axis == kPixelsAxis
-            ? fmt::format("- {} on {} with {} {}: time grows as P^{:.2f} from {} to {} pixels.\n",
-                          s.renderer, s.scene, format_number(s.n), r.axes.at(s.scene), s.exponent,
-                          format_number(s.from), format_number(s.to))
-            : fmt::format("- {} on {}: time grows as N^{:.2f} from {} to {}.\n", s.renderer,
-                          s.scene, s.exponent, format_number(s.from), format_number(s.to));
-  text += "\n## Cost per triangle and per ray\n\n";
-  for (const UnitCost& c : r.costs)
-    text += fmt::format("- {} on {} at {} {}: {} ms a frame, {} ns per triangle, {} ns per ray.\n",
-                        c.renderer, c.scene, format_number(c.n), r.axes.at(c.scene),
-                        format_number(1e3 * c.seconds), format_number(c.ns_per_triangle),
-                        format_number(c.ns_per_ray));
+std::string header(const StudyResult& r) {
+  std::string text = "# rvr study\n\n";
+  text += "**Scope.** " + scope_text(r) + "\n\n";
+  text += "**Method.** " + method_text(r) + "\n\n";
+  text += fmt::format("**Machine.** {}, {} threads; kernels: {}. Before the sweep: {}; after: {}.\n",
+                      r.machine.cpu, r.machine.threads, r.machine.kernels,
+                      describe(r.system_before), describe(r.system_after));
+  if (!r.no_conclusion.empty())
+    text += "\n## No conclusion\n\n" + r.no_conclusion + ".\n";
   return text;
+}
+
+std::vector<std::string> scaling_sentences(const StudyResult& r) {
+  std::vector<std::string> out;
+  for (const ScalingExponent& s : r.scaling)
+    out.push_back(s.axis == kPixelsAxis
+                      ? fmt::format("{} on {} with {} {}: time grows as P^{:.2f} from {} to {} pixels.",
+                                    s.renderer, s.scene, format_number(s.n), r.axes.at(s.scene),
+                                    s.exponent, format_number(s.from), format_number(s.to))
+                      : fmt::format("{} on {}: time grows as N^{:.2f} from {} to {}.", s.renderer,
+                                    s.scene, s.exponent, format_number(s.from),
+                                    format_number(s.to)));
+  return out;
+}
+
+std::vector<std::string> cost_sentences(const StudyResult& r) {
+  std::vector<std::string> out;
+  for (const UnitCost& c : r.costs)
+    out.push_back(fmt::format("{} on {} at {} {}: {} ms a frame, {} ns per triangle, {} ns per ray.",
+                              c.renderer, c.scene, format_number(c.n), r.axes.at(c.scene),
+                              format_number(1e3 * c.seconds), format_number(c.ns_per_triangle),
+                              format_number(c.ns_per_ray)));
+  return out;
+}
+
+std::vector<std::string> split_sentences(const StudyResult& r) {
+  std::vector<std::string> out;
+  for (const PhaseSplit& s : r.splits)
+    out.push_back(fmt::format(
+        "{} on {} at {} {}: z-buffer pass {} ms, the tracer's part {} ms ({:.0f}% z-buffer).",
+        s.renderer, s.scene, format_number(s.n), r.axes.at(s.scene),
+        format_number(1e3 * s.zbuffer_seconds), format_number(1e3 * s.trace_seconds),
+        100 * s.zbuffer_share));
+  return out;
 }
 
 }  // namespace
+
+std::string scope_text(const StudyResult& r) {
+  const char* mode = r.mode == "visibility" ? "ids and depth only, no shading"
+                     : r.mode == "local"    ? "the shading equation, no shadows or reflections"
+                                            : "shadows, reflections and every effect each renderer "
+                                              "renders";
+  return fmt::format(
+      "{} at {}×{} in {} mode ({}). Frame times of static scenes: what a renderer builds per scene "
+      "(the tracers' BVH) is timed apart from its frames. One machine type ({}).",
+      join(r.scenes), r.width, r.height, r.mode, mode, r.machine.cpu.empty() ? "unnamed" : r.machine.cpu);
+}
+
+std::string method_text(const StudyResult& r) {
+  size_t processes = 0;
+  for (const SessionInfo& s : r.sessions) processes += s.kind == "process";
+  const std::string sessions =
+      processes == r.sessions.size() ? "fresh processes" : "fresh preparations of the scene";
+  return fmt::format(
+      "Each point was measured in {} sessions ({}), {} rounds each, the renderers in a random "
+      "order in every round; ratios are paired round by round. A renderer is called faster only "
+      "beyond a {:.0f}% noise threshold, judged at each point on the trend through it and its "
+      "nearest neighbours, Holm-corrected over the points of a sweep ({:.0f}% family-wise); a "
+      "crossover needs two consecutive such points on each side. Intervals: a hierarchical "
+      "bootstrap ({} replicates: sessions, then rounds) with the scatter between neighbouring "
+      "points. {:.0f} s of measuring of a {:.0f} s budget.",
+      r.sessions_per_point, sessions, r.repetitions, 100 * r.noise_threshold, 100 * kFamilyAlpha,
+      r.bootstrap_replicates, r.elapsed_seconds, r.budget_seconds);
+}
 
 std::string crossover_sentence(const StudyResult& r, const Crossover& c) {
   const std::string& below = c.a_faster_below ? c.a : c.b;
   const std::string& above = c.a_faster_below ? c.b : c.a;
   std::string where = where_text(r, c.scene, c.axis, c.n);
+  const std::string demoted =
+      c.contradicted ? " A prediction check contradicts it: it is not confirmed." : "";
   if (!c.measured)
     return fmt::format(
         "{}, the fitted models put the crossover of {} and {} at {} {}, outside the swept "
-        "range {} (extrapolated, not measured): {} is faster below it, {} above.",
+        "range {} (extrapolated, not measured): {} is faster below it, {} above.{}",
         where, c.a, c.b, format_number(c.value), c.axis,
-        range_text(c.range_low, c.range_high, c.axis), below, above);
-  return fmt::format("{}, {} is faster than {} below {} {} {}; {} is faster above.", where, below,
-                     above, format_number(c.value), c.axis, interval_text(c), above);
+        range_text(c.range_low, c.range_high, c.axis), below, above, demoted);
+  return fmt::format(
+      "{}, {} is faster than {} below {} {} {}; {} is faster above (significantly at {} points "
+      "below, by {:.2f}× at the nearest, and {} above, by {:.2f}×).{}",
+      where, below, above, format_number(c.value), c.axis, interval_text(c), above, c.below_points,
+      c.below_ratio, c.above_points, c.above_ratio, demoted);
 }
 
 std::string dominance_sentence(const StudyResult& r, const Dominance& d) {
-  return fmt::format(
-      "{}, {} is faster than {} over the whole swept range {}, by at least {:.2f}× (at {} {}).",
-      where_text(r, d.scene, d.axis, d.n), d.faster, d.slower,
-      range_text(d.range_low, d.range_high, d.axis), d.min_ratio, format_number(d.at), d.axis);
+  std::string text = fmt::format(
+      "{}, {} is faster than {} where significant: at {} of {} points ({}), by at least {:.2f}× "
+      "(at {} {})",
+      where_text(r, d.scene, d.axis, d.n), d.faster, d.slower, d.significant, d.points,
+      range_text(d.significant_low, d.significant_high, d.axis), d.min_ratio, format_number(d.at),
+      d.axis);
+  text += d.significant < d.points
+              ? fmt::format("; at the others the two are within the {:.0f}% noise threshold",
+                            100 * r.noise_threshold)
+              : "";
+  if (!d.contrary.empty()) {
+    std::vector<std::string> at;
+    for (size_t k = 0; k < d.contrary.size() && k < 6; ++k)
+      at.push_back(fmt::format("{} ({:.2f}×)", format_number(d.contrary[k]), d.contrary_ratios[k]));
+    if (d.contrary.size() > 6) at.push_back(fmt::format("{} more", d.contrary.size() - 6));
+    text += fmt::format(". {} measured faster at {} {}", d.slower, join(at), d.axis);
+  }
+  return text + ".";
 }
 
 std::string coefficient_text(const Coefficient& c) {
@@ -115,15 +190,56 @@ std::string model_sentence(const RendererModels& m, const std::string& scene, co
 }
 
 std::string check_sentence(const PredictionCheck& c) {
-  const std::string& other = c.predicted_faster == c.a ? c.b : c.a;
+  std::string where;
+  if (c.extrapolated && std::fabs(std::log(c.at / c.crossover)) < std::log(1.5))
+    where = fmt::format("at the extrapolated crossover {}", format_number(c.crossover));
+  else
+    where = fmt::format("{} the {}crossover at {}", c.at < c.crossover ? "below" : "above",
+                        c.extrapolated ? "extrapolated " : "", format_number(c.crossover));
+  const std::string expected =
+      c.predicted_faster.empty() ? "the two should be about equal"
+                                 : c.predicted_faster + " should be faster";
+  const std::string model =
+      std::isfinite(c.predicted_ratio)
+          ? fmt::format(", the models predicted {:.2f} (95%: {:.2f} – {:.2f})", c.predicted_ratio,
+                        c.predicted_ci95.low, c.predicted_ci95.high)
+          : "";
   return fmt::format(
-      "on {} at {} {} ({} the crossover at {}), {} should be faster than {}: {}, {:.2f}×{}.",
-      c.scene, format_number(c.at), c.axis, c.at < c.crossover ? "below" : "above",
-      format_number(c.crossover), c.predicted_faster, other, c.holds ? "it is" : "it is not",
-      c.ratio,
-      c.holds ? ""
-              : fmt::format(" the other way ({} is faster): the prediction does not hold",
-                            c.measured_faster));
+      "on {} at {} {} ({}), {}: measured t({}) / t({}) = {:.2f} (95%: {:.2f} – {:.2f}){}. "
+      "{}: {}.",
+      c.scene, format_number(c.at), c.axis, where, expected, c.a, c.b, c.ratio, c.ratio_ci95.low,
+      c.ratio_ci95.high, model,
+      c.verdict == "holds" ? "Holds" : c.verdict == "fails" ? "Fails" : "Inconclusive", c.why);
+}
+
+std::vector<std::string> headline_sentences(const StudyResult& r) {
+  std::vector<std::string> out;
+  auto order = [](const std::string& name) { return model_form_of(name); };
+  auto loop_pair = [&](const std::string& a, const std::string& b) {
+    return (order(a) == ModelForm::ZBuffer && order(b) == ModelForm::Tracer) ||
+           (order(a) == ModelForm::Tracer && order(b) == ModelForm::ZBuffer);
+  };
+  for (const std::string& scene : r.scenes)
+    for (const Comparison& x : r.comparisons) {
+      if (x.scene != scene || x.axis == kPixelsAxis || !loop_pair(x.a, x.b)) continue;
+      std::vector<std::string> found;
+      for (const Crossover& c : r.crossovers)
+        if (c.scene == scene && c.a == x.a && c.b == x.b && c.axis == x.axis)
+          found.push_back(crossover_sentence(r, c));
+      for (const Dominance& d : r.dominance)
+        if (d.scene == scene && d.axis == x.axis &&
+            ((d.faster == x.a && d.slower == x.b) || (d.faster == x.b && d.slower == x.a)))
+          found.push_back(dominance_sentence(r, d));
+      if (found.empty())
+        found.push_back(x.inconclusive.empty()
+                            ? fmt::format("{} on {}: {} and {} are within the noise threshold at "
+                                          "every point measured.",
+                                          x.axis, scene, x.a, x.b)
+                            : fmt::format("{} on {}: nothing is concluded for {} and {}: {}.",
+                                          x.axis, scene, x.a, x.b, x.inconclusive));
+      for (const std::string& s : found) out.push_back(s);
+    }
+  return out;
 }
 
 std::string format_number(double v) {
@@ -139,29 +255,27 @@ std::string format_number(double v) {
 
 std::string study_markdown(const StudyResult& r) {
   std::string text = header(r);
-  text += "\n## Crossovers\n\n";
-  for (const Crossover& c : r.crossovers) text += "- " + crossover_sentence(r, c) + "\n";
-  for (const Dominance& d : r.dominance) text += "- " + dominance_sentence(r, d) + "\n";
-  if (r.crossovers.empty() && r.dominance.empty()) text += "No pair of loop orders was measured.\n";
-  if (!r.checks.empty()) {
-    text +=
-        "\n## Predictions checked\n\nEach crossover measured again after the fit, at a third of "
-        "and three times its value:\n\n";
-    for (const PredictionCheck& c : r.checks) text += "- " + check_sentence(c) + "\n";
-  }
-  if (!r.splits.empty()) {
-    text += "\n## The hybrids' split\n\n";
-    for (const PhaseSplit& s : r.splits)
-      text += fmt::format(
-          "- {} on {} at {} {}: z-buffer pass {} ms, the tracer's part {} ms ({:.0f}% z-buffer).\n",
-          s.renderer, s.scene, format_number(s.n), r.axes.at(s.scene),
-          format_number(1e3 * s.zbuffer_seconds), format_number(1e3 * s.trace_seconds),
-          100 * s.zbuffer_share);
-  }
-  text += "\n## Cost models\n\n";
+  text += section("Where the pixel-major loop overtakes the triangle-major one",
+                  "The chapter's question: the z-buffer against the tracer along N.",
+                  headline_sentences(r));
+  std::vector<std::string> crossovers, dominance, checks, models, notes;
+  for (const Crossover& c : r.crossovers) crossovers.push_back(crossover_sentence(r, c));
+  for (const Dominance& d : r.dominance) dominance.push_back(dominance_sentence(r, d));
+  for (const PredictionCheck& c : r.checks) checks.push_back(check_sentence(c));
   for (const RendererModels& m : r.models)
-    for (const auto& [scene, f] : m.fits) text += "- " + model_sentence(m, scene, f) + "\n";
-  text += scaling_section(r);
+    for (const auto& [scene, f] : m.fits) models.push_back(model_sentence(m, scene, f));
+  for (const std::string& note : r.notes) notes.push_back(note + ".");
+  text += section("Crossovers", "", crossovers);
+  text += section("Faster where significant", "", dominance);
+  text += section("Predictions checked",
+                  "Each crossover checked out of sample after the fit: points off the sweep's "
+                  "grid, measured in fresh sessions.",
+                  checks);
+  text += section("The hybrids' split", "", split_sentences(r));
+  text += section("Cost models", "", models);
+  text += section("Scaling (log-log slope per decade)", "", scaling_sentences(r));
+  text += section("Cost per triangle and per ray", "", cost_sentences(r));
+  text += section("Notes", "", notes);
   return text;
 }
 

@@ -43,6 +43,9 @@ struct ModelFit {
   bool fits = false;
   std::string verdict;      // "fits", or why the model does not
   double fixed_pixels = 0;  // > 0: every point had this P, so b is folded into a
+  // The coefficients of each bootstrap replicate (as coefficient_values: 0 where not
+  // identifiable), for the intervals of what the model predicts. Not written to study.json.
+  std::vector<std::vector<double>> replicates;
 };
 
 // Which coefficients can be fitted to these points: all but b when P never varies.
@@ -80,5 +83,14 @@ std::vector<double> coefficient_values(const ModelFit& fit);
 
 // The fitted model's time of a frame of P pixels and axis value N (what charts draw).
 double predict_seconds(const ModelFit& fit, double pixels, double n);
+
+// What two fitted models predict for the ratio t_a / t_b at (P, N), and its 95% interval over
+// their bootstrap replicates (replicate k of one with replicate k of the other). NaN when
+// either does not fit or predicts no positive time there.
+struct PredictedRatio {
+  double ratio = 0;
+  double low = 0, high = 0;
+};
+PredictedRatio predict_ratio(const ModelFit& a, const ModelFit& b, double pixels, double n);
 
 }  // namespace rvr::study

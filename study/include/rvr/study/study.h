@@ -11,6 +11,7 @@
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
 #include "rvr/study/sweep_plan.h"
+#include "rvr/study/system_probe.h"
 
 namespace rvr::study {
 
@@ -47,16 +48,25 @@ struct UnitCost {
   double ns_per_triangle = 0, ns_per_ray = 0;
 };
 
-// A crossover's prediction checked by new measurements after the fit: at a third of and at
-// three times the crossover, the renderer the study says is faster there, and which one was.
+// A crossover's prediction checked out of sample after the fit: a point off the sweep's grid
+// (a third of and three times a measured crossover; an extrapolated one at its value and three
+// times it) measured in fresh sessions, its paired ratio set against what the conclusions say
+// there: which renderer is faster, and what the fitted models predict for the ratio.
 struct PredictionCheck {
   std::string a, b, scene, axis;
-  double crossover = 0;  // the crossover's value on the axis
-  double at = 0;         // where the check measured: the axis value of its point
-  double pixels = 0;
-  std::string predicted_faster, measured_faster;
-  double ratio = 0;  // the measured slower's time over the faster's
-  bool holds = false;
+  double crossover = 0;   // the crossover's value on the axis
+  bool extrapolated = false;  // the crossover lay outside the swept range
+  double at = 0;          // where the check measured: the axis value of its point
+  double pixels = 0, n = 0;  // the pixel count and N of the point measured
+  std::string predicted_faster;  // "" where the conclusion is that they are equal (at the value)
+  std::string measured_faster;   // "" where the measured ratio is within the noise threshold
+  double ratio = 0;        // measured t_a / t_b, paired
+  Interval ratio_ci95;     // its hierarchical bootstrap interval
+  double p = 1;            // that it is within the noise threshold (Holm over the checks)
+  double predicted_ratio = 0;  // the fitted models' t_a / t_b there (NaN: no model fits)
+  Interval predicted_ci95;     // over the models' bootstrap replicates
+  std::string verdict;     // "holds", "fails" or "inconclusive"
+  std::string why;         // the reason, in words
 };
 
 // A hybrid's frame split into its z-buffer pass and its tracer's part, at one point.
@@ -67,6 +77,14 @@ struct PhaseSplit {
   double zbuffer_share = 0;                       // zbuffer / (zbuffer + trace)
 };
 
+// A session: the level above a run's frames. In the CLI each is a fresh process (a worker
+// started for it); in-process callers (Python, tests) prepare each scene afresh instead.
+struct SessionInfo {
+  std::string kind;       // "process" or "preparation"
+  std::string study;      // the run_id of the study that ran it (several after --merge)
+  SystemSnapshot system;  // the machine as the session began
+};
+
 struct StudyResult {
   std::vector<std::string> scenes;          // families: "tessphere"
   std::vector<std::string> renderers;       // in the order asked for
@@ -74,20 +92,32 @@ struct StudyResult {
   int width = 0, height = 0;
   std::string mode;
   double budget_seconds = 0, elapsed_seconds = 0;
-  int repetitions = 0;
+  int repetitions = 0;         // rounds per run
+  int sessions_per_point = 0;  // runs per point, each in a fresh session
+  double noise_threshold = 0;  // the smallest difference called one (a ratio minus 1)
   uint64_t seed = 0;
   int bootstrap_replicates = 0;
   std::string command;  // the command line, when the caller sets it
+  // Unique to one sweep (random, set when it starts): --merge refuses a study it already holds.
+  std::string run_id;
+  std::vector<std::string> merged_runs;  // after --merge: the run_id of every study pooled
   MachineInfo machine;
+  std::vector<SessionInfo> sessions;     // Run::session indexes these
+  SystemSnapshot system_before, system_after;  // the machine before and after the sweep
   std::vector<Measurement> points;
   std::vector<RendererModels> models;
+  std::vector<Comparison> comparisons;  // every pair along every axis, point by point
   std::vector<Crossover> crossovers;
   std::vector<Dominance> dominance;
   std::vector<ScalingExponent> scaling;
   std::vector<UnitCost> costs;
   std::vector<PhaseSplit> splits;  // the hybrids', at the smallest and largest N at full width
   std::vector<PredictionCheck> checks;
+  std::vector<Measurement> check_points;  // what the checks measured (not in the fits)
   std::vector<std::string> notes;  // what the budget cut short, and the like
+  // Why the study concludes nothing (no crossover, dominance or tie, no model that fits);
+  // empty when it concludes something.
+  std::string no_conclusion;
   bool interrupted = false;        // the sweep was stopped (Ctrl-C) before its end
   std::optional<Shard> shard;      // the share of the planned points measured (--shard)
 };

@@ -1,4 +1,4 @@
-// study.json, format rvr-study/1 (docs/rvr-study-1.schema.json; fields in docs/cli.md).
+// study.json, format rvr-study/2 (docs/rvr-study-2.schema.json; fields in docs/cli.md).
 #pragma once
 
 #include <string>
@@ -8,7 +8,7 @@
 
 namespace rvr::study {
 
-constexpr const char* kStudyFormat = "rvr-study/1";
+constexpr const char* kStudyFormat = "rvr-study/2";
 
 // The whole study as JSON text; non-finite numbers are null.
 std::string study_json(const StudyResult& result);

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
@@ -19,8 +20,17 @@ std::string study_markdown(const StudyResult& result);
 std::string crossover_sentence(const StudyResult& r, const Crossover& c);
 std::string dominance_sentence(const StudyResult& r, const Dominance& d);
 std::string model_sentence(const RendererModels& m, const std::string& scene, const ModelFit& f);
-// A crossover's prediction checked after the fit: held or not, by how much.
+// A crossover's prediction checked after the fit: held, failed or inconclusive, and why.
 std::string check_sentence(const PredictionCheck& c);
+
+// What the study covers (families, image size, mode, static scenes, one machine type), and how
+// it measured and judged: said at the top of study.md and study.html alike.
+std::string scope_text(const StudyResult& r);
+std::string method_text(const StudyResult& r);
+
+// The chapter's question, per family: every z-buffer against every tracer along N, as a
+// crossover, a dominance, a tie or why nothing is concluded.
+std::vector<std::string> headline_sentences(const StudyResult& r);
 
 // "a = 1.2 ms (95%: 0.9 – 1.5)" (ns for the per-pixel, per-triangle and per-ray terms); empty
 // for a coefficient that is not identifiable.

@@ -1,0 +1,286 @@
+// Worker processes for the study's sessions (see study_processes.h).
+#include "study_processes.h"
+
+#include <fmt/format.h>
+#include <signal.h>
+#include <spawn.h>
+#include <stddef.h>
+#include <sys/prctl.h>
+#include <sys/socket.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "rvr/shared/expected.h"
+#include "rvr/study/renderer_frames.h"
+#include "rvr/study/sweep_plan.h"
+#include "commands.h"
+
+extern char** environ;
+
+namespace rvr::cli {
+namespace {
+
+using nlohmann::json;
+
+json error_json(const Error& e) {
+  return {{"error", {{"kind", int(e.kind)}, {"message", e.message}}}};
+}
+
+Error error_of(const json& reply) {
+  const json& e = reply.at("error");
+  const int kind = e.value("kind", int(ErrorKind::Internal));
+  return Error{e.value("message", std::string("study worker failed")),
+               kind == int(ErrorKind::BadInput)    ? ErrorKind::BadInput
+               : kind == int(ErrorKind::Cancelled) ? ErrorKind::Cancelled
+                                                   : ErrorKind::Internal};
+}
+
+json family_json(const study::Family& f) {
+  return {{"name", f.name}, {"axis", f.axis},     {"low", f.low},
+          {"high", f.high}, {"points", f.points}, {"source", f.source}};
+}
+
+study::Family family_of(const json& j) {
+  return study::Family{j.at("name").get<std::string>(), j.at("axis").get<std::string>(),
+                       j.at("low").get<size_t>(),       j.at("high").get<size_t>(),
+                       j.at("points").get<int>(),       j.at("source").get<std::string>()};
+}
+
+// One worker process and the socket to it.
+class Worker {
+ public:
+  static Expected<std::shared_ptr<Worker>> start(const std::string& executable,
+                                                 const std::vector<std::string>& renderers,
+                                                 RenderMode mode) {
+    int fds[2];
+    if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, fds) != 0)
+      return internal_error(fmt::format("study: cannot make a socket: {}", std::strerror(errno)));
+    std::string names;
+    for (const std::string& r : renderers) names += (names.empty() ? "" : ",") + r;
+    std::vector<std::string> args = {executable, "study-worker", "--mode", to_string(mode),
+                                     "--renderers", names};
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], 0);
+    posix_spawn_file_actions_adddup2(&actions, fds[1], 1);
+    pid_t pid = 0;
+    const int err = posix_spawn(&pid, executable.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(fds[1]);
+    if (err != 0) {
+      ::close(fds[0]);
+      return internal_error(
+          fmt::format("study: cannot start {} study-worker: {}", executable, std::strerror(err)));
+    }
+    return std::make_shared<Worker>(pid, fds[0]);
+  }
+
+  Worker(pid_t pid, int fd) : pid_(pid), fd_(fd) {}
+  Worker(const Worker&) = delete;
+  Worker& operator=(const Worker&) = delete;
+
+  // Closing the socket ends the worker's loop; one that does not end is killed.
+  ~Worker() {
+    ::close(fd_);
+    for (int k = 0; k < 200; ++k) {
+      if (waitpid(pid_, nullptr, WNOHANG) == pid_) return;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ::kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
+
+  // Sends one request and reads its one-line reply.
+  Expected<json> call(const json& request) {
+    const std::string line = request.dump() + "\n";
+    for (size_t sent = 0; sent < line.size();) {
+      const ssize_t k = ::send(fd_, line.data() + sent, line.size() - sent, MSG_NOSIGNAL);
+      if (k < 0 && errno == EINTR) continue;
+      if (k <= 0) return lost("sending to it");
+      sent += size_t(k);
+    }
+    std::string reply;
+    while (true) {
+      if (size_t end = buffer_.find('\n'); end != std::string::npos) {
+        reply = buffer_.substr(0, end);
+        buffer_.erase(0, end + 1);
+        break;
+      }
+      char chunk[4096];
+      const ssize_t k = ::recv(fd_, chunk, sizeof chunk, 0);
+      if (k < 0 && errno == EINTR) continue;
+      if (k <= 0) return lost("reading its answer");
+      buffer_.append(chunk, size_t(k));
+    }
+    json parsed = json::parse(reply, nullptr, false);
+    if (parsed.is_discarded() || !parsed.is_object())
+      return internal_error("study: a worker answered something that is not JSON: " + reply);
+    if (parsed.contains("error")) return error_of(parsed);
+    return parsed;
+  }
+
+ private:
+  Error lost(const char* doing) {
+    int status = 0;
+    std::string how = "it closed the connection";
+    if (waitpid(pid_, &status, WNOHANG) == pid_)
+      how = WIFSIGNALED(status) ? fmt::format("it was killed by signal {}", WTERMSIG(status))
+                                : fmt::format("it exited with status {}", WEXITSTATUS(status));
+    return internal_error(fmt::format("study: lost the worker process {} while {}: {}", pid_,
+                                      doing, how));
+  }
+
+  pid_t pid_;
+  int fd_;
+  std::string buffer_;
+};
+
+// A scene prepared in a worker: what the worker said of it, and its frames timed there.
+class ProcessFrames : public study::FrameSource {
+ public:
+  ProcessFrames(std::shared_ptr<Worker> worker, int id, const json& prepared)
+      : worker_(std::move(worker)), id_(id) {
+    axis_ = prepared.at("axis").get<double>();
+    pixels_ = prepared.at("pixels").get<double>();
+    prepare_ = prepared.at("prepare_seconds").get<std::vector<double>>();
+    counters_ = prepared.at("counters").get<std::vector<std::map<std::string, double>>>();
+  }
+  ProcessFrames(const ProcessFrames&) = delete;
+  ProcessFrames& operator=(const ProcessFrames&) = delete;
+  ~ProcessFrames() override { (void)worker_->call({{"op", "release"}, {"id", id_}}); }
+
+  double axis_value() const override { return axis_; }
+  double pixels() const override { return pixels_; }
+  double prepare_seconds(size_t index) const override { return prepare_.at(index); }
+  std::map<std::string, double> counters(size_t index) const override {
+    return counters_.at(index);
+  }
+  Expected<study::FrameTime> time_frame(size_t index) override {
+    Expected<json> reply = worker_->call({{"op", "frame"}, {"id", id_}, {"renderer", index}});
+    if (!reply) return reply.error();
+    study::FrameTime t;
+    t.seconds = reply->at("seconds").get<double>();
+    t.phases = reply->at("phases").get<std::map<std::string, double>>();
+    return t;
+  }
+
+ private:
+  std::shared_ptr<Worker> worker_;
+  int id_;
+  double axis_ = 0, pixels_ = 0;
+  std::vector<double> prepare_;
+  std::vector<std::map<std::string, double>> counters_;
+};
+
+class ProcessSession : public study::Session {
+ public:
+  explicit ProcessSession(std::shared_ptr<Worker> worker) : worker_(std::move(worker)) {}
+  std::string kind() const override { return "process"; }
+  Expected<std::unique_ptr<study::FrameSource>> prepare(const study::Family& family, size_t n,
+                                                        int width) override {
+    const int id = next_id_++;
+    Expected<json> reply = worker_->call({{"op", "prepare"},
+                                          {"id", id},
+                                          {"family", family_json(family)},
+                                          {"n", n},
+                                          {"width", width}});
+    if (!reply) return reply.error();
+    return std::unique_ptr<study::FrameSource>(std::make_unique<ProcessFrames>(worker_, id, *reply));
+  }
+
+ private:
+  std::shared_ptr<Worker> worker_;
+  int next_id_ = 0;
+};
+
+// The worker's answer to one request.
+json answer(const json& request, const std::vector<std::string>& renderers, RenderMode mode,
+            std::map<int, std::unique_ptr<study::FrameSource>>& prepared) {
+  const std::string op = request.at("op").get<std::string>();
+  const int id = request.at("id").get<int>();
+  if (op == "prepare") {
+    Expected<std::unique_ptr<study::FrameSource>> frames = study::prepare_frames(
+        renderers, mode, family_of(request.at("family")), request.at("n").get<size_t>(),
+        request.at("width").get<int>());
+    if (!frames) return error_json(frames.error());
+    json prepare = json::array(), counters = json::array();
+    for (size_t i = 0; i < renderers.size(); ++i) {
+      prepare.push_back((*frames)->prepare_seconds(i));
+      counters.push_back((*frames)->counters(i));
+    }
+    json out = {{"axis", (*frames)->axis_value()},
+                {"pixels", (*frames)->pixels()},
+                {"prepare_seconds", prepare},
+                {"counters", counters}};
+    prepared[id] = std::move(*frames);
+    return out;
+  }
+  auto it = prepared.find(id);
+  if (it == prepared.end()) return error_json(internal_error(fmt::format("no scene {}", id)));
+  if (op == "release") {
+    prepared.erase(it);
+    return json::object();
+  }
+  if (op == "frame") {
+    Expected<study::FrameTime> t = it->second->time_frame(request.at("renderer").get<size_t>());
+    if (!t) return error_json(t.error());
+    return {{"seconds", t->seconds}, {"phases", t->phases}};
+  }
+  return error_json(internal_error("unknown request " + op));
+}
+
+}  // namespace
+
+std::string own_executable() {
+  std::error_code ec;
+  std::filesystem::path p = std::filesystem::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("rvr") : p.string();
+}
+
+study::StartSession process_sessions(const std::string& executable,
+                                     const std::vector<std::string>& renderers, RenderMode mode) {
+  return [=]() -> Expected<std::unique_ptr<study::Session>> {
+    Expected<std::shared_ptr<Worker>> worker = Worker::start(executable, renderers, mode);
+    if (!worker) return worker.error();
+    return std::unique_ptr<study::Session>(std::make_unique<ProcessSession>(*worker));
+  };
+}
+
+int run_study_worker(const std::vector<std::string>& renderers, const std::string& mode_name) {
+  // Ctrl-C reaches the whole process group: the parent decides what stops. A worker whose
+  // parent dies goes with it.
+  ::signal(SIGINT, SIG_IGN);
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  const RenderMode mode = parse_mode(mode_name);
+  std::map<int, std::unique_ptr<study::FrameSource>> prepared;
+  std::string line;
+  while (std::getline(std::cin, line)) {
+    json reply;
+    try {
+      reply = answer(json::parse(line), renderers, mode, prepared);
+    } catch (const json::exception& e) {
+      reply = error_json(internal_error(std::string("study worker: bad request: ") + e.what()));
+    }
+    std::cout << reply.dump() << '\n' << std::flush;
+  }
+  return 0;
+}
+
+}  // namespace rvr::cli
