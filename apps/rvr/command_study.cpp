@@ -184,6 +184,7 @@ int run_study(const StudyArgs& a, const std::string& command_line) {
   TerminalProgress progress(progress_wanted(a.quiet));
   study::StudyHooks hooks;
   hooks.start_session = process_sessions(own_executable(), request.renderers, request.mode);
+  hooks.probe_memory = process_memory_probes(own_executable(), request.renderers, request.mode);
   hooks.on_progress = [&](const std::string& what) { progress.begin(what, "measure"); };
   study::StudyResult result;
   {

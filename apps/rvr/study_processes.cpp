@@ -25,6 +25,7 @@
 #include <utility>
 
 #include "rvr/shared/expected.h"
+#include "rvr/study/memory_estimate.h"
 #include "rvr/study/renderer_frames.h"
 #include "rvr/study/sweep_plan.h"
 #include "commands.h"
@@ -215,6 +216,14 @@ json answer(const json& request, const std::vector<std::string>& renderers, Rend
             std::map<int, std::unique_ptr<study::FrameSource>>& prepared) {
   const std::string op = request.at("op").get<std::string>();
   const int id = request.at("id").get<int>();
+  // The memory a session holds at one point (memory_estimate.h): asked of a fresh worker.
+  if (op == "memory") {
+    Expected<study::MemoryProbe> probe =
+        study::probe_memory_here(renderers, mode, family_of(request.at("family")),
+                                 request.at("n").get<size_t>(), request.at("width").get<int>());
+    if (!probe) return error_json(probe.error());
+    return {{"probe", json::parse(study::memory_probe_json(*probe))}};
+  }
   if (op == "prepare") {
     Expected<std::unique_ptr<study::FrameSource>> frames = study::prepare_frames(
         renderers, mode, family_of(request.at("family")), request.at("n").get<size_t>(),
@@ -260,6 +269,19 @@ study::StartSession process_sessions(const std::string& executable,
     Expected<std::shared_ptr<Worker>> worker = Worker::start(executable, renderers, mode);
     if (!worker) return worker.error();
     return std::unique_ptr<study::Session>(std::make_unique<ProcessSession>(*worker));
+  };
+}
+
+study::ProbeMemory process_memory_probes(const std::string& executable,
+                                         const std::vector<std::string>& renderers,
+                                         RenderMode mode) {
+  return [=](const study::Family& family, size_t n, int width) -> Expected<study::MemoryProbe> {
+    Expected<std::shared_ptr<Worker>> worker = Worker::start(executable, renderers, mode);
+    if (!worker) return worker.error();
+    Expected<json> reply = (*worker)->call(
+        {{"op", "memory"}, {"id", 0}, {"family", family_json(family)}, {"n", n}, {"width", width}});
+    if (!reply) return reply.error();
+    return study::parse_memory_probe(reply->at("probe").dump());
   };
 }
 

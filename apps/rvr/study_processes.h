@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rvr/shared/renderer.h"
+#include "rvr/study/memory_estimate.h"
 #include "rvr/study/run_study.h"
 
 namespace rvr::cli {
@@ -15,6 +16,11 @@ namespace rvr::cli {
 // Sessions that each start `executable study-worker --mode MODE -r RENDERERS`.
 study::StartSession process_sessions(const std::string& executable,
                                      const std::vector<std::string>& renderers, RenderMode mode);
+
+// Memory probes (memory_estimate.h) each taken in a fresh `executable study-worker`.
+study::ProbeMemory process_memory_probes(const std::string& executable,
+                                         const std::vector<std::string>& renderers,
+                                         RenderMode mode);
 
 // The worker's loop: requests from stdin until it closes, answers on stdout. Exit status 0.
 int run_study_worker(const std::vector<std::string>& renderers, const std::string& mode);

@@ -1,6 +1,6 @@
 // The built-in scenes: small, deterministic, and chosen to stress one axis each
 // (cornell: everything; spheres: analytic shapes; occluders: depth complexity; soup and
-// tessphere: triangle count).
+// tessphere: triangle count; effects: triangle count with shadows and a reflection to pay for).
 #include <stddef.h>
 
 #include <algorithm>
@@ -23,7 +23,10 @@
 namespace rvr {
 namespace {
 
-constexpr size_t kMaxBuiltinCount = 10'000'000;
+// The study sweeps soup and tessphere past 10^7 triangles, where the headline crossovers lie
+// (at 10^8 a soup's scene alone is 4.8 GB; render's --max-triangles and --max-memory-mb guard
+// what a single render may take).
+constexpr size_t kMaxBuiltinCount = 100'000'000;
 
 // splitmix64: a fixed generator, so soup:N is the same triangles on every platform.
 class SplitMix64 {
@@ -238,6 +241,27 @@ Scene tessphere(size_t n) {
   return s;
 }
 
+// tessphere's sphere on a floor in front of a mirror, lit from above: in full mode the sphere's
+// shadow falls on the floor (shadow rays or shadow maps over its N triangles) and the mirror
+// shows it again (reflection rays traced into its N triangles), so the tracer pays for effects
+// the z-buffers draw only in part (shadow maps, no reflection).
+Scene effects(size_t n) {
+  Scene s = base_scene("effects:" + std::to_string(n));
+  uint32_t m = add_material(s, "sphere", {0.3f, 0.5f, 0.8f}, {0.5f, 0.5f, 0.5f}, 48.0f);
+  Object& o = add_object(s, "sphere", ObjectType::Triangles, m);
+  o.mesh = tessellate_sphere({{0.5f, 0.0f, 0.0f}, 1.0f}, sphere_segments_for_triangles(n));
+  add_floor(s, {0.7f, 0.7f, 0.65f}, {0.0f, -1.0f, 0.0f}, 5.0f);
+  uint32_t mirror = add_material(s, "mirror", {0.1f, 0.1f, 0.1f}, {0.9f, 0.9f, 0.9f}, 200.0f);
+  s.materials[mirror].mirror = 0.85f;
+  // Turned towards the sphere and the camera, to its left: the reflection is seen beside it.
+  Object& wall = add_object(s, "mirror", ObjectType::Plane, mirror);
+  wall.plane = {{-1.6f, 0.8f, -1.6f}, glm::normalize(glm::vec3(0.7f, 0.0f, 0.5f)), 1.8f};
+  look_at(s, {1.2f, 1.4f, 5.5f}, {-0.2f, 0.2f, -0.4f}, 45.0f, 0.1f, 100.0f);
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  add_point_light(s, {3.0f, 4.0f, 2.5f}, {30.0f, 30.0f, 30.0f});
+  return s;
+}
+
 std::shared_ptr<CsgNode> csg_sphere(glm::vec3 c, float r) {
   auto n = std::make_shared<CsgNode>();
   n->sphere = {c, r};
@@ -407,6 +431,9 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
       {"occluders_back:N", "the same quads drawn back to front (what hierarchical z cannot skip)"},
       {"soup:N", "N random triangles in a box, seeded, constant total area (default 1000)"},
       {"tessphere:N", "one smooth sphere tessellated into about N triangles (default 10000)"},
+      {"effects:N",
+       "tessphere's sphere of about N triangles on a floor in front of a mirror: a shadow and a "
+       "reflection of N triangles (default 10000)"},
       {"csg", "union, intersection, difference of spheres and a nested tree, on a floor"},
       {"dof", "spheres at several depths, thin lens focused on the middle one, 16 samples"},
       {"glass", "a glass slab and a glass sphere in front of coloured quads"},
@@ -440,6 +467,7 @@ Expected<Scene> make_builtin_scene(const std::string& spec) {
   if (name == "occluders_back") return occluders(has_count ? count : 8, true);
   if (name == "soup") return soup(has_count ? count : 1000);
   if (name == "tessphere") return tessphere(has_count ? count : 10000);
+  if (name == "effects") return effects(has_count ? count : 10000);
   if (name == "csg") return has_count ? no_count() : Expected<Scene>(csg());
   if (name == "dof") return has_count ? no_count() : Expected<Scene>(dof());
   if (name == "glass") return has_count ? no_count() : Expected<Scene>(glass());

@@ -18,6 +18,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
+#include "rvr/study/scene_changes.h"
 #include "rvr/study/study_markdown.h"
 
 namespace rvr::study {
@@ -337,6 +338,7 @@ void conclude(StudyResult& result, const BootstrapOptions& boot) {
   scaling(result);
   unit_costs(result);
   phase_splits(result);
+  scene_change_conclusions(result, boot);
   result.no_conclusion = no_conclusion_reason(result);
   if (!result.no_conclusion.empty())
     result.notes.push_back(std::string(kNoConclusionWords) + ": " + result.no_conclusion);

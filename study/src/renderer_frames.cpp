@@ -80,23 +80,6 @@ class RendererFrames : public FrameSource {
   std::vector<std::map<std::string, double>> counters_;
 };
 
-// builtin:<family>:<n>, or n copies of the family's file, at width × width·3/4.
-Expected<Scene> family_scene(const Family& family, size_t n, int width) {
-  if (family.source.empty()) {
-    Expected<Scene> scene = make_builtin_scene(family.name + ":" + std::to_string(n));
-    if (!scene) return scene.error();
-    scene->image.width = width;
-    scene->image.height = width * 3 / 4;
-    return scene;
-  }
-  SceneOverrides size;
-  size.width = width;
-  size.height = width * 3 / 4;
-  Expected<Scene> base = load_scene(family.source, size);
-  if (!base) return base.error();
-  return grid_of_copies(*base, n);
-}
-
 class InProcessSession : public Session {
  public:
   InProcessSession(std::vector<std::string> renderers, RenderMode mode)
@@ -113,6 +96,22 @@ class InProcessSession : public Session {
 };
 
 }  // namespace
+
+Expected<Scene> family_scene(const Family& family, size_t n, int width) {
+  if (family.source.empty()) {
+    Expected<Scene> scene = make_builtin_scene(family.name + ":" + std::to_string(n));
+    if (!scene) return scene.error();
+    scene->image.width = width;
+    scene->image.height = width * 3 / 4;
+    return scene;
+  }
+  SceneOverrides size;
+  size.width = width;
+  size.height = width * 3 / 4;
+  Expected<Scene> base = load_scene(family.source, size);
+  if (!base) return base.error();
+  return grid_of_copies(*base, n);
+}
 
 bool is_work_counter(const std::string& stat) {
   return stat.rfind("time.", 0) != 0 && stat.rfind("memory.", 0) != 0;

@@ -354,7 +354,7 @@ Expected<bool> Sweep::try_first_run(const Family& family, size_t n, int width, d
 
 // The log-spaced sweep of N at the full width, stopped where a point would end past `limit`.
 Status Sweep::sweep_n(const Family& family, double limit, OpenSession& session) {
-  for (size_t n : log_spaced(family.low, family.high, family.points)) {
+  for (size_t n : sweep_ns(family)) {
     if (stopped()) return ok_status();
     if (!in_this_shard(n, request_.width)) continue;
     Expected<bool> done = try_first_run(family, n, request_.width, limit, session);
@@ -377,7 +377,7 @@ Status Sweep::sweep_pixels(const Family& family, double limit, OpenSession& sess
     if (point.second == request_.width) measured.push_back(point.first);
   std::sort(measured.begin(), measured.end());
   // A shard takes the pixel sweep at the N planned: the other shards measure the rest of them.
-  if (request_.shard) measured = log_spaced(family.low, family.high, family.points);
+  if (request_.shard) measured = sweep_ns(family);
   for (size_t n : pixel_sweep_ns(measured))
     for (int width : pixel_sweep_widths(request_.width)) {
       if (stopped()) return ok_status();
@@ -524,7 +524,7 @@ Status Sweep::run_family(const Family& family, double share_end) {
 
 Status Sweep::measure_checks(const std::vector<Family>& families) {
   const std::vector<CheckPoint> plan = plan_checks(result_);
-  size_t skipped = 0;
+  size_t skipped = 0, too_large = 0;
   for (int s = 0; s < request_.sessions; ++s)
     for (const Family& family : families) {
       std::vector<PointKey> points;
@@ -539,6 +539,11 @@ Status Sweep::measure_checks(const std::vector<Family>& families) {
       for (size_t i = points.size(); i > 1; --i) std::swap(points[i - 1], points[rng_.below(i)]);
       for (PointKey p : points) {
         if (stopped()) break;
+        // A point the memory check found too large for a session is not measured.
+        if (family.max_n > 0 && p.first > family.max_n) {
+          ++too_large;
+          continue;
+        }
         // Every session of the checks is to come: the point's share of what is left.
         if (elapsed() + f_->cost.predict(p.first) * double(request_.sessions - s) >
             request_.budget_seconds) {
@@ -553,6 +558,35 @@ Status Sweep::measure_checks(const std::vector<Family>& families) {
     result_.notes.push_back(fmt::format(
         "{} runs of the prediction checks were left out: they would have overrun the budget",
         skipped));
+  if (too_large > 0)
+    result_.notes.push_back(fmt::format(
+        "{} runs of the prediction checks were left out: their points would not fit in the "
+        "memory a session may take",
+        too_large));
+  return ok_status();
+}
+
+// Before the sweep: each family's memory estimated from probes (memory_estimate.h), its planned
+// N that would not fit dropped (family.max_n), with a note. Nothing without a probe.
+Status check_memory(const StudyRequest& request, const StudyHooks& hooks,
+                    std::vector<Family>& families, StudyResult& result) {
+  if (!hooks.probe_memory) return ok_status();
+  const double available =
+      hooks.available_memory ? hooks.available_memory() : available_memory_bytes();
+  for (Family& family : families) {
+    if (hooks.on_progress) hooks.on_progress(family.name + ": estimating memory");
+    Expected<FamilyMemory> m = check_family_memory(family, request.renderers, request.width,
+                                                   hooks.probe_memory, available);
+    if (!m) return m.error();
+    if (m->max_n == 0)
+      return bad_input(fmt::format("{}: not even its smallest point fits in memory: {}",
+                                   family.name, memory_note(*m)));
+    if (!m->dropped.empty()) {
+      family.max_n = m->max_n;
+      result.notes.push_back(memory_note(*m));
+    }
+    result.memory.push_back(std::move(*m));
+  }
   return ok_status();
 }
 
@@ -579,14 +613,15 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
         "crossovers, and no crossover is checked (they depend on the other shards' points); rvr "
         "study --merge pools the shards",
         request.shard->index, request.shard->count, request.shard->index, request.shard->count));
+  std::vector<Family> families;
+  for (const std::string& scene : request.scenes) families.push_back(*find_family(scene));
+  if (Status s = check_memory(request, hooks, families, result); !s) return s.error();
   Sweep sweep(request, hooks, result);
   result.system_before = sweep.probe();
   const bool checks = request.check_predictions && !request.shard;
   const double sweep_budget = request.budget_seconds * (checks ? 1 - kCheckShare : 1.0);
-  std::vector<Family> families;
-  for (size_t i = 0; i < request.scenes.size(); ++i) {
-    Family family = *find_family(request.scenes[i]);
-    families.push_back(family);
+  for (size_t i = 0; i < families.size(); ++i) {
+    const Family& family = families[i];
     result.scenes.push_back(family.name);
     result.axes[family.name] = family.axis;
     double left = sweep_budget - sweep.elapsed();

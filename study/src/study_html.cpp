@@ -22,7 +22,9 @@
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
+#include "rvr/study/memory_estimate.h"
 #include "rvr/study/study_markdown.h"
+#include "scene_changes_html.h"
 
 namespace rvr::study {
 namespace {
@@ -406,6 +408,10 @@ std::string scene_section(const StudyResult& r, size_t index, const Colours& col
                                                     format_number(n), axis)) +
                            kMarksCaption);
   o += conclusions_html(r, scene);
+  o += builds_html(r, scene);
+  for (const FamilyMemory& m : r.memory)
+    if (m.scene == scene && !memory_sentence(m).empty())
+      o += "<p class=\"memory\">" + html_with_powers(memory_sentence(m)) + "</p>\n";
   o += "<h3>Cost models</h3>\n" + models_table(r, scene, colours);
   return o + "</section>\n";
 }

@@ -14,6 +14,8 @@
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
+#include "rvr/study/memory_estimate.h"
+#include "rvr/study/scene_changes.h"
 #include "rvr/study/sweep_plan.h"
 #include "rvr/study/system_probe.h"
 
@@ -124,6 +126,76 @@ json sessions_json(const StudyResult& r) {
   return out;
 }
 
+// Each renderer's preparation per point, and the frames per scene change (scene_changes.h).
+void builds_json(const StudyResult& r, json& doc) {
+  json builds = json::array();
+  for (const BuildCost& b : r.builds)
+    builds.push_back({{"renderer", b.renderer},
+                      {"scene", b.scene},
+                      {"n", b.n},
+                      {"pixels", b.pixels},
+                      {"prepare_seconds", number(b.prepare_seconds)},
+                      {"range", json::array({number(b.low), number(b.high)})},
+                      {"ns_per_triangle", number(b.ns_per_triangle)},
+                      {"runs", b.runs}});
+  doc["builds"] = builds;
+  json changes = json::array();
+  for (const SceneChange& c : r.scene_changes)
+    changes.push_back({{"a", c.a},
+                       {"b", c.b},
+                       {"scene", c.scene},
+                       {"n", c.n},
+                       {"pixels", c.pixels},
+                       {"frame_a", number(c.frame_a)},
+                       {"frame_b", number(c.frame_b)},
+                       {"prepare_a", number(c.prepare_a)},
+                       {"prepare_b", number(c.prepare_b)},
+                       {"frames", number(c.frames)},
+                       {"ci95", interval(c.ci95)}});
+  doc["scene_changes"] = changes;
+}
+
+// Each family's memory estimate before the sweep (memory_estimate.h).
+json memory_json(const StudyResult& r) {
+  json out = json::array();
+  auto line = [](const LinearBytes& l) { return json{{"fixed", l.fixed}, {"per_n", l.per_n}}; };
+  for (const FamilyMemory& m : r.memory) {
+    json probes = json::array();
+    for (const MemoryProbe& p : m.probes) probes.push_back(json::parse(memory_probe_json(p)));
+    json renderers = json::object();
+    for (size_t k = 0; k < m.renderers.size(); ++k)
+      renderers[m.renderers[k]] = {{"retained", line(m.model.retained[k])},
+                                   {"prepare_peak", line(m.model.prepare_peak[k])},
+                                   {"frame_peak", line(m.model.frame_peak[k])}};
+    json points = json::array();
+    for (const PointMemory& p : m.points) {
+      json parts = json::object();
+      for (size_t k = 0; k < m.renderers.size(); ++k)
+        parts[m.renderers[k]] = {{"retained", p.renderer_bytes[k]},
+                                 {"prepare_peak", p.build_peak_bytes[k]}};
+      points.push_back({{"n", p.n},
+                        {"peak_bytes", p.peak_bytes},
+                        {"scene_bytes", p.scene_bytes},
+                        {"renderers", parts},
+                        {"fits", p.fits}});
+    }
+    out.push_back({{"scene", m.scene},
+                   {"renderer_order", m.renderers},
+                   {"probes", probes},
+                   {"model",
+                    {{"baseline", line(m.model.baseline)},
+                     {"scene", line(m.model.scene)},
+                     {"scene_peak", line(m.model.scene_peak)},
+                     {"renderers", renderers}}},
+                   {"available_bytes", m.available_bytes},
+                   {"usable_bytes", m.usable_bytes},
+                   {"points", points},
+                   {"max_n", m.max_n},
+                   {"dropped", m.dropped}});
+  }
+  return out;
+}
+
 void conclusions_json(const StudyResult& r, json& doc) {
   json dominance = json::array();
   for (const Dominance& d : r.dominance) {
@@ -194,6 +266,7 @@ void conclusions_json(const StudyResult& r, json& doc) {
                       {"trace_seconds", number(s.trace_seconds)},
                       {"zbuffer_share", number(s.zbuffer_share)}});
   doc["splits"] = splits;
+  builds_json(r, doc);
   doc["dominance"] = dominance;
   doc["scaling"] = scaling;
   doc["costs"] = costs;
@@ -276,6 +349,7 @@ std::string study_json(const StudyResult& r) {
               {"comparisons", comparisons_json(r)},
               {"crossovers", crossovers_json(r)},
               {"no_conclusion", r.no_conclusion.empty() ? json(nullptr) : json(r.no_conclusion)},
+              {"memory", memory_json(r)},
               {"notes", r.notes},
               {"interrupted", r.interrupted},
               {"shard", r.shard ? json{{"index", r.shard->index}, {"count", r.shard->count}}

@@ -139,7 +139,8 @@ const std::vector<std::string> kTopKeys = {
     "renderers",     "comparisons",     "crossovers",      "no_conclusion",
     "dominance",     "scaling",         "costs",           "checks",
     "notes",         "interrupted",     "shard",           "points",
-    "check_points",  "splits"};
+    "check_points",  "splits",          "builds",          "scene_changes",
+    "memory"};
 const std::vector<std::string> kPointKeys = {
     "renderer", "scene",  "scene_n", "n",      "width",        "height", "pixels",
     "counters", "runs",   "seconds", "median", "relative_mad", "busy"};
@@ -291,6 +292,10 @@ void check_conclusions(const Fields& top) {
   for (const char* key : {"comparisons", "crossovers", "dominance", "scaling", "costs", "checks",
                           "splits", "check_points"})
     top.array(key);
+  // Studies written before the preparations were concluded on and memory estimated have none.
+  // The memory estimate was the sweep's, before it: not carried to a study concluded again.
+  for (const char* key : {"builds", "scene_changes", "memory"})
+    if (top.has(key)) top.array(key);
   if (!top.at("no_conclusion").is_null()) top.string("no_conclusion");
 }
 

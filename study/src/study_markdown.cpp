@@ -10,6 +10,9 @@
 
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
+#include "rvr/study/cost_model.h"
+#include "rvr/study/memory_estimate.h"
+#include "rvr/study/scene_changes.h"
 
 namespace rvr::study {
 namespace {
@@ -95,6 +98,32 @@ std::vector<std::string> split_sentences(const StudyResult& r) {
   return out;
 }
 
+// In full mode the loop orders do not render the same frame: what each renderer of the study
+// renders there. "" in the other modes, where they do.
+std::string full_mode_text(const StudyResult& r) {
+  if (r.mode != "full") return "";
+  std::vector<std::string> each;
+  for (const std::string& name : r.renderers) {
+    switch (model_form_of(name)) {
+      case ModelForm::ZBuffer:
+        each.push_back(name +
+                       " shadow maps (a cube of six per light sample, drawn over every "
+                       "triangle) and no reflection or refraction: where a family has a mirror "
+                       "(effects) its frame does less work than a tracer's");
+        break;
+      case ModelForm::Tracer:
+        each.push_back(name + " shadow rays and reflection and refraction rays");
+        break;
+      case ModelForm::Hybrid:
+        each.push_back(name +
+                       " its z-buffer's visibility pass, then the tracer's shadow, reflection "
+                       "and refraction rays");
+        break;
+    }
+  }
+  return " What each renderer renders in full mode: " + join(each) + ".";
+}
+
 }  // namespace
 
 std::string scope_text(const StudyResult& r) {
@@ -103,9 +132,12 @@ std::string scope_text(const StudyResult& r) {
                                             : "shadows, reflections and every effect each renderer "
                                               "renders";
   return fmt::format(
-      "{} at {}×{} in {} mode ({}). Frame times of static scenes: what a renderer builds per scene "
-      "(the tracers' BVH) is timed apart from its frames. One machine type ({}).",
-      join(r.scenes), r.width, r.height, r.mode, mode, r.machine.cpu.empty() ? "unnamed" : r.machine.cpu);
+      "{} at {}×{} in {} mode ({}).{} Frame times of static scenes: what a renderer builds per "
+      "scene (the tracers' and the hybrids' BVH) is timed apart from its frames, and the frames "
+      "a scene must last to pay for it are given with it; the z-buffers build nothing per "
+      "scene. One machine type ({}).",
+      join(r.scenes), r.width, r.height, r.mode, mode, full_mode_text(r),
+      r.machine.cpu.empty() ? "unnamed" : r.machine.cpu);
 }
 
 std::string method_text(const StudyResult& r) {
@@ -272,6 +304,17 @@ std::string study_markdown(const StudyResult& r) {
                   "grid, measured in fresh sessions.",
                   checks);
   text += section("The hybrids' split", "", split_sentences(r));
+  text += section("Building per scene",
+                  "What each renderer builds before its first frame, timed in every run; a scene "
+                  "that changes every k frames costs t_frame + t_prepare / k a frame.",
+                  build_sentences(r));
+  std::vector<std::string> memory;
+  for (const FamilyMemory& m : r.memory)
+    if (std::string s = memory_sentence(m); !s.empty()) memory.push_back(s);
+  text += section("Memory",
+                  "Estimated before the sweep; planned N that would not fit were dropped (see the "
+                  "notes).",
+                  memory);
   text += section("Cost models", "", models);
   text += section("Scaling (log-log slope per decade)", "", scaling_sentences(r));
   text += section("Cost per triangle and per ray", "", cost_sentences(r));

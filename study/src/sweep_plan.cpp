@@ -35,18 +35,25 @@ Expected<Family> file_family(const std::string& path) {
   return Family{std::filesystem::path(path).filename().string(), "triangles", 1, high, 9, path};
 }
 
+// A built-in triangle family from 10^2 to `high`, kPointsPerDecade log-spaced points a decade.
+Family triangle_family(const std::string& name, size_t high) {
+  const double decades = std::log10(double(high) / 100.0);
+  return Family{name, "triangles", 100, high, int(std::lround(decades * kPointsPerDecade)) + 1, ""};
+}
+
 }  // namespace
 
 Expected<Family> find_family(const std::string& name) {
   const bool builtin = name.rfind("builtin:", 0) == 0;
   std::string bare = builtin ? name.substr(8) : name;
-  if (bare == "tessphere") return Family{"tessphere", "triangles", 100, 1000000, 13, ""};
-  if (bare == "soup") return Family{"soup", "triangles", 100, 1000000, 13, ""};
+  if (bare == "tessphere" || bare == "effects") return triangle_family(bare, kTessphereHigh);
+  if (bare == "soup") return triangle_family(bare, kSoupHigh);
   if (bare == "occluders") return Family{"occluders", "depth", 1, 256, 9, ""};
   if (!builtin && std::filesystem::exists(name)) return file_family(name);
   return bad_input(name +
                    ": not a scene family the study sweeps (builtin:tessphere, builtin:soup, "
-                   "builtin:occluders, or a scene or model file; the study chooses N)");
+                   "builtin:effects, builtin:occluders, or a scene or model file; the study "
+                   "chooses N)");
 }
 
 std::vector<size_t> log_spaced(size_t low, size_t high, int count) {
@@ -71,7 +78,10 @@ std::vector<int> pixel_sweep_widths(int width) {
   return out;
 }
 
-std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured) {
+std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& all) {
+  std::vector<size_t> measured;
+  for (size_t n : all)
+    if (n <= kPixelSweepMaxN) measured.push_back(n);
   if (measured.empty()) return {};
   const double middle = std::sqrt(double(measured.front()) * double(measured.back()));  // in log N
   size_t nearest = measured.front();
@@ -83,9 +93,15 @@ std::vector<size_t> pixel_sweep_ns(const std::vector<size_t>& measured) {
   return out;
 }
 
+std::vector<size_t> sweep_ns(const Family& family) {
+  std::vector<size_t> ns = log_spaced(family.low, family.high, family.points);
+  if (family.max_n > 0) std::erase_if(ns, [&](size_t n) { return n > family.max_n; });
+  return ns;
+}
+
 std::vector<PlannedPoint> planned_points(const Family& family, int width) {
   std::vector<PlannedPoint> plan;
-  const std::vector<size_t> ns = log_spaced(family.low, family.high, family.points);
+  const std::vector<size_t> ns = sweep_ns(family);
   const std::vector<size_t> pixel_ns = pixel_sweep_ns(ns);
   const std::vector<int> widths = pixel_sweep_widths(width);
   plan.reserve(ns.size() + pixel_ns.size() * widths.size());

@@ -29,7 +29,8 @@ double loglog_slope(const std::vector<Measurement>& points, double from, double 
 // these, for conclude() to add them again.
 bool is_conclusion_note(const std::string& note);
 
-// Fills result.models, crossovers, dominance, scaling and costs from result.points.
+// Fills result.models, crossovers, dominance, scaling, costs, splits, builds and scene_changes
+// from result.points.
 void conclude(StudyResult& result, const BootstrapOptions& boot);
 
 }  // namespace rvr::study

@@ -11,6 +11,7 @@
 
 #include "rvr/shared/expected.h"
 #include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
 #include "rvr/study/run_study.h"
 #include "rvr/study/sweep_plan.h"
 
@@ -21,6 +22,9 @@ namespace rvr::study {
 Expected<std::unique_ptr<FrameSource>> prepare_frames(const std::vector<std::string>& renderers,
                                                       RenderMode mode, const Family& family,
                                                       size_t n, int width);
+
+// builtin:<family>:<n>, or n copies of the family's file, at width × width·3/4.
+Expected<Scene> family_scene(const Family& family, size_t n, int width);
 
 // Sessions in this process: each scene prepared afresh in each (kind "preparation"). What the
 // Python module and tests use; the CLI starts a process per session instead.

@@ -10,6 +10,8 @@
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
+#include "rvr/study/memory_estimate.h"
+#include "rvr/study/scene_changes.h"
 #include "rvr/study/sweep_plan.h"
 #include "rvr/study/system_probe.h"
 
@@ -112,6 +114,13 @@ struct StudyResult {
   std::vector<ScalingExponent> scaling;
   std::vector<UnitCost> costs;
   std::vector<PhaseSplit> splits;  // the hybrids', at the smallest and largest N at full width
+  // Each renderer's preparation per point, and the frames per scene change above which a
+  // renderer that builds per scene beats a z-buffer (scene_changes.h): at the full image size.
+  std::vector<BuildCost> builds;
+  std::vector<SceneChange> scene_changes;
+  // Each family's memory estimated before the sweep, and the planned N it dropped
+  // (memory_estimate.h); empty when the sweep had no way to probe memory.
+  std::vector<FamilyMemory> memory;
   std::vector<PredictionCheck> checks;
   std::vector<Measurement> check_points;  // what the checks measured (not in the fits)
   std::vector<std::string> notes;  // what the budget cut short, and the like
