@@ -80,8 +80,8 @@ std::vector<RendererCase> renderer_cases() {
 // a csg object has no z-buffer form, so rasterizers skip it (with a warning; tested in
 // test_raster) and there is nothing to agree on.
 const char* kScenes[] = {"cornell",   "spheres",         "occluders:16", "occluders_back:16",
-                         "soup:2000", "tessphere:20000", "dof",          "glass",
-                         "textured"};
+                         "soup:2000", "tessphere:20000", "effects:5000", "dof",
+                         "glass",     "textured"};
 
 TEST(ConformanceScenes, CoverEveryBuiltinSceneButCsg) {
   std::set<std::string> listed;

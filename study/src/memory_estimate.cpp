@@ -368,6 +368,7 @@ Expected<MemoryProbe> parse_memory_probe(const std::string& text) {
 std::string format_bytes(double bytes) {
   const double mib = bytes / double(1 << 20);
   if (mib >= 1024) return fmt::format("{:.1f} GiB", mib / 1024);
+  if (mib < 0.5) return "under 1 MiB";
   return fmt::format("{:.0f} MiB", mib);
 }
 

@@ -144,9 +144,9 @@ std::string build_sentence(const StudyResult& r, const std::string& renderer,
 // Where k* falls along N for one pair on one scene.
 std::string pair_sentence(const StudyResult& r, const std::string& a, const std::string& b,
                           const std::string& scene) {
-  std::vector<const SceneChange*> along;
+  std::vector<const SceneChange*> along;  // the points with a session both measured in
   for (const SceneChange& c : r.scene_changes)
-    if (c.a == a && c.b == b && c.scene == scene) along.push_back(&c);
+    if (c.a == a && c.b == b && c.scene == scene && !std::isnan(c.frames)) along.push_back(&c);
   if (along.empty()) return "";
   std::vector<const SceneChange*> finite;
   for (const SceneChange* c : along)

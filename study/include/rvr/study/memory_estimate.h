@@ -144,7 +144,7 @@ double available_memory_bytes();
 std::string memory_probe_json(const MemoryProbe& p);
 Expected<MemoryProbe> parse_memory_probe(const std::string& json_text);
 
-// "1.5 GiB", "310 MiB".
+// "1.5 GiB", "310 MiB", "under 1 MiB".
 std::string format_bytes(double bytes);
 
 }  // namespace rvr::study
