@@ -123,6 +123,7 @@ MemoryModel fit_memory_model(const std::vector<MemoryProbe>& probes) {
   RVR_CHECK(!probes.empty(), "a memory model needs at least one probe");
   const size_t renderers = probes[0].retained_bytes.size();
   std::vector<double> x;
+  x.reserve(probes.size());
   for (const MemoryProbe& p : probes) {
     RVR_CHECK(p.retained_bytes.size() == renderers && p.prepare_peak_bytes.size() == renderers &&
                   p.frame_peak_bytes.size() == renderers,
@@ -131,6 +132,7 @@ MemoryModel fit_memory_model(const std::vector<MemoryProbe>& probes) {
   }
   auto line = [&](auto part) {
     std::vector<double> y;
+    y.reserve(probes.size());
     for (const MemoryProbe& p : probes) y.push_back(part(p));
     return fit_line(x, y);
   };
