@@ -130,10 +130,10 @@ bench: build
 # The headline study (docs/cli.md#rvr-study-what-each-loop-order-costs-computed-with-confidence):
 # occluders (depth complexity), tessphere (to 1.8×10^7 triangles) and soup (to 3.2×10^7, as far
 # as the memory allows), one renderer per loop order, local mode, 1024 wide, within STUDY_BUDGET
-# seconds of sweeping (see docs/cli.md for how long it takes), into bench/study/; its study.md
+# seconds of sweeping (about 80 minutes on 2 cores: docs/cli.md), into bench/study/; its study.md
 # is pasted into bench/README.md. Occluders first: what a family leaves of its share goes to
 # the next, and soup's largest points cost the most.
-STUDY_BUDGET ?= 4800
+STUDY_BUDGET ?= 6000
 study: build
 	$(BUILD_DIR)/bin/rvr study builtin:occluders builtin:tessphere builtin:soup --width 1024 \
 		--mode local --budget $(STUDY_BUDGET) -o bench/study

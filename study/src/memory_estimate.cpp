@@ -160,7 +160,8 @@ double estimate_peak(const MemoryModel& m, double n) {
     frame_peak.push_back(m.frame_peak[k].at(n));
   }
   return compose(m.baseline.at(n), m.scene.at(n), m.scene_peak.at(n), retained, prepare_peak,
-                 frame_peak);
+                 frame_peak) +
+         kStalePixelBytes;
 }
 
 double composed_peak(const MemoryProbe& p) {

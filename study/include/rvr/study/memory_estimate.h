@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "rvr/shared/expected.h"
+#include "rvr/shared/pixel_memory.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/study/sweep_plan.h"
 
@@ -68,11 +69,18 @@ MemoryModel fit_memory_model(const std::vector<MemoryProbe>& probes);
 
 // The session's peak resident memory at N: baseline plus the largest of the scene's peak while
 // it is built and the scene plus the largest of, for each renderer k, what the renderers before
-// it retain plus k's preparation peak, and what all retain plus any renderer's frame peak.
-// Through two probes it gives each probe's composed_peak back.
+// it retain plus k's preparation peak, and what all retain plus any renderer's frame peak; plus
+// kStalePixelBytes. Through two probes it gives each probe's composed_peak back, plus that.
 double estimate_peak(const MemoryModel& model, double n);
 // The same sum over a probe's measured parts.
 double composed_peak(const MemoryProbe& probe);
+
+// What a session holds that no probe does: a session measures the pixel sweep's narrower images
+// too, in random order in its later sessions, and the frame-memory pool (pixel_memory.h) keeps
+// released frame blocks of those sizes, up to kRecycleLimitBytes, while a larger point's
+// full-size frames are allocated afresh. The probe's own pool holds full-size blocks the
+// point's frames take again.
+constexpr double kStalePixelBytes = double(kRecycleLimitBytes);
 
 // What a session may hold: this share of the memory available (MemAvailable) when the study
 // starts. The rest covers the estimate's error (see kMemoryProbeMaxN) and what other processes
@@ -83,7 +91,7 @@ constexpr double kMemoryUsableShare = 0.8;
 // grows with N to outweigh what does not, and the smaller one must sit well below the larger:
 // softraster's buffers stop growing at a chunk of 262,144 triangles, and between neighbouring
 // N the BVH's bytes per triangle vary by ±10% with its vectors' capacities. Probes at 10^5 and
-// 10^6 (a few seconds on two cores) give the peaks measured at 3×10^6 and 10^7 within 5%
+// 10^6 (a few seconds on two cores) give the peaks measured at 3×10^6 and 10^7 within 2%
 // (tests/test_study_plan.cpp holds them to 10%).
 constexpr size_t kMemoryProbeMaxN = 1'000'000;
 
