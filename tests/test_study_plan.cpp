@@ -498,6 +498,29 @@ TEST(SceneChanges, EveryZBufferAgainstEveryRendererThatBuilds) {
   EXPECT_NE(all.find("a scene rebuilt every frame (k = 1) is cheaper with softraster"),
             std::string::npos)
       << all;
+  // Where the builder wins even a scene rebuilt every frame (k* <= 1), said as the points where
+  // it does, not as "from" the first of them: here not above 10^4.
+  StudyResult e;
+  e.scenes = {"effects"};
+  e.axes["effects"] = "triangles";
+  for (auto [n, k] : {std::pair{1e2, 0.5}, {1e4, 0.2}, {1e6, 20.0}}) {
+    SceneChange c;
+    c.a = "softraster";
+    c.b = "raytrace";
+    c.scene = "effects";
+    c.n = n;
+    c.frames = k;
+    c.ci95 = {k, k};
+    e.scene_changes.push_back(c);
+  }
+  const std::vector<std::string> effects = build_sentences(e);
+  ASSERT_EQ(effects.size(), 1u);
+  EXPECT_NE(effects[0].find("(3 of 3 points, 100–1.0×10^6 triangles)"), std::string::npos)
+      << effects[0];
+  EXPECT_NE(effects[0].find("raytrace wins even a scene rebuilt every frame at 2 of them "
+                            "(100–1.0×10^4 triangles)"),
+            std::string::npos)
+      << effects[0];
   // In full mode the scope says that the z-buffer renders less.
   const std::string scope = scope_text(r);
   EXPECT_NE(scope.find("softraster shadow maps"), std::string::npos) << scope;

@@ -142,7 +142,8 @@ void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
   cmd = app.add_subcommand(
       "study", "time the loop orders over swept scene sizes; fit cost models; find crossovers");
   cmd->add_option("scenes", a.scenes,
-                  "families to sweep: builtin:tessphere, builtin:soup, builtin:occluders, or a "
+                  "families to sweep: builtin:tessphere, builtin:soup, builtin:effects, "
+                  "builtin:occluders, or a "
                   "scene or model file grown by copies in a grid (default: tessphere and soup; "
                   "the study chooses N)");
   cmd->add_option("-r,--renderers", a.renderers,

@@ -107,6 +107,12 @@ std::string frames_text(double k, const Interval& ci) {
   return fmt::format("{} (95%: {} – {})", one(k), one(ci.low), one(ci.high));
 }
 
+// "88–3.2×10^5", or one value.
+std::string range_text(double from, double to) {
+  return from == to ? format_number(from)
+                    : fmt::format("{}–{}", format_number(from), format_number(to));
+}
+
 std::string seconds_text(double s) {
   if (s >= 1) return fmt::format("{} s", format_number(s));
   if (s >= 1e-3) return fmt::format("{} ms", format_number(1e3 * s));
@@ -164,21 +170,23 @@ std::string pair_sentence(const StudyResult& r, const std::string& a, const std:
                              format_number(finite[i]->n)));
   std::string list;
   for (const std::string& s : at) list += (list.empty() ? "" : ", ") + s;
-  const SceneChange* every_frame = nullptr;  // the first N where b wins a scene rebuilt each frame
+  // Where b wins even a scene rebuilt every frame (k* <= 1): not always one stretch of N.
+  std::vector<const SceneChange*> every_frame;
   for (const SceneChange* c : along)
-    if (c->frames <= 1 && !every_frame) every_frame = c;
+    if (c->frames <= 1) every_frame.push_back(c);
   const std::string rebuilt =
-      every_frame ? fmt::format("{} wins even a scene rebuilt every frame from {} {}", b,
-                                format_number(every_frame->n), r.axes.at(scene))
-                  : fmt::format(
-                        "a scene rebuilt every frame (k = 1) is cheaper with {} at "
-                        "every N measured",
-                        a);
+      every_frame.empty()
+          ? fmt::format(
+                "a scene rebuilt every frame (k = 1) is cheaper with {} at every N measured", a)
+          : fmt::format("{} wins even a scene rebuilt every frame at {} of them ({} {})", b,
+                        every_frame.size(),
+                        range_text(every_frame.front()->n, every_frame.back()->n),
+                        r.axes.at(scene));
   return fmt::format(
-      "On {}, where {}'s frames are faster than {}'s ({} of {} points, from {} {}), a scene "
-      "that changes every k frames costs less with {} only above k = {}; {}.",
-      scene, b, a, finite.size(), along.size(), format_number(finite.front()->n), r.axes.at(scene),
-      b, list, rebuilt);
+      "On {}, where {}'s frames are faster than {}'s ({} of {} points, {} {}), a scene that "
+      "changes every k frames costs less with {} only above k = {}; {}.",
+      scene, b, a, finite.size(), along.size(), range_text(finite.front()->n, finite.back()->n),
+      r.axes.at(scene), b, list, rebuilt);
 }
 
 }  // namespace
