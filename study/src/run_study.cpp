@@ -96,6 +96,9 @@ struct FamilyState {
   double quickest_reference = kInfinity;      // its quickest time in the family so far
   std::vector<PlannedPoint> plan;
   size_t plan_offset = 0;  // the index of its first point in the study's plan
+  // The largest N a session may hold (memory_estimate.h; 0: no limit), once checked.
+  size_t max_n = 0;
+  bool memory_checked = false;
 };
 
 // A session opened for one family: the session, its reference frame and what its probe saw.
@@ -150,6 +153,7 @@ class Sweep {
   Expected<bool> try_first_run(const Family& family, size_t n, int width, double limit,
                                OpenSession& session);
   Status sweep_n(const Family& family, double limit, OpenSession& session);
+  Status check_memory(const Family& family);
   Status sweep_pixels(const Family& family, double limit, OpenSession& session);
   Status more_sessions(const Family& family, double limit);
   Status refine_near_crossovers(const Family& family, double share_end);
@@ -330,8 +334,9 @@ std::vector<size_t> Sweep::crossover_midpoints(const Family& family) const {
 }
 
 // A point's first run, in the family's first session, unless it was measured, or all of its
-// sessions would end past `limit` as predicted from the points measured at the full width:
-// false then.
+// sessions would end past `limit` as predicted from the points measured at the full width, or
+// it would not fit in the memory (checked before the first point larger than the memory
+// probes'): false then.
 Expected<bool> Sweep::try_first_run(const Family& family, size_t n, int width, double limit,
                                     OpenSession& session) {
   if (f_->points.index.count({n, width})) return false;
@@ -344,6 +349,10 @@ Expected<bool> Sweep::try_first_run(const Family& family, size_t n, int width, d
       elapsed() + f_->cost.predict(n) * double(request_.sessions) + sessions_left * committed >
           limit)
     return false;
+  // Up to the largest probe's N a session holds no more than the probe did.
+  if (!f_->memory_checked && hooks_.probe_memory && n > memory_probe_ns(family).back())
+    if (Status s = check_memory(family); !s) return s.error();
+  if (f_->max_n > 0 && n > f_->max_n) return false;
   double before = elapsed();
   if (Status s = measure_run(family, n, width, session, f_->points); !s) return s.error();
   if (!f_->points.index.count({n, width})) return false;  // cut short
@@ -360,9 +369,10 @@ Status Sweep::sweep_n(const Family& family, double limit, OpenSession& session) 
     Expected<bool> done = try_first_run(family, n, request_.width, limit, session);
     if (!done) return done.error();
     if (!*done) {
-      result_.notes.push_back(
-          fmt::format("{}: the sweep stopped below {} (its points would have overrun the budget)",
-                      family.name, point_name(family, n)));
+      if (f_->max_n == 0 || n <= f_->max_n)  // else the memory's note says why
+        result_.notes.push_back(fmt::format(
+            "{}: the sweep stopped below {} (its points would have overrun the budget)",
+            family.name, point_name(family, n)));
       break;
     }
   }
@@ -497,6 +507,27 @@ Status Sweep::measure_busy_runs_again(const Family& family, double share_end) {
   return ok_status();
 }
 
+// Before the sweep starts a point larger than the memory probes' (memory_estimate.h): the
+// family's memory estimated, the planned N that would not fit dropped (f_->max_n) with a note.
+// The probes run in fresh processes beside the open session; their time is not the budget's.
+Status Sweep::check_memory(const Family& family) {
+  f_->memory_checked = true;
+  const double before = elapsed();
+  progress(family.name + ": estimating memory");
+  const double available =
+      hooks_.available_memory ? hooks_.available_memory() : available_memory_bytes();
+  Expected<FamilyMemory> m = check_family_memory(family, request_.renderers, request_.width,
+                                                 hooks_.probe_memory, available);
+  exclude(elapsed() - before);
+  if (!m) return m.error();
+  if (!m->dropped.empty()) {
+    f_->max_n = std::max<size_t>(m->max_n, 1);
+    result_.notes.push_back(memory_note(*m));
+  }
+  result_.memory.push_back(std::move(*m));
+  return ok_status();
+}
+
 // The first session sweeps N up to kBaseShare of the scene's share and the pixel count up to
 // kPixelShare (every session to come counted); sessions 2 … S repeat those points; then points
 // near crossovers, then busy runs again.
@@ -540,7 +571,7 @@ Status Sweep::measure_checks(const std::vector<Family>& families) {
       for (PointKey p : points) {
         if (stopped()) break;
         // A point the memory check found too large for a session is not measured.
-        if (family.max_n > 0 && p.first > family.max_n) {
+        if (f_->max_n > 0 && p.first > f_->max_n) {
           ++too_large;
           continue;
         }
@@ -563,30 +594,6 @@ Status Sweep::measure_checks(const std::vector<Family>& families) {
         "{} runs of the prediction checks were left out: their points would not fit in the "
         "memory a session may take",
         too_large));
-  return ok_status();
-}
-
-// Before the sweep: each family's memory estimated from probes (memory_estimate.h), its planned
-// N that would not fit dropped (family.max_n), with a note. Nothing without a probe.
-Status check_memory(const StudyRequest& request, const StudyHooks& hooks,
-                    std::vector<Family>& families, StudyResult& result) {
-  if (!hooks.probe_memory) return ok_status();
-  const double available =
-      hooks.available_memory ? hooks.available_memory() : available_memory_bytes();
-  for (Family& family : families) {
-    if (hooks.on_progress) hooks.on_progress(family.name + ": estimating memory");
-    Expected<FamilyMemory> m = check_family_memory(family, request.renderers, request.width,
-                                                   hooks.probe_memory, available);
-    if (!m) return m.error();
-    if (m->max_n == 0)
-      return bad_input(fmt::format("{}: not even its smallest point fits in memory: {}",
-                                   family.name, memory_note(*m)));
-    if (!m->dropped.empty()) {
-      family.max_n = m->max_n;
-      result.notes.push_back(memory_note(*m));
-    }
-    result.memory.push_back(std::move(*m));
-  }
   return ok_status();
 }
 
@@ -613,15 +620,14 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
         "crossovers, and no crossover is checked (they depend on the other shards' points); rvr "
         "study --merge pools the shards",
         request.shard->index, request.shard->count, request.shard->index, request.shard->count));
-  std::vector<Family> families;
-  for (const std::string& scene : request.scenes) families.push_back(*find_family(scene));
-  if (Status s = check_memory(request, hooks, families, result); !s) return s.error();
   Sweep sweep(request, hooks, result);
   result.system_before = sweep.probe();
   const bool checks = request.check_predictions && !request.shard;
   const double sweep_budget = request.budget_seconds * (checks ? 1 - kCheckShare : 1.0);
-  for (size_t i = 0; i < families.size(); ++i) {
-    const Family& family = families[i];
+  std::vector<Family> families;
+  for (size_t i = 0; i < request.scenes.size(); ++i) {
+    Family family = *find_family(request.scenes[i]);
+    families.push_back(family);
     result.scenes.push_back(family.name);
     result.axes[family.name] = family.axis;
     double left = sweep_budget - sweep.elapsed();

@@ -155,7 +155,7 @@ void builds_json(const StudyResult& r, json& doc) {
   doc["scene_changes"] = changes;
 }
 
-// Each family's memory estimate before the sweep (memory_estimate.h).
+// Each family's memory estimate (memory_estimate.h).
 json memory_json(const StudyResult& r) {
   json out = json::array();
   auto line = [](const LinearBytes& l) { return json{{"fixed", l.fixed}, {"per_n", l.per_n}}; };

@@ -312,8 +312,8 @@ std::string study_markdown(const StudyResult& r) {
   for (const FamilyMemory& m : r.memory)
     if (std::string s = memory_sentence(m); !s.empty()) memory.push_back(s);
   text += section("Memory",
-                  "Estimated before the sweep; planned N that would not fit were dropped (see the "
-                  "notes).",
+                  "Estimated before a family's sweep went past 10^6 triangles; planned N that "
+                  "would not fit were dropped (see the notes).",
                   memory);
   text += section("Cost models", "", models);
   text += section("Scaling (log-log slope per decade)", "", scaling_sentences(r));

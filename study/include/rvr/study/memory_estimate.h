@@ -1,5 +1,5 @@
-// What a session of the study holds in memory at one point, estimated before the sweep, and
-// which of a family's planned N fit in the machine's memory.
+// What a session of the study holds in memory at one point, estimated before the sweep goes
+// past the N the estimate is made from, and which of a family's planned N fit in the memory.
 //
 // A session process holds the family's reference point and one point at a time: the point's
 // scene, then every renderer prepared for it (the tracers' and the hybrids' BVH, built over
@@ -7,8 +7,10 @@
 // triangle of the scene in each frame). Each of these grows about linearly with N, so the
 // estimate is a straight line per part, through the same parts measured in fresh processes at
 // two small N of the family (memory_probe_ns), composed in the order a session takes them.
-// Planned N whose estimate is above kMemoryUsableShare of the memory available when the study
-// starts are dropped from the sweep, with a note, rather than run out of memory mid-sweep.
+// Planned N whose estimate is above kMemoryUsableShare of the memory available then are dropped
+// from the sweep, with a note, rather than run out of memory mid-sweep. (Up to the probes' N,
+// a session holds no more than the probe did: the sweep starts at once and the check is made
+// before its first larger point, so a study of small N or a short budget pays nothing for it.)
 #pragma once
 
 #include <stddef.h>

@@ -101,17 +101,18 @@ struct StudyHooks {
   std::function<bool()> cancelled;
   // The machine's state, waiting `window` seconds; null: probe_system. Tests replace it.
   std::function<SystemSnapshot(double window)> probe;
-  // A session's memory at one point, measured in a fresh process (memory_estimate.h): before
-  // the sweep, each family is probed and its planned N that would not fit in the memory
-  // available are dropped, with a note. Null: no estimate, nothing dropped.
+  // A session's memory at one point, measured in a fresh process (memory_estimate.h): before a
+  // family's sweep starts its first point above the probes' N, the family is probed and its
+  // planned N that would not fit in the memory available are dropped, with a note. Null: no
+  // estimate, nothing dropped.
   ProbeMemory probe_memory;
   // The memory available (bytes) the estimate is checked against; null: MemAvailable.
   std::function<double()> available_memory;
 };
 
 // Validates the request (families, renderer names, budget, width, repetitions, sessions:
-// BadInput errors before any work), checks each family's planned N against the memory
-// (hooks.probe_memory), sweeps, fits and concludes. The machine facts are left for the caller.
+// BadInput errors before any work), sweeps (each family's large N checked against the memory
+// first: hooks.probe_memory), fits and concludes. The machine facts are left for the caller.
 Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& hooks);
 
 }  // namespace rvr::study

@@ -118,8 +118,9 @@ struct StudyResult {
   // renderer that builds per scene beats a z-buffer (scene_changes.h): at the full image size.
   std::vector<BuildCost> builds;
   std::vector<SceneChange> scene_changes;
-  // Each family's memory estimated before the sweep, and the planned N it dropped
-  // (memory_estimate.h); empty when the sweep had no way to probe memory.
+  // Each family's memory, estimated before its sweep went past the probes' N, and the planned N
+  // it dropped (memory_estimate.h); empty for a family that never went past them, or when the
+  // sweep had no way to probe memory.
   std::vector<FamilyMemory> memory;
   std::vector<PredictionCheck> checks;
   std::vector<Measurement> check_points;  // what the checks measured (not in the fits)
