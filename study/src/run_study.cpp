@@ -16,6 +16,7 @@
 #include "rvr/renderers/registry.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
+#include "rvr/study/crossover.h"
 #include "rvr/study/measurement.h"
 #include "rvr/study/prediction_checks.h"
 #include "rvr/study/sweep_plan.h"
@@ -306,24 +307,30 @@ Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession
   return ok_status();
 }
 
-// The midpoints (in log N) of every bracket of measured points between which two renderers of
-// different loop orders change places.
+// The midpoints (in log N) of every bracket of neighbouring points between which the trend of
+// two renderers' ratio (crossover.h) changes sign: where a crossover lies, judged on the trend,
+// not on single points that noise can swap.
 std::vector<size_t> Sweep::crossover_midpoints(const Family& family) const {
-  std::map<size_t, std::map<std::string, double>> t;  // n -> renderer -> time
+  std::map<std::string, std::vector<Measurement>> along_n;
   for (const Measurement& m : result_.points)
-    if (m.scene == family.name && m.width == request_.width)
-      t[size_t(m.scene_n)][m.renderer] = typical_seconds(m);
+    if (m.scene == family.name && m.width == request_.width) along_n[m.renderer].push_back(m);
+  const CompareOptions options{BootstrapOptions{200, request_.seed}, request_.noise_threshold};
   std::set<size_t> mids;
   for (size_t i = 0; i < request_.renderers.size(); ++i)
     for (size_t j = i + 1; j < request_.renderers.size(); ++j) {
       const std::string &a = request_.renderers[i], &b = request_.renderers[j];
       if (!compared_pair(a, b)) continue;
-      for (auto it = t.begin(); it != t.end() && std::next(it) != t.end(); ++it) {
-        auto next = std::next(it);
-        bool before = it->second.at(a) < it->second.at(b);
-        bool after = next->second.at(a) < next->second.at(b);
-        if (before != after)
-          if (size_t mid = log_midpoint(it->first, next->first)) mids.insert(mid);
+      const Comparison c = compare_curves(along_n[a], along_n[b], family.axis, options).comparison;
+      if (!c.inconclusive.empty()) continue;
+      for (size_t k = 0; k + 1 < c.points.size(); ++k) {
+        if ((c.points[k].trend < 1) == (c.points[k + 1].trend < 1)) continue;
+        // The scene N of the two points (the axis value is the triangles drawn).
+        size_t low = 0, high = 0;
+        for (const Measurement& m : along_n[a]) {
+          if (m.n == c.points[k].at) low = size_t(m.scene_n);
+          if (m.n == c.points[k + 1].at) high = size_t(m.scene_n);
+        }
+        if (size_t mid = log_midpoint(low, high)) mids.insert(mid);
       }
     }
   return {mids.begin(), mids.end()};

@@ -23,6 +23,7 @@
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
 #include "rvr/study/study_markdown.h"
+#include "rvr/study/system_probe.h"
 
 namespace rvr::study {
 namespace {
@@ -435,13 +436,16 @@ std::string header_html(const StudyResult& r) {
   return o;
 }
 
-// The machine the study ran on.
-std::string machine_html(const MachineInfo& m) {
+// The machine the study ran on, and its state before and after the sweep.
+std::string machine_html(const StudyResult& r) {
+  const MachineInfo& m = r.machine;
   std::string o = "<h2>Machine</h2>\n<dl class=\"machine\">";
   o += fmt::format("<dt>CPU</dt><dd>{}</dd><dt>threads</dt><dd>{}</dd><dt>kernels</dt><dd>{}</dd>",
                    escape_html(m.cpu), m.threads, escape_html(m.kernels));
   for (const auto& [name, version] : m.versions)
     o += fmt::format("<dt>{}</dt><dd>{}</dd>", escape_html(name), escape_html(version));
+  o += fmt::format("<dt>before the sweep</dt><dd>{}</dd><dt>after</dt><dd>{}</dd>",
+                   escape_html(describe(r.system_before)), escape_html(describe(r.system_after)));
   return o + "</dl>\n";
 }
 
@@ -458,7 +462,7 @@ std::string study_html(const StudyResult& r) {
       escape_html(scenes), kCss);
   o += header_html(r);
   for (size_t i = 0; i < r.scenes.size(); ++i) o += scene_section(r, i, colours);
-  o += machine_html(r.machine);
+  o += machine_html(r);
   return o + "</main></body></html>\n";
 }
 
