@@ -19,10 +19,10 @@ using CostFn = std::function<double(double pixels, double n)>;
 
 // Log-normal standard deviations of the noise at each level.
 struct Noise {
-  double frame = 0.03;    // every frame on its own
-  double round = 0.0;     // a round's frames alike, every renderer (a load that comes and goes)
-  double session = 0.0;   // a run, each renderer its own (a process's memory layout)
-  double point = 0.0;     // a renderer at a point, in every run (a size that suits it)
+  double frame = 0.03;   // every frame on its own
+  double round = 0.0;    // a round's frames alike, every renderer (a load that comes and goes)
+  double session = 0.0;  // a run, each renderer its own (a process's memory layout)
+  double point = 0.0;    // a renderer at a point, in every run (a size that suits it)
 };
 
 // One point of each renderer, `runs` runs of `rounds` rounds, sessions 0 .. runs-1.
@@ -49,8 +49,8 @@ inline std::vector<Measurement> synthetic_point(const std::vector<std::string>& 
     for (int k = 0; k < rounds; ++k) {
       const double shared = noise.round * rng.normal();
       for (size_t r = 0; r < renderers.size(); ++r)
-        run[r].seconds.push_back(costs[r](pixels, n) *
-                                 std::exp(point[r] + session[r] + shared + noise.frame * rng.normal()));
+        run[r].seconds.push_back(costs[r](pixels, n) * std::exp(point[r] + session[r] + shared +
+                                                                noise.frame * rng.normal()));
     }
     for (size_t r = 0; r < renderers.size(); ++r) {
       run[r].session = s;

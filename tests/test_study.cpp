@@ -126,8 +126,7 @@ TEST(StudyCrossover, TwoSamplesADecadeApartCrossWhereTheClosedFormSays) {
   const double truth = std::pow(B / A, 1 / (alpha - beta));
   const double n0 = std::pow(10.0, std::floor(std::log10(truth))), n1 = 10 * n0;
   auto d = [&](double n) { return std::log(A * std::pow(n, alpha) / (B * std::pow(n, beta))); };
-  const double at = std::exp(
-      zero_crossing({std::log(n0), std::log(n1)}, {d(n0), d(n1)}, 0, 1));
+  const double at = std::exp(zero_crossing({std::log(n0), std::log(n1)}, {d(n0), d(n1)}, 0, 1));
   EXPECT_NEAR(at / truth, 1.0, 0.01) << at << " vs " << truth;
   // The same through compare_curves on a noise-free grid a decade apart.
   std::vector<double> ns;
@@ -135,9 +134,9 @@ TEST(StudyCrossover, TwoSamplesADecadeApartCrossWhereTheClosedFormSays) {
   Noise quiet;
   quiet.frame = 0;
   Rng rng(1);
-  auto [a, b] = sweep_pair([&](double, double n) { return A * std::pow(n, alpha); },
-                           [&](double, double n) { return B * std::pow(n, beta); }, ns, kP, quiet,
-                           rng);
+  auto [a, b] =
+      sweep_pair([&](double, double n) { return A * std::pow(n, alpha); },
+                 [&](double, double n) { return B * std::pow(n, beta); }, ns, kP, quiet, rng);
   CurveComparison c = compare_curves(a, b, "triangles", options(200, 1));
   ASSERT_EQ(c.crossovers.size(), 1u);
   EXPECT_NEAR(c.crossovers[0].value / truth, 1.0, 0.01);
@@ -305,8 +304,8 @@ StudyResult checked_study(const CostFn& z, const CostFn& t, uint64_t seed) {
   Noise noise;
   noise.frame = 0.02;
   for (size_t n : log_spaced(100, 1000000, 13))
-    for (Measurement& m : synthetic_point(r.renderers, {kZCurve, kTCurve}, kP, double(n), 3, 5,
-                                          noise, rng))
+    for (Measurement& m :
+         synthetic_point(r.renderers, {kZCurve, kTCurve}, kP, double(n), 3, 5, noise, rng))
       r.points.push_back(m);
   conclude(r, {300, seed});
   for (const CheckPoint& p : plan_checks(r))
@@ -393,7 +392,7 @@ struct SimulatedMachine {
 class SimulatedFrames : public FrameSource {
  public:
   SimulatedFrames(double n, int width, SimulatedMachine& machine)
-      : n_(n), pixels_(double(width) * (width * 3 / 4)), machine_(machine) {
+      : n_(n), pixels_(double(width) * double(width * 3 / 4)), machine_(machine) {
     machine_.clock += 1e-6 * n;
   }
   double axis_value() const override { return n_; }
@@ -582,7 +581,7 @@ TEST(StudyRun, RefusesBadInputBeforeAnyWork) {
     started = true;
     return internal_error("not reached");
   };
-  auto refused = [&](StudyRequest r, const std::string& words) {
+  auto refused = [&](const StudyRequest& r, const std::string& words) {
     Expected<StudyResult> out = run_study(r, hooks);
     ASSERT_FALSE(out.ok());
     EXPECT_EQ(out.error().kind, ErrorKind::BadInput);

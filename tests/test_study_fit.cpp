@@ -25,7 +25,7 @@ using namespace rvr::study::fake;
 
 namespace {
 
-CostFn model_cost(CostModel model, std::vector<double> c) {
+CostFn model_cost(CostModel model, const std::vector<double>& c) {
   return [model, c](double p, double n) { return predict(model, c, p, n); };
 }
 
@@ -256,4 +256,3 @@ TEST(StudyModelChoice, DepthComplexityAddsTheFragmentTerm) {
         << f.coefficients[j].name << " = " << truth[j] << " not in [" << f.coefficients[j].ci95.low
         << ", " << f.coefficients[j].ci95.high << "]";
 }
-

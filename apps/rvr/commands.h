@@ -105,7 +105,7 @@ struct StudyArgs {
   std::string mode = "local";
   double budget = 300;
   int repetitions = 5;
-  int processes = 3;             // --processes: runs per point, each in a fresh process
+  int processes = 3;              // --processes: runs per point, each in a fresh process
   double noise_threshold = 0.03;  // --noise-threshold
   uint64_t seed = 1;
   std::string shard;               // --shard I/N

@@ -15,11 +15,11 @@
 
 #include "cli_exit.h"
 #include "commands.h"
-#include "study_processes.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
+#include "study_processes.h"
 #include "suggest.h"
 #include "terminal_progress.h"
 

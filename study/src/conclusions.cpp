@@ -46,9 +46,9 @@ std::vector<Measurement> fit_points(StudyResult& r, const std::string& renderer,
   for (const Measurement& m : all)
     if (!m.busy()) quiet.push_back(m);
   if (quiet.size() >= enough || quiet.size() == all.size()) return quiet;
-  r.notes.push_back(fmt::format(
-      "{} on {}: {} (only {} of {} points had a quiet run): its costs are overstated", renderer,
-      scene, kBusyFitWords, quiet.size(), all.size()));
+  r.notes.push_back(
+      fmt::format("{} on {}: {} (only {} of {} points had a quiet run): its costs are overstated",
+                  renderer, scene, kBusyFitWords, quiet.size(), all.size()));
   return all;
 }
 
@@ -173,10 +173,9 @@ void compare_pairs(StudyResult& r, const BootstrapOptions& boot) {
       for (size_t j = i + 1; j < r.renderers.size(); ++j) {
         const std::string &a = r.renderers[i], &b = r.renderers[j];
         if (!compared_pair(a, b)) continue;
-        add_comparison(r,
-                       compare_curves(along_n(r, a, scene), along_n(r, b, scene), r.axes[scene],
-                                      options),
-                       true);
+        add_comparison(
+            r, compare_curves(along_n(r, a, scene), along_n(r, b, scene), r.axes[scene], options),
+            true);
         for (double n : pixel_sweep_columns(r, scene))
           add_comparison(r,
                          compare_curves(along_pixels(r, a, scene, n), along_pixels(r, b, scene, n),
@@ -324,8 +323,7 @@ std::string no_conclusion_reason(const StudyResult& r) {
       "{} measurements at {} points, too few for a comparison ({} points along an axis) or "
       "a model",
       points, points / std::max<size_t>(r.renderers.size(), 1), kMinComparedPoints);
-  if (busy > 0)
-    why += fmt::format("; {} of them measured only while the machine was busy", busy);
+  if (busy > 0) why += fmt::format("; {} of them measured only while the machine was busy", busy);
   return why + ": give the study a larger --budget";
 }
 

@@ -109,7 +109,8 @@ void judge_points(const std::vector<double>& trend, const std::vector<double>& s
     if (!(sd[j] > 0)) {  // no spread at all: beyond the threshold or not, exactly
       p[j] = std::fabs(trend[j]) > delta ? 0.0 : 1.0;
     } else {
-      const double below = boost::math::cdf(boost::math::complement(t, (-delta - trend[j]) / sd[j]));
+      const double below =
+          boost::math::cdf(boost::math::complement(t, (-delta - trend[j]) / sd[j]));
       const double above = boost::math::cdf(boost::math::complement(t, (trend[j] - delta) / sd[j]));
       p[j] = std::min(1.0, 2 * std::min(below, above));
     }
@@ -241,9 +242,8 @@ std::vector<double> holm_adjusted(const std::vector<double>& p) {
   return out;
 }
 
-CurveComparison compare_curves(const std::vector<Measurement>& a,
-                               const std::vector<Measurement>& b, const std::string& axis,
-                               const CompareOptions& options) {
+CurveComparison compare_curves(const std::vector<Measurement>& a, const std::vector<Measurement>& b,
+                               const std::string& axis, const CompareOptions& options) {
   CurveComparison out;
   Comparison& c = out.comparison;
   if (a.empty() || b.empty()) return out;

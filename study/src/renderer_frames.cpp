@@ -133,10 +133,10 @@ Expected<std::unique_ptr<FrameSource>> prepare_frames(const std::vector<std::str
 }
 
 StartSession in_process_sessions(const StudyRequest& request) {
-  return [renderers = request.renderers,
-          mode = request.mode]() -> Expected<std::unique_ptr<Session>> {
-    return std::unique_ptr<Session>(std::make_unique<InProcessSession>(renderers, mode));
-  };
+  return
+      [renderers = request.renderers, mode = request.mode]() -> Expected<std::unique_ptr<Session>> {
+        return std::unique_ptr<Session>(std::make_unique<InProcessSession>(renderers, mode));
+      };
 }
 
 }  // namespace rvr::study

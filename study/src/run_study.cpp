@@ -56,9 +56,8 @@ Status validate(const StudyRequest& r) {
   if (r.sessions < 3)
     return bad_input(fmt::format("--processes: must be >= 3, got {}", r.sessions));
   if (!(r.noise_threshold >= 0 && r.noise_threshold < 1))
-    return bad_input(
-        fmt::format("--noise-threshold: must be in 0 .. 1 (a ratio minus 1), got {}",
-                    r.noise_threshold));
+    return bad_input(fmt::format("--noise-threshold: must be in 0 .. 1 (a ratio minus 1), got {}",
+                                 r.noise_threshold));
   if (r.shard && (r.shard->count < 1 || r.shard->index >= r.shard->count))
     return bad_input(fmt::format("--shard: must be I/N with 0 <= I < N, got {}/{}", r.shard->index,
                                  r.shard->count));
@@ -103,8 +102,8 @@ struct FamilyState {
 struct OpenSession {
   std::unique_ptr<Session> session;
   std::unique_ptr<FrameSource> reference;
-  int index = 0;              // into StudyResult::sessions
-  bool other_work = false;    // its system probe saw other work on the CPUs
+  int index = 0;            // into StudyResult::sessions
+  bool other_work = false;  // its system probe saw other work on the CPUs
 };
 
 // The state of one running study.
@@ -271,9 +270,8 @@ void Sweep::time_rounds(const std::string& what, FrameSource& frames, FrameSourc
 // family's points (created at the point's first run). A run cut short is dropped.
 Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession& session,
                           PointSet& into) {
-  const std::string what =
-      fmt::format("{} {} {}×{} session {}", family.name, point_name(family, n), width,
-                  width * 3 / 4, session.index + 1);
+  const std::string what = fmt::format("{} {} {}×{} session {}", family.name, point_name(family, n),
+                                       width, width * 3 / 4, session.index + 1);
   progress(what + ": preparing");
   Expected<std::unique_ptr<FrameSource>> frames = session.session->prepare(family, n, width);
   if (!frames) return frames.error();
@@ -476,9 +474,10 @@ Status Sweep::measure_busy_runs_again(const Family& family, double share_end) {
         return s;
       if (result_.points[first].runs.size() == before) break;  // cut short
       if (result_.points[first].runs.back().busy) continue;    // busy again: both kept
+      const int replaced_session = busy_session;
       for (size_t i = 0; i < request_.renderers.size(); ++i)
         std::erase_if(result_.points[first + i].runs,
-                      [&](const Run& r) { return r.session == busy_session && r.busy; });
+                      [&](const Run& r) { return r.session == replaced_session && r.busy; });
       ++replaced;
     }
   }

@@ -156,10 +156,10 @@ ChartPoint chart_point(const Measurement& m, double x, const std::string& what) 
   const auto [lo, hi] = std::minmax_element(seconds.begin(), seconds.end());
   p.low = lo == seconds.end() ? p.typical : *lo;
   p.high = hi == seconds.end() ? p.typical : *hi;
-  p.tooltip = fmt::format("{}, {}: {} ms (fastest {}, slowest {}; {} repetitions in {} runs)",
-                          m.renderer, what, format_number(1e3 * p.typical),
-                          format_number(1e3 * p.low), format_number(1e3 * p.high),
-                          seconds.size(), m.runs.size());
+  p.tooltip =
+      fmt::format("{}, {}: {} ms (fastest {}, slowest {}; {} repetitions in {} runs)", m.renderer,
+                  what, format_number(1e3 * p.typical), format_number(1e3 * p.low),
+                  format_number(1e3 * p.high), seconds.size(), m.runs.size());
   return p;
 }
 
@@ -380,9 +380,10 @@ std::string conclusions_html(const StudyResult& r, const std::string& scene) {
                            c.verdict, html_with_powers(check_sentence(c)));
   for (const Comparison& c : r.comparisons)
     if (c.scene == scene && !c.inconclusive.empty())
-      items += fmt::format("<li class=\"inconclusive\">{} and {} along {}: nothing concluded: {}</li>\n",
-                           escape_html(c.a), escape_html(c.b), escape_html(c.axis),
-                           html_with_powers(c.inconclusive));
+      items +=
+          fmt::format("<li class=\"inconclusive\">{} and {} along {}: nothing concluded: {}</li>\n",
+                      escape_html(c.a), escape_html(c.b), escape_html(c.axis),
+                      html_with_powers(c.inconclusive));
   if (items.empty()) return "";
   return "<h3>Conclusions</h3>\n<ul class=\"conclusions\">\n" + items + "</ul>\n";
 }
@@ -424,7 +425,8 @@ std::string header_html(const StudyResult& r) {
          html_with_powers(r.no_conclusion) + ".</div>\n";
   const std::vector<std::string> headline = headline_sentences(r);
   if (!headline.empty()) {
-    o += "<h2>Where the pixel-major loop overtakes the triangle-major one</h2>\n<ul class=\"headline\">";
+    o += "<h2>Where the pixel-major loop overtakes the triangle-major one</h2>\n<ul "
+         "class=\"headline\">";
     for (const std::string& h : headline) o += "<li>" + html_with_powers(h) + "</li>";
     o += "</ul>\n";
   }

@@ -91,7 +91,9 @@ json comparisons_json(const StudyResult& r) {
                         {"trend", number(p.trend)},
                         {"ci95", interval(p.ci95)},
                         {"p", number(p.p)},
-                        {"faster", p.faster < 0 ? json(c.a) : p.faster > 0 ? json(c.b) : json(nullptr)}});
+                        {"faster", p.faster < 0   ? json(c.a)
+                                   : p.faster > 0 ? json(c.b)
+                                                  : json(nullptr)}});
     out.push_back({{"a", c.a},
                    {"b", c.b},
                    {"scene", c.scene},

@@ -130,19 +130,43 @@ class Fields {
   std::string path_;
 };
 
-const std::vector<std::string> kTopKeys = {
-    "format",        "command",         "scenes",          "renderer_order",
-    "width",         "height",          "mode",            "budget_seconds",
-    "elapsed_seconds", "repetitions",   "sessions_per_point", "noise_threshold",
-    "seed",          "run_id",          "merged_runs",     "bootstrap_replicates",
-    "machine",       "system_before",   "system_after",    "sessions",
-    "renderers",     "comparisons",     "crossovers",      "no_conclusion",
-    "dominance",     "scaling",         "costs",           "checks",
-    "notes",         "interrupted",     "shard",           "points",
-    "check_points",  "splits"};
+const std::vector<std::string> kTopKeys = {"format",
+                                           "command",
+                                           "scenes",
+                                           "renderer_order",
+                                           "width",
+                                           "height",
+                                           "mode",
+                                           "budget_seconds",
+                                           "elapsed_seconds",
+                                           "repetitions",
+                                           "sessions_per_point",
+                                           "noise_threshold",
+                                           "seed",
+                                           "run_id",
+                                           "merged_runs",
+                                           "bootstrap_replicates",
+                                           "machine",
+                                           "system_before",
+                                           "system_after",
+                                           "sessions",
+                                           "renderers",
+                                           "comparisons",
+                                           "crossovers",
+                                           "no_conclusion",
+                                           "dominance",
+                                           "scaling",
+                                           "costs",
+                                           "checks",
+                                           "notes",
+                                           "interrupted",
+                                           "shard",
+                                           "points",
+                                           "check_points",
+                                           "splits"};
 const std::vector<std::string> kPointKeys = {
-    "renderer", "scene",  "scene_n", "n",      "width",        "height", "pixels",
-    "counters", "runs",   "seconds", "median", "relative_mad", "busy"};
+    "renderer", "scene", "scene_n", "n",      "width",        "height", "pixels",
+    "counters", "runs",  "seconds", "median", "relative_mad", "busy"};
 const std::vector<std::string> kRunKeys = {"session", "prepare_seconds", "seconds", "order",
                                            "phases",  "reference_ratio", "busy"};
 const std::vector<std::string> kSystemKeys = {"at",         "known", "cpus", "load",
@@ -205,7 +229,8 @@ SystemSnapshot read_system(const json& v, const std::string& path) {
   if (load.size() != 3) fail(f.path("load"), "must hold 3 load averages, got " + describe(load));
   double* loads[] = {&s.load1, &s.load5, &s.load15};
   for (size_t k = 0; k < 3; ++k)
-    *loads[k] = load[k].is_null() ? 0.0 : Fields::number_at(load[k], index_path(f.path("load"), k), 0);
+    *loads[k] =
+        load[k].is_null() ? 0.0 : Fields::number_at(load[k], index_path(f.path("load"), k), 0);
   s.other_busy = f.number_or_nan("other_busy");
   s.steal = f.number_or_nan("steal");
   if (!f.at("mhz").is_null()) s.mhz = f.number("mhz", 0);
@@ -232,7 +257,8 @@ std::vector<std::string> strings_of(const Fields& top, const char* key) {
   const json& list = top.array(key);
   std::vector<std::string> out;
   for (size_t i = 0; i < list.size(); ++i) {
-    if (!list[i].is_string()) fail(index_path(key, i), "must be a string, got " + describe(list[i]));
+    if (!list[i].is_string())
+      fail(index_path(key, i), "must be a string, got " + describe(list[i]));
     out.push_back(list[i].get<std::string>());
   }
   return out;
@@ -317,7 +343,8 @@ Run read_run(const json& v, const std::string& path, const StudyResult& r) {
     fail(f.path("order"), fmt::format("must have one entry per round ({}), got {}",
                                       run.seconds.size(), order.size()));
   for (size_t k = 0; k < order.size(); ++k)
-    run.order.push_back(int(Fields::whole_at(order[k], index_path(f.path("order"), k), 0, 1u << 20)));
+    run.order.push_back(
+        int(Fields::whole_at(order[k], index_path(f.path("order"), k), 0, 1u << 20)));
   for (const auto& item : f.object("phases").items()) {
     const std::string where = f.path("phases") + "." + item.key();
     run.phases[item.key()] = seconds_of(item.value(), where);
