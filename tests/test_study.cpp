@@ -721,6 +721,40 @@ TEST(StudyHtml, MarksTheCrossoverWithItsInterval) {
                    plot_right);
 }
 
+// The grey band of the range not measured never covers a measured point, in any chart: the
+// main one, the pixel sweeps' and a study whose points were measured at the range's edges only.
+TEST(StudyHtml, TheUnmeasuredBandNeverCoversAPoint) {
+  StudyResult r = html_study();
+  const size_t count = r.points.size();
+  for (size_t i = 0; i < count; ++i)
+    if (r.points[i].scene == "synthetic" && r.points[i].n < 1e5) {
+      Measurement m = r.points[i];
+      m.pixels = kP / 4;
+      r.points.push_back(m);
+    }
+  auto numbers_after = [](const std::string& svg, size_t from, const std::string& name) {
+    const size_t at = svg.find(" " + name + "=\"", from);
+    return at == std::string::npos ? std::nan("") : std::stod(svg.substr(at + name.size() + 3));
+  };
+  size_t marks = 0;
+  for (const std::string& chart : charts_of(study_html(r))) {
+    std::vector<std::pair<double, double>> bands;
+    for (size_t at = chart.find("<rect class=\"unmeasured\""); at != std::string::npos;
+         at = chart.find("<rect class=\"unmeasured\"", at + 1)) {
+      const double x = numbers_after(chart, at, "x");
+      bands.push_back({x, x + numbers_after(chart, at, "width")});
+    }
+    for (size_t at = chart.find("<circle class=\"mark\""); at != std::string::npos;
+         at = chart.find("<circle class=\"mark\"", at + 1)) {
+      const double cx = numbers_after(chart, at, "cx");
+      ++marks;
+      for (const auto& [lo, hi] : bands)
+        EXPECT_FALSE(cx > lo && cx < hi) << "a point at x " << cx << " under [" << lo << ", " << hi << "]";
+    }
+  }
+  EXPECT_GT(marks, 0u);
+}
+
 TEST(StudyHtml, EscapesEveryStringFromTheData) {
   std::string html = study_html(html_study());
   EXPECT_EQ(html.find("<script"), std::string::npos) << "markup from the data got through";

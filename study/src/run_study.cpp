@@ -198,12 +198,12 @@ Expected<OpenSession> Sweep::open_session(const Family& family) {
         int(std::clamp(std::ceil(kReferenceSeconds / one->seconds), 1.0, 1000.0));
   }
   std::vector<double> times;
-  for (int k = 0; k < 5; ++k) {
+  for (int k = 0; k < 5 && !stopped(); ++k) {
     Expected<double> t = time_reference(*open.reference);
     if (!t) return t.error();
     times.push_back(*t);
   }
-  f_->quickest_reference = std::min(f_->quickest_reference, median(times));
+  if (!times.empty()) f_->quickest_reference = std::min(f_->quickest_reference, median(times));
   return open;
 }
 
@@ -272,6 +272,7 @@ Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession
                           PointSet& into) {
   const std::string what = fmt::format("{} {} {}×{} session {}", family.name, point_name(family, n),
                                        width, width * 3 / 4, session.index + 1);
+  if (stopped()) return ok_status();
   progress(what + ": preparing");
   Expected<std::unique_ptr<FrameSource>> frames = session.session->prepare(family, n, width);
   if (!frames) return frames.error();
