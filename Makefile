@@ -4,14 +4,17 @@ JOBS ?= $(shell nproc)
 # DEMO_PACKAGES: what building the rvr command and running it need (the libraries it links or
 # opens, the GL loader generator, OSMesa and EGL). TEST_PACKAGES: what only the tests, the
 # benchmarks, `make sanitize` and `make fuzz` need (GoogleTest, Google Benchmark, idiff, the
-# browser tests' Chromium, the schema and chart checks' Python modules, clang for libFuzzer)
+# browser tests' Chromium, the schema and chart checks' Python modules, clang for libFuzzer,
+# Slurm and MUNGE for the test that runs a sharded study as a job array on a one-node cluster,
+# shellcheck for the Slurm scripts)
 # and the Python module with its tests (pybind11, pytest, OpenImageIO's Python reader).
 DEMO_PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
 	libpng-dev libopenexr-dev libembree-dev libtbb-dev nlohmann-json3-dev libcli11-dev \
 	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0
 TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools python3-matplotlib \
 	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev clang-tidy-14 iwyu \
-	pybind11-dev python3-pybind11 python3-dev python3-pytest python3-openimageio
+	pybind11-dev python3-pybind11 python3-dev python3-pytest python3-openimageio slurm-wlm munge \
+	shellcheck
 PACKAGES := $(DEMO_PACKAGES) $(TEST_PACKAGES)
 
 .PHONY: all deps deps-demo build demo test check sanitize fuzz bench study clean format lint
