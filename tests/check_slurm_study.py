@@ -302,13 +302,14 @@ def sweep_after(pid, root):
 
 
 def points_by_key(study, where):
-    """{(renderer, scene, scene_n, n, width, height): sorted repetitions} of a study.json."""
+    """{(renderer, scene, scene_n, n, width, height): sorted frame times of every run} of a
+    study.json."""
     points = {}
     for p in study["points"]:
         key = (p["renderer"], p["scene"], p["scene_n"], p["n"], p["width"], p["height"])
         if key in points:
             raise Failure(f"{where}: point {key} appears twice")
-        points[key] = sorted(p["seconds"])
+        points[key] = sorted(t for run in p["runs"] for t in run["seconds"])
     return points
 
 

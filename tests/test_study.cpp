@@ -460,6 +460,20 @@ struct SimulatedStudy {
   SimulatedStudy(const SimulatedStudy&) = delete;  // the hooks point at this one
 };
 
+// Every point holds one run per session at most, every renderer's runs of it in the same
+// sessions.
+void expect_one_run_per_session(const StudyResult& r) {
+  std::map<std::tuple<std::string, double, int>, std::set<int>> sessions_of;  // scene, N, width
+  for (const Measurement& m : r.points) {
+    std::set<int> sessions;
+    for (const study::Run& run : m.runs)
+      EXPECT_TRUE(sessions.insert(run.session).second)
+          << m.renderer << " N=" << m.n << ": session " << run.session << " twice";
+    auto [it, fresh] = sessions_of.try_emplace({m.scene, m.scene_n, m.width}, sessions);
+    if (!fresh) EXPECT_EQ(it->second, sessions) << m.renderer << " N=" << m.n;
+  }
+}
+
 bool noted(const StudyResult& r, const std::string& words) {
   for (const std::string& note : r.notes)
     if (note.find(words) != std::string::npos) return true;
@@ -509,6 +523,7 @@ TEST(StudyRun, RunsMeasuredWhileTheMachineWasBusyAreMeasuredAgain) {
   study.machine.busy_to = 14;
   Expected<StudyResult> r = run_study(study.request, study.hooks);
   ASSERT_TRUE(r.ok()) << r.error().message;
+  expect_one_run_per_session(*r);
   bool still_busy = false;
   for (const Measurement& m : r->points)
     for (const study::Run& run : m.runs) still_busy |= run.busy;
@@ -533,6 +548,7 @@ TEST(StudyRun, ABusyMachineStillGetsAnAnswer) {
   Expected<StudyResult> q = run_study(quiet.request, quiet.hooks);
   Expected<StudyResult> b = run_study(busy.request, busy.hooks);
   ASSERT_TRUE(q.ok() && b.ok());
+  expect_one_run_per_session(*b);
   for (const Measurement& m : b->points) EXPECT_TRUE(m.busy());
   EXPECT_TRUE(b->no_conclusion.empty()) << b->no_conclusion;
   auto along_n = [](const StudyResult& r) -> const Crossover* {
@@ -749,7 +765,8 @@ TEST(StudyHtml, TheUnmeasuredBandNeverCoversAPoint) {
       const double cx = numbers_after(chart, at, "cx");
       ++marks;
       for (const auto& [lo, hi] : bands)
-        EXPECT_FALSE(cx > lo && cx < hi) << "a point at x " << cx << " under [" << lo << ", " << hi << "]";
+        EXPECT_FALSE(cx > lo && cx < hi)
+            << "a point at x " << cx << " under [" << lo << ", " << hi << "]";
     }
   }
   EXPECT_GT(marks, 0u);

@@ -172,8 +172,7 @@ constexpr double kMarkRadius = 3.5;
 // Grey over the parts of the x axis outside the swept range, short of the outermost marks
 // (shifted sideways by their dodge) so that no measured point lies under it.
 std::string unmeasured_svg(const Frame& f, const ChartSpec& spec) {
-  const double clearance =
-      kDodge * std::max(0.0, double(spec.series.size()) - 1) / 2 + kMarkRadius;
+  const double clearance = kDodge * std::max(0.0, double(spec.series.size()) - 1) / 2 + kMarkRadius;
   std::string o;
   auto shade = [&](double x0, double x1) {
     if (x1 - x0 < 1) return;

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/check.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/crossover.h"
@@ -287,6 +288,9 @@ Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession
   if (runs[0].seconds.size() < size_t(request_.repetitions)) return ok_status();  // cut short
   std::vector<Measurement>& list = *into.list;
   auto [it, fresh] = into.index.try_emplace({n, width}, list.size());
+  for (const Run& held : list[it->second].runs)
+    RVR_DCHECK(held.session != session.index, "one run per session and point: session ",
+               session.index, " measured ", family.name, ":", n, " twice");
   for (size_t i = 0; i < runs.size(); ++i) {
     runs[i].busy = runs[i].reference_ratio > kBusyRatio || session.other_work;
     if (fresh) {
@@ -458,16 +462,22 @@ Status Sweep::refine_near_crossovers(const Family& family, double share_end) {
 // The family's runs measured while the machine was busy, measured again in a fresh session
 // while the share lasts: a quiet run replaces the busy one. Notes say how many and what is left.
 Status Sweep::measure_busy_runs_again(const Family& family, double share_end) {
-  std::vector<std::pair<PointKey, int>> busy;  // point, session of the busy run
-  for (const auto& [point, index] : f_->points.index)
-    for (const Run& run : result_.points[index].runs)
-      if (run.busy) busy.push_back({point, run.session});
+  // Each round a fresh session measures every point that still has a busy run once; a quiet
+  // run replaces one busy run. Rounds go on while they replace something and the share lasts.
   size_t replaced = 0;
-  if (!busy.empty() && !stopped() &&
-      elapsed() + f_->cost.predict(busy[0].first.first) < share_end) {
+  for (size_t in_round = 1; in_round > 0;) {
+    in_round = 0;
+    std::vector<PointKey> busy;
+    for (const auto& [point, index] : f_->points.index)
+      for (const Run& run : result_.points[index].runs)
+        if (run.busy) {
+          busy.push_back(point);
+          break;
+        }
+    if (busy.empty() || stopped() || elapsed() + f_->cost.predict(busy[0].first) > share_end) break;
     Expected<OpenSession> session = open_session(family);
     if (!session) return session.error();
-    for (auto [point, busy_session] : busy) {
+    for (PointKey point : busy) {
       if (stopped() || elapsed() + f_->cost.predict(point.first) > share_end) break;
       const size_t first = f_->points.index.at(point);
       const size_t before = result_.points[first].runs.size();
@@ -475,12 +485,19 @@ Status Sweep::measure_busy_runs_again(const Family& family, double share_end) {
         return s;
       if (result_.points[first].runs.size() == before) break;  // cut short
       if (result_.points[first].runs.back().busy) continue;    // busy again: both kept
-      const int replaced_session = busy_session;
+      // The first busy run goes, for every renderer (their runs of a session go together).
+      int busy_session = -1;
+      for (const Run& run : result_.points[first].runs)
+        if (run.busy) {
+          busy_session = run.session;
+          break;
+        }
       for (size_t i = 0; i < request_.renderers.size(); ++i)
         std::erase_if(result_.points[first + i].runs,
-                      [&](const Run& r) { return r.session == replaced_session && r.busy; });
-      ++replaced;
+                      [&](const Run& r) { return r.session == busy_session; });
+      ++in_round;
     }
+    replaced += in_round;
   }
   if (replaced > 0)
     result_.notes.push_back(fmt::format(
