@@ -634,7 +634,14 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   sweep.exclude(sweep.elapsed() - before_fits);
   if (!result.interrupted && checks && !sweep.stopped() && !result.crossovers.empty()) {
     if (Status s = sweep.measure_checks(families); !s) return s.error();
+    // Checks cut short are evaluated from the points they measured.
     evaluate_checks(result, CompareOptions{boot, request.noise_threshold});
+    if (sweep.cancelled()) {
+      result.interrupted = true;
+      result.notes.push_back(
+          "the study was interrupted during its prediction checks: only the checks measured "
+          "before the interruption are given");
+    }
   }
   result.elapsed_seconds = sweep.elapsed();
   result.system_after = sweep.probe();
