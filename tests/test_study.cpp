@@ -339,6 +339,24 @@ TEST(StudyChecks, HoldWhereTheConclusionIsTrue) {
   EXPECT_FALSE(r.crossovers[0].contradicted);
 }
 
+// Over 100 seeded studies whose checks measure the truth, a check fails in at most 5% of them:
+// a check that fails is evidence, not noise.
+TEST(StudyChecks, RarelyFailWhereTheConclusionIsTrue) {
+  const int studies = 100;
+  int failed = 0, held = 0;
+  for (int s = 0; s < studies; ++s) {
+    StudyResult r = checked_study(kZCurve, kTCurve, 600 + s);
+    bool any = false;
+    for (const PredictionCheck& c : r.checks) {
+      any = any || c.verdict == "fails";
+      held += c.verdict == "holds";
+    }
+    failed += any;
+  }
+  EXPECT_LE(failed, studies * 5 / 100) << failed << " of " << studies << " studies had a check fail";
+  EXPECT_GE(held, studies) << "checks hold at under half the points they measured";
+}
+
 // A planted wrong conclusion: at the check points the other renderer is faster (the renderer's
 // cost off the grid is not what the sweep saw). The check fails and the crossover is demoted in
 // study.md.
