@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "counted_work_text.h"
 #include "html_text.h"
 #include "loglog_chart.h"
 #include "rvr/shared/html_escape.h"
@@ -464,6 +465,7 @@ std::string study_html(const StudyResult& r) {
       escape_html(scenes), kCss);
   o += header_html(r);
   for (size_t i = 0; i < r.scenes.size(); ++i) o += scene_section(r, i, colours);
+  o += counted_work_html(r);
   o += machine_html(r);
   return o + "</main></body></html>\n";
 }

@@ -164,6 +164,8 @@ const std::vector<std::string> kTopKeys = {"format",
                                            "points",
                                            "check_points",
                                            "splits"};
+// The counted work's conclusions (counted_work.h), computed again like the others.
+const std::vector<std::string> kCountedWorkKeys = {"work_models", "count_scaling", "count_claims"};
 const std::vector<std::string> kPointKeys = {
     "renderer", "scene", "scene_n", "n",      "width",        "height", "pixels",
     "counters", "runs",  "seconds", "median", "relative_mad", "busy"};
@@ -317,6 +319,9 @@ void check_conclusions(const Fields& top) {
   for (const char* key : {"comparisons", "crossovers", "dominance", "scaling", "costs", "checks",
                           "splits", "check_points"})
     top.array(key);
+  // Studies written before the counted-work models have none of these.
+  for (const std::string& key : kCountedWorkKeys)
+    if (top.has(key.c_str())) top.array(key.c_str());
   if (!top.at("no_conclusion").is_null()) top.string("no_conclusion");
 }
 
@@ -388,7 +393,9 @@ Measurement read_point(const json& v, const std::string& path, const StudyResult
 }
 
 StudyResult read_study(const json& doc) {
-  Fields top(doc, "", kTopKeys);
+  std::vector<std::string> top_keys = kTopKeys;
+  top_keys.insert(top_keys.end(), kCountedWorkKeys.begin(), kCountedWorkKeys.end());
+  Fields top(doc, "", top_keys);
   StudyResult r;
   read_request(top, r);
   check_conclusions(top);

@@ -8,6 +8,7 @@
 #include <map>
 #include <vector>
 
+#include "counted_work_text.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
 
@@ -276,6 +277,7 @@ std::string study_markdown(const StudyResult& r) {
                   checks);
   text += section("The hybrids' split", "", split_sentences(r));
   text += section("Cost models", "", models);
+  text += counted_work_markdown(r);
   text += section("Scaling (log-log slope per decade)", "", scaling_sentences(r));
   text += section("Cost per triangle and per ray", "", cost_sentences(r));
   text += section("Notes", "", notes);

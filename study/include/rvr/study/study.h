@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "rvr/study/counted_work.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
@@ -112,6 +113,11 @@ struct StudyResult {
   std::vector<ScalingExponent> scaling;
   std::vector<UnitCost> costs;
   std::vector<PhaseSplit> splits;  // the hybrids', at the smallest and largest N at full width
+  // Per renderer and family: the cost model from counted work, each count's scaling with N and
+  // the pixel count, and the chapter's claims checked on counts (counted_work.h).
+  std::vector<WorkModel> work_models;
+  std::vector<CountScaling> count_scaling;
+  std::vector<CountClaim> count_claims;
   std::vector<PredictionCheck> checks;
   std::vector<Measurement> check_points;  // what the checks measured (not in the fits)
   std::vector<std::string> notes;         // what the budget cut short, and the like
