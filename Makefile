@@ -10,7 +10,7 @@ JOBS ?= $(shell nproc)
 # and the Python module with its tests (pybind11, pytest, OpenImageIO's Python reader).
 DEMO_PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
 	libpng-dev libopenexr-dev libembree-dev libtbb-dev nlohmann-json3-dev libcli11-dev \
-	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0
+	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0 libboost-dev
 TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools python3-matplotlib \
 	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev clang-tidy-14 iwyu \
 	pybind11-dev python3-pybind11 python3-dev python3-pytest python3-openimageio slurm-wlm munge \

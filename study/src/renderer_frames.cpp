@@ -115,7 +115,12 @@ class InProcessSession : public Session {
 }  // namespace
 
 bool is_work_counter(const std::string& stat) {
-  return stat.rfind("time.", 0) != 0 && stat.rfind("memory.", 0) != 0;
+  // Times and memory, at the top or under a prefix ("zbuffer.time.raster"), are not work; nor
+  // are ratios of counts (fills, overdraw), which the counts themselves give.
+  for (const char* part : {"time.", "memory.", "fill", "overdraw"})
+    if (stat.rfind(part, 0) == 0 || stat.find(std::string(".") + part) != std::string::npos)
+      return false;
+  return true;
 }
 
 Expected<std::unique_ptr<FrameSource>> prepare_frames(const std::vector<std::string>& renderers,
