@@ -40,7 +40,8 @@ int export_scene(const ScenesArgs& a) {
                           (reads_as_path && std::filesystem::exists(a.export_name, ec)));
   if (!builtin_prefix && !is_file && reads_as_path)
     fail(bad_input(a.export_name + ": no such file"));
-  if (is_file) refuse_overwriting_inputs({a.export_name}, {a.out});
+  refuse_overwriting_inputs(
+      is_file ? std::vector<std::string>{a.export_name} : std::vector<std::string>{}, {a.out});
   Scene scene = is_file ? take(load_scene(a.export_name)) : take(make_builtin_scene(name));
   if (is_file) name = std::filesystem::path(a.export_name).stem().string();
   std::filesystem::path out(a.out);
