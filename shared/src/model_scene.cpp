@@ -13,7 +13,6 @@
 #include <exception>
 #include <filesystem>
 #include <glm/glm.hpp>
-#include <initializer_list>
 #include <new>
 #include <optional>
 #include <set>
@@ -184,10 +183,12 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
       overrides.judge_file_camera) {
     // A file camera that shows a part of the model, a close-up, a speck or nothing at all (an
     // exporter's camera left where it was) is replaced by the framing camera, with a warning.
-    float aspect = model.camera_aspect > 0.0f
-                       ? model.camera_aspect
-                       : float(overrides.width.value_or(scene.image.width)) /
-                             float(overrides.height.value_or(scene.image.height));
+    // Judged in the frame the image will have: a height given makes its shape, else the
+    // camera's aspect ratio does (below).
+    const float width = float(overrides.width.value_or(scene.image.width));
+    const float aspect = overrides.height             ? width / float(*overrides.height)
+                         : model.camera_aspect > 0.0f ? model.camera_aspect
+                                                      : width / float(scene.image.height);
     if (const std::string problem = camera_problem(view_of_model(scene, *model.camera, aspect));
         !problem.empty()) {
       model.warnings.push_back("the file's camera " + problem +
