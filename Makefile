@@ -3,7 +3,8 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 # DEMO_PACKAGES: what building the rvr command and running it need (the libraries it links or
 # opens, the GL loader generator, OSMesa and EGL). TEST_PACKAGES: what only the tests, the
-# benchmarks, `make sanitize` and `make fuzz` need (GoogleTest, Google Benchmark, idiff, the
+# benchmarks, `make sanitize` and `make fuzz` need (GoogleTest, Google Benchmark, idiff,
+# Assimp's test models (tests/test_assimp_testmodels.cpp), the
 # browser tests' Chromium, the schema and chart checks' Python modules, clang for libFuzzer,
 # Slurm and MUNGE for the test that runs a sharded study as a job array on a one-node cluster,
 # shellcheck for the Slurm scripts)
@@ -11,7 +12,7 @@ JOBS ?= $(shell nproc)
 DEMO_PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
 	libpng-dev libopenexr-dev libembree-dev libtbb-dev nlohmann-json3-dev libcli11-dev \
 	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0 libboost-dev
-TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools python3-matplotlib \
+TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools assimp-testmodels python3-matplotlib \
 	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev clang-tidy-14 iwyu \
 	pybind11-dev python3-pybind11 python3-dev python3-pytest python3-openimageio slurm-wlm munge \
 	shellcheck

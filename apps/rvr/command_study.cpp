@@ -22,6 +22,7 @@
 
 #include "cli_exit.h"
 #include "commands.h"
+#include "one_of.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
@@ -151,7 +152,7 @@ void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
       ->delimiter(',');
   cmd->add_option("--width", a.width, "image width, height 3/4 of it (default 1024)");
   cmd->add_option("--mode", a.mode, "visibility | local | full (default local)")
-      ->check(CLI::IsMember({"visibility", "local", "full"}));
+      ->check(one_of({"visibility", "local", "full"}));
   cmd->add_option("--budget", a.budget, "seconds the sweep may take (default 300)");
   cmd->add_option("--repetitions", a.repetitions,
                   "rounds timed per run: frames per renderer in each process (>= 3, default 5)");

@@ -121,6 +121,11 @@ Status write_atomically(const std::string& path, F&& write_temp) {
   fs::path target(path), temp;
   try {
     if (path.empty()) return write_error(path, "empty file name");
+    // A folder (or a name ending in a separator, which can only be one) is never a file to
+    // write: said before any folder is created.
+    std::error_code is_folder;
+    if (!target.has_filename() || fs::is_directory(target, is_folder))
+      return write_error(path, "is a directory");
     std::string reason;
     if (!make_parent(target, reason)) return write_error(path, reason);
     temp = temp_path_for(target);
