@@ -13,16 +13,22 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <system_error>
 #include <vector>
 
 #include "base64.h"
+#include "render_stats.h"
 #include "report.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/mismatch_classes.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
+#include "rvr/shared/scene_loader.h"
 
 namespace fs = std::filesystem;
 using namespace rvr;
@@ -200,6 +206,77 @@ TEST(MetricsJson, HasEveryRequiredField) {
   EXPECT_EQ(doc["renderers"]["raytrace"]["cost"]["image"], "raytrace.cost.png");
   EXPECT_EQ(doc["renderers"]["raytrace"]["cost"]["mean"], 12.5);
   EXPECT_EQ(doc["renderers"]["raytrace"]["cost"]["scale"], 31.0);
+}
+
+// Counts are whole numbers and written as JSON integers ("peak_memory_bytes": 159305728, not
+// 159305728.0); seconds and the declared ratios stay numbers, even when whole (a block fill of
+// exactly 1), in --stats and in metrics.json alike.
+TEST(StatsJson, CountsAreIntegersSecondsAndRatiosNumbers) {
+  const std::map<std::string, double> stats = {
+      {"rays.primary", 307200.0},
+      {"bvh.nodes_visited", 8178646.0},
+      {"memory.raster_bytes", 4.5e9},
+      {"zbuffer.fragments.generated", 12.0},
+      {"time.render", 0.5},
+      {"zbuffer.time.setup", 1.0},
+      {"overdraw", 1.0},
+      {"zbuffer.overdraw", 2.0},
+      {"bvh.block_fill", 1.0},
+      {"bvh.node_fill", 0.25},
+      {"bvh.sah_cost", 3.0},
+      {"rays.shadow", std::numeric_limits<double>::infinity()}};
+  const std::set<std::string> counts = {"rays.primary", "bvh.nodes_visited", "memory.raster_bytes",
+                                        "zbuffer.fragments.generated"};
+  RenderOutput out;
+  out.stats = stats;
+  Scene scene;
+  scene.image.width = 4;
+  scene.image.height = 3;
+  const nlohmann::json doc = nlohmann::json::parse(
+      render_stats_json("raytrace", scene, RenderMode::Full, {0.1, 0.2, 0.3}, out));
+  ReportInput in = sample_input("out");
+  in.renderers[0].stats = stats;
+  const nlohmann::json metrics = nlohmann::json::parse(metrics_json(in));
+  for (const nlohmann::json* written : {&doc["stats"], &metrics["renderers"]["raster"]["stats"]}) {
+    for (const auto& [name, value] : stats) {
+      const nlohmann::json& v = (*written)[name];
+      if (!std::isfinite(value)) {
+        EXPECT_TRUE(v.is_null()) << name;
+      } else if (counts.count(name)) {
+        EXPECT_TRUE(v.is_number_integer()) << name << ": " << v.dump();
+        EXPECT_EQ(v.get<double>(), value) << name;
+      } else {
+        EXPECT_TRUE(v.is_number_float()) << name << ": " << v.dump();
+        EXPECT_EQ(v.get<double>(), value) << name;
+      }
+    }
+  }
+  EXPECT_TRUE(doc["peak_memory_bytes"].is_number_integer()) << doc["peak_memory_bytes"].dump();
+  EXPECT_GT(doc["peak_memory_bytes"].get<double>(), 0.0);
+  EXPECT_TRUE(doc["scene_mesh_bytes"].is_number_integer()) << doc["scene_mesh_bytes"].dump();
+  EXPECT_TRUE(doc["width"].is_number_integer());
+}
+
+// Every stat every renderer reports in every mode is what stat_kind says: a count a whole
+// number, so a new ratio stat cannot go out as a truncated integer (it must be declared).
+TEST(StatsJson, EveryRendererCountsInWholeNumbers) {
+  Scene scene = make_builtin_scene("cornell").value();
+  scene.image.width = 32;
+  scene.image.height = 24;
+  for (const RendererInfo& info : renderers())
+    for (RenderMode mode : {RenderMode::Visibility, RenderMode::Local, RenderMode::Full}) {
+      RenderOptions options;
+      options.mode = mode;
+      std::unique_ptr<Renderer> r = make_renderer(info.name).value();
+      Expected<RenderOutput> out = r->render(scene, options);
+      ASSERT_TRUE(out.ok()) << info.name << ": " << out.error().message;
+      for (const auto& [name, value] : out->stats) {
+        if (stat_kind(name) == StatKind::Count && std::isfinite(value)) {
+          EXPECT_EQ(value, std::floor(value))
+              << info.name << " " << to_string(mode) << ": " << name << " is not a count";
+        }
+      }
+    }
 }
 
 TEST(MetricsJson, InfiniteAndNanValuesStayValidJson) {

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "render_stats.h"
 #include "report.h"
 #include "report_text.h"
 #include "rvr/shared/compare.h"
@@ -124,7 +125,7 @@ std::string metrics_json(const ReportInput& input) {
       std::string key = r.name;
       for (int k = 2; renderers.contains(key); ++k) key = r.name + "-" + std::to_string(k);
       ordered_json stats = ordered_json::object();
-      for (const auto& [name, value] : r.stats) stats[name] = number(value);
+      for (const auto& [name, value] : r.stats) stats[name] = stat_json<ordered_json>(name, value);
       renderers[key] = {{"seconds", number(r.seconds)},
                         {"warnings", r.warnings},
                         {"stats", stats},

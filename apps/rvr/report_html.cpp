@@ -27,6 +27,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/shared/html_escape.h"
 #include "rvr/shared/mismatch_classes.h"
+#include "rvr/shared/renderer.h"
 #include "timing_chart.h"
 
 namespace rvr {
@@ -496,7 +497,8 @@ std::string all_statistics(const ReportInput& input) {
       h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">" << escape_html(v)
         << "</td></tr>\n";
     for (const auto& [k, v] : r.stats)
-      h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">" << fmt("%.6g", v)
+      h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">"
+        << (stat_kind(k) == StatKind::Count && v == std::floor(v) ? fmt("%.0f", v) : fmt("%.6g", v))
         << "</td></tr>\n";
     h << "</tbody></table></details>\n";
   }
