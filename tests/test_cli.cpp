@@ -280,6 +280,16 @@ TEST_F(Cli, CompareWritesEverythingAndThresholdGivesExit1) {
   named.insert("metrics.json");
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_TRUE(named.count(e.path().filename().string())) << e.path() << " is not in files";
+  // The summary's "wrote DIR/{...}" names every file written, the cost pictures included.
+  const std::string wrote = "  wrote " + out.string() + "/{";
+  const size_t from = r.out.find(wrote), to = r.out.find("}\n", from);
+  ASSERT_TRUE(from != std::string::npos && to != std::string::npos) << r.out;
+  std::set<std::string> listed;
+  std::stringstream list(r.out.substr(from + wrote.size(), to - from - wrote.size()));
+  for (std::string file; std::getline(list, file, ',');) listed.insert(file);
+  std::set<std::string> written;
+  for (const auto& e : fs::directory_iterator(out)) written.insert(e.path().filename().string());
+  EXPECT_EQ(listed, written) << r.out;
   EXPECT_TRUE(m["warnings"].is_array() && m["warnings"].empty()) << m["warnings"];
 
   // The measured agreement, and every mismatch an edge tie.

@@ -134,8 +134,12 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   for (const ReportRenderer& r : report.renderers)
     std::printf("  %-12s %9.3f s  depth %s\n", r.name.c_str(), r.seconds, r.depth_format.c_str());
   for (const ReportPair& p : report.pairs) print_pair(p, keys[p.a], keys[p.b]);
+  // Every file written, in the order written.
   std::printf("  wrote %s/{", a.out_dir.c_str());
-  for (const ReportRenderer& r : report.renderers) std::printf("%s,", r.image_file.c_str());
+  for (const ReportRenderer& r : report.renderers) {
+    std::printf("%s,", r.image_file.c_str());
+    if (!r.cost_file.empty()) std::printf("%s,", r.cost_file.c_str());
+  }
   for (const ReportPair& p : report.pairs)
     std::printf("%s,%s,%s,%s,", p.file("diff").c_str(), p.file("depth_diff").c_str(),
                 p.file("id_mismatch").c_str(), p.file("mismatch_classes").c_str());
