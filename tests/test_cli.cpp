@@ -621,10 +621,20 @@ TEST_F(Cli, ChapterTriangleTestRunsOnBvh2AndRendersTheSameImage) {
 // The default compare (no scene, no renderers) goes through. How long it takes is a speed
 // target, not a test: the process is bounded only by the suite's time limit, so a slow machine
 // does not fail it.
+// The demo's depth outliers are what the README calls expected: on outlines, and on the two
+// analytic spheres (the z-buffer draws a polygon inside each); none elsewhere, so the report
+// shows none in red.
 TEST_F(Cli, DefaultCompareWritesTheReport) {
   RunResult r = run("compare -o " + (dir_ / "rvr-out").string());
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "rvr-out" / "report.html"));
+  const nlohmann::json m = nlohmann::json::parse(slurp(dir_ / "rvr-out" / "metrics.json"));
+  const nlohmann::json& depth = m["depth"];
+  EXPECT_EQ(depth["outliers_elsewhere"], 0) << depth.dump();
+  EXPECT_GT(depth["outliers_on_analytic_spheres"].get<int>(), 0) << depth.dump();
+  const std::string html = slurp(dir_ / "rvr-out" / "report.html");
+  EXPECT_NE(html.find("<code>outliers_elsewhere</code></td><td class=\"num\">0<"),
+            std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -83,12 +83,14 @@ ReportInput sample_input(const std::string& out_dir) {
   in.metrics.depth.mean_rel_error = 0.00001;
   in.metrics.depth.p99_rel_error = 0.00007;
   in.metrics.depth.p999_rel_error = 0.0002;
-  in.metrics.depth.outliers = 3;
+  in.metrics.depth.outliers = 7;
   in.metrics.depth.outliers_at_silhouettes = 2;
+  in.metrics.depth.outliers_on_analytic_spheres = 4;
   in.metrics.depth.outliers_elsewhere = 1;
   in.metrics.depth.worst_outliers = {
       {5, 4, 7, 0.0035, 2.5f, 2.51f, DepthOutlierCause::Elsewhere},
-      {1, 2, 3, 0.0012, 6.0f, 6.0075f, DepthOutlierCause::Silhouette}};
+      {1, 2, 3, 0.0012, 6.0f, 6.0075f, DepthOutlierCause::Silhouette},
+      {3, 3, 6, 0.0011, 4.0f, 4.0044f, DepthOutlierCause::AnalyticSphere}};
   in.metrics.color = {0.004, 47.9, 0.21, 0.998};
   in.heat_map_scale = 0.1f;
   return in;
@@ -180,11 +182,13 @@ TEST(MetricsJson, HasEveryRequiredField) {
   EXPECT_DOUBLE_EQ(number("depth", "p99_rel_error"), 0.00007);
   EXPECT_DOUBLE_EQ(number("depth", "p999_rel_error"), 0.0002);
   EXPECT_DOUBLE_EQ(number("depth", "outlier_threshold"), 1e-3);
-  EXPECT_EQ(number("depth", "outliers"), 3.0);
+  EXPECT_EQ(number("depth", "outliers"), 7.0);
   EXPECT_EQ(number("depth", "outliers_at_silhouettes"), 2.0);
+  EXPECT_EQ(number("depth", "outliers_on_analytic_spheres"), 4.0);
   EXPECT_EQ(number("depth", "outliers_elsewhere"), 1.0);
   const auto& listed = doc["depth"]["outlier_pixels"];
-  ASSERT_EQ(listed.size(), 2u);
+  ASSERT_EQ(listed.size(), 3u);
+  EXPECT_EQ(listed[2]["cause"], "analytic_sphere");
   EXPECT_EQ(listed[0]["x"], 5);
   EXPECT_EQ(listed[0]["y"], 4);
   EXPECT_EQ(listed[0]["object"], 7);
@@ -367,7 +371,8 @@ TEST_F(ReportDir, HtmlIsSelfContained) {
 }
 
 // The depth outliers: ringed on depth_diff.png at their pixel centres (orange at a
-// silhouette, red elsewhere) in the image's own coordinates, and listed in a table.
+// silhouette, blue on an analytic sphere, red elsewhere) in the image's own coordinates, and
+// listed in a table where only the real disagreements are marked bad.
 TEST_F(ReportDir, DepthOutliersAreRingedAndListed) {
   auto html = report_html(sample_input(dir_.string()));
   ASSERT_TRUE(html.ok()) << html.error().message;
@@ -379,15 +384,70 @@ TEST_F(ReportDir, DepthOutliersAreRingedAndListed) {
   EXPECT_NE(marks.find("<circle cx=\"1.5\" cy=\"2.5\""), std::string::npos) << marks;
   EXPECT_EQ(count_of(marks, "stroke=\"#ff1744\""), 1u);  // the one elsewhere
   EXPECT_EQ(count_of(marks, "stroke=\"#ff9f1c\""), 1u);  // the silhouette one
-  EXPECT_NE(h.find("3 pixels differ in depth by more than 1e-3 (relative): 2 on an object's "
-                   "outline, 1 elsewhere"),
+  EXPECT_EQ(count_of(marks, "stroke=\"#4dabf7\""), 1u);  // the analytic sphere's
+  EXPECT_NE(h.find("7 pixels differ in depth by more than 1e-3 (relative): 2 on an object's "
+                   "outline, 4 on analytic spheres, 1 elsewhere"),
             std::string::npos);
   EXPECT_NE(h.find("<tr><td class=\"num\">5</td><td class=\"num\">4</td><td class=\"num\">7"
                    "</td><td class=\"num\">2.5</td><td class=\"num\">2.51</td><td class=\"num "
-                   "bad\">0.0035</td><td>elsewhere</td></tr>"),
+                   "bad\">0.0035</td><td><span class=\"sw\" style=\"background:#ff1744\">"
+                   "</span>elsewhere</td></tr>"),
+            std::string::npos);
+  EXPECT_NE(h.find("<td class=\"num\">0.0011</td><td><span class=\"sw\" "
+                   "style=\"background:#4dabf7\"></span>analytic_sphere</td>"),
             std::string::npos);
   for (const char* word : {"p99_rel_error", "p999_rel_error", "outliers_elsewhere"})
     EXPECT_NE(h.find(word), std::string::npos) << word;
+}
+
+// Outliers on analytic spheres are expected (the z-buffer's polygon): their count is never
+// flagged, while any outlier elsewhere is, as a real disagreement.
+TEST_F(ReportDir, OnlyOutliersElsewhereAreFlagged) {
+  ReportInput in = sample_input(dir_.string());
+  auto row = [](const std::string& html, const std::string& metric) {
+    const size_t at = html.find("<code>" + metric + "</code>");
+    return at == std::string::npos ? std::string() : html.substr(at, html.find("</tr>", at) - at);
+  };
+  in.metrics.depth.outliers_elsewhere = 0;
+  auto expected = report_html(in);
+  ASSERT_TRUE(expected.ok()) << expected.error().message;
+  EXPECT_NE(row(*expected, "outliers_on_analytic_spheres").find("class=\"num\">4<"),
+            std::string::npos)
+      << row(*expected, "outliers_on_analytic_spheres");
+  EXPECT_NE(row(*expected, "outliers_elsewhere").find("class=\"num\">0<"), std::string::npos);
+  in.metrics.depth.outliers_elsewhere = 1;
+  auto real = report_html(in);
+  ASSERT_TRUE(real.ok());
+  EXPECT_NE(row(*real, "outliers_elsewhere").find("class=\"num bad\">1<"), std::string::npos)
+      << row(*real, "outliers_elsewhere");
+  EXPECT_EQ(row(*real, "outliers_on_analytic_spheres").find("bad"), std::string::npos);
+}
+
+// A long listing of outliers shows its first 10 rows; the rest are folded away in a
+// <details>, still in the page.
+TEST_F(ReportDir, LongOutlierListingIsFoldedAfterTenRows) {
+  ReportInput in = sample_input(dir_.string());
+  in.metrics.depth.worst_outliers.clear();
+  for (int k = 0; k < 100; ++k)
+    in.metrics.depth.worst_outliers.push_back(
+        {k % 8, k / 8 % 6, 6, 0.01 - 1e-5 * k, 4.0f, 4.04f, DepthOutlierCause::Silhouette});
+  in.metrics.depth.outliers = 295;
+  auto html = report_html(in);
+  ASSERT_TRUE(html.ok()) << html.error().message;
+  const std::string& h = html.value();
+  const size_t table = h.find("<h2>Depth outliers</h2>");
+  const size_t fold =
+      h.find("<details class=\"more-outliers\"><summary>The other 90 listed", table);
+  ASSERT_NE(table, std::string::npos);
+  ASSERT_NE(fold, std::string::npos) << "no fold after the first rows";
+  const size_t end = h.find("</details>", fold);
+  EXPECT_EQ(count_of(h.substr(table, fold - table), ">silhouette</td></tr>"), 10u);
+  EXPECT_EQ(count_of(h.substr(fold, end - fold), ">silhouette</td></tr>"), 90u);
+  // Ten or fewer: no fold.
+  in.metrics.depth.worst_outliers.resize(10);
+  auto short_listing = report_html(in);
+  ASSERT_TRUE(short_listing.ok());
+  EXPECT_EQ(short_listing->find("<details class=\"more-outliers\""), std::string::npos);
 }
 
 TEST_F(ReportDir, EmbeddedImageDecodesToTheFile) {

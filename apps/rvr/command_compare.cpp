@@ -39,9 +39,11 @@ void print_pair(const ReportPair& p, const std::string& name_a, const std::strin
               m.depth.max_rel_error, m.depth.mean_rel_error, m.depth.p99_rel_error,
               m.depth.p999_rel_error);
   if (m.depth.outliers)
-    std::printf("  depth outliers    %zu above %g: %zu at silhouettes, %zu elsewhere\n",
-                m.depth.outliers, kDepthOutlierThreshold, m.depth.outliers_at_silhouettes,
-                m.depth.outliers_elsewhere);
+    std::printf(
+        "  depth outliers    %zu above %g: %zu at silhouettes, %zu on analytic spheres, %zu "
+        "elsewhere\n",
+        m.depth.outliers, kDepthOutlierThreshold, m.depth.outliers_at_silhouettes,
+        m.depth.outliers_on_analytic_spheres, m.depth.outliers_elsewhere);
   std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
               m.color.psnr_db, m.color.max_abs, m.color.ssim);
   if (m.lod.pixels > 0)

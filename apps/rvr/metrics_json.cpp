@@ -80,6 +80,7 @@ ordered_json pair_metrics(const ComparisonMetrics& m) {
                   {"outlier_threshold", kDepthOutlierThreshold},
                   {"outliers", d.outliers},
                   {"outliers_at_silhouettes", d.outliers_at_silhouettes},
+                  {"outliers_on_analytic_spheres", d.outliers_on_analytic_spheres},
                   {"outliers_elsewhere", d.outliers_elsewhere},
                   {"outlier_pixels", outliers}};
   const auto& c = m.color;
