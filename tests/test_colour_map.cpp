@@ -7,15 +7,17 @@
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/typedesc.h>
 #include <gtest/gtest.h>
-#include <stdint.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstring>
+#include <glm/glm.hpp>
+#include <initializer_list>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
+#include "rvr/shared/check.h"
 #include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/srgb.h"

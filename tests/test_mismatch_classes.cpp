@@ -5,7 +5,6 @@
 // pixels, so a point (X, Y, -Z) projects to pixel position (8 (X/Z + 1), 8 (1 - Y/Z)): a square
 // of half-size Z/2 at depth Z covers pixels 4..11 in x and y, its outline on pixel boundaries.
 #include <gtest/gtest.h>
-#include <stddef.h>
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,6 @@
 #include <OpenImageIO/oiioversion.h>
 #include <OpenImageIO/typedesc.h>
 
-#include <algorithm>
 #include <cstring>
 #include <exception>
 #include <memory>

@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 #include <initializer_list>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string>
