@@ -1,7 +1,7 @@
 // rvr's inferno colour map (shared/src/image_io.cpp: the cost pictures, the heat maps of
-// compare) against OpenImageIO's ImageBufAlgo::color_map(..., "inferno"), which drew them
-// before: the same values must give the same colours, bit for bit. This test links OpenImageIO
-// itself as the oracle; rvr computes the map without loading it.
+// compare) against OpenImageIO's ImageBufAlgo::color_map(..., "inferno"): the same values must
+// give the same colours, bit for bit. This test links OpenImageIO itself as the oracle; rvr
+// computes the map without loading it.
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>

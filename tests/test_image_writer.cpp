@@ -147,8 +147,8 @@ TEST_F(ImageWriter, ExrIsWhatOpenImageIOWrites) {
 }
 
 // The colour-mapped pictures (the cost AOV's OUT.cost.png, compare's heat maps) are drawn
-// without OpenImageIO: loading its ~260 shared libraries for one colour map made writing the
-// AOVs of a frame cost more than rendering it. test_colour_map holds the map to the library's.
+// without OpenImageIO, so that writing a frame's AOVs does not load its ~260 shared libraries
+// for one colour map. test_colour_map holds the map to the library's.
 TEST_F(ImageWriter, ColourMapsDoNotLoadOpenImageIO) {
   ASSERT_FALSE(library_loaded("libOpenImageIO")) << "loaded before the test: nothing to check";
   FrameBuffers a, b;

@@ -123,7 +123,7 @@ int write_exr(const char* path, int w, int h, int channels, const char* const* n
               const float* pixels, char* err, size_t err_size) {
   try {
     // OpenEXR compresses blocks of scan lines on its global thread pool, which has no threads
-    // unless asked for; OpenImageIO, which wrote these files before, gives it one per core.
+    // unless asked for: one per core, as OpenImageIO gives it.
     static const bool threaded = [] {
       Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
       return true;

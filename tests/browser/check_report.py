@@ -5,9 +5,8 @@ Runs `rvr compare` at a small size, loads the report through the Chrome DevTools
 fails on: console errors, uncaught exceptions, error log entries, failed loads, any request
 other than the report file itself or a data: URI, an image that did not decode, fewer images
 than the report must have, a missing timing chart, anything cut off (a box whose content is
-wider than the box: its scroll width above its client width, as the mismatch-class legend and
-the timing table once were), or a depth-outlier table showing more than 10 rows before it is
-unfolded. Saves a full-page screenshot.
+wider than the box: its scroll width above its client width), or a depth-outlier table showing
+more than 10 rows before it is unfolded. Saves a full-page screenshot.
 
 With --self-check it instead loads a deliberately broken page (an undecodable data URI image, a
 JS exception, a console error, a request to the network, a card whose text runs past its edge)
