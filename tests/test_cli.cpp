@@ -280,6 +280,16 @@ TEST_F(Cli, CompareWritesEverythingAndThresholdGivesExit1) {
   named.insert("metrics.json");
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_TRUE(named.count(e.path().filename().string())) << e.path() << " is not in files";
+  // The summary's "wrote DIR/{...}" names every file written, the cost pictures included.
+  const std::string wrote = "  wrote " + out.string() + "/{";
+  const size_t from = r.out.find(wrote), to = r.out.find("}\n", from);
+  ASSERT_TRUE(from != std::string::npos && to != std::string::npos) << r.out;
+  std::set<std::string> listed;
+  std::stringstream list(r.out.substr(from + wrote.size(), to - from - wrote.size()));
+  for (std::string file; std::getline(list, file, ',');) listed.insert(file);
+  std::set<std::string> written;
+  for (const auto& e : fs::directory_iterator(out)) written.insert(e.path().filename().string());
+  EXPECT_EQ(listed, written) << r.out;
   EXPECT_TRUE(m["warnings"].is_array() && m["warnings"].empty()) << m["warnings"];
 
   // The measured agreement, and every mismatch an edge tie.
@@ -611,10 +621,20 @@ TEST_F(Cli, ChapterTriangleTestRunsOnBvh2AndRendersTheSameImage) {
 // The default compare (no scene, no renderers) goes through. How long it takes is a speed
 // target, not a test: the process is bounded only by the suite's time limit, so a slow machine
 // does not fail it.
+// The demo's depth outliers are what the README calls expected: on outlines, and on the two
+// analytic spheres (the z-buffer draws a polygon inside each); none elsewhere, so the report
+// shows none in red.
 TEST_F(Cli, DefaultCompareWritesTheReport) {
   RunResult r = run("compare -o " + (dir_ / "rvr-out").string());
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "rvr-out" / "report.html"));
+  const nlohmann::json m = nlohmann::json::parse(slurp(dir_ / "rvr-out" / "metrics.json"));
+  const nlohmann::json& depth = m["depth"];
+  EXPECT_EQ(depth["outliers_elsewhere"], 0) << depth.dump();
+  EXPECT_GT(depth["outliers_on_analytic_spheres"].get<int>(), 0) << depth.dump();
+  const std::string html = slurp(dir_ / "rvr-out" / "report.html");
+  EXPECT_NE(html.find("<code>outliers_elsewhere</code></td><td class=\"num\">0<"),
+            std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------------
