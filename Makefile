@@ -3,15 +3,19 @@ BUILD_DIR ?= build
 JOBS ?= $(shell nproc)
 # DEMO_PACKAGES: what building the rvr command and running it need (the libraries it links or
 # opens, the GL loader generator, OSMesa and EGL). TEST_PACKAGES: what only the tests, the
-# benchmarks, `make sanitize` and `make fuzz` need (GoogleTest, Google Benchmark, idiff, the
-# browser tests' Chromium, the schema and chart checks' Python modules, clang for libFuzzer)
+# benchmarks, `make sanitize` and `make fuzz` need (GoogleTest, Google Benchmark, idiff,
+# Assimp's test models (tests/test_assimp_testmodels.cpp), the
+# browser tests' Chromium, the schema and chart checks' Python modules, clang for libFuzzer,
+# Slurm and MUNGE for the test that runs a sharded study as a job array on a one-node cluster,
+# shellcheck for the Slurm scripts)
 # and the Python module with its tests (pybind11, pytest, OpenImageIO's Python reader).
 DEMO_PACKAGES := cmake g++ make pkg-config libosmesa6-dev libglm-dev libopenimageio-dev \
 	libpng-dev libopenexr-dev libembree-dev libtbb-dev nlohmann-json3-dev libcli11-dev \
-	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0
-TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools python3-matplotlib \
+	libfmt-dev libassimp-dev python3-glad libegl-dev libegl-mesa0 libboost-dev
+TEST_PACKAGES := libgtest-dev libbenchmark-dev openimageio-tools assimp-testmodels python3-matplotlib \
 	python3-jsonschema python3-websocket chromium clang-14 libclang-rt-14-dev clang-tidy-14 iwyu \
-	pybind11-dev python3-pybind11 python3-dev python3-pytest python3-openimageio
+	pybind11-dev python3-pybind11 python3-dev python3-pytest python3-openimageio slurm-wlm munge \
+	shellcheck
 PACKAGES := $(DEMO_PACKAGES) $(TEST_PACKAGES)
 
 .PHONY: all deps deps-demo build demo test check sanitize fuzz bench study clean format lint
@@ -119,7 +123,7 @@ fuzz: deps
 # and interleaving spreads the drift over every benchmark alike.
 # BM_Visibility: the frame chart's z-buffers, tracers and hybrids, without the brute-force and
 # binary-BVH tracers, and without 10^7 triangles for llvmpipe and the hybrids (seconds a frame).
-BENCH_FILTER ?= BM_Frame/(raster|softraster|raytrace|raytrace_bvh2|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_Frame/(hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_Visibility/(softraster|raytrace|embree)/(tessphere|soup)/[0-9]+/1024|BM_Visibility/(raster|hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_DepthComplexity|BM_Effects|BM_Trace|BM_Build|BM_Threads
+BENCH_FILTER ?= BM_Frame/(raster|softraster|raytrace|raytrace_bvh2|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_Frame/(hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_Visibility/(softraster|raytrace|embree)/(tessphere|soup)/[0-9]+/1024|BM_Visibility/(raster|hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_DepthComplexity|BM_Effects|BM_Trace|BM_Build|BM_Threads|BM_WriteAovs
 bench: build
 	mkdir -p bench/results bench/charts
 	$(BUILD_DIR)/bin/rvr_bench --benchmark_filter='$(BENCH_FILTER)' --benchmark_min_time=0.2 \

@@ -335,7 +335,7 @@ def threads(rows, context, out):
 
 
 def targets(rows, context, out):
-    """The performance targets (issues 4, 11, 12 and 23) as ratios of figures from this one run."""
+    """The performance targets (issues 4, 11, 12, 23 and 34) as ratios of figures from this one run."""
     by_name = {b["name"].replace("/real_time", ""): b for b in rows}
 
     def value(name, key=None):
@@ -388,6 +388,10 @@ def targets(rows, context, out):
     for name, want in [("raytrace", 1.9), ("softraster", 1.9)]:
         r = ratio(value(f"BM_Threads/{name}/1"), value(f"BM_Threads/{name}/2"))
         checks.append((f"BM_Threads/{name}: speed-up with 2 threads", r, f">= {want}", r and r >= want))
+    # Issue 34: writing a frame's AOVs costs no more than rendering it.
+    r = value("BM_WriteAovs/depth,id,normal,cost", "write/render")
+    checks.append(("BM_WriteAovs depth,id,normal,cost: writing the AOVs / rendering the frame (cornell 640x480)",
+                   r, "<= 1", r is not None and r <= 1))
     lines = ["| target | measured | wanted | met |", "|---|---|---|---|"]
     for what, v, want, ok in checks:
         shown = "not run" if v is None else f"{v:.3g}"

@@ -12,6 +12,9 @@
 //     counter texel_bytes/pixel: texel bytes one frame's trilinear filter reads per pixel,
 //     counted from its lod AOV (8 texels of 12 bytes where two levels blend, 4 where one does)
 //   BM_Threads/<renderer>/<threads>            tessphere:100000 at 1024x768 on 1 or 2 threads
+//   BM_WriteAovs/<aovs>                        writing what `rvr render --aov` writes for
+//     cornell at 640x480 (the image, then the AOVs); counters render_ms (the frame itself) and
+//     write/render
 // Scenes and acceleration structures are built outside the timed loops (FrameRenderer).
 // Counters of every frame benchmark: rays/s, triangles/s, pixels/s; from the renderer's phase
 // stats, each the mean over the timed frames in ms and only when the renderer reports it:
@@ -24,13 +27,16 @@
 // rvr/renderers/registry.h.
 #include <benchmark/benchmark.h>
 #include <tbb/global_control.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <glm/glm.hpp>
 #include <initializer_list>
 #include <map>
@@ -54,6 +60,7 @@
 #include "rvr/shared/camera.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
+#include "rvr/shared/image_io.h"
 #include "rvr/shared/isa.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
@@ -295,6 +302,53 @@ void BM_Effects(benchmark::State& state, const std::string& effect) {
     benchmark::DoNotOptimize(out.buffers.color.data());
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
+}
+
+// What `rvr render builtin:cornell -r raytrace --aov depth,id,normal,cost` writes after its
+// frame (640x480, full mode): OUT.png, then each AOV named in `aovs` ("" for the image alone),
+// into a scratch folder. The frame is rendered before the timed loop; render_ms is the median
+// of three such frames, write/render the time of one write over it: writing must not cost more
+// than rendering. In a fresh process the first write also loads the image writer module (the
+// whole runs of bench/JOURNAL.md show that part).
+void BM_WriteAovs(benchmark::State& state, const std::vector<std::string>& aovs) {
+  Scene scene = builtin("cornell");
+  scene.image.width = 640;
+  scene.image.height = 480;
+  RenderOptions options;
+  options.mode = RenderMode::Full;
+  RayTracer tracer;
+  std::vector<double> render_seconds;
+  RenderOutput out;
+  for (int k = 0; k < 3; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    out = tracer.render(scene, options).value();
+    render_seconds.push_back(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  std::sort(render_seconds.begin(), render_seconds.end());
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("rvr_bench_aovs_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string image = (dir / "cornell.png").string();
+  const Image colour = color_image(out.buffers);
+  double seconds = 0.0;
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    if (!write_image(image, colour).ok() ||
+        (!aovs.empty() && !write_aovs(image, out.buffers, aovs).ok())) {
+      state.SkipWithError("cannot write the AOVs");
+      break;
+    }
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  double bytes = 0.0;
+  for (const auto& entry : fs::directory_iterator(dir)) bytes += double(entry.file_size());
+  fs::remove_all(dir);
+  const double render = render_seconds[1];
+  state.counters["render_ms"] = 1e3 * render;
+  if (state.iterations() > 0)
+    state.counters["write/render"] = seconds / double(state.iterations()) / render;
+  state.counters["MB"] = bytes / 1e6;
 }
 
 // The same frames with another renderer of the table (the hybrid: the z-buffer finds the
@@ -647,6 +701,16 @@ void register_all() {
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
   }
+  for (const auto& [name, aovs] : std::vector<std::pair<std::string, std::vector<std::string>>>{
+           {"image", {}},
+           {"depth", {"depth"}},
+           {"id", {"id"}},
+           {"normal", {"normal"}},
+           {"cost", {"cost"}},
+           {"depth,id,normal,cost", {"depth", "id", "normal", "cost"}}})
+    benchmark::RegisterBenchmark(("BM_WriteAovs/" + name).c_str(), BM_WriteAovs, aovs)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   for (std::string a : {"bvh", "bvh2", "embree"})
     for (std::string rays : {"primary", "random"}) {
       benchmark::RegisterBenchmark(bench_name({"BM_Trace", a, rays, "tessphere"}).c_str(), BM_Trace,

@@ -67,8 +67,8 @@ Expected<study::StudyResult> run_interruptibly(const study::StudyRequest& reques
 }
 
 py::object run(const std::vector<std::string>& scenes, const std::vector<std::string>& renderers,
-               int width, const std::string& mode, double budget, int repetitions, uint64_t seed,
-               bool check_predictions) {
+               int width, const std::string& mode, double budget, int repetitions, int sessions,
+               double noise_threshold, uint64_t seed, bool check_predictions) {
   study::StudyRequest request;
   request.scenes = scenes;
   request.renderers = study_renderers(renderers);
@@ -76,6 +76,8 @@ py::object run(const std::vector<std::string>& scenes, const std::vector<std::st
   request.mode = render_settings(mode, 0, py::kwargs()).options.mode;
   request.budget_seconds = budget;
   request.repetitions = repetitions;
+  request.sessions = sessions;
+  request.noise_threshold = noise_threshold;
   request.seed = seed;
   request.check_predictions = check_predictions;
   study::StudyResult result = take(run_interruptibly(request));
@@ -91,11 +93,14 @@ void bind_study(py::module_& m) {
         py::arg("scenes") = std::vector<std::string>{"builtin:tessphere", "builtin:soup"},
         py::kw_only(), py::arg("renderers") = std::vector<std::string>{}, py::arg("width") = 1024,
         py::arg("mode") = "local", py::arg("budget") = 300.0, py::arg("repetitions") = 5,
-        py::arg("seed") = uint64_t(1), py::arg("check_predictions") = true,
+        py::arg("sessions") = 3, py::arg("noise_threshold") = 0.03, py::arg("seed") = uint64_t(1),
+        py::arg("check_predictions") = true,
         "Runs `rvr study` (docs/cli.md): the scene families swept within BUDGET seconds, one "
         "renderer per loop order plus RENDERERS, cost models fitted, crossovers found. Returns "
         "the study.json document as a dict; its 'points' is a list of records for "
-        "pandas.DataFrame. Ctrl-C stops the sweep and raises KeyboardInterrupt.");
+        "pandas.DataFrame. Each point is measured in SESSIONS fresh preparations of its scene "
+        "in this process (the command line starts a process for each). Ctrl-C stops the sweep "
+        "and raises KeyboardInterrupt.");
 }
 
 }  // namespace rvr::python

@@ -95,6 +95,8 @@ def study(
     mode: str = "local",
     budget: float = 300.0,
     repetitions: int = 5,
+    sessions: int = 3,
+    noise_threshold: float = 0.03,
     seed: int = 1,
     check_predictions: bool = True,
 ) -> dict[str, Any]: ...

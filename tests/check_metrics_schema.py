@@ -13,7 +13,11 @@
    plausible mean; the untextured cornell compare has none.
 5. Documents the schema must refuse, each a copy of the real one with one thing wrong: the
    dropped mismatched_off_edge count back in `visibility`, a mismatch class missing, no pairs,
-   an unknown depth format, a negative count, a lod block without its p99.
+   an unknown depth format, a negative count, a lod block without its p99, a count stat that is
+   not a whole number.
+6. Every count stat of the real documents is written as a JSON integer (159305728, not
+   159305728.0; JSON Schema cannot tell the two apart): a stat is a count unless the schema's
+   patternProperties for stats name it (seconds, declared ratios).
 
 Usage: check_metrics_schema.py --rvr build/bin/rvr --source-dir . [--work-dir DIR]
 Exits 1 with one line per failure.
@@ -22,6 +26,7 @@ Exits 1 with one line per failure.
 import argparse
 import copy
 import json
+import re
 import shutil
 import subprocess
 import sys
@@ -117,6 +122,23 @@ def check_nothing_visible(rvr, validator, work):
         failure(f"nothing visible: covered_pixels {doc['visibility']['covered_pixels']}")
 
 
+def count_stats_written_as_integers(schema, text, label):
+    """Stats the schema does not name as seconds or ratios must be JSON integers in `text`."""
+    patterns = [re.compile(p) for p in
+                schema["$defs"]["renderer"]["properties"]["stats"]["patternProperties"]]
+    doc = json.loads(text)  # "1.0" comes back a float, "1" an int
+    counts = 0
+    for name, renderer in doc.get("renderers", {}).items():
+        for key, value in renderer.get("stats", {}).items():
+            if value is None or any(p.search(key) for p in patterns):
+                continue
+            counts += 1
+            if not isinstance(value, int):
+                failure(f"{label}: {name}'s count {key} is written as {value!r}, not an integer")
+    if counts == 0:
+        failure(f"{label}: no count stat to check")
+
+
 def check_refused(validator, doc):
     def off_edge(d):
         d["visibility"]["mismatched_off_edge"] = 0
@@ -133,10 +155,14 @@ def check_refused(validator, doc):
     def negative(d):
         d["visibility"]["mismatch_classes"]["occlusion"] = -1
 
+    def fractional_count(d):
+        d["renderers"]["raytrace"]["stats"]["rays.primary"] = 3072.5
+
     for what, mutate in [("mismatched_off_edge in visibility", off_edge),
                          ("a mismatch class missing in a pair", no_class),
                          ("no pairs", no_pairs), ("depth format d16", depth_format),
-                         ("a negative class count", negative)]:
+                         ("a negative class count", negative),
+                         ("a count stat that is not whole", fractional_count)]:
         bad = copy.deepcopy(doc)
         mutate(bad)
         if not schema_errors(validator, bad):
@@ -160,6 +186,11 @@ def main():
         return 1
     doc = check_three(args.rvr, validator, work)
     textured = check_textured(args.rvr, validator, work, doc)
+    schema = json.loads((source / "docs/rvr-metrics-2.schema.json").read_text())
+    for label, folder in [("three renderers", "three"), ("textured", "textured")]:
+        written = work / folder / "metrics.json"
+        if written.is_file():
+            count_stats_written_as_integers(schema, written.read_text(), label)
     check_nothing_visible(args.rvr, validator, work)
     if doc is not None:
         check_refused(validator, doc)

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Checks `rvr study` as a user runs it, and docs/rvr-study-1.schema.json against its output.
+"""Checks `rvr study` as a user runs it, and docs/rvr-study-2.schema.json against its output.
 
 1. The schema is a valid draft 2020-12 schema.
 2. A small study (builtin:tessphere, --width 128, --budget 20) exits 0, writes study.json that
@@ -9,8 +9,9 @@
    line starting "error: " and creates nothing.
 4. A study stopped by Ctrl-C (SIGINT after 3 s) exits 130 and writes a study.json the schema
    accepts, marked interrupted, with at least one point.
-5. --merge of the study with itself, and with a copy whose SIMD kernels say another machine
-   type, writes studies the schema accepts (one pooled; one per machine type and comparison.md).
+5. --merge of the study with itself is refused (exit 2: a study is merged once); with a copy
+   whose SIMD kernels say another machine type, it writes studies the schema accepts (one per
+   machine type and comparison.md).
 
 Usage: check_study_schema.py --rvr build/bin/rvr --source-dir . [--work-dir DIR]
 Exits 1 with one line per failure.
@@ -74,19 +75,24 @@ def check_merge(rvr, validator, work):
     doc = json.loads((study / "study.json").read_text())
     doc["machine"]["kernels"] = "sse (edited: another machine type)"
     (other / "study.json").write_text(json.dumps(doc))
-    for name, inputs in [("pooled", [study, study]), ("compared", [study, other])]:
-        out = work / name
-        r = run([rvr, "study", "--merge", *map(str, inputs), "-o", str(out)])
-        if r.returncode != 0:
-            failure(f"--merge ({name}): exit {r.returncode}: {r.stderr.strip()}")
-            continue
-        written = sorted(out.glob("**/study.json"))
-        if len(written) != (1 if name == "pooled" else 2):
-            failure(f"--merge ({name}): wrote {[str(p) for p in written]}")
-        for path in written:
-            validate(validator, path)
-        if name == "compared" and not (out / "comparison.md").exists():
-            failure("--merge (compared): no comparison.md")
+    twice = run([rvr, "study", "--merge", str(study), str(study), "-o", str(work / "twice")])
+    if twice.returncode != 2 or "merged once" not in twice.stderr:
+        failure(f"--merge of a study with itself: want exit 2 and 'merged once', got exit "
+                f"{twice.returncode}: {twice.stderr.strip()}")
+    if (work / "twice").exists():
+        failure("--merge of a study with itself wrote its output folder")
+    out = work / "compared"
+    r = run([rvr, "study", "--merge", str(study), str(other), "-o", str(out)])
+    if r.returncode not in (0, 1):
+        failure(f"--merge (compared): exit {r.returncode}: {r.stderr.strip()}")
+        return
+    written = sorted(out.glob("**/study.json"))
+    if len(written) != 2:
+        failure(f"--merge (compared): wrote {[str(p) for p in written]}")
+    for path in written:
+        validate(validator, path)
+    if not (out / "comparison.md").exists():
+        failure("--merge (compared): no comparison.md")
 
 
 def check_study(rvr, validator, work):
@@ -101,13 +107,20 @@ def check_study(rvr, validator, work):
     if seconds > 40:
         failure(f"rvr study --budget 20 took {seconds:.0f} s")
     doc = validate(validator, out / "study.json")
+    if doc["elapsed_seconds"] > 20:
+        failure(f"study.json: {doc['elapsed_seconds']:.1f} s of measuring in a 20 s budget")
+    kinds = {s["kind"] for s in doc["sessions"]}
+    if kinds != {"process"} or len(doc["sessions"]) < 3:
+        failure(f"study.json: sessions {len(doc['sessions'])} of kinds {kinds}: want >= 3 processes")
     for name in ["softraster", "raytrace", "hybrid_soft"]:
         if "tessphere" not in doc["renderers"].get(name, {}).get("fits", {}):
             failure(f"study.json: renderers.{name}.fits.tessphere missing")
     if len(doc["points"]) < 3 * 3:
         failure(f"study.json: only {len(doc['points'])} points")
     md = (out / "study.md").read_text()
-    for section in ["## Crossovers", "## Cost models", "## Scaling"]:
+    for section in ["**Scope.**", "**Method.**",
+                    "## Where the pixel-major loop overtakes the triangle-major one",
+                    "## Cost models", "## Scaling"]:
         if section not in md:
             failure(f"study.md: no '{section}' section")
     print(f"study: {len(doc['points'])} points in {seconds:.1f} s; "
@@ -144,7 +157,7 @@ def main():
     work = Path(args.work_dir or tempfile.mkdtemp(prefix="rvr-study-schema-"))
     shutil.rmtree(work, ignore_errors=True)
     work.mkdir(parents=True)
-    validator, problems = load_validator(source / "docs/rvr-study-1.schema.json")
+    validator, problems = load_validator(source / "docs/rvr-study-2.schema.json")
     for problem in problems:
         failure(problem)
     if validator is None:

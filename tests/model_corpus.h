@@ -430,11 +430,11 @@ inline std::string ascii_stl_cube_with_stated_normals(bool degenerate_facet) {
 }
 
 // ASCII FBX 7.4, Y up, of one triangle (0, 0, 0), (0, 0, 2s), (0, s, 0) (facing -x) and a camera
-// "shot" at
-// (-5s, 0.5s, s) looking along +x (Assimp's FBX camera convention: its node's +x) with near
-// plane 0.1s and far plane 100s, all in file units. `unit_scale_factor`: GlobalSettings'
-// UnitScaleFactor (centimetres per file unit) as written, no such line when empty (FBX's
-// default: 1, centimetres).
+// "shot" at (-5s, 0.5s, s) looking along +x (Assimp's FBX camera convention: its node's +x),
+// 40 degrees across (FieldOfView; without it Assimp reads 1 degree), with near plane 0.1s and
+// far plane 100s, all in file units. `unit_scale_factor`: GlobalSettings' UnitScaleFactor
+// (centimetres per file unit) as written, no such line when empty (FBX's default: 1,
+// centimetres).
 inline std::string fbx_triangle_and_camera(float s, const std::string& unit_scale_factor) {
   std::string unit = unit_scale_factor.empty() ? ""
                                                : "\t\tP: \"UnitScaleFactor\", \"double\", "
@@ -471,6 +471,7 @@ Objects:  {
 	NodeAttribute: 5000, "NodeAttribute::shot", "Camera" {
 		TypeFlags: "Camera"
 		Properties70:  {
+			P: "FieldOfView", "FieldOfView", "", "A",40
 			P: "NearPlane", "double", "Number", "",)FBX" +
          num(0.1f * s) + R"FBX(
 			P: "FarPlane", "double", "Number", "",)FBX" +

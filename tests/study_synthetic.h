@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -19,10 +20,10 @@ using CostFn = std::function<double(double pixels, double n)>;
 
 // Log-normal standard deviations of the noise at each level.
 struct Noise {
-  double frame = 0.03;    // every frame on its own
-  double round = 0.0;     // a round's frames alike, every renderer (a load that comes and goes)
-  double session = 0.0;   // a run, each renderer its own (a process's memory layout)
-  double point = 0.0;     // a renderer at a point, in every run (a size that suits it)
+  double frame = 0.03;   // every frame on its own
+  double round = 0.0;    // a round's frames alike, every renderer (a load that comes and goes)
+  double session = 0.0;  // a run, each renderer its own (a process's memory layout)
+  double point = 0.0;    // a renderer at a point, in every run (a size that suits it)
 };
 
 // One point of each renderer, `runs` runs of `rounds` rounds, sessions 0 .. runs-1.
@@ -49,8 +50,8 @@ inline std::vector<Measurement> synthetic_point(const std::vector<std::string>& 
     for (int k = 0; k < rounds; ++k) {
       const double shared = noise.round * rng.normal();
       for (size_t r = 0; r < renderers.size(); ++r)
-        run[r].seconds.push_back(costs[r](pixels, n) *
-                                 std::exp(point[r] + session[r] + shared + noise.frame * rng.normal()));
+        run[r].seconds.push_back(costs[r](pixels, n) * std::exp(point[r] + session[r] + shared +
+                                                                noise.frame * rng.normal()));
     }
     for (size_t r = 0; r < renderers.size(); ++r) {
       run[r].session = s;
@@ -92,6 +93,34 @@ inline std::pair<std::vector<Measurement>, std::vector<Measurement>> sweep_pair(
     out.first.push_back(p[0]);
     out.second.push_back(p[1]);
   }
+  return out;
+}
+
+// The counts of one frame's work at (pixels, n), by counter name.
+using CountsFn = std::function<std::map<std::string, double>(double pixels, double n)>;
+
+// One renderer's sweep of 13 log-spaced N from 10^2 to 10^6 at each of the pixel counts, whose
+// every point records counts(P, N) as its counters and whose frames cost
+// u0 + Σ unit[k]·count_k seconds ("pixels" in `unit` is P), with `noise`.
+inline std::vector<Measurement> counted_sweep(const std::string& renderer, const CountsFn& counts,
+                                              double u0, const std::map<std::string, double>& unit,
+                                              const std::vector<double>& pixel_counts,
+                                              const Noise& noise, Rng& rng, int runs = 3,
+                                              int rounds = 5) {
+  CostFn cost = [&](double p, double n) {
+    std::map<std::string, double> c = counts(p, n);
+    double t = u0;
+    for (const auto& [name, u] : unit) t += u * (name == "pixels" ? p : c.at(name));
+    return t;
+  };
+  std::vector<Measurement> out;
+  for (double p : pixel_counts)
+    for (size_t n : log_spaced(100, 1000000, 13)) {
+      Measurement m =
+          synthetic_point({renderer}, {cost}, p, double(n), runs, rounds, noise, rng)[0];
+      m.counters = counts(p, double(n));
+      out.push_back(m);
+    }
   return out;
 }
 

@@ -280,6 +280,16 @@ TEST_F(Cli, CompareWritesEverythingAndThresholdGivesExit1) {
   named.insert("metrics.json");
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_TRUE(named.count(e.path().filename().string())) << e.path() << " is not in files";
+  // The summary's "wrote DIR/{...}" names every file written, the cost pictures included.
+  const std::string wrote = "  wrote " + out.string() + "/{";
+  const size_t from = r.out.find(wrote), to = r.out.find("}\n", from);
+  ASSERT_TRUE(from != std::string::npos && to != std::string::npos) << r.out;
+  std::set<std::string> listed;
+  std::stringstream list(r.out.substr(from + wrote.size(), to - from - wrote.size()));
+  for (std::string file; std::getline(list, file, ',');) listed.insert(file);
+  std::set<std::string> written;
+  for (const auto& e : fs::directory_iterator(out)) written.insert(e.path().filename().string());
+  EXPECT_EQ(listed, written) << r.out;
   EXPECT_TRUE(m["warnings"].is_array() && m["warnings"].empty()) << m["warnings"];
 
   // The measured agreement, and every mismatch an edge tie.
@@ -611,10 +621,20 @@ TEST_F(Cli, ChapterTriangleTestRunsOnBvh2AndRendersTheSameImage) {
 // The default compare (no scene, no renderers) goes through. How long it takes is a speed
 // target, not a test: the process is bounded only by the suite's time limit, so a slow machine
 // does not fail it.
+// The demo's depth outliers are what the README calls expected: on outlines, and on the two
+// analytic spheres (the z-buffer draws a polygon inside each); none elsewhere, so the report
+// shows none in red.
 TEST_F(Cli, DefaultCompareWritesTheReport) {
   RunResult r = run("compare -o " + (dir_ / "rvr-out").string());
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir_ / "rvr-out" / "report.html"));
+  const nlohmann::json m = nlohmann::json::parse(slurp(dir_ / "rvr-out" / "metrics.json"));
+  const nlohmann::json& depth = m["depth"];
+  EXPECT_EQ(depth["outliers_elsewhere"], 0) << depth.dump();
+  EXPECT_GT(depth["outliers_on_analytic_spheres"].get<int>(), 0) << depth.dump();
+  const std::string html = slurp(dir_ / "rvr-out" / "report.html");
+  EXPECT_NE(html.find("<code>outliers_elsewhere</code></td><td class=\"num\">0<"),
+            std::string::npos);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1336,6 +1356,16 @@ TEST_F(Cli, UnknownCommandOrOptionSuggestsTheNearest) {
        "'cones'?\n"},
       {"render -r raytrace --texture-lod zzzz",
        "error: --texture-lod: 'zzzz' is not one of cones, differentials, none\n"},
+      {"render -r raytrace --mode ful",
+       "error: --mode: 'ful' is not one of visibility, local, full: did you mean 'full'?\n"},
+      {"render -r raytrace --camera fil",
+       "error: --camera: 'fil' is not one of file, auto, file-always: did you mean 'file'?\n"},
+      {"render -r softrastr",
+       "error: --renderer: 'softrastr' is not one of raster, softraster, raytrace, embree, "
+       "hybrid, hybrid_soft: did you mean 'softraster'?\n"},
+      {"compare -r raster,raytrce",
+       "error: --renderers: 'raytrce' is not one of raster, softraster, raytrace, embree, "
+       "hybrid, hybrid_soft: did you mean 'raytrace'?\n"},
   };
   for (const auto& [args, message] : expected) {
     RunResult r = run(args);
@@ -1344,3 +1374,69 @@ TEST_F(Cli, UnknownCommandOrOptionSuggestsTheNearest) {
   }
   EXPECT_TRUE(outputs({}).empty());
 }
+
+namespace {
+
+// An output file that names a folder, existing or ending in '/', is refused before any work
+// with "is a directory" (not the image library's "could not find a format writer"), and no
+// folder is made for it.
+TEST_F(Cli, OutputFileThatIsAFolderIsRefused) {
+  fs::create_directories(dir_ / "folder");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"render builtin:spheres -r softraster -q -o ", (dir_ / "folder").string()},
+      {"render builtin:spheres -r softraster -q -o ", (dir_ / "made" / "").string()},
+      {"render builtin:spheres -r softraster -q --stats ", (dir_ / "folder").string()},
+      {"scenes --export spheres -o ", (dir_ / "made" / "").string()},
+  };
+  for (const auto& [args, out] : cases) {
+    RunResult r = run(args + out);
+    EXPECT_EQ(r.status, 2) << args << out;
+    EXPECT_EQ(r.err, "error: cannot write '" + out + "': is a directory\n") << args << out;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "made"));
+  EXPECT_TRUE(fs::is_empty(dir_ / "folder"));
+}
+
+// A .gltf whose JSON does not parse says where, as a scene file's JSON errors do: the line and
+// column (counted here from the text written) and, for a file cut short, that the file ends
+// there.
+TEST_F(Cli, GltfWithBrokenJsonSaysWhere) {
+  const std::string json = rvr::test::corpus::gltf_json(rvr::test::corpus::GltfExtras{}, false);
+  ASSERT_EQ(json.find('\n'), std::string::npos);  // one line: the column is the offset + 1
+  const size_t colon = json.find(':');
+  const fs::path cut = write("cut.gltf", json.substr(0, colon + 1));
+  RunResult r = run("render " + cut.string() + " -r softraster -q");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "error: " + cut.string() + ": cannot read '" + cut.string() +
+                       "': JSON syntax at line 1, column " + std::to_string(colon + 2) +
+                       ", where the file ends: unexpected end of input (expected a value)\n");
+  // A comma missing before "nodes": the string after the bracket is reported where it starts.
+  std::string broken = json;
+  const size_t nodes = broken.find("],\"nodes\"");
+  ASSERT_NE(nodes, std::string::npos);
+  broken.erase(nodes + 1, 1);
+  const fs::path bad = write("bad.gltf", "{\n" + broken.substr(1));
+  r = run("render " + bad.string() + " -r softraster -q");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "error: " + bad.string() + ": cannot read '" + bad.string() +
+                       "': JSON syntax at line 2, column " + std::to_string(nodes + 1) +
+                       ": expected ',' or '}', got a string\n");
+  EXPECT_TRUE(outputs({"cut.gltf", "bad.gltf"}).empty());
+}
+
+// A path in an error message is printed whole, however long.
+TEST_F(Cli, LongPathsInErrorsArePrintedWhole) {
+  const fs::path folder = dir_ / std::string(150, 'd') / std::string(150, 'e');
+  fs::create_directories(folder);
+  const std::string mesh = (folder / (std::string(100, 'm') + ".obj")).string();
+  const fs::path scene =
+      write("long.json", R"({"camera": {"eye": [0, 0, 4], "target": [0, 0, 0], "up": [0, 1, 0]},
+    "objects": [{"type": "mesh", "file": ")" +
+                             mesh + R"("}]})");
+  RunResult r = run("render " + scene.string() + " -r softraster -q");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.err, "error: " + scene.string() + ": objects[0].file: cannot read '" + mesh +
+                       "': No such file or directory\n");
+}
+
+}  // namespace

@@ -217,6 +217,39 @@ TEST_F(DiffVsIdiff, PngPairs) {
   every_case(".png", 1.0f / 255.0f);
 }
 
+// The README's `rvr diff` example, with the options it shows (read from README.md), says what
+// its text promises on images like the demo's: PASS when at most 0.1% of the pixels differ by
+// more than 0.01, however many differ by less; FAILURE beyond. With --fail and --failpercent
+// alone the warn threshold stays 1e-6 and such a pair is a WARNING (exit 1).
+TEST_F(DiffVsIdiff, ReadmeExampleSaysWhatItPromises) {
+  const std::string readme = slurp(fs::path(RVR_SOURCE_DIR) / "README.md");
+  const std::string example = "rvr diff rvr-out/raster.png rvr-out/raytrace.png";
+  const size_t at = readme.find(example);
+  ASSERT_NE(at, std::string::npos) << "README.md has no `" << example << "` example";
+  const std::string line = readme.substr(at, readme.find('\n', at) - at);
+  // Its threshold options, without -o.
+  std::string options;
+  static const std::regex option(
+      R"(--(fail|failpercent|hardfail|warn|warnpercent|hardwarn) (\S+))");
+  for (auto it = std::sregex_iterator(line.begin(), line.end(), option);
+       it != std::sregex_iterator(); ++it) {
+    if (!options.empty()) options += ' ';
+    options += it->str();
+  }
+  ASSERT_NE(options.find("--fail 0.01"), std::string::npos) << line;
+  ASSERT_NE(options.find("--failpercent 0.1"), std::string::npos) << line;
+
+  // 3072 pixels: 0.1% is 3.07. Many pixels one 8-bit step apart (about 0.004: under 0.01), as
+  // along the demo's shading, and a few far apart, as along its silhouettes.
+  const rvr::Image base = base_image();
+  const fs::path a = save("a.png", base);
+  const rvr::Image shaded = with_pixels_moved(base, 400, 1.0f / 255.0f, 0);
+  const fs::path few = save("few.png", with_pixels_moved(shaded, 3, 0.3f, 2));
+  const fs::path many = save("many.png", with_pixels_moved(shaded, 4, 0.3f, 2));
+  same_verdict(a, few, options, "PASS", "README example, 3 pixels (0.098%) over 0.01");
+  same_verdict(a, many, options, "FAILURE", "README example, 4 pixels (0.13%) over 0.01");
+}
+
 // Images that cannot be compared: rvr exits 2 with one error line; idiff does not PASS.
 TEST_F(DiffVsIdiff, DifferentSizesAreBadInput) {
   const fs::path a = save("a.exr", base_image()), b = save("b.exr", base_image(kW + 1, kH));

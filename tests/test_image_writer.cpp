@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <glm/glm.hpp>
 #include <initializer_list>
 #include <iterator>
 #include <limits>
@@ -20,7 +21,9 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/shared/compare.h"
 #include "rvr/shared/expected.h"
+#include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
 
 namespace fs = std::filesystem;
@@ -141,6 +144,29 @@ TEST_F(ImageWriter, ExrIsWhatOpenImageIOWrites) {
       dir_, {{"rgb.exr", test_image(37, 23, 3, {"R", "G", "B"}, 5)},
              {"depth.exr", test_image(31, 17, 1, {"Z"}, 6)},
              {"aovs.exr", test_image(13, 11, 5, {"N.x", "N.y", "N.z", "id", "Z"}, 7)}});
+}
+
+// The colour-mapped pictures (the cost AOV's OUT.cost.png, compare's heat maps) are drawn
+// without OpenImageIO, so that writing a frame's AOVs does not load its ~260 shared libraries
+// for one colour map. test_colour_map holds the map to the library's.
+TEST_F(ImageWriter, ColourMapsDoNotLoadOpenImageIO) {
+  ASSERT_FALSE(library_loaded("libOpenImageIO")) << "loaded before the test: nothing to check";
+  FrameBuffers a, b;
+  a.reset(24, 16, glm::vec3(0.25f));
+  b.reset(24, 16, glm::vec3(0.5f));
+  for (size_t i = 0; i < a.pixel_count(); ++i) {
+    a.cost[i] = float(i % 17);
+    a.object_id[i] = b.object_id[i] = 0;
+    a.depth[i] = 2.0f;
+    b.depth[i] = 2.0f + 1e-3f * float(i % 5);
+  }
+  ASSERT_TRUE(write_aovs(path("r.png"), a, {"depth", "id", "normal", "cost"}).ok());
+  EXPECT_TRUE(fs::exists(path("r.cost.png")));
+  const Image heat = diff_heat_map(color_image(a), color_image(b), 0.1f);
+  EXPECT_GT(heat.pixels.at(0), 0.5f);  // a difference of 0.25 is at the top of the map
+  const Image depth = depth_diff_image(a, b, DepthDiffScale{});
+  EXPECT_EQ(depth.width, 24);
+  EXPECT_FALSE(library_loaded("libOpenImageIO"));
 }
 
 // Images the light writer declines go to OpenImageIO and are still written: alpha (which

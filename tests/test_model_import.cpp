@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <glm/glm.hpp>
 #include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
 #include <initializer_list>
 #include <memory>
 #include <optional>
@@ -390,6 +391,140 @@ TEST_F(ModelFiles, CameraAndLightsAutoReplaceTheFilesOwn) {
                kTextTolerance);
 }
 
+// view_of_model against the closed form: the square [0, 2] x [0, 1] in z = 0 seen straight on
+// from (2, 0.5, 1) with a 90-degree field of view and a square frame covers x in [1, 3] and
+// y in [-0.5, 1.5] at z = 0: it sees the half x >= 1 (50 % of the area), which spans x - 2 in
+// [-1, 0] and y - 0.5 in [-0.5, 0.5] of the frame's [-1, 1]: half the frame across. Behind the
+// camera, or beyond far, it sees nothing.
+TEST(ViewOfModel, SeenShareAndSizeOfASquareHalfInView) {
+  rvr::Scene s;
+  rvr::Object o;
+  o.type = rvr::ObjectType::Triangles;
+  o.mesh.positions = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}};
+  o.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  s.objects.push_back(o);
+  rvr::Camera c;
+  c.eye = {2.0f, 0.5f, 1.0f};
+  c.target = {2.0f, 0.5f, 0.0f};
+  c.up = {0.0f, 1.0f, 0.0f};
+  c.fov_y_deg = 90.0f;
+  c.near = 0.1f;
+  c.far = 10.0f;
+  rvr::ViewOfModel v = rvr::view_of_model(s, c, 1.0f);
+  // 4096 points in proportion to area: the share within half a percent of 1/2; the extreme
+  // points seen within a few hundredths of the edges.
+  EXPECT_NEAR(v.seen, 0.5f, 0.005f);
+  EXPECT_NEAR(v.size, 0.5f, 0.03f);
+  // Twice as far: the frame covers x in [0, 4] at z = 0, the whole square, 2 wide of 4 across.
+  c.eye.z = 2.0f;
+  v = rvr::view_of_model(s, c, 1.0f);
+  EXPECT_EQ(v.seen, 1.0f);
+  EXPECT_NEAR(v.size, 0.5f, 0.03f);
+  c.far = 1.5f;  // the square lies beyond far
+  EXPECT_EQ(rvr::view_of_model(s, c, 1.0f).seen, 0.0f);
+  c.far = 10.0f;
+  c.target = {2.0f, 0.5f, 3.0f};  // looking away
+  v = rvr::view_of_model(s, c, 1.0f);
+  EXPECT_EQ(v.seen, 0.0f);
+  EXPECT_EQ(v.size, 0.0f);
+}
+
+// The share of the model's vertices inside the camera's frame, by GLM's projection (an
+// independent computation of what the image shows), for the camera a scene was given.
+// `extent`, when given, receives how large the vertices are in the frame: the larger of the
+// width and the height of the rectangle round their projections, as shares of the frame's.
+double vertices_in_frame(const rvr::Scene& s, double* extent = nullptr) {
+  const rvr::Camera& c = s.camera;
+  const glm::mat4 m =
+      glm::perspective(glm::radians(c.fov_y_deg), float(s.image.width) / float(s.image.height),
+                       c.near, c.far) *
+      glm::lookAt(c.eye, c.target, c.up);
+  size_t in = 0, all = 0;
+  double x0 = 1, x1 = -1, y0 = 1, y1 = -1;
+  for (const rvr::Object& o : s.objects) {
+    for (const glm::vec3& p : o.mesh.positions) {
+      const glm::vec4 q = m * glm::vec4(p, 1.0f);
+      ++all;
+      if (q.w > 0.0f) {
+        x0 = std::min(x0, double(q.x / q.w)), x1 = std::max(x1, double(q.x / q.w));
+        y0 = std::min(y0, double(q.y / q.w)), y1 = std::max(y1, double(q.y / q.w));
+      }
+      in += q.w > 0.0f && std::fabs(q.x) <= q.w && std::fabs(q.y) <= q.w && std::fabs(q.z) <= q.w;
+    }
+  }
+  if (extent) *extent = std::max(x1 - x0, y1 - y0) / 2;
+  return all ? double(in) / double(all) : 0.0;
+}
+
+std::string camera_warning(const rvr::Scene& s) {
+  for (const std::string& w : s.warnings)
+    if (w.find("the file's camera") != std::string::npos) return w;
+  return {};
+}
+
+// A file camera is judged by how much of the model it sees and how large the model is in
+// frame: a close-up of one face, a camera so far that the cube is a speck, and one that cuts
+// the cube in half are replaced by the framing camera (which shows every vertex), each with a
+// warning saying why; the corpus' own camera, which shows the whole cube, is kept, and
+// judge_file_camera = false (--camera file-always) keeps any of them.
+TEST_F(ModelFiles, FileCameraThatDoesNotFrameTheModelIsReplacedSayingWhy) {
+  struct Case {
+    const char* name;
+    std::array<float, 3> at;
+    const char* why;  // empty: kept
+  };
+  const Case cases[] = {
+      {"kept", {0.5f, 0.5f, 4.0f}, ""},
+      // 0.3 in front of the face z = 1, of which the frame holds 0.22 x 0.33: a close-up (the
+      // view volume takes in more of the faces behind, hidden or not).
+      {"closeup", {0.5f, 0.5f, 1.3f}, "the file's camera sees "},
+      // From 90 away (far is 100) the unit cube spans about 1 / (2 * 89 * tan(20 deg)) = 1.5 % of
+      // the frame's height.
+      {"speck", {0.5f, 0.5f, 90.0f}, "the file's camera shows the model "},
+      // Centred on the edge x = 1 from 1.5 in front of the face z = 1: the frame, 2 * 1.5 *
+      // tan(20 deg) * 1.5 = 1.64 wide there, holds x > 0.18 of that face, z < 0.67 of the face
+      // x = 0 and 97 % of the top and bottom: 91 % of the surface, the cube cut.
+      {"cut", {1.0f, 0.5f, 2.5f}, "the file's camera sees 9"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    corpus::GltfExtras e;
+    e.camera = true;
+    e.camera_at = c.at;
+    const std::string p = write(std::string(c.name) + ".gltf", corpus::gltf_json(e, false));
+    rvr::Scene s = rvr::load_scene(p).value();
+    rvr::SceneOverrides keep;
+    keep.judge_file_camera = false;
+    rvr::Scene as_is = rvr::load_scene(p, keep).value();
+    expect_near3(as_is.camera.eye, {c.at[0], c.at[1], c.at[2]}, kTextTolerance);
+    EXPECT_EQ(camera_warning(as_is), "");
+    if (std::string(c.why).empty()) {
+      EXPECT_EQ(camera_warning(s), "");
+      expect_near3(s.camera.eye, {c.at[0], c.at[1], c.at[2]}, kTextTolerance);
+      EXPECT_EQ(vertices_in_frame(s), 1.0);
+      continue;
+    }
+    const std::string w = camera_warning(s);
+    EXPECT_EQ(w.rfind(p + ": " + c.why, 0), 0u) << w;
+    double extent = 0;
+    const double in_frame = vertices_in_frame(as_is, &extent);
+    if (std::string(c.name) == "speck") {
+      EXPECT_LT(extent, 0.1);
+    } else {
+      EXPECT_LT(in_frame, 1.0);
+    }
+    EXPECT_NE(w.find("; framing the model instead (--camera file-always keeps it)"),
+              std::string::npos)
+        << w;
+    rvr::SceneOverrides o;
+    o.camera = rvr::FromFile::Auto;
+    rvr::Scene framed = rvr::load_scene(p, o).value();
+    EXPECT_EQ(s.camera.eye, framed.camera.eye);
+    EXPECT_EQ(s.camera.target, framed.camera.target);
+    EXPECT_EQ(vertices_in_frame(s), 1.0);
+  }
+}
+
 // --up z: a Z-up OBJ turned so that its +z is +y, by the quarter turn about x that takes
 // (x, y, z) to (x, z, -y). The triangle standing 2 high along z stands 2 high along y.
 TEST_F(ModelFiles, UpZTurnsTheModelSoItsZIsUp) {
@@ -416,8 +551,9 @@ TEST_F(ModelFiles, UpZTurnsTheModelSoItsZIsUp) {
 // UpAxisSign 1), with the viewport camera "Producer Perspective" of FBX 6 exporters as a model of
 // its own, and a camera the user placed, "shot", at (-5, 0.5, 1) looking along its node's +x
 // (Assimp's FBX camera convention). Assimp reads both cameras and the axes into the scene's
-// metadata without applying them. rvr takes "shot", not the viewport camera, and turns the model
-// (x, y, z) -> (x, z, -y): the triangle's (0, 1, 2) to (0, 2, -1), the eye to (-5, 1, -0.5).
+// metadata without applying them. rvr takes "shot" (40 degrees across, which frames the
+// triangle), not the viewport camera, and turns the model (x, y, z) -> (x, z, -y): the
+// triangle's (0, 1, 2) to (0, 2, -1), the eye to (-5, 1, -0.5).
 TEST_F(ModelFiles, FbxUpAxisFromItsMetadataAndItsViewportCameraSkipped) {
   std::string p = write("cam.fbx", R"FBX(; FBX 7.4.0 project file
 FBXHeaderExtension:  {
@@ -462,6 +598,9 @@ Objects:  {
 	}
 	NodeAttribute: 5000, "NodeAttribute::shot", "Camera" {
 		TypeFlags: "Camera"
+		Properties70:  {
+			P: "FieldOfView", "FieldOfView", "", "A",40
+		}
 	}
 	Model: 6000, "Model::shot", "Camera" {
 		Version: 232

@@ -188,6 +188,65 @@ TEST_F(ModelTextures, AbsoluteWindowsPathAndMovedFolderFindTheFileByName) {
   }
 }
 
+// A path from the root of the drive as Windows exporters write it for a path from the model's
+// folder (\..\Maps\..., as Collada/earthCylindrical.DAE of assimp-testmodels names its image),
+// with another case than the files on disk: read from the model's folder.
+TEST_F(ModelTextures, PathFromTheDrivesRootIsReadFromTheModelsFolder) {
+  fs::create_directories(dir_ / "collada");
+  fs::create_directories(dir_ / "lwo" / "maps");
+  corpus::write_file(dir_ / "lwo" / "maps" / "earthCyl.png", png_bytes(dir_ / "scratch.png"));
+  corpus::write_file(dir_ / "collada" / "square.mtl",
+                     "newmtl wood\nmap_Kd \\..\\LWO\\Maps\\EarthCyl.png\n");
+  corpus::write_file(dir_ / "collada" / "square.obj", obj_square("square.mtl"));
+  rvr::Scene s = rvr::load_scene((dir_ / "collada" / "square.obj").string()).value();
+  EXPECT_TRUE(s.warnings.empty()) << all_warnings(s);
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(fs::path(s.textures[0].resolved).lexically_normal(),
+            dir_ / "lwo" / "maps" / "earthCyl.png");
+  expect_texels_of_the_png(s.textures[0]);
+}
+
+// A Windows absolute path to a folder beside the model's (the model in FBX/, its images in
+// OBJ/, as FBX/spider.fbx of assimp-testmodels names them): found by name under the parent of
+// the model's folder, when the model's own folder has no such file.
+TEST_F(ModelTextures, AbsoluteWindowsPathFindsTheFileInASiblingFolder) {
+  fs::create_directories(dir_ / "models" / "FBX" / "deeper");
+  fs::create_directories(dir_ / "models" / "OBJ");
+  corpus::write_file(dir_ / "models" / "OBJ" / "drkwood.png", png_bytes(dir_ / "scratch.png"));
+  corpus::write_file(dir_ / "models" / "FBX" / "square.mtl",
+                     "newmtl wood\nmap_Kd D:\\projects\\test\\models\\OBJ\\drkwood.png\n");
+  corpus::write_file(dir_ / "models" / "FBX" / "square.obj", obj_square("square.mtl"));
+  rvr::Scene s = rvr::load_scene((dir_ / "models" / "FBX" / "square.obj").string()).value();
+  EXPECT_TRUE(s.warnings.empty()) << all_warnings(s);
+  ASSERT_EQ(s.textures.size(), 1u);
+  EXPECT_EQ(fs::path(s.textures[0].resolved), dir_ / "models" / "OBJ" / "drkwood.png");
+  expect_texels_of_the_png(s.textures[0]);
+
+  // The model's own folder tree comes first: a file of that name below it wins.
+  corpus::write_file(dir_ / "models" / "FBX" / "deeper" / "drkwood.png",
+                     png_bytes(dir_ / "scratch.png"));
+  rvr::Scene own = rvr::load_scene((dir_ / "models" / "FBX" / "square.obj").string()).value();
+  ASSERT_EQ(own.textures.size(), 1u);
+  EXPECT_EQ(fs::path(own.textures[0].resolved), dir_ / "models" / "FBX" / "deeper" / "drkwood.png");
+}
+
+// A texture nowhere near: the warning names both folders looked in, with the path as written
+// (single backslashes) and whole however long.
+TEST_F(ModelTextures, MissingTextureWarningNamesTheFoldersAndTheWholePath) {
+  const std::string folder = (dir_ / "models" / std::string(120, 'f') / "FBX").string();
+  fs::create_directories(folder);
+  const std::string named = "D:\\projects\\" + std::string(80, 'p') + "\\nowhere_at_all.png";
+  corpus::write_file(fs::path(folder) / "square.mtl", "newmtl wood\nmap_Kd " + named + "\n");
+  corpus::write_file(fs::path(folder) / "square.obj", obj_square("square.mtl"));
+  const std::string obj = (fs::path(folder) / "square.obj").string();
+  rvr::Scene s = rvr::load_scene(obj).value();
+  ASSERT_EQ(s.warnings.size(), 1u) << all_warnings(s);
+  EXPECT_EQ(s.warnings[0], obj + ": material 'wood': texture '" + named +
+                               "' not found (looked in '" + folder + "', '" +
+                               fs::path(folder).parent_path().string() +
+                               "' and their subfolders): rendered without it");
+}
+
 // A texture that is nowhere: one warning naming it, no error, the material untextured.
 TEST_F(ModelTextures, MissingTextureIsAWarningNamingIt) {
   write("square.mtl", "newmtl wood\nKd 0.5 0.25 1\nmap_Kd gone.png\n");

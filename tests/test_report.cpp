@@ -13,16 +13,23 @@
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include "base64.h"
+#include "render_stats.h"
 #include "report.h"
+#include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/mismatch_classes.h"
+#include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
+#include "rvr/shared/scene_loader.h"
 
 namespace fs = std::filesystem;
 using namespace rvr;
@@ -77,12 +84,14 @@ ReportInput sample_input(const std::string& out_dir) {
   in.metrics.depth.mean_rel_error = 0.00001;
   in.metrics.depth.p99_rel_error = 0.00007;
   in.metrics.depth.p999_rel_error = 0.0002;
-  in.metrics.depth.outliers = 3;
+  in.metrics.depth.outliers = 7;
   in.metrics.depth.outliers_at_silhouettes = 2;
+  in.metrics.depth.outliers_on_analytic_spheres = 4;
   in.metrics.depth.outliers_elsewhere = 1;
   in.metrics.depth.worst_outliers = {
       {5, 4, 7, 0.0035, 2.5f, 2.51f, DepthOutlierCause::Elsewhere},
-      {1, 2, 3, 0.0012, 6.0f, 6.0075f, DepthOutlierCause::Silhouette}};
+      {1, 2, 3, 0.0012, 6.0f, 6.0075f, DepthOutlierCause::Silhouette},
+      {3, 3, 6, 0.0011, 4.0f, 4.0044f, DepthOutlierCause::AnalyticSphere}};
   in.metrics.color = {0.004, 47.9, 0.21, 0.998};
   in.heat_map_scale = 0.1f;
   return in;
@@ -174,11 +183,13 @@ TEST(MetricsJson, HasEveryRequiredField) {
   EXPECT_DOUBLE_EQ(number("depth", "p99_rel_error"), 0.00007);
   EXPECT_DOUBLE_EQ(number("depth", "p999_rel_error"), 0.0002);
   EXPECT_DOUBLE_EQ(number("depth", "outlier_threshold"), 1e-3);
-  EXPECT_EQ(number("depth", "outliers"), 3.0);
+  EXPECT_EQ(number("depth", "outliers"), 7.0);
   EXPECT_EQ(number("depth", "outliers_at_silhouettes"), 2.0);
+  EXPECT_EQ(number("depth", "outliers_on_analytic_spheres"), 4.0);
   EXPECT_EQ(number("depth", "outliers_elsewhere"), 1.0);
   const auto& listed = doc["depth"]["outlier_pixels"];
-  ASSERT_EQ(listed.size(), 2u);
+  ASSERT_EQ(listed.size(), 3u);
+  EXPECT_EQ(listed[2]["cause"], "analytic_sphere");
   EXPECT_EQ(listed[0]["x"], 5);
   EXPECT_EQ(listed[0]["y"], 4);
   EXPECT_EQ(listed[0]["object"], 7);
@@ -200,6 +211,77 @@ TEST(MetricsJson, HasEveryRequiredField) {
   EXPECT_EQ(doc["renderers"]["raytrace"]["cost"]["image"], "raytrace.cost.png");
   EXPECT_EQ(doc["renderers"]["raytrace"]["cost"]["mean"], 12.5);
   EXPECT_EQ(doc["renderers"]["raytrace"]["cost"]["scale"], 31.0);
+}
+
+// Counts are whole numbers and written as JSON integers ("peak_memory_bytes": 159305728, not
+// 159305728.0); seconds and the declared ratios stay numbers, even when whole (a block fill of
+// exactly 1), in --stats and in metrics.json alike.
+TEST(StatsJson, CountsAreIntegersSecondsAndRatiosNumbers) {
+  const std::map<std::string, double> stats = {
+      {"rays.primary", 307200.0},
+      {"bvh.nodes_visited", 8178646.0},
+      {"memory.raster_bytes", 4.5e9},
+      {"zbuffer.fragments.generated", 12.0},
+      {"time.render", 0.5},
+      {"zbuffer.time.setup", 1.0},
+      {"overdraw", 1.0},
+      {"zbuffer.overdraw", 2.0},
+      {"bvh.block_fill", 1.0},
+      {"bvh.node_fill", 0.25},
+      {"bvh.sah_cost", 3.0},
+      {"rays.shadow", std::numeric_limits<double>::infinity()}};
+  const std::set<std::string> counts = {"rays.primary", "bvh.nodes_visited", "memory.raster_bytes",
+                                        "zbuffer.fragments.generated"};
+  RenderOutput out;
+  out.stats = stats;
+  Scene scene;
+  scene.image.width = 4;
+  scene.image.height = 3;
+  const nlohmann::json doc = nlohmann::json::parse(
+      render_stats_json("raytrace", scene, RenderMode::Full, {0.1, 0.2, 0.3}, out));
+  ReportInput in = sample_input("out");
+  in.renderers[0].stats = stats;
+  const nlohmann::json metrics = nlohmann::json::parse(metrics_json(in));
+  for (const nlohmann::json* written : {&doc["stats"], &metrics["renderers"]["raster"]["stats"]}) {
+    for (const auto& [name, value] : stats) {
+      const nlohmann::json& v = (*written)[name];
+      if (!std::isfinite(value)) {
+        EXPECT_TRUE(v.is_null()) << name;
+      } else if (counts.count(name)) {
+        EXPECT_TRUE(v.is_number_integer()) << name << ": " << v.dump();
+        EXPECT_EQ(v.get<double>(), value) << name;
+      } else {
+        EXPECT_TRUE(v.is_number_float()) << name << ": " << v.dump();
+        EXPECT_EQ(v.get<double>(), value) << name;
+      }
+    }
+  }
+  EXPECT_TRUE(doc["peak_memory_bytes"].is_number_integer()) << doc["peak_memory_bytes"].dump();
+  EXPECT_GT(doc["peak_memory_bytes"].get<double>(), 0.0);
+  EXPECT_TRUE(doc["scene_mesh_bytes"].is_number_integer()) << doc["scene_mesh_bytes"].dump();
+  EXPECT_TRUE(doc["width"].is_number_integer());
+}
+
+// Every stat every renderer reports in every mode is what stat_kind says: a count a whole
+// number, so a new ratio stat cannot go out as a truncated integer (it must be declared).
+TEST(StatsJson, EveryRendererCountsInWholeNumbers) {
+  Scene scene = make_builtin_scene("cornell").value();
+  scene.image.width = 32;
+  scene.image.height = 24;
+  for (const RendererInfo& info : renderers())
+    for (RenderMode mode : {RenderMode::Visibility, RenderMode::Local, RenderMode::Full}) {
+      RenderOptions options;
+      options.mode = mode;
+      std::unique_ptr<Renderer> r = make_renderer(info.name).value();
+      Expected<RenderOutput> out = r->render(scene, options);
+      ASSERT_TRUE(out.ok()) << info.name << ": " << out.error().message;
+      for (const auto& [name, value] : out->stats) {
+        if (stat_kind(name) == StatKind::Count && std::isfinite(value)) {
+          EXPECT_EQ(value, std::floor(value))
+              << info.name << " " << to_string(mode) << ": " << name << " is not a count";
+        }
+      }
+    }
 }
 
 TEST(MetricsJson, InfiniteAndNanValuesStayValidJson) {
@@ -290,7 +372,8 @@ TEST_F(ReportDir, HtmlIsSelfContained) {
 }
 
 // The depth outliers: ringed on depth_diff.png at their pixel centres (orange at a
-// silhouette, red elsewhere) in the image's own coordinates, and listed in a table.
+// silhouette, blue on an analytic sphere, red elsewhere) in the image's own coordinates, and
+// listed in a table where only the real disagreements are marked bad.
 TEST_F(ReportDir, DepthOutliersAreRingedAndListed) {
   auto html = report_html(sample_input(dir_.string()));
   ASSERT_TRUE(html.ok()) << html.error().message;
@@ -302,15 +385,70 @@ TEST_F(ReportDir, DepthOutliersAreRingedAndListed) {
   EXPECT_NE(marks.find("<circle cx=\"1.5\" cy=\"2.5\""), std::string::npos) << marks;
   EXPECT_EQ(count_of(marks, "stroke=\"#ff1744\""), 1u);  // the one elsewhere
   EXPECT_EQ(count_of(marks, "stroke=\"#ff9f1c\""), 1u);  // the silhouette one
-  EXPECT_NE(h.find("3 pixels differ in depth by more than 1e-3 (relative): 2 on an object's "
-                   "outline, 1 elsewhere"),
+  EXPECT_EQ(count_of(marks, "stroke=\"#4dabf7\""), 1u);  // the analytic sphere's
+  EXPECT_NE(h.find("7 pixels differ in depth by more than 1e-3 (relative): 2 on an object's "
+                   "outline, 4 on analytic spheres, 1 elsewhere"),
             std::string::npos);
   EXPECT_NE(h.find("<tr><td class=\"num\">5</td><td class=\"num\">4</td><td class=\"num\">7"
                    "</td><td class=\"num\">2.5</td><td class=\"num\">2.51</td><td class=\"num "
-                   "bad\">0.0035</td><td>elsewhere</td></tr>"),
+                   "bad\">0.0035</td><td><span class=\"sw\" style=\"background:#ff1744\">"
+                   "</span>elsewhere</td></tr>"),
+            std::string::npos);
+  EXPECT_NE(h.find("<td class=\"num\">0.0011</td><td><span class=\"sw\" "
+                   "style=\"background:#4dabf7\"></span>analytic_sphere</td>"),
             std::string::npos);
   for (const char* word : {"p99_rel_error", "p999_rel_error", "outliers_elsewhere"})
     EXPECT_NE(h.find(word), std::string::npos) << word;
+}
+
+// Outliers on analytic spheres are expected (the z-buffer's polygon): their count is never
+// flagged, while any outlier elsewhere is, as a real disagreement.
+TEST_F(ReportDir, OnlyOutliersElsewhereAreFlagged) {
+  ReportInput in = sample_input(dir_.string());
+  auto row = [](const std::string& html, const std::string& metric) {
+    const size_t at = html.find("<code>" + metric + "</code>");
+    return at == std::string::npos ? std::string() : html.substr(at, html.find("</tr>", at) - at);
+  };
+  in.metrics.depth.outliers_elsewhere = 0;
+  auto expected = report_html(in);
+  ASSERT_TRUE(expected.ok()) << expected.error().message;
+  EXPECT_NE(row(*expected, "outliers_on_analytic_spheres").find("class=\"num\">4<"),
+            std::string::npos)
+      << row(*expected, "outliers_on_analytic_spheres");
+  EXPECT_NE(row(*expected, "outliers_elsewhere").find("class=\"num\">0<"), std::string::npos);
+  in.metrics.depth.outliers_elsewhere = 1;
+  auto real = report_html(in);
+  ASSERT_TRUE(real.ok());
+  EXPECT_NE(row(*real, "outliers_elsewhere").find("class=\"num bad\">1<"), std::string::npos)
+      << row(*real, "outliers_elsewhere");
+  EXPECT_EQ(row(*real, "outliers_on_analytic_spheres").find("bad"), std::string::npos);
+}
+
+// A long listing of outliers shows its first 10 rows; the rest are folded away in a
+// <details>, still in the page.
+TEST_F(ReportDir, LongOutlierListingIsFoldedAfterTenRows) {
+  ReportInput in = sample_input(dir_.string());
+  in.metrics.depth.worst_outliers.clear();
+  for (int k = 0; k < 100; ++k)
+    in.metrics.depth.worst_outliers.push_back(
+        {k % 8, k / 8 % 6, 6, 0.01 - 1e-5 * k, 4.0f, 4.04f, DepthOutlierCause::Silhouette});
+  in.metrics.depth.outliers = 295;
+  auto html = report_html(in);
+  ASSERT_TRUE(html.ok()) << html.error().message;
+  const std::string& h = html.value();
+  const size_t table = h.find("<h2>Depth outliers</h2>");
+  const size_t fold =
+      h.find("<details class=\"more-outliers\"><summary>The other 90 listed", table);
+  ASSERT_NE(table, std::string::npos);
+  ASSERT_NE(fold, std::string::npos) << "no fold after the first rows";
+  const size_t end = h.find("</details>", fold);
+  EXPECT_EQ(count_of(h.substr(table, fold - table), ">silhouette</td></tr>"), 10u);
+  EXPECT_EQ(count_of(h.substr(fold, end - fold), ">silhouette</td></tr>"), 90u);
+  // Ten or fewer: no fold.
+  in.metrics.depth.worst_outliers.resize(10);
+  auto short_listing = report_html(in);
+  ASSERT_TRUE(short_listing.ok());
+  EXPECT_EQ(short_listing->find("<details class=\"more-outliers\""), std::string::npos);
 }
 
 TEST_F(ReportDir, EmbeddedImageDecodesToTheFile) {

@@ -699,7 +699,8 @@ TEST_F(SceneLoader, TexturesUvsAndColours) {
   EXPECT_FALSE(s.textures[2].mips);
   ASSERT_EQ(s.warnings.size(), 1u);
   EXPECT_EQ(s.warnings[0], "materials.lost.texture: texture 'nowhere.png' not found (looked in '" +
-                               dir_.string() + "' and its subfolders): rendered without it");
+                               dir_.string() + "', '" + dir_.parent_path().string() +
+                               "' and their subfolders): rendered without it");
 
   const rvr::TriangleMesh& tri = s.objects[0].mesh;
   ASSERT_EQ(tri.uvs.size(), 3u);

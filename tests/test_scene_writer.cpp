@@ -260,8 +260,9 @@ INSTANTIATE_TEST_SUITE_P(Builtin, SceneWriter, ::testing::ValuesIn(names()),
 
 // A scene with a texture read from a file (in another folder than the exported document), a
 // transform and wrap modes per axis, a mesh with texture coordinates and vertex colours (to
-// PLY) and a triangle with both (inline): exported, read back, the same; the texture named by
-// its path relative to the document's folder, not copied.
+// PLY) and a triangle with both (inline): exported, read back, the same; the texture, which
+// lies outside the document's folder, named by its absolute path (a relative one would climb
+// out of the folder and break when it moves) and not copied.
 TEST(SceneWriterTextures, FileTexturesUvsAndColoursReadBackTheSame) {
   fs::path dir = fs::temp_directory_path() / ("rvr-scene-writer-tex-" + std::to_string(::getpid()));
   fs::remove_all(dir);
@@ -294,13 +295,72 @@ TEST(SceneWriterTextures, FileTexturesUvsAndColoursReadBackTheSame) {
   Expected<SceneDocument> doc = write_scene(*original, "scene", (dir / "out").string());
   ASSERT_TRUE(doc.ok()) << doc.error().message;
   EXPECT_TRUE(doc->texture_files.empty());
-  EXPECT_NE(doc->json.find(R"("file": "../in/img/t.png")"), std::string::npos) << doc->json;
+  EXPECT_TRUE(doc->copied_files.empty());
+  EXPECT_NE(doc->json.find("\"file\": \"" + (dir / "in" / "img" / "t.png").generic_string() + "\""),
+            std::string::npos)
+      << doc->json;
   for (const SceneMeshFile& m : doc->mesh_files) {
     std::ofstream(dir / "out" / m.name, std::ios::binary) << m.bytes;
   }
   Expected<Scene> loaded = parse_scene(doc->json, "out.json", (dir / "out").string());
   ASSERT_TRUE(loaded.ok()) << loaded.error().message;
   expect_same_scene(*original, *loaded);
+  fs::remove_all(dir);
+}
+
+// Where an exported document names a texture file: relative to the document's folder when it
+// lies below it, absolute when it lies elsewhere, and with copy_texture_files a copy beside the
+// document (PREFIX.textureI.EXT) for one elsewhere. Each document reads back with its texture
+// after its folder has moved.
+TEST(SceneWriterTextures, TexturePathsSurviveTheDocumentsFolderMoving) {
+  fs::path dir =
+      fs::temp_directory_path() / ("rvr-scene-writer-move-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "in");
+  fs::create_directories(dir / "out" / "maps");
+  Image image;
+  image.width = image.height = 1;
+  image.channels = 3;
+  image.pixels = {0.25f, 0.5f, 0.75f};
+  ASSERT_TRUE(write_image((dir / "in" / "far.png").string(), image, false).ok());
+  ASSERT_TRUE(write_image((dir / "out" / "maps" / "near.png").string(), image, false).ok());
+  const std::string text = R"({"camera": {"eye": [0, 0, 4], "target": [0, 0, 0], "up": [0, 1, 0]},
+    "materials": {"far": {"texture": "far.png"}, "near": {"texture": "../out/maps/near.png"}},
+    "objects": [
+      {"type": "triangle", "vertices": [[0,0,0],[1,0,0],[0,1,0]], "material": "far",
+       "uvs": [[0, 0], [1, 0], [0, 1]]},
+      {"type": "triangle", "vertices": [[0,0,1],[1,0,1],[0,1,1]], "material": "near",
+       "uvs": [[0, 0], [1, 0], [0, 1]]}]})";
+  Expected<Scene> original = parse_scene(text, "in.json", (dir / "in").string());
+  ASSERT_TRUE(original.ok()) << original.error().message;
+  ASSERT_TRUE(original->warnings.empty()) << original->warnings.front();
+  for (const bool copy : {false, true}) {
+    SCOPED_TRACE(copy ? "copied" : "named where it is");
+    Expected<SceneDocument> doc = write_scene(*original, "scene", (dir / "out").string(), copy);
+    ASSERT_TRUE(doc.ok()) << doc.error().message;
+    EXPECT_NE(doc->json.find(R"("file": "maps/near.png")"), std::string::npos) << doc->json;
+    const std::string far = copy ? "scene.texture0.png" : (dir / "in" / "far.png").generic_string();
+    EXPECT_NE(doc->json.find("\"file\": \"" + far + "\""), std::string::npos) << doc->json;
+    ASSERT_EQ(doc->copied_files.size(), copy ? 1u : 0u);
+    // Written as `rvr scenes --export` writes it, then the folder moved one level down.
+    fs::remove_all(dir / "moved");
+    fs::create_directories(dir / "moved");
+    fs::copy(dir / "out", dir / "moved" / "out", fs::copy_options::recursive);
+    for (const SceneCopiedFile& c : doc->copied_files) {
+      EXPECT_EQ(c.name, "scene.texture0.png");
+      EXPECT_EQ(fs::path(c.source), dir / "in" / "far.png");
+      fs::copy_file(c.source, dir / "moved" / "out" / c.name);
+    }
+    const fs::path moved = dir / "moved" / "out";
+    Expected<Scene> loaded = parse_scene(doc->json, "scene.json", moved.string());
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    EXPECT_TRUE(loaded->warnings.empty()) << loaded->warnings.front();
+    ASSERT_EQ(loaded->textures.size(), 2u);
+    EXPECT_EQ(fs::path(loaded->textures[1].resolved), moved / "maps" / "near.png");
+    EXPECT_EQ(fs::path(loaded->textures[0].resolved),
+              copy ? moved / "scene.texture0.png" : dir / "in" / "far.png");
+    for (const Texture& t : loaded->textures) EXPECT_TRUE(t.mips) << t.file;
+  }
   fs::remove_all(dir);
 }
 

@@ -39,9 +39,11 @@ void print_pair(const ReportPair& p, const std::string& name_a, const std::strin
               m.depth.max_rel_error, m.depth.mean_rel_error, m.depth.p99_rel_error,
               m.depth.p999_rel_error);
   if (m.depth.outliers)
-    std::printf("  depth outliers    %zu above %g: %zu at silhouettes, %zu elsewhere\n",
-                m.depth.outliers, kDepthOutlierThreshold, m.depth.outliers_at_silhouettes,
-                m.depth.outliers_elsewhere);
+    std::printf(
+        "  depth outliers    %zu above %g: %zu at silhouettes, %zu on analytic spheres, %zu "
+        "elsewhere\n",
+        m.depth.outliers, kDepthOutlierThreshold, m.depth.outliers_at_silhouettes,
+        m.depth.outliers_on_analytic_spheres, m.depth.outliers_elsewhere);
   std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
               m.color.psnr_db, m.color.max_abs, m.color.ssim);
   if (m.lod.pixels > 0)
@@ -134,8 +136,12 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   for (const ReportRenderer& r : report.renderers)
     std::printf("  %-12s %9.3f s  depth %s\n", r.name.c_str(), r.seconds, r.depth_format.c_str());
   for (const ReportPair& p : report.pairs) print_pair(p, keys[p.a], keys[p.b]);
+  // Every file written, in the order written.
   std::printf("  wrote %s/{", a.out_dir.c_str());
-  for (const ReportRenderer& r : report.renderers) std::printf("%s,", r.image_file.c_str());
+  for (const ReportRenderer& r : report.renderers) {
+    std::printf("%s,", r.image_file.c_str());
+    if (!r.cost_file.empty()) std::printf("%s,", r.cost_file.c_str());
+  }
   for (const ReportPair& p : report.pairs)
     std::printf("%s,%s,%s,%s,", p.file("diff").c_str(), p.file("depth_diff").c_str(),
                 p.file("id_mismatch").c_str(), p.file("mismatch_classes").c_str());

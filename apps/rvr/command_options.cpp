@@ -28,7 +28,7 @@ namespace rvr::cli {
 void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("scene", o.scene, "scene file or builtin:NAME (default builtin:cornell)");
   cmd.add_option("--mode", o.mode, "visibility | local | full")
-      ->check(CLI::IsMember({"visibility", "local", "full"}));
+      ->check(one_of({"visibility", "local", "full"}));
   cmd.add_option("--width", o.width, "image width (overrides the scene)")
       ->check(CLI::Range(1, 16384));
   cmd.add_option("--height", o.height, "image height (overrides the scene)")
@@ -46,15 +46,15 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--up", o.up,
                  "model files: the up axis of the file's coordinates, turned to +y: auto (the "
                  "file's metadata; +y where it has none) | y | z")
-      ->check(CLI::IsMember({"auto", "y", "z"}));
+      ->check(one_of({"auto", "y", "z"}));
   cmd.add_option("--camera", o.camera,
-                 "model files: file (the file's own camera where it has one) | auto (the "
-                 "framing camera)")
-      ->check(CLI::IsMember({"file", "auto"}));
+                 "model files: file (the file's own camera where it frames the model) | auto "
+                 "(the framing camera) | file-always (the file's own camera whatever it shows)")
+      ->check(one_of({"file", "auto", "file-always"}));
   cmd.add_option("--lights", o.lights,
                  "model files: file (the file's own lights where it has them) | auto (the "
                  "default key light and ambient)")
-      ->check(CLI::IsMember({"file", "auto"}));
+      ->check(one_of({"file", "auto"}));
   cmd.add_option("--spp", o.spp, "samples per pixel (overrides the scene)")
       ->check(CLI::Range(1, 65536));
   cmd.add_option("--threads", o.threads, "worker threads, 0 = every core")
@@ -62,15 +62,15 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--accel", o.accel,
                  "tracer acceleration: bvh (wide SIMD BVH, default) | bvh2 (binary, one box at a "
                  "time) | none (every object for every ray)")
-      ->check(CLI::IsMember({"bvh", "bvh2", "none"}));
+      ->check(one_of({"bvh", "bvh2", "none"}));
   cmd.add_option("--spheres", o.spheres,
                  "tracer spheres: analytic | mesh (the raster's tessellation)")
-      ->check(CLI::IsMember({"analytic", "mesh"}));
+      ->check(one_of({"analytic", "mesh"}));
   cmd.add_option("--sphere-segments", o.sphere_segments, "sphere tessellation: longitudes")
       ->check(CLI::Range(3, 4096));
   cmd.add_option("--triangle-test", o.triangle_test,
                  "tracer ray-triangle test: mt (Moller-Trumbore) | chapter (plane, then edges)")
-      ->check(CLI::IsMember({"mt", "chapter"}));
+      ->check(one_of({"mt", "chapter"}));
   cmd.add_option("--texture-lod", o.texture_lod,
                  "tracers' texture level of detail: cones (ray cones, default) | differentials "
                  "(ray differentials) | none (level 0, bilinear)")
@@ -80,7 +80,7 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--seed", o.seed, "seed of the per-pixel random streams");
   cmd.add_option("--gl", o.gl,
                  "raster GL back end: osmesa | egl (default osmesa, egl when OSMesa is missing)")
-      ->check(CLI::IsMember({"osmesa", "egl"}));
+      ->check(one_of({"osmesa", "egl"}));
   cmd.add_option("--shadow-map-size", o.shadow_map_size, "raster shadow maps: texels per side")
       ->check(CLI::Range(16, 8192));
   cmd.add_option("--shadow-bias", o.shadow_bias, "raster shadow maps: depth bias (scene units)")
@@ -89,11 +89,11 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("--hiz", o.hiz,
                  "softraster: hierarchical z, each 8x8 block's farthest depth rejecting what lies "
                  "behind it: on | off (the textbook z-buffer)")
-      ->check(CLI::IsMember({"on", "off"}));
+      ->check(one_of({"on", "off"}));
   cmd.add_option("--depth-format", o.depth_format,
                  "rasterizers' z-buffer: d24 | d32f | d32f_reversed (default: the most precise "
                  "the renderer has)")
-      ->check(CLI::IsMember({"d24", "d32f", "d32f_reversed"}));
+      ->check(one_of({"d24", "d32f", "d32f_reversed"}));
   cmd.add_flag("--quiet,-q", o.quiet, "no progress output");
   cmd.add_option("--max-samples", o.limits.max_samples,
                  "refuse more than N pixels x samples (default 2^30)")
@@ -180,6 +180,7 @@ Scene load(const CommonOptions& o, const RenderOptions& options, double& load_se
   overrides.exposure = o.exposure;
   overrides.up = o.up == "z" ? UpAxis::Z : o.up == "y" ? UpAxis::Y : UpAxis::Auto;
   overrides.camera = o.camera == "auto" ? FromFile::Auto : FromFile::File;
+  overrides.judge_file_camera = o.camera != "file-always";
   overrides.lights = o.lights == "auto" ? FromFile::Auto : FromFile::File;
   request.spp = o.spp;
   request.limits = o.limits;

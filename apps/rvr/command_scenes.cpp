@@ -3,6 +3,8 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -23,6 +25,7 @@ namespace {
 // file), as an rvr-scene/1 document. Meshes other than single triangles have no inline form in
 // the format: they go to PLY files next to -o FILE.
 int export_scene(const ScenesArgs& a) {
+  if (a.copy_assets && a.out.empty()) fail(bad_input("scenes: --copy-assets needs -o FILE.json"));
   std::string name = a.export_name;
   const bool builtin_prefix = name.rfind("builtin:", 0) == 0;
   if (builtin_prefix) name = name.substr(8);
@@ -37,13 +40,15 @@ int export_scene(const ScenesArgs& a) {
                           (reads_as_path && std::filesystem::exists(a.export_name, ec)));
   if (!builtin_prefix && !is_file && reads_as_path)
     fail(bad_input(a.export_name + ": no such file"));
-  if (is_file) refuse_overwriting_inputs({a.export_name}, {a.out});
+  refuse_overwriting_inputs(
+      is_file ? std::vector<std::string>{a.export_name} : std::vector<std::string>{}, {a.out});
   Scene scene = is_file ? take(load_scene(a.export_name)) : take(make_builtin_scene(name));
   if (is_file) name = std::filesystem::path(a.export_name).stem().string();
   std::filesystem::path out(a.out);
   std::string prefix = a.out.empty() ? name : out.stem().string();
   std::string folder = out.parent_path().string();
-  SceneDocument doc = take(write_scene(scene, prefix, folder.empty() ? "." : folder));
+  SceneDocument doc =
+      take(write_scene(scene, prefix, folder.empty() ? "." : folder, a.copy_assets));
   if (a.out.empty()) {
     if (!doc.texture_files.empty()) {
       fail(bad_input(fmt::format(
@@ -69,6 +74,12 @@ int export_scene(const ScenesArgs& a) {
   for (const SceneTextureFile& t : doc.texture_files) {
     check(write_image((out.parent_path() / t.name).string(), t.image));
   }
+  for (const SceneCopiedFile& c : doc.copied_files) {
+    std::ifstream in(c.source, std::ios::binary);
+    if (!in) fail(bad_input("cannot read '" + c.source + "' to copy it beside " + a.out));
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    check(write_text_file((out.parent_path() / c.name).string(), bytes));
+  }
   check(write_text_file(a.out, doc.json));
   return 0;
 }
@@ -78,6 +89,7 @@ int export_scene(const ScenesArgs& a) {
 int run_scenes(const ScenesArgs& a) {
   if (!a.export_name.empty()) return export_scene(a);
   if (!a.out.empty()) fail(bad_input("scenes: -o needs --export NAME"));
+  if (a.copy_assets) fail(bad_input("scenes: --copy-assets needs --export NAME -o FILE.json"));
   for (const BuiltinSceneInfo& s : builtin_scenes())
     std::printf("builtin:%-14s %s\n", s.name.c_str(), s.description.c_str());
   return 0;

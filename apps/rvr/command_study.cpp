@@ -22,6 +22,7 @@
 
 #include "cli_exit.h"
 #include "commands.h"
+#include "one_of.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
@@ -90,9 +91,10 @@ study::StudyRequest request_of(const StudyArgs& a) {
   return r;
 }
 
-// A study that concludes nothing says why (study.md does too) and exits 1.
+// A study that concludes nothing says why (study.md does too) and exits 1; a shard is not meant
+// to conclude on its own (its merge is), so it exits 0.
 int no_conclusion_status(const study::StudyResult& result) {
-  if (result.no_conclusion.empty()) return 0;
+  if (result.no_conclusion.empty() || result.shard) return 0;
   std::fprintf(stderr, "rvr study: no conclusion: %s\n", result.no_conclusion.c_str());
   return 1;
 }
@@ -151,7 +153,7 @@ void add_study_command(CLI::App& app, StudyArgs& a, CLI::App*& cmd) {
       ->delimiter(',');
   cmd->add_option("--width", a.width, "image width, height 3/4 of it (default 1024)");
   cmd->add_option("--mode", a.mode, "visibility | local | full (default local)")
-      ->check(CLI::IsMember({"visibility", "local", "full"}));
+      ->check(one_of({"visibility", "local", "full"}));
   cmd->add_option("--budget", a.budget, "seconds the sweep may take (default 300)");
   cmd->add_option("--repetitions", a.repetitions,
                   "rounds timed per run: frames per renderer in each process (>= 3, default 5)");

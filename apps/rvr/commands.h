@@ -30,7 +30,7 @@ struct CommonOptions {
   std::string camera_from;        // --camera-from X,Y,Z
   std::optional<float> exposure;  // --exposure EV
   std::string up = "auto";        // --up auto | y | z (model files)
-  std::string camera = "file";    // --camera file | auto (model files)
+  std::string camera = "file";    // --camera file | auto | file-always (model files)
   std::string lights = "file";    // --lights file | auto (model files)
   int threads = 0;
   std::string accel = "bvh";
@@ -57,7 +57,8 @@ RenderMode parse_mode(const std::string& s);
 RenderOptions render_options(const CommonOptions& o, const std::string& default_mode);
 Scene load(const CommonOptions& o, const RenderOptions& options, double& load_seconds);
 
-// Refuses, before any work, an output that would overwrite one of the inputs.
+// Refuses, before any work, an output file that names a folder (an existing one, or a name
+// ending in '/') or that would overwrite one of the inputs.
 void refuse_overwriting_inputs(const std::vector<std::string>& inputs,
                                const std::vector<std::string>& outputs);
 
@@ -90,8 +91,9 @@ struct DiffArgs {
 int run_diff(const DiffArgs& d);
 
 struct ScenesArgs {
-  std::string export_name;  // --export NAME
-  std::string out;          // -o FILE (default: stdout)
+  std::string export_name;   // --export NAME
+  std::string out;           // -o FILE (default: stdout)
+  bool copy_assets = false;  // --copy-assets: texture files copied beside FILE
 };
 
 int run_scenes(const ScenesArgs& a);
@@ -105,7 +107,7 @@ struct StudyArgs {
   std::string mode = "local";
   double budget = 300;
   int repetitions = 5;
-  int processes = 3;             // --processes: runs per point, each in a fresh process
+  int processes = 3;              // --processes: runs per point, each in a fresh process
   double noise_threshold = 0.03;  // --noise-threshold
   uint64_t seed = 1;
   std::string shard;               // --shard I/N

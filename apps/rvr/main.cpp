@@ -10,16 +10,18 @@
 #include <exception>
 #include <initializer_list>
 #include <new>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
-#include "study_processes.h"
+#include "one_of.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/compare.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
+#include "study_processes.h"
 #include "suggest.h"
 #include "terminal_progress.h"
 
@@ -101,11 +103,15 @@ int run(int argc, char** argv) {
   RenderArgs render;
   CLI::App* render_cmd = app.add_subcommand("render", "render a scene with one renderer");
   add_common_options(*render_cmd, render.common);
-  render_cmd->add_option("-r,--renderer", render.renderer, renderer_help())->required();
+  std::vector<std::string> renderer_names;
+  for (const RendererInfo& r : renderers()) renderer_names.push_back(r.name);
+  render_cmd->add_option("-r,--renderer", render.renderer, renderer_help())
+      ->required()
+      ->check(one_of(renderer_names));
   render_cmd->add_option("-o,--output", render.out, "output image (.png, .exr)");
   render_cmd->add_option("--aov", render.aovs, "extra outputs: depth,id,normal,cost,lod")
       ->delimiter(',')
-      ->check(CLI::IsMember({"depth", "id", "normal", "cost", "lod"}));
+      ->check(one_of({"depth", "id", "normal", "cost", "lod"}));
   render_cmd->add_option("--stats", render.stats, "write counters and phase times as JSON");
 
   CompareArgs compare;
@@ -115,7 +121,8 @@ int run(int argc, char** argv) {
       ->add_option(
           "-r,--renderers", compare.renderers,
           "renderers, every pair compared (default raster,raytrace): " + renderer_name_list())
-      ->delimiter(',');
+      ->delimiter(',')
+      ->check(one_of(renderer_names));
   compare_cmd->add_option("-o,--output", compare.out_dir, "output folder (default rvr-out)");
   compare_cmd
       ->add_option("--fail-below-agreement", compare.fail_below_agreement,
@@ -126,7 +133,7 @@ int run(int argc, char** argv) {
                    "exit 1 when a pair has a mismatch of one of these classes: "
                    "edge,depth_precision,occlusion,coverage")
       ->delimiter(',')
-      ->check(CLI::IsMember({"edge", "depth_precision", "occlusion", "coverage"}));
+      ->check(one_of({"edge", "depth_precision", "occlusion", "coverage"}));
 
   DiffArgs diff;
   CLI::App* diff_cmd = app.add_subcommand("diff", "compare two image files, like idiff");
@@ -156,10 +163,13 @@ int run(int argc, char** argv) {
   scenes_cmd->add_option("-o,--output", scenes.out,
                          "with --export: write FILE (and its meshes as FILE-stem.meshI.ply "
                          "beside it) instead of stdout");
+  scenes_cmd->add_flag("--copy-assets", scenes.copy_assets,
+                       "with -o: copy the texture files from outside FILE's folder beside it "
+                       "(FILE-stem.textureI.EXT), so that the folder can move");
   CLI::App* info_cmd = app.add_subcommand("info", "versions and machine facts for bug reports");
   std::string info_gl;
   info_cmd->add_option("--gl", info_gl, "GL back end to describe: osmesa | egl (default as render)")
-      ->check(CLI::IsMember({"osmesa", "egl"}));
+      ->check(one_of({"osmesa", "egl"}));
 
   StudyArgs study;
   CLI::App* study_cmd = nullptr;

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "render_stats.h"
 #include "report.h"
 #include "report_text.h"
 #include "rvr/shared/compare.h"
@@ -79,6 +80,7 @@ ordered_json pair_metrics(const ComparisonMetrics& m) {
                   {"outlier_threshold", kDepthOutlierThreshold},
                   {"outliers", d.outliers},
                   {"outliers_at_silhouettes", d.outliers_at_silhouettes},
+                  {"outliers_on_analytic_spheres", d.outliers_on_analytic_spheres},
                   {"outliers_elsewhere", d.outliers_elsewhere},
                   {"outlier_pixels", outliers}};
   const auto& c = m.color;
@@ -124,7 +126,7 @@ std::string metrics_json(const ReportInput& input) {
       std::string key = r.name;
       for (int k = 2; renderers.contains(key); ++k) key = r.name + "-" + std::to_string(k);
       ordered_json stats = ordered_json::object();
-      for (const auto& [name, value] : r.stats) stats[name] = number(value);
+      for (const auto& [name, value] : r.stats) stats[name] = stat_json<ordered_json>(name, value);
       renderers[key] = {{"seconds", number(r.seconds)},
                         {"warnings", r.warnings},
                         {"stats", stats},

@@ -1,4 +1,4 @@
-// Refusing an output that would overwrite an input (see commands.h).
+// Refusing an output that names a folder or would overwrite an input (see commands.h).
 #include <filesystem>
 #include <string>
 #include <system_error>
@@ -12,6 +12,12 @@ namespace rvr::cli {
 
 void refuse_overwriting_inputs(const std::vector<std::string>& inputs,
                                const std::vector<std::string>& outputs) {
+  for (const std::string& out : outputs) {
+    std::error_code ec;
+    if (out.empty()) continue;  // standard output
+    if (!std::filesystem::path(out).has_filename() || std::filesystem::is_directory(out, ec))
+      fail(bad_input("cannot write '" + out + "': is a directory"));
+  }
   for (const std::string& out : outputs) {
     for (const std::string& in : inputs) {
       std::error_code ec;

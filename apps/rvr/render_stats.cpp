@@ -2,7 +2,7 @@
 
 #include <sys/resource.h>
 
-#include <cmath>
+#include <cstdint>
 #include <glm/glm.hpp>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -11,14 +11,10 @@
 namespace rvr {
 namespace {
 
-double peak_memory_bytes() {
+uint64_t peak_memory_bytes() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_maxrss) * 1024.0;
-}
-
-nlohmann::json finite_or_null(double v) {
-  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+  return uint64_t(usage.ru_maxrss) * 1024;
 }
 
 }  // namespace
@@ -33,7 +29,7 @@ std::string render_stats_json(const std::string& renderer, const Scene& scene, R
   j["mode"] = to_string(mode);
   j["time"] = {{"load", times.load}, {"render", times.render}, {"write", times.write}};
   nlohmann::json counters = nlohmann::json::object();
-  for (const auto& [k, v] : out.stats) counters[k] = finite_or_null(v);
+  for (const auto& [k, v] : out.stats) counters[k] = stat_json<nlohmann::json>(k, v);
   j["stats"] = counters;
   j["info"] = out.info;
   // The scene loader's warnings (each names the file), then the renderer's.
@@ -42,11 +38,11 @@ std::string render_stats_json(const std::string& renderer, const Scene& scene, R
   j["warnings"] = warnings;
   j["peak_memory_bytes"] = peak_memory_bytes();
   // The scene's own vertex and index data, to read peak memory against.
-  double scene_bytes = 0;
+  uint64_t scene_bytes = 0;
   for (const Object& o : scene.objects)
-    scene_bytes += double(o.mesh.positions.size() * sizeof(glm::vec3) +
-                          o.mesh.normals.size() * sizeof(glm::vec3) +
-                          o.mesh.triangles.size() * sizeof(glm::uvec3));
+    scene_bytes += o.mesh.positions.size() * sizeof(glm::vec3) +
+                   o.mesh.normals.size() * sizeof(glm::vec3) +
+                   o.mesh.triangles.size() * sizeof(glm::uvec3);
   j["scene_mesh_bytes"] = scene_bytes;
   return j.dump(2) + "\n";
 }

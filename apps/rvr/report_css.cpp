@@ -46,6 +46,9 @@ footer{margin-top:30px;color:#7a8394;font-size:12px}
 svg.bar{display:block;margin-top:4px;font-size:11px;fill:#4a5366}
 .sw{display:inline-block;width:11px;height:11px;border:1px solid #9aa3b5;
   vertical-align:-1px;margin-right:4px}
+.key{display:block;padding-left:17px;text-indent:-17px}
+table.timings td:first-child{white-space:nowrap}
+details.more-outliers{margin:0 0 8px} details.more-outliers summary{margin-bottom:6px}
 svg.chart{display:block;width:100%;max-width:1000px;background:#fff;border-radius:6px;
   box-shadow:0 1px 3px rgba(0,0,0,.12);font-size:12px}
 svg.chart text{fill:#1d2330} svg.chart text.tick{fill:#4a5366;font-size:11px}

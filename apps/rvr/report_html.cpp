@@ -27,6 +27,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/shared/html_escape.h"
 #include "rvr/shared/mismatch_classes.h"
+#include "rvr/shared/renderer.h"
 #include "timing_chart.h"
 
 namespace rvr {
@@ -48,8 +49,22 @@ struct MetricRow {
   bool flagged = false;
 };
 
+// A listed outlier's colour, on depth_diff.png and in its table: orange on an outline, blue on
+// an analytic sphere (both expected), red elsewhere (a real disagreement).
+const char* outlier_colour(DepthOutlierCause cause) {
+  switch (cause) {
+    case DepthOutlierCause::Silhouette:
+      return "#ff9f1c";
+    case DepthOutlierCause::AnalyticSphere:
+      return "#4dabf7";
+    case DepthOutlierCause::Elsewhere:
+      break;
+  }
+  return "#ff1744";
+}
+
 // Rings over depth_diff.png around the listed depth outliers, in its pixel coordinates (the
-// SVG stretches with the image): orange at a silhouette, red elsewhere.
+// SVG stretches with the image), coloured by cause.
 std::string outlier_marks(const DepthMetrics& depth, int width, int height) {
   if (depth.worst_outliers.empty() || width <= 0 || height <= 0) return "";
   std::ostringstream svg;
@@ -58,40 +73,64 @@ std::string outlier_marks(const DepthMetrics& depth, int width, int height) {
       << "\" preserveAspectRatio=\"none\" aria-hidden=\"true\">";
   for (const DepthOutlier& o : depth.worst_outliers)
     svg << "<circle cx=\"" << o.x + 0.5 << "\" cy=\"" << o.y + 0.5 << "\" r=\"" << r
-        << "\" fill=\"none\" stroke-width=\"" << r / 4 << "\" stroke=\""
-        << (o.cause == DepthOutlierCause::Silhouette ? "#ff9f1c" : "#ff1744") << "\"/>";
+        << "\" fill=\"none\" stroke-width=\"" << r / 4 << "\" stroke=\"" << outlier_colour(o.cause)
+        << "\"/>";
   svg << "</svg>";
   return svg.str();
 }
 
-// The listed depth outliers as a table: where, which object, both depths, why.
+// Rows of the outlier table shown before the rest is folded away: enough to see the worst,
+// few enough that the listing does not fill the page.
+constexpr size_t kOutlierRowsShown = 10;
+
+// Rows of the outlier table, from `begin` to `end` of the listed outliers.
+std::string outlier_rows(const std::vector<DepthOutlier>& listed, size_t begin, size_t end) {
+  std::ostringstream h;
+  for (size_t k = begin; k < end && k < listed.size(); ++k) {
+    const DepthOutlier& o = listed[k];
+    h << "<tr><td class=\"num\">" << o.x << "</td><td class=\"num\">" << o.y
+      << "</td><td class=\"num\">" << o.object << "</td><td class=\"num\">"
+      << fmt("%.7g", o.depth_a) << "</td><td class=\"num\">" << fmt("%.7g", o.depth_b)
+      << "</td><td class=\"num" << (o.cause == DepthOutlierCause::Elsewhere ? " bad" : "") << "\">"
+      << fmt("%.3g", o.rel_error)
+      << "</td><td><span class=\"sw\" style=\"background:" << outlier_colour(o.cause)
+      << "\"></span>" << to_string(o.cause) << "</td></tr>\n";
+  }
+  return h.str();
+}
+
+// The listed depth outliers as a table: where, which object, both depths, why; the first
+// kOutlierRowsShown shown, the rest folded away.
 std::string outlier_table(const DepthMetrics& depth, const std::string& name_a,
                           const std::string& name_b) {
   std::ostringstream h;
   h << "<h2>Depth outliers</h2>\n<p class=\"why\">" << depth.outliers
     << " pixels differ in depth by more than " << short_number(kDepthOutlierThreshold)
     << " (relative): " << depth.outliers_at_silhouettes << " on an object's outline, "
-    << depth.outliers_elsewhere
+    << depth.outliers_on_analytic_spheres << " on analytic spheres, " << depth.outliers_elsewhere
     << " elsewhere. On an outline, a facet seen edge-on changes depth faster than the "
        "z-buffer's sub-pixel vertex snapping (1/256 pixel) can follow, so a pixel centre a hair "
-       "outside one facet may be drawn on it while the tracer hits its neighbour. Anywhere else "
-       "the renderers disagree, unless spheres are analytic: then the z-buffer draws a polygon "
-       "inside the sphere (--spheres mesh compares like with like). They are ringed on "
-       "depth_diff.png (orange: outline, red: "
-       "elsewhere).</p>\n";
-  if (depth.worst_outliers.empty()) return h.str();
-  h << "<div class=\"scroll\"><table><thead><tr><th>x</th><th>y</th><th>object</th><th>depth "
-    << escape_html(name_a) << "</th><th>depth " << escape_html(name_b)
-    << "</th><th>relative error</th><th>cause</th></tr></thead><tbody>\n";
-  for (const DepthOutlier& o : depth.worst_outliers)
-    h << "<tr><td class=\"num\">" << o.x << "</td><td class=\"num\">" << o.y
-      << "</td><td class=\"num\">" << o.object << "</td><td class=\"num\">"
-      << fmt("%.7g", o.depth_a) << "</td><td class=\"num\">" << fmt("%.7g", o.depth_b)
-      << "</td><td class=\"num" << (o.cause == DepthOutlierCause::Elsewhere ? " bad" : "") << "\">"
-      << fmt("%.3g", o.rel_error) << "</td><td>" << to_string(o.cause) << "</td></tr>\n";
-  h << "</tbody></table></div>\n";
-  if (depth.outliers > depth.worst_outliers.size())
-    h << "<p class=\"why\">The " << depth.worst_outliers.size()
+       "outside one facet may be drawn on it while the tracer hits its neighbour. On an "
+       "analytic sphere the tracer sees the sphere and the z-buffer the polygon it draws "
+       "inside it: both depths lie between where the pixel's ray enters the sphere and where "
+       "it enters the largest ball inside the polygon (--spheres mesh compares like with "
+       "like). Both are expected. Anywhere else the renderers disagree. They are ringed on "
+       "depth_diff.png (orange: outline, blue: analytic sphere, red: elsewhere).</p>\n";
+  const std::vector<DepthOutlier>& listed = depth.worst_outliers;
+  if (listed.empty()) return h.str();
+  const std::string head =
+      "<div class=\"scroll\"><table><thead><tr><th>x</th><th>y</th>"
+      "<th>object</th><th>depth " +
+      escape_html(name_a) + "</th><th>depth " + escape_html(name_b) +
+      "</th><th>relative error</th><th>cause</th></tr></thead><tbody>\n";
+  const std::string tail = "</tbody></table></div>\n";
+  h << head << outlier_rows(listed, 0, kOutlierRowsShown) << tail;
+  if (listed.size() > kOutlierRowsShown)
+    h << "<details class=\"more-outliers\"><summary>The other " << listed.size() - kOutlierRowsShown
+      << " listed</summary>\n"
+      << head << outlier_rows(listed, kOutlierRowsShown, listed.size()) << tail << "</details>\n";
+  if (depth.outliers > listed.size())
+    h << "<p class=\"why\">The " << listed.size()
       << " largest are listed (metrics.json lists the same).</p>\n";
   return h.str();
 }
@@ -108,8 +147,9 @@ std::string class_legend() {
       "error)",
       "coverage: a surface in one image only, away from its edges"};
   std::ostringstream h;
+  // One line per class, wrapped within the card (a swatch hanging before its text).
   for (size_t c = 1; c < kMismatchClassColours.size(); ++c)
-    h << "<br><span class=\"nowrap\">" << swatch(kMismatchClassColours[c].data()) << kMeaning[c]
+    h << "<span class=\"key\">" << swatch(kMismatchClassColours[c].data()) << kMeaning[c]
       << "</span>";
   return h.str();
 }
@@ -410,7 +450,10 @@ std::vector<MetricRow> metric_rows(const ComparisonMetrics& m) {
            " (see Depth outliers below)."},
       {"depth", "outliers_at_silhouettes", std::to_string(dep.outliers_at_silhouettes),
        "Of those, on an object's outline: an edge-on facet under the z-buffer's vertex "
-       "snapping."},
+       "snapping. Expected."},
+      {"depth", "outliers_on_analytic_spheres", std::to_string(dep.outliers_on_analytic_spheres),
+       "Of those, on an analytic sphere, within what the z-buffer's polygon of it can differ "
+       "from the sphere along the pixel's ray. Expected; 0 with --spheres mesh."},
       {"depth", "outliers_elsewhere", std::to_string(dep.outliers_elsewhere),
        "Of those, anywhere else: unexplained, a real disagreement. Should be 0.",
        dep.outliers_elsewhere != 0},
@@ -451,7 +494,8 @@ std::string metrics_table(const std::vector<MetricRow>& rows) {
   return h.str();
 }
 
-// Timings: seconds and every "time.*" stat, one row per renderer.
+// Timings: seconds and every "time.*" stat, one column per renderer (phases are many more
+// than renderers, so the table grows down, not off the page's right edge).
 std::string timings(const ReportInput& input) {
   std::ostringstream h;
   std::set<std::string> time_keys;
@@ -463,25 +507,31 @@ std::string timings(const ReportInput& input) {
     << "<p class=\"why\" style=\"color:#4a5366;font-size:13px\">Each bar: the scene load "
        "(shared, outside the render call), the phases the renderer reports (time.* below) "
        "and, as <i>other</i>, the rest of its render call.</p>\n"
-    << "<div class=\"scroll\"><table><thead><tr><th>renderer</th><th>seconds</th>"
-       "<th>relative</th>";
-  for (const auto& k : time_keys) h << "<th>" << escape_html(k) << "</th>";
-  h << "<th>warnings</th></tr></thead><tbody>\n";
+    << "<div class=\"scroll\"><table class=\"timings\"><thead><tr><th></th>";
+  for (const auto& r : input.renderers) h << "<th class=\"num\">" << escape_html(r.name) << "</th>";
+  h << "</tr></thead><tbody>\n<tr><td><b>seconds</b></td>";
+  for (const auto& r : input.renderers)
+    h << "<td class=\"num\">" << fmt_seconds(r.seconds) << "</td>";
+  h << "</tr>\n<tr><td><b>relative</b></td>";
   const double base = input.renderers.empty() ? 0.0 : input.renderers[0].seconds;
-  for (const auto& r : input.renderers) {
-    h << "<tr><td><b>" << escape_html(r.name) << "</b></td><td class=\"num\">"
-      << fmt_seconds(r.seconds) << "</td><td class=\"num\">"
+  for (const auto& r : input.renderers)
+    h << "<td class=\"num\">"
       << (base > 0 ? fmt("%.2f&times;", r.seconds / base) : std::string("n/a")) << "</td>";
-    for (const auto& k : time_keys) {
+  h << "</tr>\n";
+  for (const auto& k : time_keys) {
+    h << "<tr><td><code>" << escape_html(k) << "</code></td>";
+    for (const auto& r : input.renderers) {
       auto it = r.stats.find(k);
       h << "<td class=\"num\">" << (it == r.stats.end() ? "&ndash;" : fmt_seconds(it->second))
         << "</td>";
     }
-    h << "<td class=\"num\">" << r.warnings.size() << "</td></tr>\n";
+    h << "</tr>\n";
   }
-  h << "</tbody></table></div>\n<p class=\"why\" style=\"color:#4a5366;font-size:13px\">seconds: "
-       "wall-clock time of the render call; relative: divided by the first renderer's; "
-       "time.*: the phases each renderer reports.</p>\n";
+  h << "<tr><td><b>warnings</b></td>";
+  for (const auto& r : input.renderers) h << "<td class=\"num\">" << r.warnings.size() << "</td>";
+  h << "</tr>\n</tbody></table></div>\n<p class=\"why\" style=\"color:#4a5366;font-size:13px\">"
+       "seconds: wall-clock time of the render call; relative: divided by the first "
+       "renderer's; time.*: the phases each renderer reports.</p>\n";
   return h.str();
 }
 
@@ -496,7 +546,8 @@ std::string all_statistics(const ReportInput& input) {
       h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">" << escape_html(v)
         << "</td></tr>\n";
     for (const auto& [k, v] : r.stats)
-      h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">" << fmt("%.6g", v)
+      h << "<tr><td><code>" << escape_html(k) << "</code></td><td class=\"num\">"
+        << (stat_kind(k) == StatKind::Count && v == std::floor(v) ? fmt("%.0f", v) : fmt("%.6g", v))
         << "</td></tr>\n";
     h << "</tbody></table></details>\n";
   }

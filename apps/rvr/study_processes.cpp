@@ -24,11 +24,11 @@
 #include <thread>
 #include <utility>
 
+#include "commands.h"
 #include "rvr/shared/expected.h"
 #include "rvr/study/memory_estimate.h"
 #include "rvr/study/renderer_frames.h"
 #include "rvr/study/sweep_plan.h"
-#include "commands.h"
 
 extern char** environ;
 
@@ -72,9 +72,10 @@ class Worker {
       return internal_error(fmt::format("study: cannot make a socket: {}", std::strerror(errno)));
     std::string names;
     for (const std::string& r : renderers) names += (names.empty() ? "" : ",") + r;
-    std::vector<std::string> args = {executable, "study-worker", "--mode", to_string(mode),
-                                     "--renderers", names};
+    std::vector<std::string> args = {executable,      "study-worker", "--mode",
+                                     to_string(mode), "--renderers",  names};
     std::vector<char*> argv;
+    argv.reserve(args.size() + 1);
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
     posix_spawn_file_actions_t actions;
@@ -144,8 +145,8 @@ class Worker {
     if (waitpid(pid_, &status, WNOHANG) == pid_)
       how = WIFSIGNALED(status) ? fmt::format("it was killed by signal {}", WTERMSIG(status))
                                 : fmt::format("it exited with status {}", WEXITSTATUS(status));
-    return internal_error(fmt::format("study: lost the worker process {} while {}: {}", pid_,
-                                      doing, how));
+    return internal_error(
+        fmt::format("study: lost the worker process {} while {}: {}", pid_, doing, how));
   }
 
   pid_t pid_;
@@ -203,7 +204,8 @@ class ProcessSession : public study::Session {
                                           {"n", n},
                                           {"width", width}});
     if (!reply) return reply.error();
-    return std::unique_ptr<study::FrameSource>(std::make_unique<ProcessFrames>(worker_, id, *reply));
+    return std::unique_ptr<study::FrameSource>(
+        std::make_unique<ProcessFrames>(worker_, id, *reply));
   }
 
  private:
@@ -225,9 +227,9 @@ json answer(const json& request, const std::vector<std::string>& renderers, Rend
     return {{"probe", json::parse(study::memory_probe_json(*probe))}};
   }
   if (op == "prepare") {
-    Expected<std::unique_ptr<study::FrameSource>> frames = study::prepare_frames(
-        renderers, mode, family_of(request.at("family")), request.at("n").get<size_t>(),
-        request.at("width").get<int>());
+    Expected<std::unique_ptr<study::FrameSource>> frames =
+        study::prepare_frames(renderers, mode, family_of(request.at("family")),
+                              request.at("n").get<size_t>(), request.at("width").get<int>());
     if (!frames) return error_json(frames.error());
     json prepare = json::array(), counters = json::array();
     for (size_t i = 0; i < renderers.size(); ++i) {

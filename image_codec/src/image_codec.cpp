@@ -1,12 +1,9 @@
 // OpenImageIO behind rvr_image_codec's C table (see image_codec_abi.h). No codec is written by
 // hand: the library picks the format from the extension. Exceptions never cross the C boundary.
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 #include <OpenImageIO/oiioversion.h>
 #include <OpenImageIO/typedesc.h>
 
-#include <algorithm>
 #include <cstring>
 #include <exception>
 #include <memory>
@@ -131,20 +128,8 @@ void close(rvr_image_reader* r) {
   delete r;
 }
 
-int inferno(const float* values, int w, int h, float* rgb) {
-  try {
-    OIIO::ImageBuf src(OIIO::ImageSpec(w, h, 1, OIIO::TypeDesc::FLOAT));
-    src.set_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, values);
-    OIIO::ImageBuf mapped = OIIO::ImageBufAlgo::color_map(src, 0, "inferno");
-    if (!mapped.initialized()) return 0;
-    return mapped.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, rgb) ? 1 : 0;
-  } catch (...) {
-    return 0;
-  }
-}
-
 const rvr_image_codec kCodec = {
-    RVR_IMAGE_CODEC_ABI_VERSION, library_version, write, open, channel_name, read, close, inferno};
+    RVR_IMAGE_CODEC_ABI_VERSION, library_version, write, open, channel_name, read, close};
 
 }  // namespace
 

@@ -10,9 +10,11 @@
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfThreading.h>
 #include <png.h>
 #include <strings.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <csetjmp>
 #include <cstdio>
@@ -20,6 +22,7 @@
 #include <exception>
 #include <set>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "rvr/image_codec/image_writer_abi.h"
@@ -119,6 +122,13 @@ int write_png(const char* path, int w, int h, int channels, const unsigned char*
 int write_exr(const char* path, int w, int h, int channels, const char* const* names,
               const float* pixels, char* err, size_t err_size) {
   try {
+    // OpenEXR compresses blocks of scan lines on its global thread pool, which has no threads
+    // unless asked for: one per core, as OpenImageIO gives it.
+    static const bool threaded = [] {
+      Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency())));
+      return true;
+    }();
+    (void)threaded;
     Imf::Header header(w, h);
     header.compression() = Imf::ZIP_COMPRESSION;  // OpenImageIO's default for EXR
     Imf::FrameBuffer frame;

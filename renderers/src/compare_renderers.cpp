@@ -56,6 +56,7 @@ ComparedPair compare_pair(const Scene& scene, const CompareResult& result, size_
   context.store_a = depth_store_of(ra.name, ra.output);
   context.store_b = depth_store_of(rb.name, rb.output);
   context.sphere_segments = compare.sphere_segments;
+  context.polygon_sphere_segments = compare.polygon_sphere_segments;
   ComparedPair p;
   p.a = ia;
   p.b = ib;
@@ -100,7 +101,10 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
 
   phase("", "compare");
   CompareOptions comparing = compare;
-  if (options.spheres == SphereMode::Mesh) comparing.sphere_segments = options.sphere_segments;
+  if (options.spheres == SphereMode::Mesh)
+    comparing.sphere_segments = options.sphere_segments;
+  else
+    comparing.polygon_sphere_segments = options.sphere_segments;
   return compare_rendered(scene, std::move(result.renderers), comparing);
 }
 

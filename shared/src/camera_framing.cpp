@@ -95,4 +95,52 @@ void frame_camera(Scene& scene, const BoundingSphere& bounds, glm::vec3 from) {
   c.focus_distance = distance;
 }
 
+ViewOfModel view_of_model(const Scene& scene, const Camera& camera, float aspect) {
+  const glm::dvec3 eye(camera.eye);
+  const glm::dvec3 f = glm::normalize(glm::dvec3(camera.target) - eye);
+  const glm::dvec3 x = glm::normalize(glm::cross(f, glm::dvec3(camera.up)));
+  const glm::dvec3 y = glm::cross(x, f);
+  const double tan_y = std::tan(glm::radians(double(camera.fov_y_deg)) * 0.5);
+  const double tan_x = tan_y * double(aspect);
+  double total = 0.0;
+  for (const Object& o : scene.objects) {
+    if (o.type != ObjectType::Triangles) continue;
+    for (const auto& t : o.mesh.triangles) {
+      const glm::dvec3 a(o.mesh.positions[t[0]]), b(o.mesh.positions[t[1]]),
+          c(o.mesh.positions[t[2]]);
+      total += 0.5 * glm::length(glm::cross(b - a, c - a));
+    }
+  }
+  ViewOfModel view;
+  if (!(total > 0.0) || !std::isfinite(total)) return view;
+  // Screen coordinates run from -1 to 1 across the frame.
+  double x0 = 1.0, x1 = -1.0, y0 = 1.0, y1 = -1.0;
+  int sample = 0, inside = 0;
+  double running = 0.0;
+  for (const Object& o : scene.objects) {
+    if (o.type != ObjectType::Triangles) continue;
+    for (const auto& t : o.mesh.triangles) {
+      const glm::dvec3 a(o.mesh.positions[t[0]]), b(o.mesh.positions[t[1]]),
+          c(o.mesh.positions[t[2]]);
+      running += 0.5 * glm::length(glm::cross(b - a, c - a));
+      for (; sample < kViewSamples && (sample + 0.5) / kViewSamples * total < running; ++sample) {
+        // The plastic number's 2-D sequence (R2), folded into the triangle.
+        double u = std::fmod(0.5 + sample * 0.7548776662466927, 1.0);
+        double v = std::fmod(0.5 + sample * 0.5698402909980532, 1.0);
+        if (u + v > 1.0) u = 1.0 - u, v = 1.0 - v;
+        const glm::dvec3 d = a + u * (b - a) + v * (c - a) - eye;
+        const double z = glm::dot(d, f);
+        if (!(z >= double(camera.near) && z <= double(camera.far))) continue;
+        const double sx = glm::dot(d, x) / (z * tan_x), sy = glm::dot(d, y) / (z * tan_y);
+        if (!(std::fabs(sx) <= 1.0 && std::fabs(sy) <= 1.0)) continue;
+        ++inside;
+        x0 = std::min(x0, sx), x1 = std::max(x1, sx), y0 = std::min(y0, sy), y1 = std::max(y1, sy);
+      }
+    }
+  }
+  view.seen = float(inside) / float(kViewSamples);
+  if (inside > 0) view.size = float(std::max(x1 - x0, y1 - y0) * 0.5);
+  return view;
+}
+
 }  // namespace rvr

@@ -10,12 +10,18 @@
 #include <glm/glm.hpp>
 #include <initializer_list>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "rvr/shared/camera.h"
 #include "rvr/shared/check.h"
+#include "rvr/shared/scene.h"
 #include "rvr/shared/srgb.h"
+#include "rvr/shared/tessellate.h"
 
 namespace rvr {
 
@@ -172,13 +178,105 @@ VisibilityMetrics with_coverage(VisibilityMetrics v, const FrameBuffers& a, cons
 }  // namespace
 
 const char* to_string(DepthOutlierCause cause) {
-  return cause == DepthOutlierCause::Silhouette ? "silhouette" : "elsewhere";
+  switch (cause) {
+    case DepthOutlierCause::Silhouette:
+      return "silhouette";
+    case DepthOutlierCause::AnalyticSphere:
+      return "analytic_sphere";
+    case DepthOutlierCause::Elsewhere:
+      return "elsewhere";
+  }
+  return "elsewhere";
 }
 
 namespace {
 
+// Where along a pixel's ray an analytic sphere and the z-buffer's polygon of it can be seen.
+// tessellate_sphere puts every vertex on the sphere, so the polygon (convex) lies inside the
+// sphere and contains the ball whose radius is the distance from the centre to the nearest
+// facet plane. A ray that enters the sphere at t_s enters the polygon at some t_p between t_s
+// and where it enters that inner ball (or, when it misses the ball, where it leaves the
+// sphere): T. A tracer sees t_s, a z-buffer t_p; both lie in [t_s, T]. Rays are the pixel
+// centres', with unit component along the view axis, so t is view depth.
+class SpherePolygons {
+ public:
+  SpherePolygons(const Scene& scene, int segments, int width, int height)
+      : scene_(scene), segments_(segments), inner_(scene.objects.size(), -1.0) {
+    const CameraFrame f = make_camera_frame(scene.camera, width, height);
+    eye_ = f.eye;
+    forward_ = f.forward;
+    right_ = f.right;
+    up_ = f.up;
+    tan_half_fov_y_ = f.tan_half_fov_y;
+    aspect_ = f.aspect;
+    width_ = width;
+    height_ = height;
+  }
+
+  // [t_s, T] of `object` at pixel (x, y); nullopt when the object is not an analytic sphere
+  // or the pixel's ray misses it.
+  std::optional<std::pair<double, double>> seen_between(uint32_t object, int x, int y) {
+    if (object >= scene_.objects.size() || scene_.objects[object].type != ObjectType::Sphere)
+      return std::nullopt;
+    const Sphere& s = scene_.objects[object].sphere;
+    const glm::dvec3 d = direction(x + 0.5, y + 0.5);
+    const std::optional<std::pair<double, double>> outer = span(d, s.center, s.radius);
+    if (!outer || !(outer->first > 0.0)) return std::nullopt;
+    const std::optional<std::pair<double, double>> ball = span(d, s.center, inner_radius(object));
+    return std::pair{outer->first, ball ? ball->first : outer->second};
+  }
+
+ private:
+  glm::dvec3 direction(double px, double py) const {
+    const double ndc_x = 2.0 * px / double(width_) - 1.0;
+    const double ndc_y = 1.0 - 2.0 * py / double(height_);
+    return forward_ + right_ * (ndc_x * tan_half_fov_y_ * aspect_) +
+           up_ * (ndc_y * tan_half_fov_y_);
+  }
+  // Where the ray eye + t d enters and leaves the ball; nullopt when it misses it.
+  std::optional<std::pair<double, double>> span(const glm::dvec3& d, const glm::vec3& centre,
+                                                double radius) const {
+    const glm::dvec3 oc = eye_ - glm::dvec3(centre);
+    const double a = glm::dot(d, d), b = glm::dot(d, oc), c = glm::dot(oc, oc) - radius * radius;
+    const double disc = b * b - a * c;
+    if (!(disc >= 0.0)) return std::nullopt;
+    const double root = std::sqrt(disc);
+    return std::pair{(-b - root) / a, (-b + root) / a};
+  }
+  // The distance from the sphere's centre to the nearest plane of its polygon's facets.
+  double inner_radius(uint32_t object) {
+    if (inner_[object] >= 0.0) return inner_[object];
+    const Sphere& s = scene_.objects[object].sphere;
+    const TriangleMesh mesh = tessellate_sphere(s, segments_);
+    double inner = s.radius;
+    for (const glm::uvec3& t : mesh.triangles) {
+      const glm::dvec3 p0(mesh.positions[t.x]), p1(mesh.positions[t.y]), p2(mesh.positions[t.z]);
+      const glm::dvec3 n = glm::cross(p1 - p0, p2 - p0);
+      const double len = glm::length(n);
+      if (len > 0.0)
+        inner = std::min(inner, std::fabs(glm::dot(n, p0 - glm::dvec3(s.center))) / len);
+    }
+    return inner_[object] = inner;
+  }
+
+  const Scene& scene_;
+  int segments_;
+  std::vector<double> inner_;  // per object, -1 until computed
+  glm::dvec3 eye_{0.0}, forward_{0.0}, right_{0.0}, up_{0.0};
+  double tan_half_fov_y_ = 1.0, aspect_ = 1.0;
+  int width_ = 1, height_ = 1;
+};
+
 // Depth statistics of the pixels whose ids agree and are not background.
-DepthMetrics depth_metrics(const FrameBuffers& a, const FrameBuffers& b) {
+DepthMetrics depth_metrics(const FrameBuffers& a, const FrameBuffers& b,
+                           const MismatchContext& context) {
+  std::optional<SpherePolygons> polygons;
+  double near = 0.0, far = 0.0;
+  if (context.scene && context.polygon_sphere_segments > 0) {
+    polygons.emplace(*context.scene, context.polygon_sphere_segments, a.width, a.height);
+    near = context.scene->camera.near;
+    far = context.scene->camera.far > near ? context.scene->camera.far : 2.0 * near;
+  }
   DepthMetrics m;
   std::vector<double> errors;
   errors.reserve(a.pixel_count());
@@ -193,10 +291,23 @@ DepthMetrics depth_metrics(const FrameBuffers& a, const FrameBuffers& b) {
       sum += rel;
       m.max_rel_error = std::max(m.max_rel_error, rel);
       if (!(rel > kDepthOutlierThreshold)) continue;
-      const DepthOutlierCause cause =
-          on_outline(a, b, x, y) ? DepthOutlierCause::Silhouette : DepthOutlierCause::Elsewhere;
+      DepthOutlierCause cause = DepthOutlierCause::Elsewhere;
+      if (on_outline(a, b, x, y)) {
+        cause = DepthOutlierCause::Silhouette;
+      } else if (polygons) {
+        const auto seen = polygons->seen_between(a.object_id[i], x, y);
+        // Each depth within its store's resolution of [t_s, T].
+        auto within = [&](double depth, DepthStore store) {
+          const double res = depth_resolution(store, std::max(depth, near), near, far);
+          return seen && depth >= seen->first - res && depth <= seen->second + res;
+        };
+        if (within(a.depth[i], context.store_a) && within(b.depth[i], context.store_b))
+          cause = DepthOutlierCause::AnalyticSphere;
+      }
       ++m.outliers;
-      ++(cause == DepthOutlierCause::Silhouette ? m.outliers_at_silhouettes : m.outliers_elsewhere);
+      ++(cause == DepthOutlierCause::Silhouette       ? m.outliers_at_silhouettes
+         : cause == DepthOutlierCause::AnalyticSphere ? m.outliers_on_analytic_spheres
+                                                      : m.outliers_elsewhere);
       listed.push_back({x, y, a.object_id[i], rel, a.depth[i], b.depth[i], cause});
       if (listed.size() > 2 * DepthMetrics::kMaxListed) {  // keep the list bounded
         std::sort(listed.begin(), listed.end(), [](const DepthOutlier& p, const DepthOutlier& q) {
@@ -281,7 +392,7 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b,
   m.visibility.id_agreement = double(n - mismatched) / double(n);
   m.visibility = with_coverage(m.visibility, a, b);
   m.visibility.classes = count_classes(classify_mismatches(a, b, context));
-  m.depth = depth_metrics(a, b);
+  m.depth = depth_metrics(a, b, context);
   m.lod = lod_metrics(a, b);
 
   // Colour, linear values, peak 1.

@@ -22,12 +22,15 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <glm/glm.hpp>
 #include <initializer_list>
+#include <iterator>
 #include <map>
 #include <memory>
 #include <new>
+#include <nlohmann/json.hpp>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -40,6 +43,7 @@
 #include "mesh_repair.h"
 #include "model_wire.h"
 #include "scene_json_errors.h"
+#include "scene_json_parse.h"
 
 namespace rvr::scene_load {
 namespace {
@@ -281,11 +285,53 @@ fs::path resolve(const std::string& file, const std::string& base_dir, const std
   return full;
 }
 
+// Where the JSON of a .gltf file breaks: Assimp's glTF readers refuse a file whose JSON does
+// not parse without saying where ("No suitable reader found"). "JSON syntax at line L, column
+// C: what" (a truncated file: where its JSON ends), or "" when the JSON parses.
+std::string gltf_json_problem(const fs::path& full) {
+  struct SyntaxOnly {  // nlohmann's SAX interface, keeping nothing but the first error
+    bool null() { return true; }
+    bool boolean(bool) { return true; }
+    bool number_integer(json::number_integer_t) { return true; }
+    bool number_unsigned(json::number_unsigned_t) { return true; }
+    bool number_float(json::number_float_t, const json::string_t&) { return true; }
+    bool string(json::string_t&) { return true; }
+    bool binary(json::binary_t&) { return true; }
+    bool start_object(std::size_t) { return true; }
+    bool key(json::string_t&) { return true; }
+    bool end_object() { return true; }
+    bool start_array(std::size_t) { return true; }
+    bool end_array() { return true; }
+    bool parse_error(std::size_t at, const std::string&, const nlohmann::detail::exception& e) {
+      position = at;
+      message = e.what();
+      return false;
+    }
+    std::size_t position = 0;
+    std::string message;
+  };
+  std::ifstream in(full, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  SyntaxOnly sax;
+  if (json::sax_parse(text, &sax, json::input_format_t::json, true, true) || sax.message.empty()) {
+    return {};
+  }
+  const bool whitespace_only = text.find_first_not_of(" \t\r\n") == std::string::npos;
+  bool token_error = false;
+  const std::string what = syntax_message(sax.message, whitespace_only, &token_error);
+  const size_t last = sax.position == 0 ? 0 : sax.position - 1;
+  const size_t at = token_error ? token_start(text, last) : last;
+  const auto [line, column] = line_column(text, at);
+  const bool at_the_end = text.find_first_not_of(" \t\r\n", at) == std::string::npos;
+  return fmt::format("JSON syntax at line {}, column {}{}: {}", line, column,
+                     at_the_end ? ", where the file ends" : "", what);
+}
+
 [[noreturn]] void import_failed(const Assimp::Importer& importer, const std::string& file,
                                 const std::string& path) {
   std::string reason = importer.GetErrorString();
   std::replace(reason.begin(), reason.end(), '\n', ' ');
-  fail(path, "cannot read " + quote_json(file) + ": " +
+  fail(path, "cannot read " + quote_path(file) + ": " +
                  (reason.empty() ? "the importer gave no reason" : reason));
 }
 
@@ -296,7 +342,7 @@ fs::path resolve(const std::string& file, const std::string& base_dir, const std
 // reader made ourselves, then post-process (post_process below).
 const aiScene* read_checked(Assimp::Importer& importer, const fs::path& full,
                             const std::string& file, const std::string& path) {
-  std::string prefix = "cannot read " + quote_json(file) + ": ";
+  std::string prefix = "cannot read " + quote_path(file) + ": ";
   if (std::string problem = file_status(full); !problem.empty()) fail(path, prefix + problem);
   std::string ext = full.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -317,9 +363,14 @@ const aiScene* read_checked(Assimp::Importer& importer, const fs::path& full,
                                       memory.limit() >> 20));
     }
   }
+  if (!ai && ext == ".gltf") {
+    if (std::string problem = gltf_json_problem(full); !problem.empty()) {
+      fail(path, prefix + problem);
+    }
+  }
   if (!ai) import_failed(importer, file, path);
   if (std::string problem = raw_mesh_problem(ai); !problem.empty()) {
-    fail(path, quote_json(file) + ": " + problem);
+    fail(path, quote_path(file) + ": " + problem);
   }
   return ai;
 }
@@ -334,7 +385,7 @@ const aiScene* post_process(Assimp::Importer& importer, unsigned flags, const st
     vertices += ai->mMeshes[m]->mNumVertices;
   }
   if (faces > kMaxMeshTriangles || vertices > 3 * kMaxMeshTriangles) {
-    fail(path, fmt::format("{} has {} faces, more than the limit of {} triangles", quote_json(file),
+    fail(path, fmt::format("{} has {} faces, more than the limit of {} triangles", quote_path(file),
                            faces, kMaxMeshTriangles));
   }
   return ai;
@@ -374,7 +425,7 @@ void append_mesh(TriangleMesh& mesh, const aiScene* ai, unsigned m, bool normals
     glm::vec3 pos(p.x, p.y, p.z);
     if (!finite(pos)) {
       fail(path, fmt::format("{}: vertex {} of mesh {} has a non-finite coordinate",
-                             quote_json(file), v, m));
+                             quote_path(file), v, m));
     }
     mesh.positions.push_back(pos);
     if (normals) {
@@ -392,7 +443,7 @@ void append_mesh(TriangleMesh& mesh, const aiScene* ai, unsigned m, bool normals
     for (int k = 0; k < 3; ++k) {
       if (face.mIndices[k] >= am->mNumVertices) {
         fail(path, fmt::format("{}: face {} of mesh {} has a vertex index out of range",
-                               quote_json(file), f, m));
+                               quote_path(file), f, m));
       }
     }
     mesh.triangles.emplace_back(base + face.mIndices[0], base + face.mIndices[1],
@@ -444,7 +495,7 @@ std::vector<std::string> other_contents(const aiScene* raw) {
     holds += (i + 1 == contents.size() ? " and " : ", ") + contents[i];
   std::string what = "no triangles (the file holds only " + holds + ")";
   if (path.empty()) fail("objects", what);
-  fail(path, quote_json(file) + ": " + what);
+  fail(path, quote_path(file) + ": " + what);
 }
 
 // Facet normals of an STL file that contradict the facet's winding: the normal points to the
@@ -988,7 +1039,7 @@ std::string import_isolated(const std::function<std::string()>& body, const std:
                             const std::string& path) {
   IsolatedResult r = run_isolated([&] { return child_side(body); }, kCpuSeconds);
   if (r.status != IsolatedResult::Status::Ok || r.bytes.empty()) {
-    fail(path, "cannot read " + quote_json(file) + ": the importer " +
+    fail(path, "cannot read " + quote_path(file) + ": the importer " +
                    (r.problem.empty() ? "returned nothing" : r.problem) + " on this file");
   }
   char tag = r.bytes.back();

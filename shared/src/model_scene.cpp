@@ -13,7 +13,6 @@
 #include <exception>
 #include <filesystem>
 #include <glm/glm.hpp>
-#include <initializer_list>
 #include <new>
 #include <optional>
 #include <set>
@@ -89,22 +88,20 @@ void turn_model(ImportedModel& model, const glm::mat3& r) {
   for (Light& l : model.lights) l.position = r * l.position;
 }
 
-// Whether any of the sphere lies inside the camera's view volume (between near and far and
-// inside the four side planes).
-bool camera_sees(const Camera& c, float aspect, const BoundingSphere& b) {
-  glm::vec3 f = glm::normalize(c.target - c.eye);
-  glm::vec3 x = glm::normalize(glm::cross(f, c.up));
-  glm::vec3 y = glm::cross(x, f);
-  glm::vec3 d = b.centre - c.eye;
-  float px = glm::dot(d, x), py = glm::dot(d, y), pz = glm::dot(d, f);
-  if (pz + b.radius < c.near || pz - b.radius > c.far) return false;
-  float half_y = 0.5f * glm::radians(c.fov_y_deg);
-  float half_x = std::atan(std::tan(half_y) * aspect);
-  // Signed distances to the side planes through the eye, positive outside.
-  for (auto [p, half] : {std::pair{px, half_x}, std::pair{py, half_y}}) {
-    if (std::fabs(p) * std::cos(half) - pz * std::sin(half) > b.radius) return false;
+// Why a file camera does not frame the model (view_of_model, kMinSeen, kMinSize), or "" when
+// it does.
+std::string camera_problem(const ViewOfModel& view) {
+  auto percent = [](float share) { return fmt::format("{:.0f}%", 100.0f * share); };
+  if (view.seen == 0.0f) return "sees none of the model";
+  if (view.seen < kMinSeen) {
+    return fmt::format("sees {} of the model's surface (under {}: a part or a close-up)",
+                       percent(view.seen), percent(kMinSeen));
   }
-  return true;
+  if (view.size < kMinSize) {
+    return fmt::format("shows the model {} of the frame across (under {})", percent(view.size),
+                       percent(kMinSize));
+  }
+  return {};
 }
 
 // The automatic exposure of a model file: the brightest a diffuse surface of the model can
@@ -182,17 +179,20 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
   }
   if (scene.objects.empty()) fail("", "all triangles are degenerate (zero area)");
   BoundingSphere bounds = scene_bounds(scene);
-  if (model.camera && !view_from && overrides.camera == FromFile::File) {
-    // A file camera that sees none of the model (e.g. an exporter's camera left where it
-    // was) gives an image of background only: framed instead, with a warning.
-    float aspect = model.camera_aspect > 0.0f
-                       ? model.camera_aspect
-                       : float(overrides.width.value_or(scene.image.width)) /
-                             float(overrides.height.value_or(scene.image.height));
-    if (!camera_sees(*model.camera, aspect, bounds)) {
-      model.warnings.push_back(
-          "the file's camera sees none of the model; framing the model "
-          "instead");
+  if (model.camera && !view_from && overrides.camera == FromFile::File &&
+      overrides.judge_file_camera) {
+    // A file camera that shows a part of the model, a close-up, a speck or nothing at all (an
+    // exporter's camera left where it was) is replaced by the framing camera, with a warning.
+    // Judged in the frame the image will have: a height given makes its shape, else the
+    // camera's aspect ratio does (below).
+    const float width = float(overrides.width.value_or(scene.image.width));
+    const float aspect = overrides.height             ? width / float(*overrides.height)
+                         : model.camera_aspect > 0.0f ? model.camera_aspect
+                                                      : width / float(scene.image.height);
+    if (const std::string problem = camera_problem(view_of_model(scene, *model.camera, aspect));
+        !problem.empty()) {
+      model.warnings.push_back("the file's camera " + problem +
+                               "; framing the model instead (--camera file-always keeps it)");
       model.camera.reset();
     }
   }

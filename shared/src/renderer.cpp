@@ -3,6 +3,7 @@
 #include <initializer_list>
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace rvr {
 
@@ -48,6 +49,15 @@ std::optional<DepthFormat> parse_depth_format(const std::string& name) {
   for (DepthFormat f : {DepthFormat::D24, DepthFormat::D32F, DepthFormat::D32FReversed})
     if (name == to_string(f)) return f;
   return std::nullopt;
+}
+
+StatKind stat_kind(const std::string& name) {
+  std::string_view n = name;
+  while (n.rfind("zbuffer.", 0) == 0) n.remove_prefix(8);
+  if (n.rfind("time.", 0) == 0) return StatKind::Seconds;
+  for (std::string_view ratio : {"overdraw", "bvh.node_fill", "bvh.block_fill", "bvh.sah_cost"})
+    if (n == ratio) return StatKind::Ratio;
+  return StatKind::Count;
 }
 
 }  // namespace rvr

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <utility>
 
@@ -31,6 +32,31 @@ std::string quote_json(const std::string& s) {
   std::string q = json(shown).dump(-1, ' ', false, json::error_handler_t::replace);
   q.front() = q.back() = '\'';
   return q;
+}
+
+std::string quote_path(const std::string& path) {
+  // JSON's escaping makes the bytes valid UTF-8 (U+FFFD for the others); reading the string
+  // back undoes every escape, and only control characters are escaped again.
+  std::string shown = path.size() > kPathMax ? path.substr(0, kPathMax) + "..." : path;
+  const std::string valid =
+      json::parse(json(shown).dump(-1, ' ', false, json::error_handler_t::replace))
+          .get<std::string>();
+  std::string q = "'";
+  for (const char c : valid) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\n') {
+      q += "\\n";
+    } else if (c == '\t') {
+      q += "\\t";
+    } else if (c == '\r') {
+      q += "\\r";
+    } else if (u < 0x20 || u == 0x7f) {
+      q += fmt::format("\\u{:04x}", u);
+    } else {
+      q += c;
+    }
+  }
+  return q + "'";
 }
 
 // What a JSON value is, for "must be X, got Y" messages.

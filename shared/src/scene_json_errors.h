@@ -28,7 +28,14 @@ struct SyntaxError {
 [[noreturn]] void fail(std::string path, std::string what);
 
 std::string fmt_num(double v);
+// 'text', JSON-escaped inside, cut short after 60 bytes with "..." so that a hostile string
+// cannot flood the message: for values read from a file.
 std::string quote_json(const std::string& s);
+// 'path' whole, as the file system spells it: backslashes stay single, control characters are
+// escaped (\n, \u001b) and bytes that are no UTF-8 become U+FFFD. Cut only past kPathMax bytes,
+// longer than any path Linux opens.
+std::string quote_path(const std::string& path);
+constexpr size_t kPathMax = 4096;
 // What a JSON value is, for "must be X, got Y" messages.
 std::string describe(const json& v);
 bool is_identifier(const std::string& s);

@@ -429,12 +429,12 @@ class Reader {
     o.mesh = import_mesh(file, base_dir_, fp, smooth, &skipped, &file_warnings);
     for (const std::string& w : file_warnings)
       scene_.warnings.push_back(fmt::format("{}: {}", label, w));
-    read_vertex_values(v, path, o.mesh, fmt::format(" of {} as loaded", quote_json(file)));
+    read_vertex_values(v, path, o.mesh, fmt::format(" of {} as loaded", quote_path(file)));
     size_t total = o.mesh.triangles.size();
     finish_mesh(o.mesh, t, path, &dropped, &repaired);
     if (o.mesh.triangles.empty()) {
       fail(fp,
-           fmt::format("{}: all {} triangles are degenerate (zero area)", quote_json(file), total));
+           fmt::format("{}: all {} triangles are degenerate (zero area)", quote_path(file), total));
     }
     if (skipped > 0) {
       scene_.warnings.push_back(
@@ -538,7 +538,7 @@ class Reader {
       scene_.objects.push_back(std::move(o));
     }
     if (scene_.objects.size() == before) {
-      fail(fp, quote_json(file) + ": all triangles are degenerate (zero area)");
+      fail(fp, quote_path(file) + ": all triangles are degenerate (zero area)");
     }
     for (const std::string& w : model.warnings)
       scene_.warnings.emplace_back(label + ": ").append(w);

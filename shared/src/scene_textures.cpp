@@ -61,17 +61,19 @@ const SceneTextures::Image& SceneTextures::image(const std::string& file, const 
                       label, quote_json(e.name), reason_of(mips.error().message)));
     }
   } else if (resolved.empty()) {
+    const std::string parent = texture_search_parent(folder);
     warnings_.push_back(fmt::format(
-        "{}: texture {} not found (looked in {} and its subfolders): rendered without it", label,
-        quote_json(file), "'" + (folder.empty() ? std::string(".") : folder) + "'"));
+        "{}: texture {} not found (looked in {}{} and {} subfolders): rendered without it", label,
+        quote_path(file), quote_path(folder.empty() ? std::string(".") : folder),
+        parent.empty() ? "" : ", " + quote_path(parent), parent.empty() ? "its" : "their"));
   } else {
     Expected<std::shared_ptr<const MipChain>> mips = read_texture_file(resolved);
     if (mips) {
       image.mips = *mips;
     } else {
-      warnings_.push_back(
-          fmt::format("{}: cannot read texture {} at '{}' ({}): rendered without it", label,
-                      quote_json(file), resolved, reason_of(mips.error().message)));
+      warnings_.push_back(fmt::format("{}: cannot read texture {} at {} ({}): rendered without it",
+                                      label, quote_path(file), quote_path(resolved),
+                                      reason_of(mips.error().message)));
     }
   }
   return image;

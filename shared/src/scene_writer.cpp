@@ -95,19 +95,25 @@ Image texture_image(const MipChain& mips) {
   return img;
 }
 
-// Where the document names texture i: its file relative to the document's folder (absolute
-// when there is no relative way), a file written beside the document for a texture in memory
-// only, the name it had for one that was not found.
+// Where the document names texture i: its file relative to the document's folder when it lies
+// under that folder, else its absolute path or (`copy`) a copy beside the document; a file
+// written beside the document for a texture in memory only; the name it had for one that was
+// not found.
 std::string texture_file(const Scene& scene, size_t i, const std::string& mesh_prefix,
-                         const std::string& document_folder, SceneDocument& doc) {
+                         const std::string& document_folder, bool copy, SceneDocument& doc) {
   namespace fs = std::filesystem;
   const Texture& t = scene.textures[i];
   if (!t.resolved.empty()) {
     std::error_code ec;
-    const fs::path file = fs::absolute(t.resolved, ec);
-    const fs::path folder = fs::absolute(document_folder.empty() ? "." : document_folder, ec);
-    fs::path relative = fs::proximate(file, folder, ec);
-    return (ec || relative.empty() ? file : relative).generic_string();
+    const fs::path file = fs::absolute(t.resolved, ec).lexically_normal();
+    const fs::path folder =
+        fs::absolute(document_folder.empty() ? "." : document_folder, ec).lexically_normal();
+    const fs::path relative = file.lexically_relative(folder);
+    if (!ec && !relative.empty() && *relative.begin() != "..") return relative.generic_string();
+    if (!copy) return file.generic_string();
+    std::string name = fmt::format("{}.texture{}{}", mesh_prefix, i, file.extension().string());
+    doc.copied_files.push_back({name, file.string()});
+    return name;
   }
   if (!t.mips || t.mips->levels.empty()) return t.file;
   std::string name = fmt::format("{}.texture{}.exr", mesh_prefix, i);
@@ -314,7 +320,7 @@ json triangle_members(json j, const TriangleMesh& mesh, const std::string& path)
 }
 
 SceneDocument write(const Scene& scene, const std::string& mesh_prefix,
-                    const std::string& document_folder) {
+                    const std::string& document_folder, bool copy_texture_files) {
   SceneDocument doc;
   json root = json::object();
   root["format"] = "rvr-scene/1";
@@ -353,7 +359,8 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix,
       if (size_t(m.texture) >= scene.textures.size()) fail(path + ": texture index out of range");
       auto [it, added] = texture_files.try_emplace(size_t(m.texture));
       if (added) {
-        it->second = texture_file(scene, size_t(m.texture), mesh_prefix, document_folder, doc);
+        it->second = texture_file(scene, size_t(m.texture), mesh_prefix, document_folder,
+                                  copy_texture_files, doc);
       }
       materials[m.name]["texture"] = texture_json(m, it->second, path + ".texture", scene);
     }
@@ -415,10 +422,10 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix,
 }  // namespace
 
 Expected<SceneDocument> write_scene(const Scene& scene, const std::string& mesh_prefix,
-                                    const std::string& document_folder) {
+                                    const std::string& document_folder, bool copy_texture_files) {
   std::string source = scene.source.empty() ? "scene" : scene.source;
   try {
-    return write(scene, mesh_prefix, document_folder);
+    return write(scene, mesh_prefix, document_folder, copy_texture_files);
   } catch (const WriteError& e) {
     return bad_input(source + ": " + e.what);
   } catch (const std::exception& e) {

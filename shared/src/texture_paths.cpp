@@ -77,8 +77,10 @@ fs::path match_case_insensitively(const fs::path& folder, const fs::path& relati
 }
 
 // A file named `name` under `folder`, at most kSearchDepth folders down, breadth first (the
-// shallowest wins); a name of the same case before one that differs in case.
-fs::path search_by_name(const fs::path& folder, const std::string& name) {
+// shallowest wins); a name of the same case before one that differs in case. The folder `skip`
+// (already searched) is not entered.
+fs::path search_by_name(const fs::path& folder, const std::string& name,
+                        const fs::path& skip = {}) {
   size_t budget = kSearchEntries;
   fs::path other_case;  // the first name that differs only in case, and its depth
   int other_depth = 0;
@@ -90,7 +92,7 @@ fs::path search_by_name(const fs::path& folder, const std::string& name) {
     for (const fs::path& e : entries(at, &budget)) {
       std::error_code ec;
       if (fs::is_directory(e, ec)) {
-        if (depth < kSearchDepth) queue.emplace_back(e, depth + 1);
+        if (depth < kSearchDepth && e != skip) queue.emplace_back(e, depth + 1);
       } else if (is_file(e)) {
         if (e.filename().string() == name) return e;
         if (other_case.empty() && lower(e.filename().string()) == lower(name)) {
@@ -123,16 +125,38 @@ std::string percent_decoded(const std::string& p) {
   return out.find('\0') == std::string::npos ? out : std::string();
 }
 
-// The path as written, then with each name matched regardless of case.
+// The path as written, then with each name matched regardless of case. A path from the root
+// that is not there is read from `base` too: Windows exporters write \..\maps\x.png (from the
+// root of the drive, which is "/../maps/x.png" here) for a path from the model's folder.
 fs::path find_as_written(const std::string& p, const fs::path& base) {
   if (windows_absolute(p)) return {};
   fs::path written = fs::path(p).is_absolute() ? fs::path(p) : base / p;
   if (is_file(written)) return written;
   if (fs::path(p).is_relative()) return match_case_insensitively(base, fs::path(p));
-  return {};
+  const size_t first = p.find_first_not_of('/');
+  if (first == std::string::npos) return {};
+  const std::string from_base = p.substr(first);
+  if (is_file(base / from_base)) return base / from_base;
+  return match_case_insensitively(base, fs::path(from_base));
+}
+
+// `folder` absolute, normalised and without a trailing separator ("" when it cannot be made
+// absolute).
+fs::path normal_folder(const std::string& folder) {
+  std::error_code ec;
+  fs::path p = fs::absolute(folder.empty() ? fs::path(".") : fs::path(folder), ec);
+  if (ec) return {};
+  p = p.lexically_normal();
+  return p.has_filename() || p == p.root_path() ? p : p.parent_path();
 }
 
 }  // namespace
+
+std::string texture_search_parent(const std::string& folder) {
+  const fs::path base = normal_folder(folder);
+  const fs::path parent = base.parent_path();
+  return base.empty() || parent == base ? std::string() : parent.string();
+}
 
 std::string find_texture_file(const std::string& named, const std::string& folder) {
   std::string p = named;
@@ -146,11 +170,16 @@ std::string find_texture_file(const std::string& named, const std::string& folde
     const fs::path found = find_as_written(candidate, base);
     if (!found.empty()) return found.string();
   }
-  for (const std::string& candidate : {p, decoded}) {
-    const std::string name = fs::path(candidate).filename().string();
-    if (candidate.empty() || name.empty() || name == "." || name == "..") continue;
-    const fs::path found = search_by_name(base, name);
-    if (!found.empty()) return found.string();
+  const std::string parent = texture_search_parent(folder);
+  for (const bool in_parent : {false, true}) {
+    if (in_parent && parent.empty()) break;
+    for (const std::string& candidate : {p, decoded}) {
+      const std::string name = fs::path(candidate).filename().string();
+      if (candidate.empty() || name.empty() || name == "." || name == "..") continue;
+      const fs::path found = in_parent ? search_by_name(parent, name, normal_folder(folder))
+                                       : search_by_name(base, name);
+      if (!found.empty()) return found.string();
+    }
   }
   return {};
 }

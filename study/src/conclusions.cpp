@@ -16,6 +16,7 @@
 
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"
+#include "rvr/study/counted_work.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/scene_changes.h"
@@ -47,9 +48,9 @@ std::vector<Measurement> fit_points(StudyResult& r, const std::string& renderer,
   for (const Measurement& m : all)
     if (!m.busy()) quiet.push_back(m);
   if (quiet.size() >= enough || quiet.size() == all.size()) return quiet;
-  r.notes.push_back(fmt::format(
-      "{} on {}: {} (only {} of {} points had a quiet run): its costs are overstated", renderer,
-      scene, kBusyFitWords, quiet.size(), all.size()));
+  r.notes.push_back(
+      fmt::format("{} on {}: {} (only {} of {} points had a quiet run): its costs are overstated",
+                  renderer, scene, kBusyFitWords, quiet.size(), all.size()));
   return all;
 }
 
@@ -95,6 +96,23 @@ LoopOrder order_of(const std::string& renderer) {
   return c ? c->info->order : LoopOrder::TriangleMajor;
 }
 
+// The renderer's work model of a family from the points its formula model is fitted to (none
+// when they carry no counts), and its counts' scaling and the chapter's claims from every point
+// it measured (counts do not depend on how busy the machine was).
+void counted_work(StudyResult& r, const std::string& renderer, ModelForm form,
+                  const std::string& scene, const std::vector<Measurement>& fitted,
+                  const BootstrapOptions& boot) {
+  const bool counted = std::any_of(fitted.begin(), fitted.end(),
+                                   [](const Measurement& m) { return !m.counters.empty(); });
+  if (counted) r.work_models.push_back(fit_work_model(renderer, form, fitted, boot));
+  const std::vector<Measurement> all = points_of(r, renderer, scene);
+  const double full = double(r.width) * double(r.height);
+  for (CountScaling& s : count_scaling(renderer, form, scene, r.axes[scene], full, all))
+    r.count_scaling.push_back(std::move(s));
+  for (CountClaim& c : count_claims(renderer, form, scene, r.axes[scene], full, all))
+    r.count_claims.push_back(std::move(c));
+}
+
 void fit_models(StudyResult& r, const BootstrapOptions& boot) {
   for (const std::string& name : r.renderers) {
     RendererModels m;
@@ -104,7 +122,9 @@ void fit_models(StudyResult& r, const BootstrapOptions& boot) {
     for (const std::string& scene : r.scenes) {
       const CostModel textbook = textbook_model(m.form, r.axes[scene]);
       const size_t enough = coefficient_names(textbook).size() + 2;
-      m.fits[scene] = fit_chosen_model(textbook, fit_points(r, name, scene, enough), boot);
+      const std::vector<Measurement> points = fit_points(r, name, scene, enough);
+      m.fits[scene] = fit_chosen_model(textbook, points, boot);
+      counted_work(r, name, m.form, scene, points, boot);
     }
     r.models.push_back(m);
   }
@@ -174,10 +194,9 @@ void compare_pairs(StudyResult& r, const BootstrapOptions& boot) {
       for (size_t j = i + 1; j < r.renderers.size(); ++j) {
         const std::string &a = r.renderers[i], &b = r.renderers[j];
         if (!compared_pair(a, b)) continue;
-        add_comparison(r,
-                       compare_curves(along_n(r, a, scene), along_n(r, b, scene), r.axes[scene],
-                                      options),
-                       true);
+        add_comparison(
+            r, compare_curves(along_n(r, a, scene), along_n(r, b, scene), r.axes[scene], options),
+            true);
         for (double n : pixel_sweep_columns(r, scene))
           add_comparison(r,
                          compare_curves(along_pixels(r, a, scene, n), along_pixels(r, b, scene, n),
@@ -325,8 +344,7 @@ std::string no_conclusion_reason(const StudyResult& r) {
       "{} measurements at {} points, too few for a comparison ({} points along an axis) or "
       "a model",
       points, points / std::max<size_t>(r.renderers.size(), 1), kMinComparedPoints);
-  if (busy > 0)
-    why += fmt::format("; {} of them measured only while the machine was busy", busy);
+  if (busy > 0) why += fmt::format("; {} of them measured only while the machine was busy", busy);
   return why + ": give the study a larger --budget";
 }
 

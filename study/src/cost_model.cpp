@@ -42,8 +42,12 @@ std::string formula(const CostModel& model) {
   if (model.edges) text += " + e·√(P·N)";
   if (model.knee > 0) {
     std::string knee = format_number(model.knee);
-    text += model.form == ModelForm::Tracer ? " + f·P·max(0, log2(N / " + knee + "))"
-                                            : " + f·max(0, N − " + knee + ")";
+    if (model.flatter)
+      text += model.form == ModelForm::Tracer ? " + f·P·min(log2 N, log2 " + knee + ")"
+                                              : " + f·min(N, " + knee + ")";
+    else
+      text += model.form == ModelForm::Tracer ? " + f·P·max(0, log2(N / " + knee + "))"
+                                              : " + f·max(0, N − " + knee + ")";
   }
   return text;
 }
@@ -74,7 +78,11 @@ std::vector<double> features(const CostModel& model, double pixels, double n) {
   }
   if (model.depth && model.form != ModelForm::Tracer) x.push_back(pixels * n);
   if (model.edges) x.push_back(std::sqrt(pixels * n));
-  if (model.knee > 0) {
+  if (model.knee > 0 && model.flatter) {
+    x.push_back(model.form == ModelForm::Tracer
+                    ? pixels * std::min(tree_levels, std::log2(model.knee))
+                    : std::min(n, model.knee));
+  } else if (model.knee > 0) {
     x.push_back(model.form == ModelForm::Tracer
                     ? pixels * std::max(0.0, std::log2(std::max(n, 1.0) / model.knee))
                     : std::max(0.0, n - model.knee));

@@ -57,18 +57,24 @@ Matched matched(const std::vector<Measurement>& a, const std::vector<Measurement
   return m;
 }
 
-// The bootstrap of the trend: per replicate, every point's log ratio redrawn hierarchically
-// (runs, then rounds) plus the noise between points (normal, sd `point_noise`), then the trend.
-// replicates[r][j] is replicate r's trend at point j.
-std::vector<std::vector<double>> trend_replicates(const Matched& m, const Trend& trend,
-                                                  double point_noise, Rng& rng, int count) {
-  std::vector<std::vector<double>> out;
-  out.reserve(size_t(count));
+// The bootstrap of the points and their trend: per replicate, every point's log ratio redrawn
+// hierarchically (runs, then rounds) plus the noise between points (normal, sd
+// `point_noise`), and the trend of those. raw[r][j], trend[r][j]: replicate r at point j.
+struct Replicates {
+  std::vector<std::vector<double>> raw, trend;
+};
+
+Replicates trend_replicates(const Matched& m, const Trend& trend, double point_noise, Rng& rng,
+                            int count) {
+  Replicates out;
+  out.raw.reserve(size_t(count));
+  out.trend.reserve(size_t(count));
   std::vector<double> y(m.d.size());
   for (int r = 0; r < count; ++r) {
     for (size_t i = 0; i < y.size(); ++i)
       y[i] = resample_ratio(m.ratios[i], rng) + point_noise * rng.normal();
-    out.push_back(trend.apply(y));
+    out.raw.push_back(y);
+    out.trend.push_back(trend.apply(y));
   }
   return out;
 }
@@ -103,7 +109,8 @@ void judge_points(const std::vector<double>& trend, const std::vector<double>& s
     if (!(sd[j] > 0)) {  // no spread at all: beyond the threshold or not, exactly
       p[j] = std::fabs(trend[j]) > delta ? 0.0 : 1.0;
     } else {
-      const double below = boost::math::cdf(boost::math::complement(t, (-delta - trend[j]) / sd[j]));
+      const double below =
+          boost::math::cdf(boost::math::complement(t, (-delta - trend[j]) / sd[j]));
       const double above = boost::math::cdf(boost::math::complement(t, (trend[j] - delta) / sd[j]));
       p[j] = std::min(1.0, 2 * std::min(below, above));
     }
@@ -152,30 +159,35 @@ std::vector<Stretch> stretches(const std::vector<PointComparison>& points) {
   return merged;
 }
 
-// The replicates' positions of a crossing at log value `log_x` where the trend goes from side
-// `from` to the other: each replicate's crossing of that direction nearest it, or ±inf when a
-// replicate has none (one renderer faster everywhere in it).
+// Where the measured log ratios `d` cross zero between a stretch of side `from` ending at point
+// `last` and one of the other side starting at point `first`: the bracket widened outward to
+// the nearest points that are on those sides in `d` itself, the crossing interpolated in log of
+// the axis (the middle of the first and last when the points between change sign more than
+// once). NaN when `d` has no point of side `from` at or below `last` (the crossing lies below
+// the range in it), or none of the other side at or above `first` (above the range).
+double crossing_in(const std::vector<double>& log_at, const std::vector<double>& d, size_t last,
+                   size_t first, int from) {
+  auto on = [&](size_t i, int side) { return side < 0 ? d[i] < 0 : d[i] > 0; };
+  size_t lo = last, hi = first;
+  while (!on(lo, from))
+    if (lo-- == 0) return -kInf;
+  while (!on(hi, -from))
+    if (++hi == d.size()) return kInf;
+  return zero_crossing(log_at, d, lo, hi);
+}
+
+// The replicates' positions of the crossing between points `last` and `first`: in each, the
+// crossing of its own log ratios by the same rule; ±inf where it has none in the range.
 std::vector<double> replicate_positions(const std::vector<std::vector<double>>& replicates,
-                                        const std::vector<double>& log_at, double log_x,
-                                        int from) {
+                                        const std::vector<double>& log_at, size_t last,
+                                        size_t first, int from) {
   std::vector<double> positions;
   positions.reserve(replicates.size());
   for (const std::vector<double>& d : replicates) {
-    double best = kNaN, best_distance = kInf;
-    for (size_t i = 0; i + 1 < d.size(); ++i) {
-      const bool crosses = from < 0 ? (d[i] < 0 && d[i + 1] >= 0) : (d[i] > 0 && d[i + 1] <= 0);
-      if (!crosses) continue;
-      const double x = zero_crossing(log_at, d, i, i + 1);
-      if (std::fabs(x - log_x) < best_distance) best_distance = std::fabs(x - log_x), best = x;
-    }
-    if (std::isnan(best)) {
-      // The side `from` everywhere: its crossing lies above the range; the other everywhere:
-      // below it.
-      const bool from_everywhere = from < 0 ? d.front() < 0 : d.front() > 0;
-      positions.push_back(from_everywhere ? kInf : -kInf);
-    } else {
-      positions.push_back(std::exp(best));
-    }
+    const double x = crossing_in(log_at, d, last, first, from);
+    // No point of side `from` at or below: the crossing lies below the range; no point of the
+    // other side above: above it.
+    positions.push_back(std::isinf(x) ? x : std::exp(x));
   }
   return positions;
 }
@@ -230,9 +242,8 @@ std::vector<double> holm_adjusted(const std::vector<double>& p) {
   return out;
 }
 
-CurveComparison compare_curves(const std::vector<Measurement>& a,
-                               const std::vector<Measurement>& b, const std::string& axis,
-                               const CompareOptions& options) {
+CurveComparison compare_curves(const std::vector<Measurement>& a, const std::vector<Measurement>& b,
+                               const std::string& axis, const CompareOptions& options) {
   CurveComparison out;
   Comparison& c = out.comparison;
   if (a.empty() || b.empty()) return out;
@@ -261,11 +272,10 @@ CurveComparison compare_curves(const std::vector<Measurement>& a,
   c.point_noise = std::sqrt(std::max(0.0, trend.residual_variance(m.d) - mean_v));
   c.dof = trend.residual_dof();
   const std::vector<double> t = trend.apply(m.d);
-  const std::vector<std::vector<double>> replicates =
-      trend_replicates(m, trend, c.point_noise, rng, count);
+  const Replicates replicates = trend_replicates(m, trend, c.point_noise, rng, count);
   std::vector<double> sd;
   for (size_t j = 0; j < t.size(); ++j) {
-    std::vector<double> col = column(replicates, j);
+    std::vector<double> col = column(replicates.trend, j);
     sd.push_back(std::sqrt(variance(col)));
     Interval ci = percentile_interval(col);
     c.points[j].trend = std::exp(t[j]);
@@ -280,9 +290,13 @@ CurveComparison compare_curves(const std::vector<Measurement>& a,
     x.b = c.b;
     x.scene = c.scene;
     x.axis = axis;
-    const double log_x = zero_crossing(m.log_at, t, lo.last, hi.first);
+    // Placed where the measured ratios cross between the two stretches (where the trend does,
+    // in the rare case that the measured ratios are on neither side there).
+    double log_x = crossing_in(m.log_at, m.d, lo.last, hi.first, lo.side);
+    if (!std::isfinite(log_x)) log_x = zero_crossing(m.log_at, t, lo.last, hi.first);
     x.value = std::exp(log_x);
-    x.ci95 = percentile_interval(replicate_positions(replicates, m.log_at, log_x, lo.side));
+    x.ci95 = percentile_interval(
+        replicate_positions(replicates.raw, m.log_at, lo.last, hi.first, lo.side));
     x.pixels = c.pixels;
     x.n = c.n;
     x.a_faster_below = lo.side < 0;

@@ -10,6 +10,7 @@
 
 #include "rvr/shared/expected.h"
 #include "rvr/study/fit.h"
+#include "rvr/study/measurement.h"
 
 namespace rvr::study {
 namespace {
@@ -30,27 +31,32 @@ double weighted_r2(const std::vector<double>& t, const std::vector<double>& mode
   return total > 0 ? 1 - residual / total : (residual == 0 ? 1.0 : 0.0);
 }
 
+double dot(const std::vector<double>& a, const std::vector<double>& b) {
+  double s = 0;
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i) s += a[i] * b[i];
+  return s;
+}
+
 }  // namespace
 
-FitQuality leave_one_out(const CostModel& model, const std::vector<Measurement>& points,
-                         const std::vector<double>& medians, const std::vector<bool>& use) {
+FitQuality leave_one_out(const std::vector<std::vector<double>>& rows,
+                         const std::vector<double>& times, const std::vector<bool>& use) {
   FitQuality q;
   std::vector<double> errors;
-  for (size_t i = 0; i < points.size(); ++i) {
-    std::vector<Measurement> rest;
-    std::vector<double> rest_medians;
-    for (size_t j = 0; j < points.size(); ++j)
+  for (size_t i = 0; i < rows.size(); ++i) {
+    std::vector<std::vector<double>> rest;
+    std::vector<double> rest_times;
+    for (size_t j = 0; j < rows.size(); ++j)
       if (j != i) {
-        rest.push_back(points[j]);
-        rest_medians.push_back(medians[j]);
+        rest.push_back(rows[j]);
+        rest_times.push_back(times[j]);
       }
-    Expected<std::vector<double>> c = fit_coefficients(model, rest, rest_medians, use);
+    Expected<std::vector<double>> c = fit_rows(rest, rest_times, use);
     if (!c) {
       q.loo_median_rel_error = q.loo_mean_rel_error = std::numeric_limits<double>::infinity();
       return q;
     }
-    errors.push_back(std::fabs(medians[i] - predict(model, *c, points[i].pixels, points[i].n)) /
-                     medians[i]);
+    errors.push_back(std::fabs(times[i] - dot(rows[i], *c)) / times[i]);
   }
   double sum = 0;
   for (double e : errors) sum += e;
@@ -59,18 +65,16 @@ FitQuality leave_one_out(const CostModel& model, const std::vector<Measurement>&
   return q;
 }
 
-FitQuality fit_quality(const CostModel& cost_model, const std::vector<Measurement>& points,
-                       const std::vector<double>& medians, const std::vector<double>& coefficients,
+FitQuality fit_quality(const std::vector<std::vector<double>>& rows,
+                       const std::vector<double>& times, const std::vector<double>& coefficients,
                        const std::vector<bool>& use) {
-  FitQuality q = leave_one_out(cost_model, points, medians, use);
+  FitQuality q = leave_one_out(rows, times, use);
   std::vector<double> model;
-  model.reserve(points.size());
-  for (const Measurement& p : points)
-    model.push_back(predict(cost_model, coefficients, p.pixels, p.n));
-  q.r2 = weighted_r2(medians, model);
-  for (size_t i = 0; i < points.size(); ++i)
-    q.max_rel_residual =
-        std::max(q.max_rel_residual, std::fabs(medians[i] - model[i]) / medians[i]);
+  model.reserve(rows.size());
+  for (const std::vector<double>& row : rows) model.push_back(dot(row, coefficients));
+  q.r2 = weighted_r2(times, model);
+  for (size_t i = 0; i < rows.size(); ++i)
+    q.max_rel_residual = std::max(q.max_rel_residual, std::fabs(times[i] - model[i]) / times[i]);
   return q;
 }
 

@@ -165,8 +165,14 @@ std::string axes_svg(const ChartSpec& spec) {
       (Frame::top() + Frame::bottom()) / 2, escape_html(spec.y_label));
 }
 
-// Grey over the parts of the x axis outside the swept range.
+// The spacing of renderers' marks at one x (points_svg's dodge), and a mark's radius.
+constexpr double kDodge = 4.0;
+constexpr double kMarkRadius = 3.5;
+
+// Grey over the parts of the x axis outside the swept range, short of the outermost marks
+// (shifted sideways by their dodge) so that no measured point lies under it.
 std::string unmeasured_svg(const Frame& f, const ChartSpec& spec) {
+  const double clearance = kDodge * std::max(0.0, double(spec.series.size()) - 1) / 2 + kMarkRadius;
   std::string o;
   auto shade = [&](double x0, double x1) {
     if (x1 - x0 < 1) return;
@@ -179,8 +185,10 @@ std::string unmeasured_svg(const Frame& f, const ChartSpec& spec) {
           "text-anchor=\"middle\">not measured</text>",
           (x0 + x1) / 2, Frame::bottom() - 8);
   };
-  if (positive(spec.swept_low)) shade(Frame::left(), f.px_edge(spec.swept_low, Frame::left()));
-  if (positive(spec.swept_high)) shade(f.px_edge(spec.swept_high, Frame::right()), Frame::right());
+  if (positive(spec.swept_low))
+    shade(Frame::left(), f.px_edge(spec.swept_low, Frame::left()) - clearance);
+  if (positive(spec.swept_high))
+    shade(f.px_edge(spec.swept_high, Frame::right()) + clearance, Frame::right());
   return o;
 }
 
@@ -268,8 +276,8 @@ std::string points_svg(const Frame& f, const ChartSeries& s, double dodge) {
     o += fmt::format(
         "<g class=\"point\"><title>{0}</title><line class=\"spread\" x1=\"{1:.1f}\" "
         "x2=\"{1:.1f}\" y1=\"{2:.1f}\" y2=\"{3:.1f}\" stroke=\"{4}\"/><circle class=\"mark\" "
-        "cx=\"{1:.1f}\" cy=\"{5:.1f}\" r=\"3.5\" fill=\"{4}\" data-x=\"{6}\" data-t=\"{7}\"/></g>",
-        escape_html(p.tooltip), x, hi, lo, s.colour, f.py(p.typical), p.x, p.typical);
+        "cx=\"{1:.1f}\" cy=\"{5:.1f}\" r=\"{8}\" fill=\"{4}\" data-x=\"{6}\" data-t=\"{7}\"/></g>",
+        escape_html(p.tooltip), x, hi, lo, s.colour, f.py(p.typical), p.x, p.typical, kMarkRadius);
   }
   return o;
 }
@@ -300,7 +308,7 @@ std::string loglog_chart_svg(const ChartSpec& spec) {
     const ChartSeries& s = spec.series[i];
     o += fmt::format("<g class=\"series\" data-renderer=\"{}\">", escape_html(s.name));
     if (s.model) o += curve_svg(f, s, s.fits ? 0 : unfit++);
-    o += points_svg(f, s, 4.0 * (double(i) - (n - 1) / 2)) + "</g>";
+    o += points_svg(f, s, kDodge * (double(i) - (n - 1) / 2)) + "</g>";
   }
   return o + "</g></svg>";
 }

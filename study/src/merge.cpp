@@ -292,13 +292,15 @@ std::string crossover_text(const Crossover& c) {
   auto end = [](double v, const char* beyond) {
     return std::isinf(v) ? std::string(beyond) : format_number(v);
   };
-  return fmt::format("crossover {} ({}–{})", format_number(c.value), end(c.ci95.low, "below range"),
-                     end(c.ci95.high, "above range"));
+  return fmt::format("crossover {} ({}–{}){}", format_number(c.value),
+                     end(c.ci95.low, "below range"), end(c.ci95.high, "above range"),
+                     c.contradicted ? ", contradicted by its check" : "");
 }
 
 std::string dominance_text(const Dominance& d) {
-  return fmt::format("{} faster throughout {}–{} (≥ {:.2f}×)", d.faster, format_number(d.range_low),
-                     format_number(d.range_high), d.min_ratio);
+  return fmt::format("{} faster where significant: {} of {} points, {}–{} (≥ {:.2f}×)", d.faster,
+                     d.significant, d.points, format_number(d.significant_low),
+                     format_number(d.significant_high), d.min_ratio);
 }
 
 }  // namespace

@@ -141,7 +141,8 @@ Measured measure_ratio(const Measurement& a, const Measurement& b, const Compare
 }
 
 std::string ratio_text(double ratio) {
-  return ratio >= 1 ? fmt::format("{:.2f}× slower", ratio) : fmt::format("{:.2f}× faster", 1 / ratio);
+  return ratio >= 1 ? fmt::format("{:.2f}× slower", ratio)
+                    : fmt::format("{:.2f}× faster", 1 / ratio);
 }
 
 // The verdict of one check from what was predicted and measured.
@@ -151,12 +152,13 @@ void judge(PredictionCheck& check, double point_noise) {
   const bool has_model = std::isfinite(check.predicted_ratio);
   // The models predict the curve; a point strays from it by the noise between points.
   const double spread = std::exp(2 * point_noise);
-  const bool model_agrees = !has_model || (check.ratio_ci95.high >= check.predicted_ci95.low / spread &&
-                                           check.ratio_ci95.low <= check.predicted_ci95.high * spread);
+  const bool model_agrees =
+      !has_model || (check.ratio_ci95.high >= check.predicted_ci95.low / spread &&
+                     check.ratio_ci95.low <= check.predicted_ci95.high * spread);
   if (side_predicted && side_measured && check.measured_faster != check.predicted_faster) {
     check.verdict = "fails";
-    check.why = fmt::format("{} was measured faster, significantly, where {} should be", check.measured_faster,
-                            check.predicted_faster);
+    check.why = fmt::format("{} was measured faster, significantly, where {} should be",
+                            check.measured_faster, check.predicted_faster);
   } else if (!model_agrees) {
     check.verdict = "fails";
     check.why = fmt::format(
@@ -170,7 +172,8 @@ void judge(PredictionCheck& check, double point_noise) {
                             ratio_text(check.ratio));
   } else if (!side_predicted && has_model) {
     check.verdict = "holds";
-    check.why = fmt::format("the measured ratio {:.2f} lies within the models' prediction", check.ratio);
+    check.why =
+        fmt::format("the measured ratio {:.2f} lies within the models' prediction", check.ratio);
   } else {
     check.verdict = "inconclusive";
     check.why = fmt::format("the measured ratio {:.2f} is within the noise threshold", check.ratio);

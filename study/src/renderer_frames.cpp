@@ -114,7 +114,12 @@ Expected<Scene> family_scene(const Family& family, size_t n, int width) {
 }
 
 bool is_work_counter(const std::string& stat) {
-  return stat.rfind("time.", 0) != 0 && stat.rfind("memory.", 0) != 0;
+  // Times and memory, at the top or under a prefix ("zbuffer.time.raster"), are not work; nor
+  // are ratios of counts (fills, overdraw), which the counts themselves give.
+  for (const char* part : {"time.", "memory.", "fill", "overdraw"})
+    if (stat.rfind(part, 0) == 0 || stat.find(std::string(".") + part) != std::string::npos)
+      return false;
+  return true;
 }
 
 Expected<std::unique_ptr<FrameSource>> prepare_frames(const std::vector<std::string>& renderers,
@@ -132,10 +137,10 @@ Expected<std::unique_ptr<FrameSource>> prepare_frames(const std::vector<std::str
 }
 
 StartSession in_process_sessions(const StudyRequest& request) {
-  return [renderers = request.renderers,
-          mode = request.mode]() -> Expected<std::unique_ptr<Session>> {
-    return std::unique_ptr<Session>(std::make_unique<InProcessSession>(renderers, mode));
-  };
+  return
+      [renderers = request.renderers, mode = request.mode]() -> Expected<std::unique_ptr<Session>> {
+        return std::unique_ptr<Session>(std::make_unique<InProcessSession>(renderers, mode));
+      };
 }
 
 }  // namespace rvr::study

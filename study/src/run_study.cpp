@@ -14,8 +14,10 @@
 #include <utility>
 
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/check.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
+#include "rvr/study/crossover.h"
 #include "rvr/study/measurement.h"
 #include "rvr/study/prediction_checks.h"
 #include "rvr/study/sweep_plan.h"
@@ -55,9 +57,8 @@ Status validate(const StudyRequest& r) {
   if (r.sessions < 3)
     return bad_input(fmt::format("--processes: must be >= 3, got {}", r.sessions));
   if (!(r.noise_threshold >= 0 && r.noise_threshold < 1))
-    return bad_input(
-        fmt::format("--noise-threshold: must be in 0 .. 1 (a ratio minus 1), got {}",
-                    r.noise_threshold));
+    return bad_input(fmt::format("--noise-threshold: must be in 0 .. 1 (a ratio minus 1), got {}",
+                                 r.noise_threshold));
   if (r.shard && (r.shard->count < 1 || r.shard->index >= r.shard->count))
     return bad_input(fmt::format("--shard: must be I/N with 0 <= I < N, got {}/{}", r.shard->index,
                                  r.shard->count));
@@ -105,8 +106,8 @@ struct FamilyState {
 struct OpenSession {
   std::unique_ptr<Session> session;
   std::unique_ptr<FrameSource> reference;
-  int index = 0;              // into StudyResult::sessions
-  bool other_work = false;    // its system probe saw other work on the CPUs
+  int index = 0;            // into StudyResult::sessions
+  bool other_work = false;  // its system probe saw other work on the CPUs
 };
 
 // The state of one running study.
@@ -202,12 +203,12 @@ Expected<OpenSession> Sweep::open_session(const Family& family) {
         int(std::clamp(std::ceil(kReferenceSeconds / one->seconds), 1.0, 1000.0));
   }
   std::vector<double> times;
-  for (int k = 0; k < 5; ++k) {
+  for (int k = 0; k < 5 && !stopped(); ++k) {
     Expected<double> t = time_reference(*open.reference);
     if (!t) return t.error();
     times.push_back(*t);
   }
-  f_->quickest_reference = std::min(f_->quickest_reference, median(times));
+  if (!times.empty()) f_->quickest_reference = std::min(f_->quickest_reference, median(times));
   return open;
 }
 
@@ -274,9 +275,9 @@ void Sweep::time_rounds(const std::string& what, FrameSource& frames, FrameSourc
 // family's points (created at the point's first run). A run cut short is dropped.
 Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession& session,
                           PointSet& into) {
-  const std::string what =
-      fmt::format("{} {} {}×{} session {}", family.name, point_name(family, n), width,
-                  width * 3 / 4, session.index + 1);
+  const std::string what = fmt::format("{} {} {}×{} session {}", family.name, point_name(family, n),
+                                       width, width * 3 / 4, session.index + 1);
+  if (stopped()) return ok_status();
   progress(what + ": preparing");
   Expected<std::unique_ptr<FrameSource>> frames = session.session->prepare(family, n, width);
   if (!frames) return frames.error();
@@ -291,6 +292,9 @@ Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession
   if (runs[0].seconds.size() < size_t(request_.repetitions)) return ok_status();  // cut short
   std::vector<Measurement>& list = *into.list;
   auto [it, fresh] = into.index.try_emplace({n, width}, list.size());
+  for (const Run& held : list[it->second].runs)
+    RVR_DCHECK(held.session != session.index, "one run per session and point: session ",
+               session.index, " measured ", family.name, ":", n, " twice");
   for (size_t i = 0; i < runs.size(); ++i) {
     runs[i].busy = runs[i].reference_ratio > kBusyRatio || session.other_work;
     if (fresh) {
@@ -310,24 +314,30 @@ Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession
   return ok_status();
 }
 
-// The midpoints (in log N) of every bracket of measured points between which two renderers of
-// different loop orders change places.
+// The midpoints (in log N) of every bracket of neighbouring points between which the trend of
+// two renderers' ratio (crossover.h) changes sign: where a crossover lies, judged on the trend,
+// not on single points that noise can swap.
 std::vector<size_t> Sweep::crossover_midpoints(const Family& family) const {
-  std::map<size_t, std::map<std::string, double>> t;  // n -> renderer -> time
+  std::map<std::string, std::vector<Measurement>> along_n;
   for (const Measurement& m : result_.points)
-    if (m.scene == family.name && m.width == request_.width)
-      t[size_t(m.scene_n)][m.renderer] = typical_seconds(m);
+    if (m.scene == family.name && m.width == request_.width) along_n[m.renderer].push_back(m);
+  const CompareOptions options{BootstrapOptions{200, request_.seed}, request_.noise_threshold};
   std::set<size_t> mids;
   for (size_t i = 0; i < request_.renderers.size(); ++i)
     for (size_t j = i + 1; j < request_.renderers.size(); ++j) {
       const std::string &a = request_.renderers[i], &b = request_.renderers[j];
       if (!compared_pair(a, b)) continue;
-      for (auto it = t.begin(); it != t.end() && std::next(it) != t.end(); ++it) {
-        auto next = std::next(it);
-        bool before = it->second.at(a) < it->second.at(b);
-        bool after = next->second.at(a) < next->second.at(b);
-        if (before != after)
-          if (size_t mid = log_midpoint(it->first, next->first)) mids.insert(mid);
+      const Comparison c = compare_curves(along_n[a], along_n[b], family.axis, options).comparison;
+      if (!c.inconclusive.empty()) continue;
+      for (size_t k = 0; k + 1 < c.points.size(); ++k) {
+        if ((c.points[k].trend < 1) == (c.points[k + 1].trend < 1)) continue;
+        // The scene N of the two points (the axis value is the triangles drawn).
+        size_t low = 0, high = 0;
+        for (const Measurement& m : along_n[a]) {
+          if (m.n == c.points[k].at) low = size_t(m.scene_n);
+          if (m.n == c.points[k + 1].at) high = size_t(m.scene_n);
+        }
+        if (size_t mid = log_midpoint(low, high)) mids.insert(mid);
       }
     }
   return {mids.begin(), mids.end()};
@@ -462,16 +472,22 @@ Status Sweep::refine_near_crossovers(const Family& family, double share_end) {
 // The family's runs measured while the machine was busy, measured again in a fresh session
 // while the share lasts: a quiet run replaces the busy one. Notes say how many and what is left.
 Status Sweep::measure_busy_runs_again(const Family& family, double share_end) {
-  std::vector<std::pair<PointKey, int>> busy;  // point, session of the busy run
-  for (const auto& [point, index] : f_->points.index)
-    for (const Run& run : result_.points[index].runs)
-      if (run.busy) busy.push_back({point, run.session});
+  // Each round a fresh session measures every point that still has a busy run once; a quiet
+  // run replaces one busy run. Rounds go on while they replace something and the share lasts.
   size_t replaced = 0;
-  if (!busy.empty() && !stopped() &&
-      elapsed() + f_->cost.predict(busy[0].first.first) < share_end) {
+  for (size_t in_round = 1; in_round > 0;) {
+    in_round = 0;
+    std::vector<PointKey> busy;
+    for (const auto& [point, index] : f_->points.index)
+      for (const Run& run : result_.points[index].runs)
+        if (run.busy) {
+          busy.push_back(point);
+          break;
+        }
+    if (busy.empty() || stopped() || elapsed() + f_->cost.predict(busy[0].first) > share_end) break;
     Expected<OpenSession> session = open_session(family);
     if (!session) return session.error();
-    for (auto [point, busy_session] : busy) {
+    for (PointKey point : busy) {
       if (stopped() || elapsed() + f_->cost.predict(point.first) > share_end) break;
       const size_t first = f_->points.index.at(point);
       const size_t before = result_.points[first].runs.size();
@@ -479,11 +495,19 @@ Status Sweep::measure_busy_runs_again(const Family& family, double share_end) {
         return s;
       if (result_.points[first].runs.size() == before) break;  // cut short
       if (result_.points[first].runs.back().busy) continue;    // busy again: both kept
+      // The first busy run goes, for every renderer (their runs of a session go together).
+      int busy_session = -1;
+      for (const Run& run : result_.points[first].runs)
+        if (run.busy) {
+          busy_session = run.session;
+          break;
+        }
       for (size_t i = 0; i < request_.renderers.size(); ++i)
         std::erase_if(result_.points[first + i].runs,
-                      [&](const Run& r) { return r.session == busy_session && r.busy; });
-      ++replaced;
+                      [&](const Run& r) { return r.session == busy_session; });
+      ++in_round;
     }
+    replaced += in_round;
   }
   if (replaced > 0)
     result_.notes.push_back(fmt::format(
@@ -651,7 +675,14 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   sweep.exclude(sweep.elapsed() - before_fits);
   if (!result.interrupted && checks && !sweep.stopped() && !result.crossovers.empty()) {
     if (Status s = sweep.measure_checks(families); !s) return s.error();
+    // Checks cut short are evaluated from the points they measured.
     evaluate_checks(result, CompareOptions{boot, request.noise_threshold});
+    if (sweep.cancelled()) {
+      result.interrupted = true;
+      result.notes.push_back(
+          "the study was interrupted during its prediction checks: only the checks measured "
+          "before the interruption are given");
+    }
   }
   result.elapsed_seconds = sweep.elapsed();
   result.system_after = sweep.probe();

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "counted_work_text.h"
 #include "html_text.h"
 #include "loglog_chart.h"
 #include "rvr/shared/html_escape.h"
@@ -24,6 +25,7 @@
 #include "rvr/study/measurement.h"
 #include "rvr/study/memory_estimate.h"
 #include "rvr/study/study_markdown.h"
+#include "rvr/study/system_probe.h"
 #include "scene_changes_html.h"
 
 namespace rvr::study {
@@ -157,10 +159,10 @@ ChartPoint chart_point(const Measurement& m, double x, const std::string& what) 
   const auto [lo, hi] = std::minmax_element(seconds.begin(), seconds.end());
   p.low = lo == seconds.end() ? p.typical : *lo;
   p.high = hi == seconds.end() ? p.typical : *hi;
-  p.tooltip = fmt::format("{}, {}: {} ms (fastest {}, slowest {}; {} repetitions in {} runs)",
-                          m.renderer, what, format_number(1e3 * p.typical),
-                          format_number(1e3 * p.low), format_number(1e3 * p.high),
-                          seconds.size(), m.runs.size());
+  p.tooltip =
+      fmt::format("{}, {}: {} ms (fastest {}, slowest {}; {} repetitions in {} runs)", m.renderer,
+                  what, format_number(1e3 * p.typical), format_number(1e3 * p.low),
+                  format_number(1e3 * p.high), seconds.size(), m.runs.size());
   return p;
 }
 
@@ -381,9 +383,10 @@ std::string conclusions_html(const StudyResult& r, const std::string& scene) {
                            c.verdict, html_with_powers(check_sentence(c)));
   for (const Comparison& c : r.comparisons)
     if (c.scene == scene && !c.inconclusive.empty())
-      items += fmt::format("<li class=\"inconclusive\">{} and {} along {}: nothing concluded: {}</li>\n",
-                           escape_html(c.a), escape_html(c.b), escape_html(c.axis),
-                           html_with_powers(c.inconclusive));
+      items +=
+          fmt::format("<li class=\"inconclusive\">{} and {} along {}: nothing concluded: {}</li>\n",
+                      escape_html(c.a), escape_html(c.b), escape_html(c.axis),
+                      html_with_powers(c.inconclusive));
   if (items.empty()) return "";
   return "<h3>Conclusions</h3>\n<ul class=\"conclusions\">\n" + items + "</ul>\n";
 }
@@ -429,7 +432,8 @@ std::string header_html(const StudyResult& r) {
          html_with_powers(r.no_conclusion) + ".</div>\n";
   const std::vector<std::string> headline = headline_sentences(r);
   if (!headline.empty()) {
-    o += "<h2>Where the pixel-major loop overtakes the triangle-major one</h2>\n<ul class=\"headline\">";
+    o += "<h2>Where the pixel-major loop overtakes the triangle-major one</h2>\n<ul "
+         "class=\"headline\">";
     for (const std::string& h : headline) o += "<li>" + html_with_powers(h) + "</li>";
     o += "</ul>\n";
   }
@@ -441,13 +445,16 @@ std::string header_html(const StudyResult& r) {
   return o;
 }
 
-// The machine the study ran on.
-std::string machine_html(const MachineInfo& m) {
+// The machine the study ran on, and its state before and after the sweep.
+std::string machine_html(const StudyResult& r) {
+  const MachineInfo& m = r.machine;
   std::string o = "<h2>Machine</h2>\n<dl class=\"machine\">";
   o += fmt::format("<dt>CPU</dt><dd>{}</dd><dt>threads</dt><dd>{}</dd><dt>kernels</dt><dd>{}</dd>",
                    escape_html(m.cpu), m.threads, escape_html(m.kernels));
   for (const auto& [name, version] : m.versions)
     o += fmt::format("<dt>{}</dt><dd>{}</dd>", escape_html(name), escape_html(version));
+  o += fmt::format("<dt>before the sweep</dt><dd>{}</dd><dt>after</dt><dd>{}</dd>",
+                   escape_html(describe(r.system_before)), escape_html(describe(r.system_after)));
   return o + "</dl>\n";
 }
 
@@ -464,7 +471,8 @@ std::string study_html(const StudyResult& r) {
       escape_html(scenes), kCss);
   o += header_html(r);
   for (size_t i = 0; i < r.scenes.size(); ++i) o += scene_section(r, i, colours);
-  o += machine_html(r.machine);
+  o += counted_work_html(r);
+  o += machine_html(r);
   return o + "</main></body></html>\n";
 }
 

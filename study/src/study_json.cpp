@@ -1,6 +1,8 @@
 // study.json (see study_json.h).
 #include "rvr/study/study_json.h"
 
+#include <stddef.h>
+
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -11,6 +13,7 @@
 
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/cost_model.h"
+#include "rvr/study/counted_work.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
@@ -44,6 +47,8 @@ json fit_json(const ModelFit& f) {
           {"r2", number(f.r2)},
           {"max_rel_residual", number(f.max_rel_residual)},
           {"loo_rel_error", number(f.loo_rel_error)},
+          {"misfit", number(f.misfit)},
+          {"repetition_noise", number(f.repetition_noise)},
           {"points", f.points},
           {"fits", f.fits},
           {"verdict", f.verdict},
@@ -93,7 +98,9 @@ json comparisons_json(const StudyResult& r) {
                         {"trend", number(p.trend)},
                         {"ci95", interval(p.ci95)},
                         {"p", number(p.p)},
-                        {"faster", p.faster < 0 ? json(c.a) : p.faster > 0 ? json(c.b) : json(nullptr)}});
+                        {"faster", p.faster < 0   ? json(c.a)
+                                   : p.faster > 0 ? json(c.b)
+                                                  : json(nullptr)}});
     out.push_back({{"a", c.a},
                    {"b", c.b},
                    {"scene", c.scene},
@@ -272,6 +279,61 @@ void conclusions_json(const StudyResult& r, json& doc) {
   doc["costs"] = costs;
 }
 
+// The cost models from counted work, the counts' scaling and the claims checked on counts.
+void counted_work_json(const StudyResult& r, json& doc) {
+  json models = json::array();
+  for (const WorkModel& m : r.work_models) {
+    json terms = json::array(), left_out = json::array();
+    for (size_t j = 0; j < m.terms.size(); ++j)
+      terms.push_back({{"counter", m.terms[j].name},
+                       {"counts", j < m.counts.size() ? m.counts[j] : ""},
+                       {"value", number(m.terms[j].value)},
+                       {"ci95", interval(m.terms[j].ci95)}});
+    for (const LeftOutCounter& l : m.left_out)
+      left_out.push_back({{"counter", l.counter}, {"why", l.why}});
+    models.push_back({{"renderer", m.renderer},
+                      {"scene", m.scene},
+                      {"terms", terms},
+                      {"left_out", left_out},
+                      {"r2", number(m.r2)},
+                      {"max_rel_residual", number(m.max_rel_residual)},
+                      {"loo_rel_error", number(m.loo_rel_error)},
+                      {"misfit", number(m.misfit)},
+                      {"repetition_noise", number(m.repetition_noise)},
+                      {"points", m.points},
+                      {"fits", m.fits},
+                      {"verdict", m.verdict}});
+  }
+  json scaling = json::array();
+  for (const CountScaling& c : r.count_scaling)
+    scaling.push_back({{"renderer", c.renderer},
+                       {"scene", c.scene},
+                       {"counter", c.counter},
+                       {"axis", c.axis},
+                       {"n", c.n},
+                       {"from", c.from},
+                       {"to", c.to},
+                       {"exponent", number(c.exponent)},
+                       {"r2", number(c.r2)},
+                       {"points", c.points}});
+  json claims = json::array();
+  for (const CountClaim& c : r.count_claims)
+    claims.push_back({{"renderer", c.renderer},
+                      {"scene", c.scene},
+                      {"claim", c.claim},
+                      {"quantity", c.quantity},
+                      {"against", c.against},
+                      {"intercept", number(c.intercept)},
+                      {"slope", number(c.slope)},
+                      {"r2", number(c.r2)},
+                      {"exponent", number(c.exponent)},
+                      {"range", json::array({c.from, c.to})},
+                      {"points", c.points}});
+  doc["work_models"] = models;
+  doc["count_scaling"] = scaling;
+  doc["count_claims"] = claims;
+}
+
 json numbers(const std::vector<double>& values) {
   json out = json::array();
   for (double v : values) out.push_back(number(v));
@@ -355,6 +417,7 @@ std::string study_json(const StudyResult& r) {
               {"shard", r.shard ? json{{"index", r.shard->index}, {"count", r.shard->count}}
                                 : json(nullptr)}};
   conclusions_json(r, doc);
+  counted_work_json(r, doc);
   doc["points"] = points_json(r.points);
   doc["check_points"] = points_json(r.check_points);
   return doc.dump(2) + "\n";

@@ -130,20 +130,48 @@ class Fields {
   std::string path_;
 };
 
-const std::vector<std::string> kTopKeys = {
-    "format",        "command",         "scenes",          "renderer_order",
-    "width",         "height",          "mode",            "budget_seconds",
-    "elapsed_seconds", "repetitions",   "sessions_per_point", "noise_threshold",
-    "seed",          "run_id",          "merged_runs",     "bootstrap_replicates",
-    "machine",       "system_before",   "system_after",    "sessions",
-    "renderers",     "comparisons",     "crossovers",      "no_conclusion",
-    "dominance",     "scaling",         "costs",           "checks",
-    "notes",         "interrupted",     "shard",           "points",
-    "check_points",  "splits",          "builds",          "scene_changes",
-    "memory"};
+const std::vector<std::string> kTopKeys = {"format",
+                                           "command",
+                                           "scenes",
+                                           "renderer_order",
+                                           "width",
+                                           "height",
+                                           "mode",
+                                           "budget_seconds",
+                                           "elapsed_seconds",
+                                           "repetitions",
+                                           "sessions_per_point",
+                                           "noise_threshold",
+                                           "seed",
+                                           "run_id",
+                                           "merged_runs",
+                                           "bootstrap_replicates",
+                                           "machine",
+                                           "system_before",
+                                           "system_after",
+                                           "sessions",
+                                           "renderers",
+                                           "comparisons",
+                                           "crossovers",
+                                           "no_conclusion",
+                                           "dominance",
+                                           "scaling",
+                                           "costs",
+                                           "checks",
+                                           "notes",
+                                           "interrupted",
+                                           "shard",
+                                           "points",
+                                           "check_points",
+                                           "splits"};
+// The counted work's conclusions (counted_work.h), computed again like the others.
+const std::vector<std::string> kCountedWorkKeys = {"work_models", "count_scaling", "count_claims"};
+// What each renderer builds per scene (scene_changes.h) and the memory estimate
+// (memory_estimate.h), likewise.
+const std::vector<std::string> kBuildAndMemoryKeys = {"builds", "scene_changes", "memory"};
 const std::vector<std::string> kPointKeys = {
-    "renderer", "scene",  "scene_n", "n",      "width",        "height", "pixels",
-    "counters", "runs",   "seconds", "median", "relative_mad", "busy"};
+    "renderer", "scene", "scene_n", "n",      "width",        "height", "pixels",
+    "counters", "runs",  "seconds", "median", "relative_mad", "busy"};
 const std::vector<std::string> kRunKeys = {"session", "prepare_seconds", "seconds", "order",
                                            "phases",  "reference_ratio", "busy"};
 const std::vector<std::string> kSystemKeys = {"at",         "known", "cpus", "load",
@@ -206,7 +234,8 @@ SystemSnapshot read_system(const json& v, const std::string& path) {
   if (load.size() != 3) fail(f.path("load"), "must hold 3 load averages, got " + describe(load));
   double* loads[] = {&s.load1, &s.load5, &s.load15};
   for (size_t k = 0; k < 3; ++k)
-    *loads[k] = load[k].is_null() ? 0.0 : Fields::number_at(load[k], index_path(f.path("load"), k), 0);
+    *loads[k] =
+        load[k].is_null() ? 0.0 : Fields::number_at(load[k], index_path(f.path("load"), k), 0);
   s.other_busy = f.number_or_nan("other_busy");
   s.steal = f.number_or_nan("steal");
   if (!f.at("mhz").is_null()) s.mhz = f.number("mhz", 0);
@@ -233,7 +262,8 @@ std::vector<std::string> strings_of(const Fields& top, const char* key) {
   const json& list = top.array(key);
   std::vector<std::string> out;
   for (size_t i = 0; i < list.size(); ++i) {
-    if (!list[i].is_string()) fail(index_path(key, i), "must be a string, got " + describe(list[i]));
+    if (!list[i].is_string())
+      fail(index_path(key, i), "must be a string, got " + describe(list[i]));
     out.push_back(list[i].get<std::string>());
   }
   return out;
@@ -292,10 +322,12 @@ void check_conclusions(const Fields& top) {
   for (const char* key : {"comparisons", "crossovers", "dominance", "scaling", "costs", "checks",
                           "splits", "check_points"})
     top.array(key);
-  // Studies written before the preparations were concluded on and memory estimated have none.
-  // The memory estimate was the sweep's, before it: not carried to a study concluded again.
-  for (const char* key : {"builds", "scene_changes", "memory"})
-    if (top.has(key)) top.array(key);
+  // Studies written before the counted-work models have none of these.
+  for (const std::string& key : kCountedWorkKeys)
+    if (top.has(key.c_str())) top.array(key.c_str());
+  // The memory estimate was the sweep's: not carried to a study concluded again.
+  for (const std::string& key : kBuildAndMemoryKeys)
+    if (top.has(key.c_str())) top.array(key.c_str());
   if (!top.at("no_conclusion").is_null()) top.string("no_conclusion");
 }
 
@@ -322,7 +354,8 @@ Run read_run(const json& v, const std::string& path, const StudyResult& r) {
     fail(f.path("order"), fmt::format("must have one entry per round ({}), got {}",
                                       run.seconds.size(), order.size()));
   for (size_t k = 0; k < order.size(); ++k)
-    run.order.push_back(int(Fields::whole_at(order[k], index_path(f.path("order"), k), 0, 1u << 20)));
+    run.order.push_back(
+        int(Fields::whole_at(order[k], index_path(f.path("order"), k), 0, 1u << 20)));
   for (const auto& item : f.object("phases").items()) {
     const std::string where = f.path("phases") + "." + item.key();
     run.phases[item.key()] = seconds_of(item.value(), where);
@@ -366,7 +399,10 @@ Measurement read_point(const json& v, const std::string& path, const StudyResult
 }
 
 StudyResult read_study(const json& doc) {
-  Fields top(doc, "", kTopKeys);
+  std::vector<std::string> top_keys = kTopKeys;
+  top_keys.insert(top_keys.end(), kCountedWorkKeys.begin(), kCountedWorkKeys.end());
+  top_keys.insert(top_keys.end(), kBuildAndMemoryKeys.begin(), kBuildAndMemoryKeys.end());
+  Fields top(doc, "", top_keys);
   StudyResult r;
   read_request(top, r);
   check_conclusions(top);

@@ -8,6 +8,7 @@
 #include <map>
 #include <vector>
 
+#include "counted_work_text.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/cost_model.h"
@@ -56,34 +57,33 @@ std::string header(const StudyResult& r) {
   std::string text = "# rvr study\n\n";
   text += "**Scope.** " + scope_text(r) + "\n\n";
   text += "**Method.** " + method_text(r) + "\n\n";
-  text += fmt::format("**Machine.** {}, {} threads; kernels: {}. Before the sweep: {}; after: {}.\n",
-                      r.machine.cpu, r.machine.threads, r.machine.kernels,
-                      describe(r.system_before), describe(r.system_after));
-  if (!r.no_conclusion.empty())
-    text += "\n## No conclusion\n\n" + r.no_conclusion + ".\n";
+  text += fmt::format(
+      "**Machine.** {}, {} threads; kernels: {}. Before the sweep: {}; after: {}.\n", r.machine.cpu,
+      r.machine.threads, r.machine.kernels, describe(r.system_before), describe(r.system_after));
+  if (!r.no_conclusion.empty()) text += "\n## No conclusion\n\n" + r.no_conclusion + ".\n";
   return text;
 }
 
 std::vector<std::string> scaling_sentences(const StudyResult& r) {
   std::vector<std::string> out;
   for (const ScalingExponent& s : r.scaling)
-    out.push_back(s.axis == kPixelsAxis
-                      ? fmt::format("{} on {} with {} {}: time grows as P^{:.2f} from {} to {} pixels.",
-                                    s.renderer, s.scene, format_number(s.n), r.axes.at(s.scene),
-                                    s.exponent, format_number(s.from), format_number(s.to))
-                      : fmt::format("{} on {}: time grows as N^{:.2f} from {} to {}.", s.renderer,
-                                    s.scene, s.exponent, format_number(s.from),
-                                    format_number(s.to)));
+    out.push_back(
+        s.axis == kPixelsAxis
+            ? fmt::format("{} on {} with {} {}: time grows as P^{:.2f} from {} to {} pixels.",
+                          s.renderer, s.scene, format_number(s.n), r.axes.at(s.scene), s.exponent,
+                          format_number(s.from), format_number(s.to))
+            : fmt::format("{} on {}: time grows as N^{:.2f} from {} to {}.", s.renderer, s.scene,
+                          s.exponent, format_number(s.from), format_number(s.to)));
   return out;
 }
 
 std::vector<std::string> cost_sentences(const StudyResult& r) {
   std::vector<std::string> out;
   for (const UnitCost& c : r.costs)
-    out.push_back(fmt::format("{} on {} at {} {}: {} ms a frame, {} ns per triangle, {} ns per ray.",
-                              c.renderer, c.scene, format_number(c.n), r.axes.at(c.scene),
-                              format_number(1e3 * c.seconds), format_number(c.ns_per_triangle),
-                              format_number(c.ns_per_ray)));
+    out.push_back(fmt::format(
+        "{} on {} at {} {}: {} ms a frame, {} ns per triangle, {} ns per ray.", c.renderer, c.scene,
+        format_number(c.n), r.axes.at(c.scene), format_number(1e3 * c.seconds),
+        format_number(c.ns_per_triangle), format_number(c.ns_per_ray)));
   return out;
 }
 
@@ -228,9 +228,9 @@ std::string check_sentence(const PredictionCheck& c) {
   else
     where = fmt::format("{} the {}crossover at {}", c.at < c.crossover ? "below" : "above",
                         c.extrapolated ? "extrapolated " : "", format_number(c.crossover));
-  const std::string expected =
-      c.predicted_faster.empty() ? "the two should be about equal"
-                                 : c.predicted_faster + " should be faster";
+  const std::string expected = c.predicted_faster.empty()
+                                   ? "the two should be about equal"
+                                   : c.predicted_faster + " should be faster";
   const std::string model =
       std::isfinite(c.predicted_ratio)
           ? fmt::format(", the models predicted {:.2f} (95%: {:.2f} – {:.2f})", c.predicted_ratio,
@@ -241,7 +241,10 @@ std::string check_sentence(const PredictionCheck& c) {
       "{}: {}.",
       c.scene, format_number(c.at), c.axis, where, expected, c.a, c.b, c.ratio, c.ratio_ci95.low,
       c.ratio_ci95.high, model,
-      c.verdict == "holds" ? "Holds" : c.verdict == "fails" ? "Fails" : "Inconclusive", c.why);
+      c.verdict == "holds"   ? "Holds"
+      : c.verdict == "fails" ? "Fails"
+                             : "Inconclusive",
+      c.why);
 }
 
 std::vector<std::string> headline_sentences(const StudyResult& r) {
@@ -316,6 +319,7 @@ std::string study_markdown(const StudyResult& r) {
                   "would not fit were dropped (see the notes).",
                   memory);
   text += section("Cost models", "", models);
+  text += counted_work_markdown(r);
   text += section("Scaling (log-log slope per decade)", "", scaling_sentences(r));
   text += section("Cost per triangle and per ray", "", cost_sentences(r));
   text += section("Notes", "", notes);

@@ -101,11 +101,12 @@ SystemSnapshot probe_system(double window_seconds) {
 
 std::string describe(const SystemSnapshot& s) {
   if (!s.known) return "machine state unknown (no /proc/stat)";
-  return fmt::format("load {:.2f} {:.2f} {:.2f} on {} CPUs, {:.0f}% other work, {:.0f}% steal, {}, "
-                     "governor {}",
-                     s.load1, s.load5, s.load15, s.cpus, 100 * s.other_busy, 100 * s.steal,
-                     s.mhz > 0 ? fmt::format("{:.0f} MHz", s.mhz) : std::string("clock unknown"),
-                     s.governor.empty() ? "unknown" : s.governor);
+  return fmt::format(
+      "load {:.2f} {:.2f} {:.2f} on {} CPUs, {:.0f}% other work, {:.0f}% steal, {}, "
+      "governor {}",
+      s.load1, s.load5, s.load15, s.cpus, 100 * s.other_busy, 100 * s.steal,
+      s.mhz > 0 ? fmt::format("{:.0f} MHz", s.mhz) : std::string("clock unknown"),
+      s.governor.empty() ? "unknown" : s.governor);
 }
 
 }  // namespace rvr::study

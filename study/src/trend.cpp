@@ -57,16 +57,14 @@ double Trend::residual_variance(const std::vector<double>& y) const {
 
 double zero_crossing(const std::vector<double>& x, const std::vector<double>& y, size_t from,
                      size_t to) {
-  RVR_CHECK(from < to && to < x.size() && x.size() == y.size(), "a bracket inside the curve: ",
-            from, "..", to, " of ", x.size());
+  RVR_CHECK(from < to && to < x.size() && x.size() == y.size(),
+            "a bracket inside the curve: ", from, "..", to, " of ", x.size());
   auto crossing = [&](size_t i) {  // between i and i + 1, y changing sign there
     if (y[i] == y[i + 1]) return x[i];
     const double f = y[i] / (y[i] - y[i + 1]);
     return x[i] + f * (x[i + 1] - x[i]);
   };
-  auto changes = [&](size_t i) {
-    return (y[i] < 0) != (y[i + 1] < 0) || y[i] == 0;
-  };
+  auto changes = [&](size_t i) { return (y[i] < 0) != (y[i + 1] < 0) || y[i] == 0; };
   size_t first = from, last = to - 1;
   while (first < to - 1 && !changes(first)) ++first;
   while (last > from && !changes(last)) --last;

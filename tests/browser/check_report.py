@@ -4,11 +4,14 @@
 Runs `rvr compare` at a small size, loads the report through the Chrome DevTools protocol and
 fails on: console errors, uncaught exceptions, error log entries, failed loads, any request
 other than the report file itself or a data: URI, an image that did not decode, fewer images
-than the report must have, or a missing timing chart. Saves a full-page screenshot.
+than the report must have, a missing timing chart, anything cut off (a box whose content is
+wider than the box: its scroll width above its client width), or a depth-outlier table showing
+more than 10 rows before it is unfolded. Saves a full-page screenshot.
 
 With --self-check it instead loads a deliberately broken page (an undecodable data URI image, a
-JS exception, a console error, a request to the network) and passes only if every one of those
-problems is reported: a check that never fails is worth nothing.
+JS exception, a console error, a request to the network, a card whose text runs past its edge)
+and passes only if every one of those problems is reported: a check that never fails is worth
+nothing.
 
 The browser plumbing and the checks any page must pass are in devtools_page.py; a watchdog
 alarm bounds the whole run so the test can never hang.
@@ -39,10 +42,44 @@ PAGE_PROBE = r"""
       renderer: g.dataset.renderer,
       phases: Array.from(g.querySelectorAll('rect[data-phase]')).map(r => r.dataset.phase),
       width: g.getBoundingClientRect().width})) : [],
-    text: document.body ? document.body.innerText : ''
+    text: document.body ? document.body.innerText : '',
+    // Every box inside main whose content is wider than the box itself: cut off at its edge
+    // (overflow hidden), drawn past it (overflow visible), or behind a scroll bar.
+    clipped: Array.from(document.querySelectorAll('main, main *')).filter(e => {
+      const display = getComputedStyle(e).display;
+      if (display === 'inline' || display === 'none' || display === 'contents') return false;
+      return e.clientWidth > 0 && e.scrollWidth > e.clientWidth + 1;
+    }).map(e => ({
+      box: e.tagName.toLowerCase() + (e.id ? '#' + e.id : '') +
+           (typeof e.className === 'string' && e.className ? '.' + e.className : ''),
+      scrollWidth: e.scrollWidth, clientWidth: e.clientWidth,
+      text: (e.innerText || e.textContent || '').trim().slice(0, 60)})),
+    pageWidth: document.documentElement.scrollWidth,
+    windowWidth: window.innerWidth,
+    // Rows of depth-outlier tables a reader sees before unfolding anything.
+    outlierRowsShown: Array.from(document.querySelectorAll('table')).filter(t =>
+        t.querySelector('th') && t.querySelector('th').textContent === 'x' &&
+        t.checkVisibility({contentVisibilityAuto: true, visibilityProperty: true}))
+      .reduce((n, t) => n + t.querySelectorAll('tbody tr').length, 0)
   };
 })()
 """
+
+# A depth-outlier table shows at most this many rows until it is unfolded.
+MAX_OUTLIER_ROWS_SHOWN = 10
+
+
+def layout_problems(probe):
+    """What is cut off or too long on the page as laid out."""
+    problems = [f"cut off: {c['box']} is {c['clientWidth']} px wide but its content "
+                f"{c['scrollWidth']} px ('{c['text']}')" for c in probe.get("clipped", [])]
+    if probe.get("pageWidth", 0) > probe.get("windowWidth", 0):
+        problems.append(f"the page is {probe['pageWidth']} px wide in a "
+                        f"{probe['windowWidth']} px window")
+    if probe.get("outlierRowsShown", 0) > MAX_OUTLIER_ROWS_SHOWN:
+        problems.append(f"the depth outliers show {probe['outlierRowsShown']} rows before "
+                        f"unfolding, more than {MAX_OUTLIER_ROWS_SHOWN}")
+    return problems
 
 
 def run_compare(rvr, out_dir, renderers):
@@ -72,6 +109,7 @@ def check_report(args, work):
 
     problems, probe = check_page(args.chromium, out_dir / "report.html", args.screenshot, work,
                                  args.timeout, PAGE_PROBE)
+    problems += layout_problems(probe)
     images = probe["images"]
     if len(images) < expected_images:
         problems.append(f"{len(images)} images on the page, expected at least {expected_images}")
@@ -127,6 +165,10 @@ BROKEN_PAGE = """<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><tit
 <img alt="from the network" src="http://127.0.0.1:9/nothing.png">
 <script>console.error('deliberate console error');</script>
 <script>undefinedFunctionCalledOnPurpose();</script>
+<main><figure style="width:200px;overflow:hidden"><figcaption><span style="white-space:nowrap">a
+legend line much too long for its card, cut off at the card's edge</span></figcaption></figure>
+<table><thead><tr><th>x</th></tr></thead><tbody>""" + "<tr><td>1</td></tr>" * 11 + """
+</tbody></table></main>
 </body></html>
 """
 
@@ -137,6 +179,7 @@ def self_check(args, work):
     html.write_text(BROKEN_PAGE)
     problems, probe = check_page(args.chromium, html, args.screenshot, work, args.timeout,
                                  PAGE_PROBE)
+    problems += layout_problems(probe)
     print("the check reported, as it should:\n  " + "\n  ".join(problems))
     expected = {
         "console error": lambda p: p.startswith("console.error") and "deliberate" in p,
@@ -144,6 +187,8 @@ def self_check(args, work):
         "undefinedFunctionCalledOnPurpose" in p,
         "undecodable data URI image": lambda p: "alt 'broken data uri'" in p,
         "network request": lambda p: "network request to http://127.0.0.1:9/" in p,
+        "card cut off": lambda p: p.startswith("cut off: figure") and "legend line" in p,
+        "unfolded outlier table": lambda p: "depth outliers show 11 rows" in p,
     }
     missed = [name for name, hit in expected.items() if not any(hit(p) for p in problems)]
     if any("alt 'good'" in p for p in problems):

@@ -12,7 +12,7 @@
 extern "C" {
 #endif
 
-#define RVR_IMAGE_CODEC_ABI_VERSION 1
+#define RVR_IMAGE_CODEC_ABI_VERSION 2
 
 struct rvr_image_reader;  // an open input file
 
@@ -33,9 +33,6 @@ struct rvr_image_codec {
   // All pixels as floats, w * h * channels values, rows top-down. Returns 1, or 0 with err.
   int (*read)(struct rvr_image_reader* r, float* pixels, char* err, size_t err_size);
   void (*close)(struct rvr_image_reader* r);
-  // The library's "inferno" colour map (linear RGB) of w * h values in [0, 1]: 3 floats per
-  // value into rgb. Returns 1, or 0 when the library could not map them.
-  int (*inferno)(const float* values, int w, int h, float* rgb);
 };
 
 // The module's one exported symbol.

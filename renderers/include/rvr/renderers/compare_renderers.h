@@ -40,6 +40,9 @@ struct CompareOptions {
   // > 0: the renders drew and traced spheres as tessellate_sphere(sphere, sphere_segments)
   // (SphereMode::Mesh), whose facets are then primitives; compare_renderers sets it.
   int sphere_segments = 0;
+  // > 0: spheres were analytic, the z-buffers drew tessellate_sphere(sphere,
+  // polygon_sphere_segments) (MismatchContext); compare_renderers sets it.
+  int polygon_sphere_segments = 0;
 };
 
 // Two of the renderers compared, a before b in the order asked for; a is the reference of the

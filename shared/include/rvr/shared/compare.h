@@ -34,12 +34,17 @@ enum class DepthOutlierCause {
   // outside one facet in exact arithmetic is drawn on it, and the tracer hits its neighbour.
   // Both are the same object (and, for a tessellated sphere, the same primitive).
   Silhouette,
-  // Anything else: a real disagreement when both draw the same triangles (--spheres mesh).
-  // With analytic spheres the z-buffer's polygon lies inside the tracer's sphere, by more
-  // than the threshold towards the outline.
+  // On an analytic sphere, away from its outline, by no more than the z-buffer's polygon of it
+  // can differ from the sphere along that pixel's ray: the polygon lies between the sphere
+  // and the largest ball inside it, so its depth lies between where the ray enters the two
+  // (or leaves the sphere, for a ray that misses the ball). Only with
+  // MismatchContext::polygon_sphere_segments > 0; expected, not a disagreement.
+  AnalyticSphere,
+  // Anything else: a real disagreement.
   Elsewhere,
 };
-const char* to_string(DepthOutlierCause cause);  // "silhouette", "elsewhere"
+// "silhouette", "analytic_sphere", "elsewhere"
+const char* to_string(DepthOutlierCause cause);
 
 inline constexpr double kDepthOutlierThreshold = 1e-3;
 
@@ -60,6 +65,7 @@ struct DepthMetrics {  // over pixels whose ids agree and are not background
   // Pixels whose error is above kDepthOutlierThreshold, by cause; the worst are listed.
   size_t outliers = 0;
   size_t outliers_at_silhouettes = 0;
+  size_t outliers_on_analytic_spheres = 0;
   size_t outliers_elsewhere = 0;
   std::vector<DepthOutlier> worst_outliers;  // by error, largest first; at most kMaxListed
   static constexpr size_t kMaxListed = 100;

@@ -74,6 +74,11 @@ struct MismatchContext {
   // > 0 when both renderers drew and traced spheres as tessellate_sphere(sphere,
   // sphere_segments) (SphereMode::Mesh): a sphere's primitive ids then index those facets.
   int sphere_segments = 0;
+  // > 0 when spheres are analytic (SphereMode::Analytic): a tracer hits the sphere itself
+  // while a z-buffer, which cannot draw one, draws tessellate_sphere(sphere,
+  // polygon_sphere_segments), a polygon inside it. Depth metrics then tell that polygon's
+  // depth differences from real disagreements (DepthOutlierCause::AnalyticSphere).
+  int polygon_sphere_segments = 0;
 };
 
 // One class per pixel (None where the (object, primitive) ids agree, background counting as

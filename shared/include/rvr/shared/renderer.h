@@ -79,13 +79,22 @@ struct RenderOptions {
 
 struct RenderOutput {
   FrameBuffers buffers;
-  // Counters and phase times (seconds), e.g. "time.build", "rays.primary", "bvh.nodes_visited".
+  // Counters and phase times (seconds), e.g. "time.build", "rays.primary", "bvh.nodes_visited";
+  // stat_kind tells which a name is.
   std::map<std::string, double> stats;
   // What the renderer could not do for this scene (e.g. "csg objects skipped: 1").
   std::vector<std::string> warnings;
   // Facts that are words, not numbers, e.g. "kernel": "avx2".
   std::map<std::string, std::string> info;
 };
+
+// What a stat of RenderOutput::stats measures, which decides how it is written: every stat
+// is a count (rays, nodes, tests, fragments, pixels, bytes: a whole number, written as an
+// integer) except the seconds of a phase (every "time.*") and the declared ratios, averages and
+// costs ("overdraw", "bvh.node_fill", "bvh.block_fill", "bvh.sah_cost"). A hybrid's copy of its
+// z-buffer's stats ("zbuffer." + name) is what the name is. docs/cli.md lists them.
+enum class StatKind { Count, Seconds, Ratio };
+StatKind stat_kind(const std::string& name);
 
 class Renderer {
  public:

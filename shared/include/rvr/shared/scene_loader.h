@@ -42,6 +42,9 @@ struct SceneOverrides {
   std::optional<float> exposure;
   UpAxis up = UpAxis::Auto;          // model files only
   FromFile camera = FromFile::File;  // model files only
+  // Model files, camera File: a file camera that does not frame the model (view_of_model in
+  // camera_framing.h) is replaced by the framing camera with a warning; false keeps it as it is.
+  bool judge_file_camera = true;
   FromFile lights = FromFile::File;  // model files only
 };
 
@@ -56,11 +59,11 @@ bool is_model_file_name(const std::string& path);
 
 // A model file as a scene (docs/scene-format.md, "Model files as scenes"): one object per
 // mesh with the file's own material, turned so that its up axis (overrides.up) is +y; the
-// file's first camera (not an FBX exporter's viewport camera, nor one that sees none of the
-// model), else one framing the model from default_view_from() (overrides.view_from replaces
-// either, overrides.camera = Auto always frames); the file's point lights, else (or with
-// overrides.lights = Auto) a key light near the camera and ambient; the automatic exposure
-// unless overrides.exposure is set.
+// file's first camera (not an FBX exporter's viewport camera, nor, unless
+// overrides.judge_file_camera is false, one that does not frame the model), else one framing
+// the model from default_view_from() (overrides.view_from replaces either, overrides.camera =
+// Auto always frames); the file's point lights, else (or with overrides.lights = Auto) a key
+// light near the camera and ambient; the automatic exposure unless overrides.exposure is set.
 Expected<Scene> load_model_scene(const std::string& path, const SceneOverrides& overrides = {});
 
 struct BuiltinSceneInfo {

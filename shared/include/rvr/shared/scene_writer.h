@@ -25,10 +25,18 @@ struct SceneTextureFile {
   Image image;       // to be written with write_image
 };
 
+// A texture file the document names beside itself, to be copied there from where the scene
+// read it (write_scene's copy_texture_files).
+struct SceneCopiedFile {
+  std::string name;    // as written in the document, relative to the document's folder
+  std::string source;  // the file the scene read
+};
+
 struct SceneDocument {
   std::string json;                             // the rvr-scene/1 text, ending in a newline
   std::vector<SceneMeshFile> mesh_files;        // to be written next to the document
   std::vector<SceneTextureFile> texture_files;  // likewise
+  std::vector<SceneCopiedFile> copied_files;    // to be copied next to the document
 };
 
 // Writes `scene` as rvr-scene/1. Every key is written, defaults included; floats are written
@@ -36,12 +44,16 @@ struct SceneDocument {
 // with exactly one triangle and no normals becomes a `triangle` object (with its `uvs` and
 // `colors`); any other mesh becomes a `mesh` object whose file is named mesh_prefix + ".mesh"
 // + object index + ".ply" (texture coordinates and vertex colours as float properties s, t and
-// red, green, blue). A texture read from a file is named by its path relative to
-// `document_folder` (the folder the document is written to; the image is not copied); one in
-// memory only goes to mesh_prefix + ".texture" + index + ".exr"; one that was not found keeps
-// the name it had. Fails (bad input) on what the format cannot express: a materials[0] that is
-// not the built-in default, duplicate or empty material names, a material index out of range.
+// red, green, blue). A texture read from a file under `document_folder` (the folder the
+// document is written to) is named by its path relative to that folder; one elsewhere by its
+// absolute path (a relative path climbing out of the folder would break when the folder
+// moves), or, with `copy_texture_files`, by mesh_prefix + ".texture" + index + its extension,
+// a copy to be made beside the document (copied_files). A texture in memory only goes to
+// mesh_prefix + ".texture" + index + ".exr"; one that was not found keeps the name it had.
+// Fails (bad input) on what the format cannot express: a materials[0] that is not the built-in
+// default, duplicate or empty material names, a material index out of range.
 Expected<SceneDocument> write_scene(const Scene& scene, const std::string& mesh_prefix,
-                                    const std::string& document_folder = ".");
+                                    const std::string& document_folder = ".",
+                                    bool copy_texture_files = false);
 
 }  // namespace rvr

@@ -4,14 +4,21 @@
 //   hybrid    t = a + b·P + c·N + d·P·log2 N   (the sum of both; the two per-pixel terms are one)
 // P is the pixel count (primary rays), N the swept axis (triangles). Where N is depth complexity
 // D (the occluders family), the z-buffers' fragments add d·P·D (g·P·D for the hybrid, whose d
-// is taken). Two extensions, added only
-// where the data demand them (fit.h chooses by leave-one-out error):
+// is taken). Two extensions, added only where the data demand them (fit.h chooses by
+// leave-one-out error):
 //   edges  + e·√(P·N): N triangles sharing a fixed part of the screen have edges of total length
 //          ∝ N·√(P/N) = √(P·N) pixels; work per edge pixel or per tile an edge crosses (the
 //          z-buffer's partly covered blocks, the tracer's packets split at silhouettes)
-//   knee   + f·max(0, N − k) (z-buffer, hybrid) or f·P·max(0, log2(N/k)) (tracer): a change
-//          of slope at N = k: where the working set leaves a cache (steeper), or where triangles
-//          become smaller than the rasterizer's blocks (flatter)
+//   knee   a change of slope at N = k, in one of two directions, each with a coefficient f ≥ 0
+//          (every coefficient is a cost, fitted non-negative):
+//          steeper past k: + f·max(0, N − k) (z-buffer, hybrid) or + f·P·max(0, log2(N/k))
+//            (tracer): each triangle (tree level) past k costs f more, where the working set
+//            leaves a cache;
+//          flatter past k: + f·min(N, k) (z-buffer, hybrid) or + f·P·min(log2 N, log2 k)
+//            (tracer): the first k triangles (levels) cost f more each than the ones past k,
+//            where triangles become smaller than the rasterizer's blocks and cost their setup,
+//            no longer their area. A negative f on the steeper term would say the same with a
+//            negative cost, which the fit does not allow.
 #pragma once
 
 #include <stddef.h>
@@ -25,14 +32,15 @@ enum class ModelForm { ZBuffer, Tracer, Hybrid };
 
 struct CostModel {
   ModelForm form = ModelForm::ZBuffer;
-  bool edges = false;  // the e·√(P·N) term
-  double knee = 0;     // > 0: the knee term, its change of slope at N = knee
-  bool depth = false;  // N is depth complexity: the z-buffers' d·P·D (g for the hybrid)
+  bool edges = false;    // the e·√(P·N) term
+  double knee = 0;       // > 0: the knee term, its change of slope at N = knee
+  bool flatter = false;  // the knee's slope falls past it (min(N, k)) instead of rising
+  bool depth = false;    // N is depth complexity: the z-buffers' d·P·D (g for the hybrid)
 
   CostModel() = default;
   CostModel(ModelForm f) : form(f) {}  // NOLINT: the textbook form, implicitly
-  CostModel(ModelForm f, bool with_edges, double cache_knee)
-      : form(f), edges(with_edges), knee(cache_knee) {}
+  CostModel(ModelForm f, bool with_edges, double cache_knee, bool knee_flatter = false)
+      : form(f), edges(with_edges), knee(cache_knee), flatter(knee_flatter) {}
   bool extended() const { return edges || knee > 0; }
 };
 

@@ -77,8 +77,9 @@ struct Crossover {
 // Neither curve crosses the other over the swept range.
 struct Dominance {
   std::string faster, slower, scene, axis;
-  double min_ratio = 0;  // the slower's time over the faster's, smallest over the significant points
-  double at = 0;         // where that smallest ratio is
+  double min_ratio =
+      0;          // the slower's time over the faster's, smallest over the significant points
+  double at = 0;  // where that smallest ratio is
   double pixels = 0;
   double n = 0;  // as in Crossover
   double range_low = 0, range_high = 0;

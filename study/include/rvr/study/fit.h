@@ -1,5 +1,6 @@
-// A cost model fitted to a renderer's sweep: weighted least squares on relative error, 95%
-// intervals from the bootstrap over repetitions, and whether the model fits at all.
+// A cost model fitted to a renderer's sweep: non-negative weighted least squares on relative
+// error, 95% intervals from a bootstrap that holds both the repetitions' noise and the points'
+// scatter about the model, and whether the model fits at all.
 #pragma once
 
 #include <stddef.h>
@@ -10,6 +11,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/cost_model.h"
+#include "rvr/study/fit_quality.h"
 #include "rvr/study/measurement.h"
 
 namespace rvr::study {
@@ -27,8 +29,14 @@ struct FitThresholds {
   double min_r2 = 0.9;
   double max_rel_residual = 0.25;
   double max_loo_rel_error = 0.20;
-  // An extension is taken only when it lowers the mean leave-one-out error by this fraction.
+  // An extension is taken only when it lowers the mean leave-one-out error by this fraction,
   double min_extension_gain = 0.20;
+  // and only when the model before it predicts the points left out worse than their timing
+  // noise explains: its mean leave-one-out error above this many times timing_noise(). A
+  // correct model's is about 0.9× (the mean absolute value of a normal error, a little more
+  // for points at the ends of the sweep); below that bar the choice among many knees would
+  // follow the noise.
+  double extension_noise_floor = 1.5;
 };
 
 struct ModelFit {
@@ -39,6 +47,9 @@ struct ModelFit {
   double r2 = 0;                // weighted (1/t²) coefficient of determination
   double max_rel_residual = 0;  // largest |t − model| / t over the points
   double loo_rel_error = 0;     // median over the points of their error when left out
+  // The points' relative scatter about the model beyond their timing noise, and that noise
+  // (LinearFit): a misfit larger than the noise widens the intervals.
+  double misfit = 0, repetition_noise = 0;
   size_t points = 0;
   bool fits = false;
   std::string verdict;      // "fits", or why the model does not
@@ -52,29 +63,79 @@ struct ModelFit {
 std::vector<bool> identifiable_terms(const CostModel& model,
                                      const std::vector<Measurement>& points);
 
-// The coefficients fitted to `medians` (one per point), each weighted by 1/scale², so that
-// the fit minimizes relative error; `scale` is the medians themselves when empty (a bootstrap
-// replicate passes the measured medians: the weights are the design, not a resampled value).
+// Each point's features under `model` (features(model, P, N)): the rows of its fit.
+std::vector<std::vector<double>> design_rows(const CostModel& model,
+                                             const std::vector<Measurement>& points);
+
+// The non-negative coefficients fitting `times` (one per row) with each row weighted by
+// 1/scale², so that the fit minimizes relative error; `scale` is the times themselves when
+// empty (a bootstrap replicate passes the measured times: the weights are the design, not a
+// resampled value). nonnegative_least_squares (least_squares.h) does the work.
+Expected<std::vector<double>> fit_rows(const std::vector<std::vector<double>>& rows,
+                                       const std::vector<double>& times,
+                                       const std::vector<bool>& use,
+                                       const std::vector<double>& scale = {});
+
+// fit_rows with the rows of a cost model.
 Expected<std::vector<double>> fit_coefficients(const CostModel& model,
                                                const std::vector<Measurement>& points,
                                                const std::vector<double>& medians,
                                                const std::vector<bool>& use,
                                                const std::vector<double>& scale = {});
 
-// The model fitted to the points' medians, its intervals from `boot` replicates of the
-// bootstrap over repetitions, its quality and verdict against `limits`. Too few points, or
+// A linear model (a cost model's features, or counted work) fitted to the points' times t_i
+// (typical_seconds) by fit_rows, with 95% intervals from `boot.replicates` replicates that each
+// refit, for every point,
+//   y*_i = ŷ_i + t_i·(κ·m*_i + w·σ·z_i)
+// ŷ_i the fitted time; m*_i = t*_i / t_i − 1, t*_i the point's hierarchical resample over its
+// repetitions (resample_time: sessions, then rounds); z_i standard normal. Two sources of error:
+//   - the repetitions' (timing noise): m*. Drawing sessions and then rounds counts the frames'
+//     noise at both levels and sees only the sessions drawn, so κ² scales the replicates'
+//     variance, summed over the points, to the unbiased one from the runs alone (the sample
+//     variance of the log of each run's Harrell–Davis median, over the run count): κ = 1 when
+//     any point has a single run;
+//   - the points' scatter about the model beyond that noise: σ² = max(0, s² − κ²·mean var m*),
+//     s² = Σ ((t_i − ŷ_i)/t_i)² / (points − coefficients fitted non-zero), the scatter the fit's
+//     1/t² weights assume is the same at every point. It holds variation between scene sizes
+//     that every run of a point repeats and the model's own error: a model that misses its
+//     points has intervals as wide as the misfit even when every repetition is the same. w, the
+//     97.5% quantile of Student's t with that many degrees of freedom over the normal one, widens
+//     the draws for σ being estimated from few points.
+struct LinearFit {
+  std::vector<double> values;  // as fitted; 0 where not used
+  std::vector<Interval> ci95;
+  std::vector<std::vector<double>> replicates;  // each replicate's coefficients
+  FitQuality quality;
+  double misfit = 0;            // σ: the relative scatter about the model beyond the noise
+  double repetition_noise = 0;  // κ·√(mean var m*): the relative timing noise of a point
+};
+Expected<LinearFit> fit_linear(const std::vector<std::vector<double>>& rows,
+                               const std::vector<Measurement>& points, const std::vector<bool>& use,
+                               const BootstrapOptions& boot);
+
+// The points' relative timing noise: the root mean square over the points of the standard error
+// of log typical_seconds from its runs (from its frames when it has one run).
+double timing_noise(const std::vector<Measurement>& points);
+
+// "fits", or the first of `limits` the fit misses, in words.
+std::string fit_verdict(const FitQuality& q, const FitThresholds& limits);
+
+// The model fitted to the points' times by fit_linear, its quality and verdict against
+// `limits`. Too few points, or
 // terms that cannot be told apart, give fits = false with the reason, not an error.
 ModelFit fit_model(const CostModel& model, const std::vector<Measurement>& points,
                    const BootstrapOptions& boot, const FitThresholds& limits = {});
 
 // The models a form may be extended to for these points: the textbook form, + edges, + a
-// knee at each measured N with at least two points on either side, + both.
+// knee (steeper or flatter) at each measured N with at least two points on either side, + both.
 std::vector<CostModel> candidate_models(const CostModel& textbook,
                                         const std::vector<Measurement>& points);
 
 // The textbook form unless the data demand an extension: each more complex tier (one
 // extension, then both) is taken when its best candidate lowers the mean leave-one-out error
-// by limits.min_extension_gain; then fitted as fit_model does, `selection` saying why.
+// by limits.min_extension_gain and the tier before misses the points by more than their
+// timing noise (limits.extension_noise_floor); then fitted as fit_model does, `selection`
+// saying why.
 ModelFit fit_chosen_model(const CostModel& textbook, const std::vector<Measurement>& points,
                           const BootstrapOptions& boot, const FitThresholds& limits = {});
 

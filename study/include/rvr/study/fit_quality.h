@@ -1,10 +1,8 @@
-// How well a fitted cost model describes the points it was fitted to.
+// How well a fitted linear model (a cost model's features, or counted work) describes the points
+// it was fitted to.
 #pragma once
 
 #include <vector>
-
-#include "rvr/study/cost_model.h"
-#include "rvr/study/measurement.h"
 
 namespace rvr::study {
 
@@ -17,12 +15,13 @@ struct FitQuality {
   double loo_mean_rel_error = 0;
 };
 
-// The leave-one-out errors alone (what choosing among models needs).
-FitQuality leave_one_out(const CostModel& model, const std::vector<Measurement>& points,
-                         const std::vector<double>& medians, const std::vector<bool>& use);
+// The leave-one-out errors alone (what choosing among models needs): `rows` holds each point's
+// features, `times` its measured time; every refit is the non-negative weighted fit of fit.h.
+FitQuality leave_one_out(const std::vector<std::vector<double>>& rows,
+                         const std::vector<double>& times, const std::vector<bool>& use);
 
-FitQuality fit_quality(const CostModel& model, const std::vector<Measurement>& points,
-                       const std::vector<double>& medians, const std::vector<double>& coefficients,
+FitQuality fit_quality(const std::vector<std::vector<double>>& rows,
+                       const std::vector<double>& times, const std::vector<double>& coefficients,
                        const std::vector<bool>& use);
 
 }  // namespace rvr::study

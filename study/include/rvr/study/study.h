@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "rvr/study/counted_work.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
@@ -56,19 +57,19 @@ struct UnitCost {
 // there: which renderer is faster, and what the fitted models predict for the ratio.
 struct PredictionCheck {
   std::string a, b, scene, axis;
-  double crossover = 0;   // the crossover's value on the axis
-  bool extrapolated = false;  // the crossover lay outside the swept range
-  double at = 0;          // where the check measured: the axis value of its point
-  double pixels = 0, n = 0;  // the pixel count and N of the point measured
+  double crossover = 0;          // the crossover's value on the axis
+  bool extrapolated = false;     // the crossover lay outside the swept range
+  double at = 0;                 // where the check measured: the axis value of its point
+  double pixels = 0, n = 0;      // the pixel count and N of the point measured
   std::string predicted_faster;  // "" where the conclusion is that they are equal (at the value)
   std::string measured_faster;   // "" where the measured ratio is within the noise threshold
-  double ratio = 0;        // measured t_a / t_b, paired
-  Interval ratio_ci95;     // its hierarchical bootstrap interval
-  double p = 1;            // that it is within the noise threshold (Holm over the checks)
-  double predicted_ratio = 0;  // the fitted models' t_a / t_b there (NaN: no model fits)
-  Interval predicted_ci95;     // over the models' bootstrap replicates
-  std::string verdict;     // "holds", "fails" or "inconclusive"
-  std::string why;         // the reason, in words
+  double ratio = 0;              // measured t_a / t_b, paired
+  Interval ratio_ci95;           // its hierarchical bootstrap interval
+  double p = 1;                  // that it is within the noise threshold (Holm over the checks)
+  double predicted_ratio = 0;    // the fitted models' t_a / t_b there (NaN: no model fits)
+  Interval predicted_ci95;       // over the models' bootstrap replicates
+  std::string verdict;           // "holds", "fails" or "inconclusive"
+  std::string why;               // the reason, in words
 };
 
 // A hybrid's frame split into its z-buffer pass and its tracer's part, at one point.
@@ -104,7 +105,7 @@ struct StudyResult {
   std::string run_id;
   std::vector<std::string> merged_runs;  // after --merge: the run_id of every study pooled
   MachineInfo machine;
-  std::vector<SessionInfo> sessions;     // Run::session indexes these
+  std::vector<SessionInfo> sessions;           // Run::session indexes these
   SystemSnapshot system_before, system_after;  // the machine before and after the sweep
   std::vector<Measurement> points;
   std::vector<RendererModels> models;
@@ -122,14 +123,19 @@ struct StudyResult {
   // it dropped (memory_estimate.h); empty for a family that never went past them, or when the
   // sweep had no way to probe memory.
   std::vector<FamilyMemory> memory;
+  // Per renderer and family: the cost model from counted work, each count's scaling with N and
+  // the pixel count, and the chapter's claims checked on counts (counted_work.h).
+  std::vector<WorkModel> work_models;
+  std::vector<CountScaling> count_scaling;
+  std::vector<CountClaim> count_claims;
   std::vector<PredictionCheck> checks;
   std::vector<Measurement> check_points;  // what the checks measured (not in the fits)
-  std::vector<std::string> notes;  // what the budget cut short, and the like
+  std::vector<std::string> notes;         // what the budget cut short, and the like
   // Why the study concludes nothing (no crossover, dominance or tie, no model that fits);
   // empty when it concludes something.
   std::string no_conclusion;
-  bool interrupted = false;        // the sweep was stopped (Ctrl-C) before its end
-  std::optional<Shard> shard;      // the share of the planned points measured (--shard)
+  bool interrupted = false;    // the sweep was stopped (Ctrl-C) before its end
+  std::optional<Shard> shard;  // the share of the planned points measured (--shard)
 };
 
 }  // namespace rvr::study

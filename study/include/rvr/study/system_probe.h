@@ -8,15 +8,15 @@
 namespace rvr::study {
 
 struct SystemSnapshot {
-  double at = 0;  // seconds since the study began
-  int cpus = 0;   // online CPUs
+  double at = 0;                            // seconds since the study began
+  int cpus = 0;                             // online CPUs
   double load1 = 0, load5 = 0, load15 = 0;  // /proc/loadavg
   // Over a short window in which the study itself waited: the share of all CPU time that
   // other work used (user, nice, system, irq, softirq), and that the hypervisor stole.
   double other_busy = 0, steal = 0;
-  double mhz = 0;         // mean current clock over the CPUs (cpufreq, else /proc/cpuinfo); 0: unknown
-  std::string governor;   // cpufreq's scaling governor of cpu0; "" where there is none
-  bool known = false;     // false where /proc/stat could not be read (the other fields are 0)
+  double mhz = 0;  // mean current clock over the CPUs (cpufreq, else /proc/cpuinfo); 0: unknown
+  std::string governor;  // cpufreq's scaling governor of cpu0; "" where there is none
+  bool known = false;    // false where /proc/stat could not be read (the other fields are 0)
 };
 
 // The share of other work above which a session counts as run on a busy machine.
