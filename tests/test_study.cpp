@@ -484,11 +484,14 @@ void expect_one_run_per_session(const StudyResult& r) {
   std::map<std::tuple<std::string, double, int>, std::set<int>> sessions_of;  // scene, N, width
   for (const Measurement& m : r.points) {
     std::set<int> sessions;
-    for (const study::Run& run : m.runs)
+    for (const study::Run& run : m.runs) {
       EXPECT_TRUE(sessions.insert(run.session).second)
           << m.renderer << " N=" << m.n << ": session " << run.session << " twice";
+    }
     auto [it, fresh] = sessions_of.try_emplace({m.scene, m.scene_n, m.width}, sessions);
-    if (!fresh) EXPECT_EQ(it->second, sessions) << m.renderer << " N=" << m.n;
+    if (!fresh) {
+      EXPECT_EQ(it->second, sessions) << m.renderer << " N=" << m.n;
+    }
   }
 }
 
@@ -501,7 +504,7 @@ bool noted(const StudyResult& r, const std::string& words) {
 }  // namespace
 
 TEST(StudyRun, SweepsInFreshSessionsWithinTheBudget) {
-  SimulatedStudy study(4, 120, 200);
+  SimulatedStudy study(4, 600, 200);
   Expected<StudyResult> r = run_study(study.request, study.hooks);
   ASSERT_TRUE(r.ok()) << r.error().message;
   EXPECT_LE(r->elapsed_seconds, study.request.budget_seconds);
@@ -509,7 +512,8 @@ TEST(StudyRun, SweepsInFreshSessionsWithinTheBudget) {
   for (const Measurement& m : r->points) {
     (m.width == study.request.width ? full_width : narrower)++;
     // Every point in three sessions, five rounds each, no session twice.
-    ASSERT_EQ(m.runs.size(), 3u) << m.renderer << " N=" << m.n;
+    ASSERT_EQ(m.runs.size(), 3u) << m.renderer << " N=" << m.n << " width " << m.width << "\n"
+                                 << study_markdown(*r);
     std::set<int> sessions;
     for (const study::Run& run : m.runs) {
       EXPECT_EQ(run.seconds.size(), 5u);

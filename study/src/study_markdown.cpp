@@ -57,9 +57,14 @@ std::string header(const StudyResult& r) {
   std::string text = "# rvr study\n\n";
   text += "**Scope.** " + scope_text(r) + "\n\n";
   text += "**Method.** " + method_text(r) + "\n\n";
-  text += fmt::format(
-      "**Machine.** {}, {} threads; kernels: {}. Before the sweep: {}; after: {}.\n", r.machine.cpu,
-      r.machine.threads, r.machine.kernels, describe(r.system_before), describe(r.system_after));
+  // A study run without the CLI (Python, tests) may not know the processor.
+  const std::string cpu = r.machine.cpu.empty() ? "processor not recorded" : r.machine.cpu;
+  const std::string threads =
+      r.machine.threads > 0 ? fmt::format(", {} threads", r.machine.threads) : "";
+  const std::string kernels =
+      r.machine.kernels.empty() ? "" : fmt::format("; kernels: {}", r.machine.kernels);
+  text += fmt::format("**Machine.** {}{}{}. Before the sweep: {}; after: {}.\n", cpu, threads,
+                      kernels, describe(r.system_before), describe(r.system_after));
   if (!r.no_conclusion.empty()) text += "\n## No conclusion\n\n" + r.no_conclusion + ".\n";
   return text;
 }
