@@ -70,7 +70,8 @@ SANITIZE_TARGETS := rvr rvr_python $(patsubst tests/%.cpp,%,$(wildcard tests/tes
 # everything at exit, so they run without the leak check (the module's own leaks are
 # python_memory's subject).
 SANITIZE_PRELOAD := $(shell gcc -print-file-name=libasan.so):$(shell gcc -print-file-name=libstdc++.so)
-SANITIZE_PYTHON ?= python_
+# lazy_loading runs python3 with the module too (and rvr under the loader's trace).
+SANITIZE_PYTHON ?= python_|lazy_loading
 # Brute-force conformance (`raytrace_none_*`: every scene traced with no acceleration
 # structure) is left out: under ASan it alone would take longer than the rest of the suite; the
 # same tracer code runs under ASan with the BVH in every other conformance case, and the

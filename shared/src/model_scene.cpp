@@ -6,7 +6,6 @@
 #include <stdint.h>
 
 #include <algorithm>
-#include <assimp/Importer.hpp>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -277,7 +276,7 @@ bool is_model_file_name(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext.empty() || ext == ".json") return false;
-  return Assimp::Importer().IsExtensionSupported(ext);
+  return scene_load::model_extension_supported(ext);
 }
 
 namespace {

@@ -1,0 +1,58 @@
+#include "rvr/shared/plugin.h"
+
+#include <dlfcn.h>
+#include <unistd.h>
+
+#include <climits>
+#include <initializer_list>
+
+namespace rvr {
+namespace {
+
+std::string folder_of(const std::string& file) {
+  const auto slash = file.rfind('/');
+  return slash == std::string::npos ? std::string() : file.substr(0, slash);
+}
+
+// The folder of the running executable, where the build puts the plugins beside it.
+std::string executable_folder() {
+  char path[PATH_MAX];
+  const ssize_t n = ::readlink("/proc/self/exe", path, sizeof(path) - 1);
+  if (n <= 0) return {};
+  return folder_of(std::string(path, size_t(n)));
+}
+
+}  // namespace
+
+std::string rvr_code_folder() {
+  Dl_info info{};
+  if (!::dladdr(reinterpret_cast<const void*>(&executable_folder), &info) || !info.dli_fname)
+    return executable_folder();
+  return folder_of(info.dli_fname);
+}
+
+Expected<const void*> open_plugin(const char* module, const char* symbol, const std::string& what) {
+  std::string tried;
+  void* handle = nullptr;
+  const std::string executable = executable_folder(), code = rvr_code_folder();
+  for (const std::string& folder : {executable, code == executable ? std::string() : code}) {
+    if (handle || folder.empty()) continue;
+    const std::string beside = folder + "/" + module;
+    handle = ::dlopen(beside.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) tried += (tried.empty() ? "" : "; ") + std::string(::dlerror());
+  }
+  if (!handle) {
+    handle = ::dlopen(module, RTLD_NOW | RTLD_LOCAL);
+    if (!handle) tried += (tried.empty() ? "" : "; ") + std::string(::dlerror());
+  }
+  if (!handle) return internal_error("cannot load " + what + " " + module + ": " + tried);
+  using Get = const void* (*)();
+  auto get = reinterpret_cast<Get>(::dlsym(handle, symbol));
+  const void* table = get ? get() : nullptr;
+  if (!table)
+    return internal_error(std::string(module) + " is not this build's " + what + " (no " + symbol +
+                          ")");
+  return table;
+}
+
+}  // namespace rvr
