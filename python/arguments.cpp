@@ -1,5 +1,7 @@
 #include "arguments.h"
 
+#include <array>
+
 #include "errors.h"
 
 namespace py = pybind11;

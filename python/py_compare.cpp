@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <glm/glm.hpp>
 #include <memory>
 #include <optional>
 #include <string>
@@ -24,6 +25,7 @@
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/renderer.h"
 #include "rvr/shared/scene.h"
+#include "rvr/shared/texture.h"
 #include "stub_docs.h"
 
 namespace py = pybind11;

@@ -4,11 +4,13 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>  // IWYU pragma: keep (type casters for std containers)
+#include <stddef.h>
 
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <glm/glm.hpp>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -20,6 +22,7 @@
 #include "arguments.h"
 #include "bindings.h"
 #include "errors.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/image_sample.h"
 #include "rvr/shared/isa.h"

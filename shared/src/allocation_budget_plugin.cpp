@@ -5,6 +5,8 @@
 // is the same, built from the same header). Where the plugin's own operator new and delete are
 // the ones found (the Python module, loaded by python3, is not searched before the plugin's
 // libraries), they forward to the program's, so that Assimp is counted there too.
+#include <stdint.h>
+
 #include <cstdlib>
 #include <new>
 

@@ -1,5 +1,8 @@
 #include "image_codec_loader.h"
 
+#include <memory>
+#include <variant>
+
 #include "rvr/shared/plugin.h"
 
 namespace rvr {

@@ -1,6 +1,9 @@
 // mesh_import.h's functions in the program: the model-import plugin (model_import_abi.h) opened
 // on first use and called through its table, so that Assimp is loaded only by a run that reads
 // a model or mesh file.
+#include <stddef.h>
+#include <stdint.h>
+
 #include <new>
 #include <string>
 #include <vector>
@@ -10,6 +13,7 @@
 #include "model_import_abi.h"
 #include "rvr/shared/expected.h"
 #include "rvr/shared/plugin.h"
+#include "rvr/shared/scene.h"
 #include "scene_json_errors.h"
 
 namespace rvr::scene_load {

@@ -2,12 +2,15 @@
 // Built as librvr_model_import.so with its own copies of the few stateless helpers
 // mesh_import.cpp uses; the allocation budget stays the opening program's
 // (allocation_budget_plugin.cpp). The one part of rvr that links Assimp.
+#include <stddef.h>
+
 #include <assimp/Importer.hpp>
 #include <string>
 #include <vector>
 
 #include "mesh_import.h"
 #include "model_import_abi.h"
+#include "rvr/shared/scene.h"
 #include "scene_json_errors.h"
 
 namespace rvr::scene_load {
