@@ -142,6 +142,7 @@ def main():
     check(has(names, EMBREE_PLUGIN) and has(names, EMBREE) and not has(names, ASSIMP),
           "the embree renderer loads the Embree plugin and Embree, not Assimp")
 
+    check_missing_plugins(rvr, work, ply)
     if args.python_dir:
         check_module(args.python_dir, args.python_preload, ply)
 
@@ -149,6 +150,27 @@ def main():
         print(f"{len(failures)} check(s) failed")
         return 1
     return 0
+
+
+def check_missing_plugins(rvr, work, ply):
+    """rvr copied alone to a folder without its plugins: what needs none runs, what needs one
+    is an internal error (exit 3) naming the plugin, not a crash nor the file's error."""
+    lonely = work / "lonely"
+    lonely.mkdir(exist_ok=True)
+    alone = lonely / "rvr"
+    alone.write_bytes(rvr.read_bytes())
+    alone.chmod(0o755)
+    done = subprocess.run([str(alone), "--version"], capture_output=True, text=True)
+    check(done.returncode == 0, "rvr without its plugins still starts")
+    for what, args, plugin in [
+            ("the embree renderer", ["builtin:spheres", "-r", "embree"], EMBREE_PLUGIN),
+            ("a model file", [str(ply), "-r", "raytrace"], MODEL_PLUGIN)]:
+        done = subprocess.run([str(alone), "render", *args, "--width", "8", "--height", "6",
+                               "-q", "-o", str(lonely / "out.exr")],
+                              capture_output=True, text=True)
+        check(done.returncode == 3 and "cannot load" in done.stderr and plugin in done.stderr,
+              f"without {plugin}, {what} is an internal error naming it "
+              f"(exit {done.returncode}: {done.stderr.strip()[:200]})")
 
 
 def check_module(python_dir, preload, ply):

@@ -5,6 +5,7 @@
 #include <stdint.h>
 
 #include <new>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -28,9 +29,9 @@ const ModelImportHost kHost = {
     [](void* p) { ::operator delete(p); },
 };
 
-// The plugin's table, opened and connected once per process; a failure to load it is an error
-// of the file being read (LoadError), with the reason.
-const rvr_model_import& plugin(const std::string& path) {
+// The plugin's table, opened and connected once per process. Failing to load it is the
+// installation's error, not the file's: an internal error (std::runtime_error) with the reason.
+const rvr_model_import& plugin() {
   static const Expected<const rvr_model_import*> table = [] {
     Expected<const rvr_model_import*> t =
         open_plugin_table<rvr_model_import>("librvr_model_import.so", "rvr_model_import_get",
@@ -38,7 +39,7 @@ const rvr_model_import& plugin(const std::string& path) {
     if (t) (*t)->connect(&kHost);
     return t;
   }();
-  if (!table) fail(path, table.error().message);
+  if (!table) throw std::runtime_error(table.error().message);
   return **table;
 }
 
@@ -49,8 +50,8 @@ TriangleMesh import_mesh(const std::string& file, const std::string& base_dir,
                          std::vector<std::string>* warnings) {
   TriangleMesh mesh;
   LoadError error;
-  if (!plugin(path).import_mesh(file, base_dir, path, smooth, skipped_primitives, warnings, &mesh,
-                                &error))
+  if (!plugin().import_mesh(file, base_dir, path, smooth, skipped_primitives, warnings, &mesh,
+                            &error))
     throw error;
   return mesh;
 }
@@ -59,14 +60,14 @@ ImportedModel import_model(const std::string& file, const std::string& base_dir,
                            const std::string& path) {
   ImportedModel model;
   LoadError error;
-  if (!plugin(path).import_model(file, base_dir, path, &model, &error)) throw error;
+  if (!plugin().import_model(file, base_dir, path, &model, &error)) throw error;
   return model;
 }
 
 bool model_extension_supported(const std::string& extension) {
   try {
-    return plugin("").extension_supported(extension);
-  } catch (const LoadError&) {
+    return plugin().extension_supported(extension);
+  } catch (const std::runtime_error&) {
     return true;  // read as a model, whose import then says why the importer is missing
   }
 }

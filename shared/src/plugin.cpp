@@ -1,7 +1,7 @@
 #include "rvr/shared/plugin.h"
 
 #include <dlfcn.h>
-#include <unistd.h>
+#include <stdlib.h>
 
 #include <climits>
 #include <initializer_list>
@@ -9,17 +9,19 @@
 namespace rvr {
 namespace {
 
+// The folder of `file`, as an absolute path without symbolic links (so that two spellings of
+// one folder compare equal); empty when it cannot be told.
 std::string folder_of(const std::string& file) {
-  const auto slash = file.rfind('/');
-  return slash == std::string::npos ? std::string() : file.substr(0, slash);
+  char resolved[PATH_MAX];
+  if (!::realpath(file.c_str(), resolved)) return {};
+  const std::string path(resolved);
+  const auto slash = path.rfind('/');
+  return slash == std::string::npos ? std::string() : path.substr(0, slash);
 }
 
 // The folder of the running executable, where the build puts the plugins beside it.
 std::string executable_folder() {
-  char path[PATH_MAX];
-  const ssize_t n = ::readlink("/proc/self/exe", path, sizeof(path) - 1);
-  if (n <= 0) return {};
-  return folder_of(std::string(path, size_t(n)));
+  return folder_of("/proc/self/exe");
 }
 
 }  // namespace
