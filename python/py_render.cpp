@@ -28,10 +28,12 @@
 #include "render_job.h"
 #include "render_kwargs.h"
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/limits.h"
 #include "stub_docs.h"
+#include "suggest.h"
 
 namespace py = pybind11;
 
@@ -46,7 +48,15 @@ PyRender render(const PyScene& scene, const std::string& renderer, const std::st
                 int threads, const py::kwargs& kwargs) {
   RenderSettings settings = render_settings(mode, threads, kwargs);
   check(check_limits(*scene.scene, settings.options, scene.limits));
-  std::unique_ptr<Renderer> made = take(make_renderer(renderer, settings.config));
+  Expected<std::unique_ptr<Renderer>> maybe = make_renderer(renderer, settings.config);
+  if (!maybe) {
+    // A name not in the table: as the command line says it of -r, naming the argument.
+    std::vector<std::string> names;
+    for (const RendererInfo& info : renderers()) names.push_back(info.name);
+    if (std::find(names.begin(), names.end(), renderer) == names.end())
+      throw BadInputError("renderer: " + cli::not_one_of(renderer, names));
+  }
+  std::unique_ptr<Renderer> made = take(std::move(maybe));
   auto result = std::make_shared<RenderResult>();
   result->renderer = renderer;
   result->scene = scene.scene;

@@ -53,12 +53,15 @@ def test_missing_file(run_cli, tmp_path):
     assert str(caught.value) == expected
 
 
-def test_unknown_renderer(run_cli, tmp_path):
-    expected = cli_message(run_cli, "render", "builtin:cornell", "-r", "nonesuch", "-q",
+@pytest.mark.parametrize("name", ["nonesuch", "raytrac"])
+def test_unknown_renderer(name, run_cli, tmp_path):
+    # The command line's words for -r (with its "did you mean"), naming the argument instead.
+    expected = cli_message(run_cli, "render", "builtin:cornell", "-r", name, "-q",
                            "-o", str(tmp_path / "out.png"))
+    assert expected.startswith("--renderer: ")
     with pytest.raises(rvr.BadInput) as caught:
-        rvr.render(rvr.Scene("builtin:cornell", width=8, height=8), "nonesuch")
-    assert str(caught.value) == expected
+        rvr.render(rvr.Scene("builtin:cornell", width=8, height=8), name)
+    assert str(caught.value) == "renderer: " + expected[len("--renderer: "):]
 
 
 def test_limits(run_cli, tmp_path):
