@@ -195,8 +195,18 @@ std::vector<V> rows_of(const char* name, const py::object& value, bool flat_ok =
   return out;
 }
 
-// Indices as a signed type first, so that a negative one is refused rather than wrapped.
+// Indices: integers only (a float would be cut silently), as a signed type first, so that a
+// negative one is refused rather than wrapped.
 std::vector<glm::uvec3> triangles_of(const py::object& value) {
+  py::array given;
+  try {
+    given = py::array::ensure(value);
+  } catch (const py::error_already_set&) {
+    given = {};
+  }
+  if (given && given.size() > 0 && given.dtype().kind() != 'i' && given.dtype().kind() != 'u')
+    throw BadInputError("indices: expected integers, got " +
+                        py::cast<std::string>(py::str(given.dtype())));
   const std::vector<glm::i64vec3> signed_rows =
       rows_of<glm::i64vec3, int64_t>("indices", value, true);
   std::vector<glm::uvec3> out(signed_rows.size());

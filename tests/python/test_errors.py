@@ -173,6 +173,8 @@ def test_mesh_errors_name_the_array():
         rvr.Scene.from_mesh(vertices, [0, 1, 2], normals=[[0, 0, 1], [0, 0, 1]])
     with pytest.raises(rvr.BadInput, match=r"^mesh: all triangles are degenerate"):
         rvr.Scene.from_mesh([[0, 0, 0], [1, 0, 0], [2, 0, 0]], [0, 1, 2])
+    with pytest.raises(rvr.BadInput, match=r"^indices: expected integers, got float64$"):
+        rvr.Scene.from_mesh(vertices, [[0.0, 1.0, 2.5]])
     with pytest.raises(rvr.BadInput, match=r"^up_axis: expected y or z, got 'x'$"):
         rvr.Scene.from_mesh(vertices, [0, 1, 2], up_axis="x")
 
