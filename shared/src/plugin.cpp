@@ -33,7 +33,7 @@ std::string rvr_code_folder() {
   return folder_of(info.dli_fname);
 }
 
-Expected<const void*> open_plugin(const char* module, const char* symbol, const std::string& what) {
+Expected<void*> open_plugin(const char* module, const char* symbol, const std::string& what) {
   std::string tried;
   void* handle = nullptr;
   const std::string executable = executable_folder(), code = rvr_code_folder();
@@ -48,13 +48,11 @@ Expected<const void*> open_plugin(const char* module, const char* symbol, const 
     if (!handle) tried += (tried.empty() ? "" : "; ") + std::string(::dlerror());
   }
   if (!handle) return internal_error("cannot load " + what + " " + module + ": " + tried);
-  using Get = const void* (*)();
-  auto get = reinterpret_cast<Get>(::dlsym(handle, symbol));
-  const void* table = get ? get() : nullptr;
-  if (!table)
+  void* function = ::dlsym(handle, symbol);
+  if (!function)
     return internal_error(std::string(module) + " is not this build's " + what + " (no " + symbol +
                           ")");
-  return table;
+  return function;
 }
 
 }  // namespace rvr

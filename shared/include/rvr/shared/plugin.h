@@ -12,19 +12,23 @@ namespace rvr {
 
 // Opens `module` (a file name such as "librvr_embree.so") from the folder of the running
 // executable, else from the folder of the shared object holding rvr's code (the Python module),
-// else wherever the dynamic loader finds it, and returns what its function `symbol` returns.
+// else wherever the dynamic loader finds it, and returns the address of its function `symbol`.
 // `what` names the plugin in errors ("the image library"), which say what was tried. The
 // plugin stays loaded for the life of the process.
-Expected<const void*> open_plugin(const char* module, const char* symbol, const std::string& what);
+Expected<void*> open_plugin(const char* module, const char* symbol, const std::string& what);
 
-// open_plugin's table as a `Table`, whose first member `abi_version` must be `abi_version`
-// (a plugin of another build is refused).
+// The table the plugin's function `symbol` (of type `const Table* ()`, called as such) returns,
+// whose first member `abi_version` must be `abi_version` (a plugin of another build is refused).
 template <class Table>
 Expected<const Table*> open_plugin_table(const char* module, const char* symbol, int abi_version,
                                          const std::string& what) {
-  Expected<const void*> opened = open_plugin(module, symbol, what);
+  Expected<void*> opened = open_plugin(module, symbol, what);
   if (!opened) return opened.error();
-  const auto* table = static_cast<const Table*>(*opened);
+  using Get = const Table* (*)();
+  const Table* table = reinterpret_cast<Get>(*opened)();
+  if (!table)
+    return internal_error(std::string(module) + " is not this build's " + what + " (" + symbol +
+                          " gave no table)");
   if (table->abi_version != abi_version)
     return internal_error(std::string(module) + " is not this build's " + what + " (interface " +
                           std::to_string(table->abi_version) + ", expected " +
