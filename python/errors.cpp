@@ -4,6 +4,7 @@
 #include <pybind11/pybind11.h>
 
 #include "bindings.h"
+#include "stub_docs.h"
 
 namespace rvr::python {
 
@@ -14,9 +15,7 @@ namespace rvr::python {
 
 void bind_errors(pybind11::module_& m) {
   auto& bad_input = pybind11::register_exception<BadInputError>(m, "BadInput", PyExc_ValueError);
-  bad_input.attr("__doc__") =
-      "Bad input: a scene, an option or a file rvr refuses. The message is the one the command "
-      "line prints after 'error: ', e.g. 'scene.json: objects[3].radius: must be > 0, got -1'.";
+  bad_input.attr("__doc__") = docs::BadInput;
 }
 
 }  // namespace rvr::python

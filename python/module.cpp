@@ -2,11 +2,10 @@
 #include <pybind11/pybind11.h>
 
 #include "bindings.h"
+#include "stub_docs.h"
 
 PYBIND11_MODULE(rvr, m) {
-  m.doc() =
-      "rvr: one scene rendered with both loop orders (rasterization and ray tracing) and "
-      "compared pixel by pixel. Frame buffers come back as numpy arrays.";
+  m.doc() = rvr::python::docs::module;
   m.attr("__version__") = RVR_VERSION;
   rvr::python::bind_errors(m);
   rvr::python::bind_scene(m);

@@ -1,13 +1,18 @@
-// rvr.compare and rvr.diff: `rvr compare`'s metrics.json for two renders, `rvr diff` for two
-// image files, through the libraries the command line uses.
+// rvr.compare and rvr.diff: `rvr compare`'s metrics.json for two renders of one scene, `rvr diff`
+// for two images (files, arrays or renders), through the libraries the command line uses.
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>  // IWYU pragma: keep (type casters for std containers)
 
+#include <algorithm>
 #include <array>
+#include <glm/glm.hpp>
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
+#include "arguments.h"
 #include "bindings.h"
 #include "errors.h"
 #include "py_render.h"
@@ -19,6 +24,9 @@
 #include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/renderer.h"
+#include "rvr/shared/scene.h"
+#include "rvr/shared/texture.h"
+#include "stub_docs.h"
 
 namespace py = pybind11;
 
@@ -33,7 +41,85 @@ ComparedRenderer compared(const RenderResult& r) {
   return c;
 }
 
-py::object compare(const PyRender& a, const PyRender& b) {
+bool same_camera(const Camera& a, const Camera& b) {
+  return a.eye == b.eye && a.target == b.target && a.up == b.up && a.fov_y_deg == b.fov_y_deg &&
+         a.near == b.near && a.far == b.far && a.aperture_radius == b.aperture_radius &&
+         a.focus_distance == b.focus_distance;
+}
+
+bool same_image(const ImageSettings& a, const ImageSettings& b) {
+  return a.width == b.width && a.height == b.height && a.background == b.background &&
+         a.samples_per_pixel == b.samples_per_pixel && a.exposure == b.exposure;
+}
+
+bool same_material(const Material& a, const Material& b) {
+  return a.diffuse == b.diffuse && a.specular == b.specular && a.emission == b.emission &&
+         a.shininess == b.shininess && a.mirror == b.mirror && a.transparency == b.transparency &&
+         a.ior == b.ior && a.texture == b.texture &&
+         a.uv_transform.offset == b.uv_transform.offset &&
+         a.uv_transform.rotation == b.uv_transform.rotation &&
+         a.uv_transform.scale == b.uv_transform.scale;
+}
+
+bool same_light(const Light& a, const Light& b) {
+  return a.type == b.type && a.position == b.position && a.corner == b.corner &&
+         a.edge_u == b.edge_u && a.edge_v == b.edge_v && a.intensity == b.intensity &&
+         a.samples == b.samples;
+}
+
+bool same_object(const Object& a, const Object& b) {
+  if (a.type != b.type || a.material != b.material) return false;
+  switch (a.type) {
+    case ObjectType::Sphere:
+      return a.sphere.center == b.sphere.center && a.sphere.radius == b.sphere.radius;
+    case ObjectType::Plane:
+      return a.plane.point == b.plane.point && a.plane.normal == b.plane.normal &&
+             a.plane.half_size == b.plane.half_size;
+    case ObjectType::Triangles:
+      return a.mesh.positions == b.mesh.positions && a.mesh.triangles == b.mesh.triangles &&
+             a.mesh.normals == b.mesh.normals && a.mesh.uvs == b.mesh.uvs &&
+             a.mesh.colours == b.mesh.colours;
+    case ObjectType::Csg:
+      return a.csg == b.csg;  // CSG trees are not edited after loading: shared when the same
+  }
+  return false;
+}
+
+template <class T, class Same>
+bool same_all(const std::vector<T>& a, const std::vector<T>& b, Same&& same) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), same);
+}
+
+bool same_texture(const Texture& a, const Texture& b) {
+  return a.resolved == b.resolved && a.file == b.file && a.wrap_u == b.wrap_u &&
+         a.wrap_v == b.wrap_v && (a.mips == nullptr) == (b.mips == nullptr);
+}
+
+// What makes the renders of `a` and `b` not renders of one scene as `rvr compare` makes them
+// (one scene, one camera, one mode); empty when nothing does.
+std::string difference(const RenderResult& a, const RenderResult& b) {
+  if (a.mode != b.mode)
+    return std::string("the renders differ in mode: ") + to_string(a.mode) + " and " +
+           to_string(b.mode);
+  const Scene& sa = *a.scene;
+  const Scene& sb = *b.scene;
+  if (&sa == &sb) return "";
+  if (sa.source != sb.source)
+    return "the renders are of different scenes: " + sa.source + " and " + sb.source;
+  if (!same_camera(sa.camera, sb.camera)) return "the renders differ in camera";
+  if (!same_image(sa.image, sb.image))
+    return "the renders differ in image settings (samples per pixel, exposure or background)";
+  if (sa.ambient != sb.ambient || !same_all(sa.lights, sb.lights, same_light))
+    return "the renders differ in lights";
+  if (!same_all(sa.materials, sb.materials, same_material) ||
+      !same_all(sa.textures, sb.textures, same_texture))
+    return "the renders differ in materials";
+  if (!same_all(sa.objects, sb.objects, same_object))
+    return "the renders are of different scenes of one source: " + sa.source + " (objects differ)";
+  return "";
+}
+
+py::object compare(const PyRender& a, const PyRender& b, bool allow_different) {
   const RenderResult& ra = *a.result;
   const RenderResult& rb = *b.result;
   const FrameBuffers& fa = ra.output.buffers;
@@ -42,6 +128,12 @@ py::object compare(const PyRender& a, const PyRender& b) {
     throw BadInputError("compare: the renders differ in size: " + std::to_string(fa.width) + "x" +
                         std::to_string(fa.height) + " and " + std::to_string(fb.width) + "x" +
                         std::to_string(fb.height));
+  if (!allow_different) {
+    if (const std::string why = difference(ra, rb); !why.empty())
+      throw BadInputError("compare: " + why +
+                          " (rvr compare compares renders of one scene; allow_different=True "
+                          "compares them anyway)");
+  }
   CompareOptions options;
   CompareResult result = compare_rendered(*ra.scene, {compared(ra), compared(rb)}, options);
   ReportContext context;
@@ -52,19 +144,48 @@ py::object compare(const PyRender& a, const PyRender& b) {
   return py::module_::import("json").attr("loads")(metrics_json(report));
 }
 
-py::dict diff(const std::string& path_a, const std::string& path_b, float fail, float fail_percent,
-              std::optional<float> hard_fail, float warn, float warn_percent,
-              std::optional<float> hard_warn, std::optional<double> fail_above,
-              const std::string& out) {
+// An image from a file, an array (H x W or H x W x C) or a render's colour.
+Image image_of(const char* name, const py::object& value) {
+  if (py::isinstance<PyRender>(value))
+    return color_image(py::cast<const PyRender&>(value).result->output.buffers);
+  if (py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__"))
+    return take(read_image(path_of(name, value)));
+  using Floats = py::array_t<float, py::array::c_style | py::array::forcecast>;
+  Floats pixels;
+  try {
+    pixels = Floats::ensure(value);
+  } catch (const py::error_already_set&) {
+    pixels = {};
+  }
+  if (!pixels || (pixels.ndim() != 2 && pixels.ndim() != 3) || pixels.size() == 0)
+    throw BadInputError(
+        std::string(name) +
+        ": expected an image file, an H x W or H x W x C array or an "
+        "rvr.Render, got " +
+        (pixels ? "an array of shape " + py::cast<std::string>(py::str(pixels.attr("shape")))
+                : type_name(value)));
+  Image image;
+  image.height = int(pixels.shape(0));
+  image.width = int(pixels.shape(1));
+  image.channels = pixels.ndim() == 3 ? int(pixels.shape(2)) : 1;
+  image.pixels.assign(pixels.data(), pixels.data() + pixels.size());
+  return image;
+}
+
+py::dict diff(const py::object& a_in, const py::object& b_in, double fail, double fail_percent,
+              std::optional<double> hard_fail, double warn, double warn_percent,
+              std::optional<double> hard_warn, std::optional<double> fail_above,
+              const py::object& out_in) {
   DiffThresholds t;
-  t.fail = fail;
-  t.fail_percent = fail_percent;
-  if (hard_fail) t.hard_fail = *hard_fail;
-  t.warn = warn;
-  t.warn_percent = warn_percent;
-  if (hard_warn) t.hard_warn = *hard_warn;
-  Image a = take(read_image(path_a));
-  Image b = take(read_image(path_b));
+  t.fail = float(fail);
+  t.fail_percent = float(fail_percent);
+  if (hard_fail) t.hard_fail = float(*hard_fail);
+  t.warn = float(warn);
+  t.warn_percent = float(warn_percent);
+  if (hard_warn) t.hard_warn = float(*hard_warn);
+  const std::string out = path_of("out", out_in);
+  Image a = image_of("a", a_in);
+  Image b = image_of("b", b_in);
   ImageDiff d = take(diff_images(a, b, t));
   if (!out.empty()) check(write_image(out, diff_heat_map(a, b, 0.1f), false));
   DiffVerdict verdict = diff_verdict(d, t);
@@ -82,22 +203,22 @@ py::dict diff(const std::string& path_a, const std::string& path_b, float fail, 
   return r;
 }
 
+// rvr.diff's defaults as the stub writes them: idiff's (DiffThresholds), exactly.
+constexpr double kFail = 1e-6, kWarn = 1e-6, kPercent = 0.0;
+static_assert(float(kFail) == DiffThresholds{}.fail && float(kWarn) == DiffThresholds{}.warn &&
+              float(kPercent) == DiffThresholds{}.fail_percent &&
+              float(kPercent) == DiffThresholds{}.warn_percent);
+
 }  // namespace
 
 void bind_compare(py::module_& m) {
-  m.def("compare", &compare, py::arg("a"), py::arg("b"),
-        "Compares two renders of one scene (A the reference) as `rvr compare` does: a dict "
-        "with the keys and values of metrics.json (docs/cli.md), through the same writer.");
-  const DiffThresholds defaults;
-  m.def("diff", &diff, py::arg("path_a"), py::arg("path_b"), py::kw_only(),
-        py::arg("fail") = defaults.fail, py::arg("fail_percent") = defaults.fail_percent,
-        py::arg("hard_fail") = py::none(), py::arg("warn") = defaults.warn,
-        py::arg("warn_percent") = defaults.warn_percent, py::arg("hard_warn") = py::none(),
-        py::arg("fail_above") = py::none(), py::arg("out") = "",
-        "Compares two image files as `rvr diff` does (idiff's thresholds; fail_above: FAILURE "
-        "when the RMS error is above it; out: a heat map file). A dict: mean_error, rms_error, "
-        "peak_snr, max_error, max_at (x, y, channel), pixels, warn_pixels, fail_pixels, "
-        "verdict (PASS, WARNING, FAILURE).");
+  m.def("compare", &compare, py::arg("a"), py::arg("b"), py::kw_only(),
+        py::arg("allow_different") = false, docs::compare);
+  m.def("diff", &diff, py::arg("a"), py::arg("b"), py::kw_only(), py::arg("fail") = kFail,
+        py::arg("fail_percent") = kPercent, py::arg("hard_fail") = py::none(),
+        py::arg("warn") = kWarn, py::arg("warn_percent") = kPercent,
+        py::arg("hard_warn") = py::none(), py::arg("fail_above") = py::none(), py::arg("out") = "",
+        docs::diff);
 }
 
 }  // namespace rvr::python

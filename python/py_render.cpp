@@ -2,19 +2,25 @@
 // GIL released.
 #include "py_render.h"
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>  // IWYU pragma: keep (type casters for std containers)
 #include <stdint.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <fstream>
 #include <glm/glm.hpp>
+#include <limits>
+#include <memory>
+#include <string>
 #include <utility>
 #include <variant>
 #include <vector>
 
+#include "arguments.h"
 #include "bindings.h"
 #include "errors.h"
 #include "numpy_views.h"
@@ -22,9 +28,12 @@
 #include "render_job.h"
 #include "render_kwargs.h"
 #include "rvr/renderers/registry.h"
+#include "rvr/shared/expected.h"
 #include "rvr/shared/framebuffers.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/limits.h"
+#include "stub_docs.h"
+#include "suggest.h"
 
 namespace py = pybind11;
 
@@ -39,7 +48,15 @@ PyRender render(const PyScene& scene, const std::string& renderer, const std::st
                 int threads, const py::kwargs& kwargs) {
   RenderSettings settings = render_settings(mode, threads, kwargs);
   check(check_limits(*scene.scene, settings.options, scene.limits));
-  std::unique_ptr<Renderer> made = take(make_renderer(renderer, settings.config));
+  Expected<std::unique_ptr<Renderer>> maybe = make_renderer(renderer, settings.config);
+  if (!maybe) {
+    // A name not in the table: as the command line says it of -r, naming the argument.
+    std::vector<std::string> names;
+    for (const RendererInfo& info : renderers()) names.push_back(info.name);
+    if (std::find(names.begin(), names.end(), renderer) == names.end())
+      throw BadInputError("renderer: " + cli::not_one_of(renderer, names));
+  }
+  std::unique_ptr<Renderer> made = take(std::move(maybe));
   auto result = std::make_shared<RenderResult>();
   result->renderer = renderer;
   result->scene = scene.scene;
@@ -75,6 +92,32 @@ std::vector<py::ssize_t> shape(const PyRender& r, int channels = 0) {
   return s;
 }
 
+// The level of detail sampled; a render with no textured surface keeps none (an empty buffer),
+// which reads as NaN everywhere, as its AOV file does.
+py::array_t<float> lod(const PyRender& r) {
+  const FrameBuffers& fb = r.result->output.buffers;
+  if (!fb.lod.empty())
+    return view(std::shared_ptr<const void>(r.result), fb.lod.data(), fb.lod.size(), shape(r));
+  auto nan = std::make_shared<const std::vector<float>>(fb.pixel_count(),
+                                                        std::numeric_limits<float>::quiet_NaN());
+  return view(std::shared_ptr<const void>(nan), nan->data(), nan->size(), shape(r));
+}
+
+// Writes as `rvr render -o PATH --aov AOVS` does.
+void save(const PyRender& r, const py::object& where, const py::object& aovs) {
+  const std::string path = path_of("path", where);
+  const std::vector<std::string> names = names_of("aovs", aovs);
+  const std::vector<std::string> known{"depth", "id", "normal", "cost", "lod"};
+  for (const std::string& name : names) {
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      throw BadInputError("aovs: expected names of depth, id, normal, cost, lod, got '" + name +
+                          "'");
+  }
+  const FrameBuffers& fb = r.result->output.buffers;
+  check(write_image(path, color_image(fb)));
+  if (!names.empty()) check(write_aovs(path, fb, names));
+}
+
 py::list renderer_table() {
   py::list out;
   for (const RendererInfo& info : renderers()) {
@@ -91,53 +134,51 @@ void bind_render_class(py::module_& m) {
   using Buffers = const FrameBuffers&;
   auto buffers = [](const PyRender& r) -> Buffers { return r.result->output.buffers; };
   auto owner = [](const PyRender& r) { return std::shared_ptr<const void>(r.result); };
-  py::class_<PyRender>(m, "Render",
-                       "A finished render. Its arrays are read-only views of the render's own "
-                       "buffers (no copy), rows top to bottom; they stay valid after the Render "
-                       "is gone.")
+  py::class_<PyRender>(m, "Render", docs::Render)
       .def_property_readonly(
           "color",
           [=](const PyRender& r) {
             return view(owner(r), &buffers(r).color.data()->x, 3 * buffers(r).color.size(),
                         shape(r, 3));
           },
-          "H x W x 3 float32, linear RGB.")
+          docs::Render_color)
       .def_property_readonly(
           "depth",
           [=](const PyRender& r) {
             return view(owner(r), buffers(r).depth.data(), buffers(r).depth.size(), shape(r));
           },
-          "H x W float32 view-axis depth, +inf on background.")
+          docs::Render_depth)
       .def_property_readonly(
           "object_id",
           [=](const PyRender& r) {
             return view(owner(r), reinterpret_cast<const int32_t*>(buffers(r).object_id.data()),
                         buffers(r).object_id.size(), shape(r));
           },
-          "H x W int32 index into the scene's objects, -1 on background.")
+          docs::Render_object_id)
       .def_property_readonly(
           "primitive_id",
           [=](const PyRender& r) {
             return view(owner(r), reinterpret_cast<const int32_t*>(buffers(r).primitive_id.data()),
                         buffers(r).primitive_id.size(), shape(r));
           },
-          "H x W int32 triangle index in the object (0 for analytic shapes), -1 on background.")
+          docs::Render_primitive_id)
       .def_property_readonly(
           "normal",
           [=](const PyRender& r) {
             return view(owner(r), &buffers(r).normal.data()->x, 3 * buffers(r).normal.size(),
                         shape(r, 3));
           },
-          "H x W x 3 float32 world-space shading normal facing the viewer, 0 on background.")
+          docs::Render_normal)
       .def_property_readonly(
           "cost",
           [=](const PyRender& r) {
             return view(owner(r), buffers(r).cost.data(), buffers(r).cost.size(), shape(r));
           },
-          "H x W float32 work per pixel (nodes visited and tests, or fragments).")
+          docs::Render_cost)
+      .def_property_readonly("lod", &lod, docs::Render_lod)
       .def_property_readonly(
           "stats", [](const PyRender& r) { return json_loads(r.result->stats_json); },
-          "The document `rvr render --stats` writes, as a dict.")
+          docs::Render_stats)
       .def_property_readonly(
           "warnings",
           [](const PyRender& r) {
@@ -146,13 +187,13 @@ void bind_render_class(py::module_& m) {
             w.insert(w.end(), own.begin(), own.end());
             return w;
           },
-          "The scene loader's warnings, then the renderer's.")
+          docs::Render_warnings)
       .def_property_readonly(
-          "renderer", [](const PyRender& r) { return r.result->renderer; }, "The renderer's name.")
+          "renderer", [](const PyRender& r) { return r.result->renderer; }, docs::Render_renderer)
       .def_property_readonly(
-          "seconds", [](const PyRender& r) { return r.result->times.render; },
-          "The render's wall time.")
-      .def("_repr_png_", &png_bytes, "The colour as PNG bytes (sRGB), for Jupyter.")
+          "seconds", [](const PyRender& r) { return r.result->times.render; }, docs::Render_seconds)
+      .def("save", &save, py::arg("path"), py::arg("aovs") = py::tuple(), docs::Render_save)
+      .def("_repr_png_", &png_bytes, docs::Render_repr_png)
       .def("__repr__", [](const PyRender& r) {
         const FrameBuffers& fb = r.result->output.buffers;
         return "rvr.Render('" + r.result->renderer + "', '" + r.result->scene->source + "', " +
@@ -163,20 +204,11 @@ void bind_render_class(py::module_& m) {
 }  // namespace
 
 void bind_render(py::module_& m) {
-  m.def("renderers", &renderer_table,
-        "The renderer table: a list of dicts {name, loop_order (triangle-major, pixel-major, "
-        "hybrid), description}.");
+  m.def("renderers", &renderer_table, docs::renderers);
   bind_render_class(m);
   m.def("render", &render, py::arg("scene"), py::arg("renderer"), py::arg("mode") = "local",
-        py::arg("threads") = 0,
-        "Renders SCENE (an rvr.Scene) with RENDERER (a name from rvr.renderers()) in MODE "
-        "(visibility, local, full) on THREADS worker threads (0: every core). Other keyword "
-        "options are the command line's of the same names: accel, spheres, sphere_segments, "
-        "triangle_test, max_depth, seed, gl, shadow_map_size, shadow_bias, shadow_pcf, hiz, "
-        "depth_format. The GIL is released while rendering; Ctrl-C cancels the render (it stops "
-        "at its next tile or chunk) and raises KeyboardInterrupt.");
-  m.def("_running_renders", &running_renders,
-        "Render threads still running: 0 outside rvr.render, also after a KeyboardInterrupt.");
+        py::arg("threads") = 0, docs::render);
+  m.def("_running_renders", &running_renders, docs::running_renders);
 }
 
 }  // namespace rvr::python

@@ -13,9 +13,12 @@
 #include <functional>
 #include <string>
 #include <thread>
+#include <type_traits>
+#include <utility>
 #include <variant>
 #include <vector>
 
+#include "arguments.h"
 #include "bindings.h"
 #include "errors.h"
 #include "render_kwargs.h"
@@ -25,6 +28,7 @@
 #include "rvr/study/run_study.h"
 #include "rvr/study/study.h"
 #include "rvr/study/study_json.h"
+#include "stub_docs.h"
 #include "study_setup.h"
 
 namespace py = pybind11;
@@ -66,12 +70,32 @@ Expected<study::StudyResult> run_interruptibly(const study::StudyRequest& reques
   return result;
 }
 
-py::object run(const std::vector<std::string>& scenes, const std::vector<std::string>& renderers,
-               int width, const std::string& mode, double budget, int repetitions, int sessions,
+// The command line's option names in the study library's messages, as rvr.study's keywords.
+constexpr std::pair<const char*, const char*> kKeywords[] = {
+    {"--renderers", "renderers"}, {"--budget", "budget"},
+    {"--width", "width"},         {"--repetitions", "repetitions"},
+    {"--processes", "sessions"},  {"--noise-threshold", "noise_threshold"},
+};
+
+// A study error as rvr.study reports it: a message that starts with an option's name names
+// the keyword instead.
+Error with_keywords(Error e) {
+  for (const auto& [option, keyword] : kKeywords) {
+    const std::string prefix = std::string(option) + ":";
+    if (e.message.rfind(prefix, 0) == 0) {
+      e.message = keyword + e.message.substr(std::string(option).size());
+      break;
+    }
+  }
+  return e;
+}
+
+py::object run(const py::object& scenes, const py::object& renderers, int width,
+               const std::string& mode, double budget, int repetitions, int sessions,
                double noise_threshold, uint64_t seed, bool check_predictions) {
   study::StudyRequest request;
-  request.scenes = scenes;
-  request.renderers = study_renderers(renderers);
+  request.scenes = names_of("scenes", scenes);
+  request.renderers = study_renderers(names_of("renderers", renderers));
   request.width = width;
   request.mode = render_settings(mode, 0, py::kwargs()).options.mode;
   request.budget_seconds = budget;
@@ -80,7 +104,9 @@ py::object run(const std::vector<std::string>& scenes, const std::vector<std::st
   request.noise_threshold = noise_threshold;
   request.seed = seed;
   request.check_predictions = check_predictions;
-  study::StudyResult result = take(run_interruptibly(request));
+  Expected<study::StudyResult> ran = run_interruptibly(request);
+  if (!ran) raise(with_keywords(ran.error()));
+  study::StudyResult result = std::move(ran).value();
   result.machine = machine_info(RVR_VERSION);
   result.command = "rvr.study()";
   return py::module_::import("json").attr("loads")(study::study_json(result));
@@ -89,18 +115,11 @@ py::object run(const std::vector<std::string>& scenes, const std::vector<std::st
 }  // namespace
 
 void bind_study(py::module_& m) {
-  m.def("study", &run,
-        py::arg("scenes") = std::vector<std::string>{"builtin:tessphere", "builtin:soup"},
-        py::kw_only(), py::arg("renderers") = std::vector<std::string>{}, py::arg("width") = 1024,
+  m.def("study", &run, py::arg("scenes") = py::make_tuple("builtin:tessphere", "builtin:soup"),
+        py::kw_only(), py::arg("renderers") = py::tuple(), py::arg("width") = 1024,
         py::arg("mode") = "local", py::arg("budget") = 300.0, py::arg("repetitions") = 5,
         py::arg("sessions") = 3, py::arg("noise_threshold") = 0.03, py::arg("seed") = uint64_t(1),
-        py::arg("check_predictions") = true,
-        "Runs `rvr study` (docs/cli.md): the scene families swept within BUDGET seconds, one "
-        "renderer per loop order plus RENDERERS, cost models fitted, crossovers found. Returns "
-        "the study.json document as a dict; its 'points' is a list of records for "
-        "pandas.DataFrame. Each point is measured in SESSIONS fresh preparations of its scene "
-        "in this process (the command line starts a process for each). Ctrl-C stops the sweep "
-        "and raises KeyboardInterrupt.");
+        py::arg("check_predictions") = true, docs::study);
 }
 
 }  // namespace rvr::python

@@ -14,10 +14,7 @@ CLI::Validator one_of(std::vector<std::string> names) {
   return CLI::Validator(
       [names](std::string& value) -> std::string {
         if (std::find(names.begin(), names.end(), value) != names.end()) return "";
-        std::string message = fmt::format("'{}' is not one of {}", value, fmt::join(names, ", "));
-        if (const std::string near = nearest(value, names); !near.empty())
-          message += fmt::format(": did you mean '{}'?", near);
-        return message;
+        return not_one_of(value, names);
       },
       description);
 }

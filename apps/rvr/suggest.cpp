@@ -49,4 +49,12 @@ std::string nearest(const std::string& typed, const std::vector<std::string>& ca
   return best;
 }
 
+std::string not_one_of(const std::string& value, const std::vector<std::string>& names) {
+  std::string message = "'" + value + "' is not one of ";
+  for (size_t i = 0; i < names.size(); ++i) message += (i ? ", " : "") + names[i];
+  if (const std::string near = nearest(value, names); !near.empty())
+    message += ": did you mean '" + near + "'?";
+  return message;
+}
+
 }  // namespace rvr::cli

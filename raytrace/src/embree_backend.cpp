@@ -1,187 +1,83 @@
 #include "embree_backend.h"
 
-#include <embree3/rtcore.h>
-#include <unistd.h>
+#include <embree3/rtcore.h>  // RTC_VERSION_STRING only: Embree is not linked here
+#include <stddef.h>
 
 #include <cstdint>
-#include <cstdio>
-#include <cstring>
-#include <glm/glm.hpp>
-#include <limits>
 #include <memory>
 #include <vector>
 
+#include "embree_abi.h"
 #include "rvr/raytrace/bvh.h"
-#include "rvr/shared/check.h"
+#include "rvr/raytrace/ray_tracer.h"
+#include "rvr/shared/expected.h"
+#include "rvr/shared/plugin.h"
 #include "rvr/shared/scene.h"
 
 namespace rvr {
-
-struct EmbreeBackend {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  const TraceGeometry* owner = nullptr;
-  std::vector<uint32_t> geometry_base;  // per geomID: unified index of its primitive 0
-  uint32_t analytic_geometry = RTC_INVALID_GEOMETRY_ID;
-  int packet_width = 8;  // rtcIntersect8 or rtcIntersect16: the widest this device runs natively
-
-  static EmbreeBackend* create(const TraceGeometry& g, std::string& error);
-  ~EmbreeBackend() {
-    if (scene) rtcReleaseScene(scene);
-    if (device) rtcReleaseDevice(device);
-  }
-
-  // Our user-geometry callbacks: the analytic shapes through TraceGeometry::hit_analytic.
-  static void bounds(const RTCBoundsFunctionArguments* args);
-  static void intersect(const RTCIntersectFunctionNArguments* args);
-  static void occluded(const RTCOccludedFunctionNArguments* args);
-};
-
-void EmbreeBackendDeleter::operator()(EmbreeBackend* backend) const {
-  delete backend;
-}
-
 namespace {
 
-// The intersect context carries where a CSG hit's extra data goes (Embree keeps only t, u, v):
-// hits[ray id] (ray ids are lane numbers in a packet, 0 for a single ray).
-struct QueryContext {
-  RTCIntersectContext embree;
-  HitRecord* hits;
-};
-
-// Lane i of a packet of N rays (N = 1 for a single ray).
-Ray lane_ray(RTCRayN* rays, unsigned N, unsigned i) {
-  return Ray{{RTCRayN_org_x(rays, N, i), RTCRayN_org_y(rays, N, i), RTCRayN_org_z(rays, N, i)},
-             {RTCRayN_dir_x(rays, N, i), RTCRayN_dir_y(rays, N, i), RTCRayN_dir_z(rays, N, i)},
-             RTCRayN_tnear(rays, N, i),
-             RTCRayN_tfar(rays, N, i)};
-}
-
-void set_ray(RTCRay& r, const Ray& ray) {
-  r.org_x = ray.origin.x;
-  r.org_y = ray.origin.y;
-  r.org_z = ray.origin.z;
-  r.dir_x = ray.dir.x;
-  r.dir_y = ray.dir.y;
-  r.dir_z = ray.dir.z;
-  r.tnear = ray.tmin;
-  r.tfar = ray.tmax;
-  r.time = 0.0f;
-  r.mask = 0xFFFFFFFFu;
-  r.id = 0;
-  r.flags = 0;
+// The plugin's table, opened once per process on first use.
+const Expected<const rvr_embree*>& embree_api() {
+  static const Expected<const rvr_embree*> api = open_plugin_table<rvr_embree>(
+      "librvr_embree.so", "rvr_embree_get", RVR_EMBREE_ABI_VERSION, "the Embree plugin");
+  return api;
 }
 
 }  // namespace
 
-void EmbreeBackend::bounds(const RTCBoundsFunctionArguments* args) {
-  auto* self = static_cast<const EmbreeBackend*>(args->geometryUserPtr);
-  RVR_CHECK(args->primID < self->owner->analytic_.size(),
-            "Embree asks for the bounds of an analytic object it was given: ", args->primID);
-  Aabb b = TraceGeometry::analytic_bounds(self->owner->analytic_[args->primID]);
-  *args->bounds_o = {b.lo.x, b.lo.y, b.lo.z, 0.0f, b.hi.x, b.hi.y, b.hi.z, 0.0f};
-}
+struct EmbreeBackend {
+  const rvr_embree* api = nullptr;
+  EmbreeScene* scene = nullptr;
 
-// Called for one ray or a packet of N (args->valid says which lanes are live).
-void EmbreeBackend::intersect(const RTCIntersectFunctionNArguments* args) {
-  auto* self = static_cast<const EmbreeBackend*>(args->geometryUserPtr);
-  auto* context = reinterpret_cast<QueryContext*>(args->context);
-  const unsigned N = args->N;
-  RTCRayN* rays = RTCRayHitN_RayN(args->rayhit, N);
-  RTCHitN* hits = RTCRayHitN_HitN(args->rayhit, N);
-  for (unsigned i = 0; i < N; ++i) {
-    if (!args->valid[i]) continue;
-    const Ray ray = lane_ray(rays, N, i);
-    HitRecord h;
-    if (!self->owner->hit_analytic(self->owner->analytic_[args->primID], ray, ray.tmax, h))
-      continue;
-    RTCRayN_tfar(rays, N, i) = h.t;
-    RTCHitN_u(hits, N, i) = 0.0f;
-    RTCHitN_v(hits, N, i) = 0.0f;
-    RTCHitN_geomID(hits, N, i) = args->geomID;
-    RTCHitN_primID(hits, N, i) = args->primID;
-    RTCHitN_instID(hits, N, i, 0) = RTC_INVALID_GEOMETRY_ID;
-    // The last accepted analytic hit is the nearest one so far.
-    HitRecord& out = context->hits[RTCRayN_id(rays, N, i)];
-    out.csg_leaf = h.csg_leaf;
-    out.csg_flip = h.csg_flip;
+  EmbreeBackend() = default;
+  EmbreeBackend(const EmbreeBackend&) = delete;
+  EmbreeBackend& operator=(const EmbreeBackend&) = delete;
+  ~EmbreeBackend() {
+    if (scene) api->destroy(scene);
   }
-}
 
-void EmbreeBackend::occluded(const RTCOccludedFunctionNArguments* args) {
-  auto* self = static_cast<const EmbreeBackend*>(args->geometryUserPtr);
-  const unsigned N = args->N;
-  RTCRayN* rays = args->ray;
-  for (unsigned i = 0; i < N; ++i) {
-    if (!args->valid[i]) continue;
-    const Ray ray = lane_ray(rays, N, i);
-    HitRecord h;
-    if (self->owner->hit_analytic(self->owner->analytic_[args->primID], ray, ray.tmax, h))
-      RTCRayN_tfar(rays, N, i) = -std::numeric_limits<float>::infinity();
+  // The analytic shapes' callbacks: the tracer's own bounds and intersection code.
+  static Aabb bounds(const void* user, uint32_t index) {
+    const auto* g = static_cast<const TraceGeometry*>(user);
+    return TraceGeometry::analytic_bounds(g->analytic_[index]);
   }
-}
+  static bool hit(const void* user, uint32_t index, const Ray& ray, HitRecord& hit) {
+    const auto* g = static_cast<const TraceGeometry*>(user);
+    return g->hit_analytic(g->analytic_[index], ray, ray.tmax, hit);
+  }
 
-EmbreeBackend* EmbreeBackend::create(const TraceGeometry& g, std::string& error) {
-  auto backend = std::make_unique<EmbreeBackend>();
-  backend->owner = &g;
-  backend->device = rtcNewDevice(nullptr);
-  if (!backend->device) {
-    error = "Embree: cannot create a device (error " +
-            std::to_string(int(rtcGetDeviceError(nullptr))) + ")";
-    return nullptr;
-  }
-  backend->scene = rtcNewScene(backend->device);
-  rtcSetSceneBuildQuality(backend->scene, g.embree_quality_ == EmbreeQuality::High
-                                              ? RTC_BUILD_QUALITY_HIGH
-                                              : RTC_BUILD_QUALITY_MEDIUM);
-  for (size_t object = 0; object < g.object_mesh_.size(); ++object) {
-    const TriangleMesh* mesh = g.object_mesh_[object];
-    if (!mesh || mesh->triangles.empty()) continue;
-    RTCGeometry geom = rtcNewGeometry(backend->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    // Embree's own buffers carry the padding its SIMD loads need after the last vertex.
-    auto* vertices = static_cast<float*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                3 * sizeof(float), mesh->positions.size()));
-    auto* indices = static_cast<uint32_t*>(
-        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                3 * sizeof(uint32_t), mesh->triangles.size()));
-    if (!vertices || !indices) {
-      rtcReleaseGeometry(geom);
-      error = "Embree: out of memory for a mesh of " + std::to_string(mesh->triangles.size()) +
-              " triangles";
+  static EmbreeBackend* create(const TraceGeometry& g, std::string& error) {
+    const Expected<const rvr_embree*>& api = embree_api();
+    if (!api) {
+      error = api.error().message;
       return nullptr;
     }
-    std::memcpy(vertices, mesh->positions.data(), mesh->positions.size() * 3 * sizeof(float));
-    std::memcpy(indices, mesh->triangles.data(), mesh->triangles.size() * 3 * sizeof(uint32_t));
-    rtcCommitGeometry(geom);
-    uint32_t id = rtcAttachGeometry(backend->scene, geom);
-    rtcReleaseGeometry(geom);
-    if (backend->geometry_base.size() <= id) backend->geometry_base.resize(id + 1, 0);
-    backend->geometry_base[id] = g.object_first_triangle_[object];
+    std::vector<EmbreeMesh> meshes;
+    for (size_t object = 0; object < g.object_mesh_.size(); ++object) {
+      const TriangleMesh* mesh = g.object_mesh_[object];
+      if (!mesh || mesh->triangles.empty()) continue;
+      meshes.push_back({mesh->positions.data(), mesh->positions.size(), mesh->triangles.data(),
+                        mesh->triangles.size(), g.object_first_triangle_[object]});
+    }
+    EmbreeSceneInput input;
+    input.meshes = meshes.data();
+    input.mesh_count = meshes.size();
+    input.analytic_count = g.analytic_.size();
+    input.first_analytic = uint32_t(g.triangles_.size());
+    input.high_quality = g.embree_quality_ == EmbreeQuality::High;
+    input.user = &g;
+    input.analytic_bounds = &EmbreeBackend::bounds;
+    input.hit_analytic = &EmbreeBackend::hit;
+    auto backend = std::make_unique<EmbreeBackend>();
+    backend->api = *api;
+    backend->scene = backend->api->create(input, error);
+    return backend->scene ? backend.release() : nullptr;
   }
-  if (!g.analytic_.empty()) {
-    RTCGeometry geom = rtcNewGeometry(backend->device, RTC_GEOMETRY_TYPE_USER);
-    rtcSetGeometryUserPrimitiveCount(geom, unsigned(g.analytic_.size()));
-    rtcSetGeometryUserData(geom, backend.get());
-    rtcSetGeometryBoundsFunction(geom, &EmbreeBackend::bounds, nullptr);
-    rtcSetGeometryIntersectFunction(geom, &EmbreeBackend::intersect);
-    rtcSetGeometryOccludedFunction(geom, &EmbreeBackend::occluded);
-    rtcCommitGeometry(geom);
-    uint32_t id = rtcAttachGeometry(backend->scene, geom);
-    rtcReleaseGeometry(geom);
-    backend->analytic_geometry = id;
-    if (backend->geometry_base.size() <= id) backend->geometry_base.resize(id + 1, 0);
-    backend->geometry_base[id] = uint32_t(g.triangles_.size());
-  }
-  rtcCommitScene(backend->scene);
-  backend->packet_width =
-      rtcGetDeviceProperty(backend->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16 : 8;
-  if (RTCError e = rtcGetDeviceError(backend->device); e != RTC_ERROR_NONE) {
-    error = "Embree: building the scene failed (error " + std::to_string(int(e)) + ")";
-    return nullptr;
-  }
-  return backend.release();
+};
+
+void EmbreeBackendDeleter::operator()(EmbreeBackend* backend) const {
+  delete backend;
 }
 
 EmbreeBackend* make_embree_backend(const TraceGeometry& geometry, std::string& error) {
@@ -189,129 +85,24 @@ EmbreeBackend* make_embree_backend(const TraceGeometry& geometry, std::string& e
 }
 
 bool embree_closest(const EmbreeBackend& backend, const Ray& ray, HitRecord& hit) {
-  QueryContext context;
-  rtcInitIntersectContext(&context.embree);
-  context.hits = &hit;
-  RTCRayHit rayhit;
-  set_ray(rayhit.ray, ray);
-  rayhit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rayhit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(backend.scene, &context.embree, &rayhit);
-  if (rayhit.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  hit.t = rayhit.ray.tfar;
-  hit.primitive = backend.geometry_base[rayhit.hit.geomID] + rayhit.hit.primID;
-  hit.u = rayhit.hit.u;  // Embree's barycentrics: p = (1-u-v) v0 + u v1 + v v2, as ours
-  hit.v = rayhit.hit.v;
-  return true;
+  return backend.api->closest(*backend.scene, ray, hit);
 }
 
 bool embree_occluded(const EmbreeBackend& backend, const Ray& ray) {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
-  RTCRay r;
-  set_ray(r, ray);
-  rtcOccluded1(backend.scene, &context, &r);
-  return r.tfar < 0.0f;
+  return backend.api->occluded(*backend.scene, ray);
 }
-
-namespace {
-
-// Rays [first, first + K) of the packet as one rtcIntersectK call.
-template <int K, class RayHitK, class Fn>
-void intersect_k(const EmbreeBackend& backend, const RayPacket& packet, int first, HitRecord* hits,
-                 Fn&& rtc_intersect) {
-  alignas(64) int valid[K];
-  alignas(64) RayHitK rh;
-  for (int i = 0; i < K; ++i) {
-    int k = first + i;
-    valid[i] = k < packet.count ? -1 : 0;
-    rh.ray.org_x[i] = packet.origin[0];
-    rh.ray.org_y[i] = packet.origin[1];
-    rh.ray.org_z[i] = packet.origin[2];
-    rh.ray.dir_x[i] = k < packet.count ? packet.dir[0][k] : 0.0f;
-    rh.ray.dir_y[i] = k < packet.count ? packet.dir[1][k] : 0.0f;
-    rh.ray.dir_z[i] = k < packet.count ? packet.dir[2][k] : 1.0f;
-    rh.ray.tnear[i] = packet.tmin;
-    rh.ray.tfar[i] = packet.tmax;
-    rh.ray.time[i] = 0.0f;
-    rh.ray.mask[i] = 0xFFFFFFFFu;
-    rh.ray.id[i] = unsigned(i);
-    rh.ray.flags[i] = 0;
-    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
-  }
-  QueryContext context;
-  rtcInitIntersectContext(&context.embree);
-  context.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  context.hits = hits + first;
-  rtc_intersect(valid, backend.scene, &context.embree, &rh);
-  for (int i = 0; i < K && first + i < packet.count; ++i) {
-    if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) continue;
-    HitRecord& h = hits[first + i];
-    h.t = rh.ray.tfar[i];
-    h.primitive = backend.geometry_base[rh.hit.geomID[i]] + rh.hit.primID[i];
-    h.u = rh.hit.u[i];
-    h.v = rh.hit.v[i];
-  }
-}
-
-}  // namespace
 
 void embree_closest_packet(const EmbreeBackend& backend, const RayPacket& packet, HitRecord* hits) {
-  RVR_CHECK(backend.packet_width == 8 || backend.packet_width == 16,
-            "create() picks Embree's 8- or 16-wide packets: ", backend.packet_width);
-  for (int i = 0; i < packet.count; ++i) hits[i] = HitRecord{};
-  if (backend.packet_width == 16) {
-    for (int first = 0; first < packet.count; first += 16)
-      intersect_k<16, RTCRayHit16>(backend, packet, first, hits,
-                                   [](const int* v, RTCScene s, RTCIntersectContext* c,
-                                      RTCRayHit16* r) { rtcIntersect16(v, s, c, r); });
-  } else {
-    for (int first = 0; first < packet.count; first += 8)
-      intersect_k<8, RTCRayHit8>(backend, packet, first, hits,
-                                 [](const int* v, RTCScene s, RTCIntersectContext* c,
-                                    RTCRayHit8* r) { rtcIntersect8(v, s, c, r); });
-  }
+  backend.api->closest_packet(*backend.scene, packet, hits);
 }
 
 int embree_packet_width(const EmbreeBackend& backend) {
-  return backend.packet_width;
+  return backend.api->packet_width(*backend.scene);
 }
 
 std::string embree_kernel_isa() {
-  // Embree says which of its kernels it runs only in its verbose start-up report, on stdout:
-  // capture it once in a temporary file.
-  static const std::string isa = [] {
-    std::fflush(stdout);
-    FILE* capture = std::tmpfile();
-    if (!capture) return std::string("unknown");
-    int saved = ::dup(1);
-    ::dup2(::fileno(capture), 1);
-    RTCDevice device = rtcNewDevice("verbose=1");
-    std::fflush(stdout);
-    ::dup2(saved, 1);
-    ::close(saved);
-    if (device) rtcReleaseDevice(device);
-    std::rewind(capture);
-    std::string result = "unknown";
-    char line[512];
-    while (std::fgets(line, sizeof line, capture)) {
-      std::string l = line;
-      size_t supported = l.find("(supported)");
-      size_t colon = l.find(':');
-      if (l.find("Targets") == std::string::npos || supported == std::string::npos ||
-          colon == std::string::npos)
-        continue;
-      // "Targets : SSE SSE2 ... AVX2  (supported)": the last one is the widest it runs.
-      std::string targets = l.substr(colon + 1, supported - colon - 1);
-      size_t end = targets.find_last_not_of(' ');
-      size_t begin = targets.find_last_of(' ', end);
-      result = targets.substr(begin == std::string::npos ? 0 : begin + 1, end - begin);
-    }
-    std::fclose(capture);
-    return result;
-  }();
-  return isa;
+  const Expected<const rvr_embree*>& api = embree_api();
+  return api ? (*api)->kernel_isa() : "unknown";
 }
 
 std::string embree_version() {

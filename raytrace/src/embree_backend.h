@@ -1,5 +1,5 @@
-// Intel Embree 3 answering TraceGeometry's queries: Embree's BVH and watertight triangle test
-// for meshes, our own intersection code (as Embree user geometry) for spheres, squares and CSG.
+// Intel Embree 3 answering TraceGeometry's queries, through the Embree plugin (embree_abi.h,
+// librvr_embree.so) opened on the first Embree scene: the tracer itself does not link Embree.
 #pragma once
 
 #include <string>
@@ -10,7 +10,8 @@
 
 namespace rvr {
 
-// Builds Embree's device and scene over `geometry`; null with `error` set on failure.
+// Builds Embree's device and scene over `geometry`; null with `error` set on failure (the
+// plugin cannot be loaded, or Embree fails).
 EmbreeBackend* make_embree_backend(const TraceGeometry& geometry, std::string& error);
 bool embree_closest(const EmbreeBackend& backend, const Ray& ray, HitRecord& hit);
 bool embree_occluded(const EmbreeBackend& backend, const Ray& ray);

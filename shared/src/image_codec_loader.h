@@ -8,9 +8,9 @@
 
 namespace rvr {
 
-// The full codec's table, loaded once per process (thread-safe): from the folder of the running
-// executable, else wherever the dynamic loader finds librvr_image_codec.so. The error names
-// what was tried.
+// The full codec's table, loaded once per process (thread-safe) by open_plugin (plugin.h): from
+// the folder of the running executable or of the Python module, else wherever the dynamic
+// loader finds librvr_image_codec.so. The error names what was tried.
 Expected<const rvr_image_codec*> image_codec();
 
 // The light writer's table (librvr_image_writer.so), found and loaded the same way.

@@ -73,4 +73,11 @@ struct ImportedModel {
 ImportedModel import_model(const std::string& file, const std::string& base_dir,
                            const std::string& path);
 
+// Whether Assimp reads files of `extension` (".ply", lower case).
+//
+// In the program these three call the model-import plugin (model_import_loader.cpp), which
+// holds this file's implementation (mesh_import.cpp) and Assimp (model_import_plugin.cpp).
+// When the plugin cannot be loaded, every extension is a model's, and the import says why.
+bool model_extension_supported(const std::string& extension);
+
 }  // namespace rvr::scene_load

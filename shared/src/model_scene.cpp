@@ -6,7 +6,6 @@
 #include <stdint.h>
 
 #include <algorithm>
-#include <assimp/Importer.hpp>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -141,9 +140,11 @@ std::string unique_name(const std::string& wanted, std::set<std::string>& taken)
   return name;
 }
 
-Scene build_model_scene(const std::string& path, const SceneOverrides& overrides) {
+// The scene of an imported model; `path` names it in warnings and its folder is where the
+// model's texture files are found. Model files and meshes from memory (load_mesh_scene).
+Scene scene_of_model(ImportedModel model, const std::string& path,
+                     const SceneOverrides& overrides) {
   const std::optional<glm::vec3>& view_from = overrides.view_from;
-  ImportedModel model = import_model(path, "", "");
   // Up: the file's (auto) or the one asked for, turned to +y before anything is framed.
   glm::vec3 up = overrides.up == UpAxis::Auto ? model.up
                  : overrides.up == UpAxis::Z  ? glm::vec3(0.0f, 0.0f, 1.0f)
@@ -243,6 +244,31 @@ Scene build_model_scene(const std::string& path, const SceneOverrides& overrides
   return scene;
 }
 
+Scene build_model_scene(const std::string& path, const SceneOverrides& overrides) {
+  return scene_of_model(import_model(path, "", ""), path, overrides);
+}
+
+// A mesh from memory checked as a model file's is by its importer: every index names a vertex,
+// positions are finite, normals and colours are one per vertex when given.
+void check_mesh(const TriangleMesh& mesh) {
+  const size_t n = mesh.positions.size();
+  if (mesh.triangles.empty()) fail("indices", "no triangle");
+  if (!mesh.normals.empty() && mesh.normals.size() != n)
+    fail("normals", fmt::format("{} normals for {} vertices", mesh.normals.size(), n));
+  if (!mesh.colours.empty() && mesh.colours.size() != n)
+    fail("colors", fmt::format("{} colours for {} vertices", mesh.colours.size(), n));
+  for (size_t i = 0; i < n; ++i) {
+    if (!finite(mesh.positions[i])) fail(fmt::format("vertices[{}]", i), "must be finite numbers");
+  }
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      if (mesh.triangles[t][k] >= n)
+        fail(fmt::format("indices[{}]", t),
+             fmt::format("vertex {} is past the last of the {} vertices", mesh.triangles[t][k], n));
+    }
+  }
+}
+
 }  // namespace scene_load
 
 bool is_model_file_name(const std::string& path) {
@@ -250,21 +276,45 @@ bool is_model_file_name(const std::string& path) {
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   if (ext.empty() || ext == ".json") return false;
-  return Assimp::Importer().IsExtensionSupported(ext);
+  return scene_load::model_extension_supported(ext);
 }
 
-Expected<Scene> load_model_scene(const std::string& path, const SceneOverrides& overrides) {
+namespace {
+
+// `build` (a model scene's) with its errors as values: bad input naming `source`, the JSON
+// path and what is wrong; internal errors otherwise.
+template <class Build>
+Expected<Scene> model_scene_or_error(const std::string& source, Build&& build) {
   try {
-    return scene_load::build_model_scene(path, overrides);
+    return build();
   } catch (const scene_load::LoadError& e) {
-    return bad_input(path + ": " + (e.path.empty() ? "" : e.path + ": ") + e.what);
+    return bad_input(source + ": " + (e.path.empty() ? "" : e.path + ": ") + e.what);
   } catch (const std::bad_alloc&) {
-    return internal_error(path + ": out of memory while loading the model");
+    return internal_error(source + ": out of memory while loading the model");
   } catch (const std::exception& e) {
-    return internal_error(path + ": internal error while loading the model: " + e.what());
+    return internal_error(source + ": internal error while loading the model: " + e.what());
   } catch (...) {
-    return internal_error(path + ": internal error while loading the model");
+    return internal_error(source + ": internal error while loading the model");
   }
+}
+
+}  // namespace
+
+Expected<Scene> load_model_scene(const std::string& path, const SceneOverrides& overrides) {
+  return model_scene_or_error(path, [&] { return scene_load::build_model_scene(path, overrides); });
+}
+
+Expected<Scene> load_mesh_scene(TriangleMesh mesh, const std::string& source,
+                                const SceneOverrides& overrides) {
+  return model_scene_or_error(source, [&] {
+    scene_load::check_mesh(mesh);
+    scene_load::ImportedModel model;  // up +y unless overrides.up says z
+    scene_load::ModelPart part;
+    part.name = source;
+    part.mesh = std::move(mesh);
+    model.parts.push_back(std::move(part));
+    return scene_load::scene_of_model(std::move(model), source, overrides);
+  });
 }
 
 }  // namespace rvr

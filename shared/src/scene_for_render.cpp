@@ -13,7 +13,8 @@ Expected<Scene> load_scene_for_render(const SceneRequest& request, const RenderO
   // A bad RVR_ISA is refused before any work.
   if (Expected<Isa> isa = selected_isa(); !isa) return isa.error();
   const auto start = std::chrono::steady_clock::now();
-  Expected<Scene> scene = load_scene(request.spec, request.overrides);
+  Expected<Scene> scene =
+      request.load ? request.load(request.overrides) : load_scene(request.spec, request.overrides);
   if (!scene) return scene.error();
   if (request.spp) scene->image.samples_per_pixel = *request.spp;
   if (load_seconds) *load_seconds = seconds_since(start);

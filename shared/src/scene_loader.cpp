@@ -820,9 +820,8 @@ void apply_overrides(Scene& scene, const SceneOverrides& overrides) {
   if (overrides.exposure) scene.image.exposure = *overrides.exposure;
 }
 
-}  // namespace
-
-Expected<Scene> load_scene(const std::string& spec, const SceneOverrides& overrides) {
+// The overrides' own errors, before anything is loaded.
+Status check_overrides(const std::string& spec, const SceneOverrides& overrides) {
   if (overrides.view_from && !(std::isfinite(glm::length(*overrides.view_from)) &&
                                glm::length(*overrides.view_from) > 0.0f)) {
     return bad_input(spec + ": the view direction must be finite and non-zero");
@@ -831,6 +830,21 @@ Expected<Scene> load_scene(const std::string& spec, const SceneOverrides& overri
     return bad_input(fmt::format("{}: the exposure must be between -{} and {} stops", spec,
                                  kMaxExposure, kMaxExposure));
   }
+  return ok_status();
+}
+
+}  // namespace
+
+Expected<Scene> load_scene_text(const std::string& json_text, const std::string& source,
+                                const std::string& base_dir, const SceneOverrides& overrides) {
+  if (Status st = check_overrides(source, overrides); !st) return st.error();
+  Expected<Scene> scene = parse_scene(json_text, source, base_dir);
+  if (scene.ok()) apply_overrides(*scene, overrides);
+  return scene;
+}
+
+Expected<Scene> load_scene(const std::string& spec, const SceneOverrides& overrides) {
+  if (Status st = check_overrides(spec, overrides); !st) return st.error();
   static const std::string kBuiltin = "builtin:";
   bool model = false;
   Expected<Scene> scene = spec.rfind(kBuiltin, 0) == 0

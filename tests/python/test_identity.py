@@ -66,3 +66,101 @@ def test_camera_settings_render_as_a_scene_file_of_them(run_cli, tmp_path):
     assert done.returncode == 0, done.stderr
     r = rvr.render(scene, "raytrace", mode="local")
     assert r.color.tobytes() == np.ascontiguousarray(read_exr(out)).tobytes()
+
+
+def test_save_writes_the_command_lines_files(run_cli, tmp_path):
+    # Render.save(path, aovs) writes the files `rvr render -o path --aov ...` writes, byte for
+    # byte: colour (PNG and EXR) and every AOV, lod included, on the textured scene.
+    args = ["builtin:textured", "--width", "48", "--height", "36", "--mode", "local",
+            "--threads", "2", "-q"]
+    aovs = ["depth", "id", "normal", "cost", "lod"]
+    scene = rvr.Scene("builtin:textured", width=48, height=36)
+    r = rvr.render(scene, "softraster", mode="local", threads=2)
+    for ext in ("png", "exr"):
+        cli_dir, py_dir = tmp_path / f"cli-{ext}", tmp_path / f"py-{ext}"
+        cli_dir.mkdir()
+        py_dir.mkdir()
+        done = run_cli("render", *args, "-r", "softraster", "--aov", ",".join(aovs),
+                       "-o", str(cli_dir / f"out.{ext}"))
+        assert done.returncode == 0, done.stderr
+        r.save(py_dir / f"out.{ext}", aovs)
+        names = sorted(p.name for p in cli_dir.iterdir())
+        assert sorted(p.name for p in py_dir.iterdir()) == names
+        assert len(names) == 7  # the image, five AOVs, and the cost's colour-mapped PNG
+        for name in names:
+            assert (py_dir / name).read_bytes() == (cli_dir / name).read_bytes(), name
+
+
+def test_lod_is_the_command_lines(run_cli, tmp_path):
+    # Render.lod is the lod AOV: NaN off the textured surfaces, the same values on them.
+    out = tmp_path / "render.exr"
+    done = run_cli("render", "builtin:textured", "-r", "raytrace", "--mode", "local", "--width",
+                   "48", "--height", "36", "--aov", "lod", "-q", "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    r = rvr.render(rvr.Scene("builtin:textured", width=48, height=36), "raytrace", mode="local")
+    lod = read_exr(tmp_path / "render.lod.exr")[:, :, 0]
+    assert r.lod.shape == (36, 48) and r.lod.dtype == np.float32
+    assert np.isfinite(r.lod).any() and np.isnan(r.lod).any()
+    assert r.lod.tobytes() == np.ascontiguousarray(lod).tobytes()
+    untextured = rvr.render(rvr.Scene(SCENE, width=8, height=6), "raytrace")
+    assert untextured.lod.shape == (6, 8) and np.isnan(untextured.lod).all()
+
+
+def test_a_dict_is_the_scene_file_of_its_json(run_cli, tmp_path):
+    document = json.loads(rvr.Scene("builtin:spheres").to_json())
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(document))
+    out = tmp_path / "render.exr"
+    done = run_cli("render", str(path), "-r", "raytrace", "--mode", "local", "--width", "40",
+                   "--height", "30", "-q", "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    scene = rvr.Scene(document, width=40, height=30)
+    assert scene.source == "dict"
+    r = rvr.render(scene, "raytrace", mode="local")
+    assert r.color.tobytes() == np.ascontiguousarray(read_exr(out)).tobytes()
+
+
+def write_ply(path, vertices, indices, colors=None):
+    lines = ["ply", "format ascii 1.0", f"element vertex {len(vertices)}",
+             "property float x", "property float y", "property float z"]
+    if colors is not None:
+        lines += ["property uchar red", "property uchar green", "property uchar blue"]
+    lines += [f"element face {len(indices)}", "property list uchar int vertex_indices",
+              "end_header"]
+    for i, v in enumerate(vertices):
+        row = " ".join(repr(float(x)) for x in v)
+        if colors is not None:
+            row += " " + " ".join(str(int(c)) for c in colors[i])
+        lines.append(row)
+    lines += ["3 " + " ".join(str(int(i)) for i in t) for t in indices]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_a_mesh_from_arrays_is_the_model_file_of_it(run_cli, tmp_path):
+    # Scene.from_mesh is a model file holding only that mesh: the same camera, lights and
+    # exposure, so the same image as `rvr render mesh.ply` (a tetrahedron, Z up, flat).
+    vertices = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0.3, 0.3, 0.8]], dtype=np.float32)
+    indices = np.array([[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]], dtype=np.int64)
+    path = tmp_path / "mesh.ply"
+    write_ply(path, vertices, indices)
+    out = tmp_path / "render.exr"
+    done = run_cli("render", str(path), "-r", "raytrace", "--mode", "local", "--width", "40",
+                   "--height", "30", "--up", "z", "--aov", "depth", "-q", "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    scene = rvr.Scene.from_mesh(vertices, indices, width=40, height=30, up_axis="z")
+    assert scene.source == "mesh" and scene.warnings == []
+    r = rvr.render(scene, "raytrace", mode="local")
+    assert (r.object_id == 0).any()
+    assert r.color.tobytes() == np.ascontiguousarray(read_exr(out)).tobytes()
+    depth = read_exr(tmp_path / "render.depth.exr")[:, :, 0]
+    assert r.depth.tobytes() == np.ascontiguousarray(depth).tobytes()
+    # A flat list of indices is the same mesh; vertex colours change the colour only.
+    flat = rvr.render(rvr.Scene.from_mesh(vertices, indices.ravel(), width=40, height=30,
+                                          up_axis="z"), "raytrace", mode="local")
+    assert flat.color.tobytes() == r.color.tobytes()
+    red = rvr.render(rvr.Scene.from_mesh(vertices, indices, colors=np.tile([1, 0, 0], (4, 1)),
+                                         width=40, height=30, up_axis="z"),
+                     "raytrace", mode="local")
+    assert np.array_equal(red.object_id, r.object_id)
+    seen = r.object_id == 0
+    assert (red.color[seen][:, 1:] == 0).all() and (red.color[seen][:, 0] > 0).any()

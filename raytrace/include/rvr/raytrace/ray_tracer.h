@@ -14,9 +14,11 @@
 
 namespace rvr {
 
-// Versions of the libraries the tracer runs on, for `rvr info`.
+// Versions of the libraries the tracer runs on, for `rvr info`: Embree's as the headers the
+// Embree plugin is built with say (nothing is loaded to tell it).
 std::string embree_version();
-// The widest of Embree's kernels it runs on this CPU, e.g. "AVX2".
+// The widest of Embree's kernels it runs on this CPU, e.g. "AVX2" ("unknown" when the Embree
+// plugin cannot be loaded; it is loaded to tell).
 std::string embree_kernel_isa();
 std::string tbb_version();
 

@@ -3,6 +3,7 @@
 // checked. The command line and the Python module load through this one function.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -16,6 +17,9 @@ namespace rvr {
 
 struct SceneRequest {
   std::string spec = "builtin:cornell";  // a scene file, a model file or builtin:NAME
+  // A scene from memory (JSON text: load_scene_text; a mesh: load_mesh_scene) loaded by this
+  // instead of `spec`, which then names it; given the overrides.
+  std::function<Expected<Scene>(const SceneOverrides&)> load;
   SceneOverrides overrides;
   std::optional<int> spp;  // replaces image.samples_per_pixel
   Limits limits;

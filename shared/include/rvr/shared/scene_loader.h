@@ -66,6 +66,20 @@ bool is_model_file_name(const std::string& path);
 // light near the camera and ambient; the automatic exposure unless overrides.exposure is set.
 Expected<Scene> load_model_scene(const std::string& path, const SceneOverrides& overrides = {});
 
+// A triangle mesh from memory (positions, triangles, optionally one normal and one linear RGB
+// colour per vertex) as a scene, as a model file holding only that mesh is one (above): the
+// framing camera, the default lights, the automatic exposure, degenerate triangles dropped with
+// a warning; overrides.up is Y or Z (Auto: Y). `source` names it in messages. Bad input: an
+// index past the vertices, a non-finite position, normals or colours not one per vertex, no
+// triangle.
+Expected<Scene> load_mesh_scene(TriangleMesh mesh, const std::string& source,
+                                const SceneOverrides& overrides = {});
+
+// Scene JSON text as load_scene reads a scene file of that text: `source` names it in messages,
+// mesh files are found from `base_dir`, the overrides apply as to a scene file.
+Expected<Scene> load_scene_text(const std::string& json_text, const std::string& source,
+                                const std::string& base_dir, const SceneOverrides& overrides = {});
+
 struct BuiltinSceneInfo {
   std::string name;         // e.g. "occluders:N"
   std::string description;  // one line
