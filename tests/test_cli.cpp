@@ -1190,8 +1190,8 @@ TEST_F(Cli, CtrlCDuringAStudyWritesThePartialStudy) {
 }
 
 // --merge of two studies of this machine (one of them shard 1/2) pools them (a point both
-// measured keeps the repetitions of each); with the SIMD kernels of one edited, they are not
-// pooled: one study per machine type and comparison.md.
+// measured keeps the runs of each, each run a session of its own); with the SIMD kernels of one
+// edited, they are not pooled: one study per machine type and comparison.md.
 TEST_F(Cli, StudyMergePoolsOneMachineTypeAndComparesTwo) {
   const std::string tiny = "study builtin:tessphere --width 32 --budget 3 -q -o ";
   for (const char* name : {"a", "b"}) {
@@ -1209,20 +1209,19 @@ TEST_F(Cli, StudyMergePoolsOneMachineTypeAndComparesTwo) {
   ASSERT_EQ(merged.status, 0) << merged.err;
   nlohmann::json p = nlohmann::json::parse(slurp(pooled / "study.json"));
   EXPECT_TRUE(fs::exists(pooled / "study.md"));
-  // A point both measured keeps every repetition, but for one measured busy beside a quiet one.
-  std::map<std::string, std::pair<size_t, size_t>> by_point;  // quiet, busy repetitions
+  // A point both measured keeps every run of each, and the sessions of both studies.
+  std::map<std::string, size_t> runs_of;  // by point
   for (const nlohmann::json* doc : {&a, &b})
     for (const nlohmann::json& point : (*doc)["points"]) {
       std::string key = point["renderer"].dump() + point["scene_n"].dump() + point["width"].dump();
-      (point["busy"] == true ? by_point[key].second : by_point[key].first) +=
-          point["seconds"].size();
+      runs_of[key] += point["runs"].size();
     }
-  size_t repetitions = 0;
-  for (const auto& [key, counts] : by_point)
-    repetitions += counts.first > 0 ? counts.first : counts.second;
-  size_t pooled_repetitions = 0;
-  for (const nlohmann::json& point : p["points"]) pooled_repetitions += point["seconds"].size();
-  EXPECT_EQ(pooled_repetitions, repetitions);
+  for (const nlohmann::json& point : p["points"]) {
+    std::string key = point["renderer"].dump() + point["scene_n"].dump() + point["width"].dump();
+    EXPECT_EQ(point["runs"].size(), runs_of[key]) << key;
+  }
+  EXPECT_EQ(p["sessions"].size(), a["sessions"].size() + b["sessions"].size());
+  EXPECT_EQ(p["merged_runs"].size(), 2u);
   EXPECT_LE(p["points"].size(), a["points"].size() + b["points"].size());
   EXPECT_GE(p["points"].size(), std::max(a["points"].size(), b["points"].size()));
   EXPECT_EQ(p["budget_seconds"], 6.0);

@@ -59,11 +59,12 @@ std::vector<std::string> option_names(const CLI::App& cmd) {
   return names;
 }
 
-// The names of `cmd`'s subcommands, in the order they were added.
+// The names of `cmd`'s listed subcommands, in the order they were added (not the hidden ones,
+// group "": study-worker is rvr study's, not the user's).
 std::vector<std::string> subcommand_names(const CLI::App& cmd) {
   std::vector<std::string> names;
   for (const CLI::App* sub : cmd.get_subcommands([](const CLI::App*) { return true; }))
-    names.push_back(sub->get_name());
+    if (!sub->get_group().empty()) names.push_back(sub->get_name());
   return names;
 }
 
