@@ -31,14 +31,16 @@
 #include "rvr/shared/scene_loader.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
-#include "rvr/study/cost_model.h"
+#include "rvr/study/counted_work.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/grid_of_copies.h"
 #include "rvr/study/measurement.h"
+#include "rvr/study/memory_estimate.h"
 #include "rvr/study/merge.h"
 #include "rvr/study/prediction_checks.h"
 #include "rvr/study/run_study.h"
+#include "rvr/study/scene_changes.h"
 #include "rvr/study/study.h"
 #include "rvr/study/study_html.h"
 #include "rvr/study/study_json.h"
@@ -353,7 +355,8 @@ TEST(StudyChecks, RarelyFailWhereTheConclusionIsTrue) {
     }
     failed += any;
   }
-  EXPECT_LE(failed, studies * 5 / 100) << failed << " of " << studies << " studies had a check fail";
+  EXPECT_LE(failed, studies * 5 / 100)
+      << failed << " of " << studies << " studies had a check fail";
   EXPECT_GE(held, studies) << "checks hold at under half the points they measured";
 }
 

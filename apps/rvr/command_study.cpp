@@ -27,6 +27,7 @@
 #include "rvr/shared/expected.h"
 #include "rvr/shared/image_io.h"
 #include "rvr/shared/isa.h"
+#include "rvr/study/memory_estimate.h"
 #include "rvr/study/merge.h"
 #include "rvr/study/run_study.h"
 #include "rvr/study/study.h"

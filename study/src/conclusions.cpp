@@ -13,6 +13,7 @@
 #include <optional>
 #include <set>
 #include <type_traits>
+#include <utility>
 
 #include "rvr/renderers/registry.h"
 #include "rvr/shared/expected.h"

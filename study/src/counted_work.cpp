@@ -8,11 +8,13 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
-#include <set>
+#include <type_traits>
 #include <utility>
 
 #include "rvr/shared/expected.h"
+#include "rvr/study/fit_quality.h"
 #include "rvr/study/least_squares.h"
 
 namespace rvr::study {
@@ -176,6 +178,7 @@ std::vector<const Measurement*> along_n(const std::vector<Measurement>& points, 
   for (const Measurement& m : points)
     if (m.pixels == pixels) by_n.emplace(m.n, &m);
   std::vector<const Measurement*> out;
+  out.reserve(by_n.size());
   for (const auto& [n, m] : by_n) out.push_back(m);
   return out;
 }

@@ -4,13 +4,17 @@
 #include <fmt/format.h>
 #include <stddef.h>
 
+#include <algorithm>
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "html_text.h"
+#include "rvr/shared/html_escape.h"
+#include "rvr/study/bootstrap.h"
 #include "rvr/study/counted_work.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"

@@ -9,10 +9,11 @@
 #include <cmath>
 #include <initializer_list>
 #include <limits>
+#include <memory>
 #include <numeric>
+#include <type_traits>
 #include <utility>
 
-#include "rvr/shared/check.h"
 #include "rvr/study/cost_model.h"
 #include "rvr/study/trend.h"
 

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <memory>
 
 #include "rvr/shared/expected.h"
 #include "rvr/study/fit.h"

@@ -5,12 +5,11 @@
 #include <malloc.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <initializer_list>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -20,6 +19,7 @@
 #include "rvr/shared/check.h"
 #include "rvr/shared/scene.h"
 #include "rvr/study/renderer_frames.h"
+#include "rvr/study/run_study.h"
 #include "rvr/study/study_markdown.h"
 
 namespace rvr::study {

@@ -23,6 +23,7 @@
 #include "rvr/study/measurement.h"
 #include "rvr/study/study_markdown.h"
 #include "rvr/study/sweep_plan.h"
+#include "rvr/study/system_probe.h"
 
 namespace rvr::study {
 namespace {

@@ -6,11 +6,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
+#include <map>
+#include <utility>
 
 #include "rvr/study/bootstrap.h"
+#include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
-#include "rvr/study/study_markdown.h"
 
 namespace rvr::study {
 namespace {

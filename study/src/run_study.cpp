@@ -6,11 +6,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <iterator>
 #include <limits>
 #include <random>
 #include <set>
-#include <tuple>
+#include <type_traits>
 #include <utility>
 
 #include "rvr/renderers/registry.h"
@@ -380,9 +379,9 @@ Status Sweep::sweep_n(const Family& family, double limit, OpenSession& session) 
     if (!done) return done.error();
     if (!*done) {
       if (f_->max_n == 0 || n <= f_->max_n)  // else the memory's note says why
-        result_.notes.push_back(fmt::format(
-            "{}: the sweep stopped below {} (its points would have overrun the budget)",
-            family.name, point_name(family, n)));
+        result_.notes.push_back(
+            fmt::format("{}: the sweep stopped below {} (its points would have overrun the budget)",
+                        family.name, point_name(family, n)));
       break;
     }
   }

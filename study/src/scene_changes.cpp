@@ -9,11 +9,14 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <set>
+#include <type_traits>
 #include <utility>
 
 #include "html_text.h"
 #include "rvr/shared/check.h"
+#include "rvr/shared/html_escape.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/cost_model.h"
 #include "rvr/study/study.h"

@@ -4,11 +4,11 @@
 #include <stddef.h>
 
 #include <cmath>
+#include <initializer_list>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 #include "rvr/study/bootstrap.h"

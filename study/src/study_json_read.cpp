@@ -10,6 +10,7 @@
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -23,6 +24,7 @@
 #include "rvr/study/study.h"
 #include "rvr/study/study_json.h"
 #include "rvr/study/sweep_plan.h"
+#include "rvr/study/system_probe.h"
 
 namespace rvr::study {
 namespace {

@@ -2,6 +2,7 @@
 #include "rvr/study/study_markdown.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include "rvr/study/cost_model.h"
 #include "rvr/study/memory_estimate.h"
 #include "rvr/study/scene_changes.h"
+#include "rvr/study/system_probe.h"
 
 namespace rvr::study {
 namespace {

@@ -2,12 +2,11 @@
 #include "rvr/study/system_probe.h"
 
 #include <fmt/format.h>
-#include <stdint.h>
 
 #include <array>
 #include <chrono>
+#include <cstdint>
 #include <fstream>
-#include <sstream>
 #include <thread>
 
 namespace rvr::study {

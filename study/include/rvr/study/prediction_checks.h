@@ -12,7 +12,6 @@
 
 #include "rvr/study/crossover.h"
 #include "rvr/study/study.h"
-#include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 

@@ -10,6 +10,8 @@
 // where its frames are the faster (frame_a > frame_b), and never where they are not.
 #pragma once
 
+#include <stddef.h>
+
 #include <string>
 #include <vector>
 
