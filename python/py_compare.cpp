@@ -101,6 +101,8 @@ std::string difference(const RenderResult& a, const RenderResult& b) {
   if (a.mode != b.mode)
     return std::string("the renders differ in mode: ") + to_string(a.mode) + " and " +
            to_string(b.mode);
+  if (a.spheres != b.spheres || a.sphere_segments != b.sphere_segments)
+    return "the renders differ in how spheres were drawn (spheres, sphere_segments)";
   const Scene& sa = *a.scene;
   const Scene& sb = *b.scene;
   if (&sa == &sb) return "";
@@ -135,6 +137,14 @@ py::object compare(const PyRender& a, const PyRender& b, bool allow_different) {
                           "compares them anyway)");
   }
   CompareOptions options;
+  // As compare_renderers sets them for the command line: the geometry the mismatch classes
+  // and depth-outlier causes are judged on (only when both renders drew spheres alike).
+  if (ra.spheres == rb.spheres && ra.sphere_segments == rb.sphere_segments) {
+    if (ra.spheres == SphereMode::Mesh)
+      options.sphere_segments = ra.sphere_segments;
+    else
+      options.polygon_sphere_segments = ra.sphere_segments;
+  }
   CompareResult result = compare_rendered(*ra.scene, {compared(ra), compared(rb)}, options);
   ReportContext context;
   context.mode = to_string(ra.mode);

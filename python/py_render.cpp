@@ -61,6 +61,8 @@ PyRender render(const PyScene& scene, const std::string& renderer, const std::st
   result->renderer = renderer;
   result->scene = scene.scene;
   result->mode = settings.options.mode;
+  result->spheres = settings.options.spheres;
+  result->sphere_segments = settings.options.sphere_segments;
   result->times.load = scene.load_seconds;
   RenderResultWithTime done = render_interruptibly(scene.scene, std::move(made), settings.options);
   result->output = take(std::move(done.output));

@@ -15,6 +15,10 @@ struct RenderResult {
   std::string renderer;
   std::shared_ptr<const Scene> scene;
   RenderMode mode = RenderMode::Local;
+  // How spheres were drawn (spheres=, sphere_segments=): rvr.compare classes depth outliers
+  // on analytic spheres with them, as rvr compare does.
+  SphereMode spheres = SphereMode::Analytic;
+  int sphere_segments = 0;
   RenderTimes times;
   RenderOutput output;
   std::string stats_json;  // the --stats document, made when the render finished

@@ -198,8 +198,10 @@ def _running_renders() -> int:
 def compare(a: Render, b: Render, *, allow_different: bool = False) -> dict[str, Any]:
     """Compares two renders of one scene (A the reference) as `rvr compare` does: a dict with
     the keys and values of metrics.json (docs/cli.md), through the same writer. Renders of
-    different scenes, cameras, image settings or modes are refused with rvr.BadInput, as the
-    command line compares only renders of one scene, unless ALLOW_DIFFERENT is true."""
+    different scenes, cameras, image settings, modes or sphere settings (spheres,
+    sphere_segments) are refused with rvr.BadInput, as the command line compares only renders
+    of one scene, unless ALLOW_DIFFERENT is true. Depth outliers on analytic spheres are
+    classed with the renders' sphere settings, as rvr compare classes them."""
 
 def diff(
     a: Union[str, os.PathLike[str], npt.ArrayLike, Render],

@@ -114,6 +114,8 @@ def test_compare_refuses_renders_of_different_scenes():
     brighter = rvr.Scene("builtin:cornell", width=16, height=12, exposure=1)
     with pytest.raises(rvr.BadInput, match="^compare: the renders differ in image settings"):
         rvr.compare(a, rvr.render(brighter, "softraster"))
+    with pytest.raises(rvr.BadInput, match="^compare: the renders differ in how spheres were drawn"):
+        rvr.compare(a, rvr.render(cornell, "softraster", sphere_segments=8))
     # One scene loaded twice is one scene.
     again = rvr.render(rvr.Scene("builtin:cornell", width=16, height=12), "softraster")
     assert rvr.compare(a, again)["visibility"]["id_agreement"] > 0.9

@@ -56,6 +56,22 @@ def test_compare_is_metrics_json(run_cli, tmp_path):
             assert got["renderers"][name][key] == expected["renderers"][name][key]
 
 
+def test_compare_classes_depth_outliers_as_the_command_line(run_cli, tmp_path):
+    # Coarse polygon spheres: the z-buffer's depth strays from the tracer's analytic spheres
+    # inside their outlines, which rvr compare classes as expected (on analytic spheres), not
+    # as disagreements (elsewhere); rvr.compare must be given the same sphere settings.
+    done = run_cli("compare", "builtin:spheres", "-r", "raster,raytrace", "--width", "64",
+                   "--height", "48", "--sphere-segments", "8", "--threads", "2", "-q",
+                   "-o", str(tmp_path))
+    assert done.returncode in (0, 1), done.stderr
+    expected = json.loads((tmp_path / "metrics.json").read_text())["pairs"][0]["depth"]
+    assert expected["outliers_on_analytic_spheres"] > 0 and expected["outliers_elsewhere"] == 0
+    scene = rvr.Scene("builtin:spheres", width=64, height=48)
+    a = rvr.render(scene, "raster", threads=2, sphere_segments=8)
+    b = rvr.render(scene, "raytrace", threads=2, sphere_segments=8)
+    assert rvr.compare(a, b)["pairs"][0]["depth"] == expected
+
+
 def test_changing_a_scene_leaves_earlier_renders_alone():
     scene = rvr.Scene("builtin:cornell", width=32, height=24)
     first = rvr.render(scene, "raytrace", threads=1)
