@@ -11,7 +11,7 @@
 #include <limits>
 #include <memory>
 #include <numeric>
-#include <type_traits>
+#include <type_traits>  // IWYU pragma: keep (std::move's type; asked for in some builds only)
 #include <utility>
 
 #include "rvr/study/cost_model.h"
