@@ -14,7 +14,6 @@
 #include <utility>
 
 #include "rvr/shared/expected.h"
-#include "rvr/study/fit_quality.h"
 #include "rvr/study/least_squares.h"
 
 namespace rvr::study {
@@ -326,14 +325,7 @@ WorkModel fit_work_model(const std::string& renderer, ModelForm form,
     model.terms[j].value = fit->values[j];
     model.terms[j].ci95 = fit->ci95[j];
   }
-  model.replicates = std::move(fit->replicates);
-  model.r2 = fit->quality.r2;
-  model.max_rel_residual = fit->quality.max_rel_residual;
-  model.loo_rel_error = fit->quality.loo_median_rel_error;
-  model.misfit = fit->misfit;
-  model.repetition_noise = fit->repetition_noise;
-  model.verdict = fit_verdict(fit->quality, limits);
-  model.fits = model.verdict == "fits";
+  take_fit(model, *fit, limits);
   return model;
 }
 

@@ -220,14 +220,7 @@ ModelFit fit_model(const CostModel& model, const std::vector<Measurement>& point
     f.coefficients[j].value = fit->values[j];
     f.coefficients[j].ci95 = fit->ci95[j];
   }
-  f.replicates = std::move(fit->replicates);
-  f.r2 = fit->quality.r2;
-  f.max_rel_residual = fit->quality.max_rel_residual;
-  f.loo_rel_error = fit->quality.loo_median_rel_error;
-  f.misfit = fit->misfit;
-  f.repetition_noise = fit->repetition_noise;
-  f.verdict = fit_verdict(fit->quality, limits);
-  f.fits = f.verdict == "fits";
+  take_fit(f, *fit, limits);
   return f;
 }
 

@@ -6,6 +6,7 @@
 #include <stddef.h>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rvr/shared/expected.h"
@@ -119,6 +120,20 @@ double timing_noise(const std::vector<Measurement>& points);
 
 // "fits", or the first of `limits` the fit misses, in words.
 std::string fit_verdict(const FitQuality& q, const FitThresholds& limits);
+
+// A fitted model (ModelFit, WorkModel) takes `fit`'s replicates, quality, misfit and noise, and
+// its verdict against `limits`.
+template <class Model>
+void take_fit(Model& model, LinearFit& fit, const FitThresholds& limits) {
+  model.replicates = std::move(fit.replicates);
+  model.r2 = fit.quality.r2;
+  model.max_rel_residual = fit.quality.max_rel_residual;
+  model.loo_rel_error = fit.quality.loo_median_rel_error;
+  model.misfit = fit.misfit;
+  model.repetition_noise = fit.repetition_noise;
+  model.verdict = fit_verdict(fit.quality, limits);
+  model.fits = model.verdict == "fits";
+}
 
 // The model fitted to the points' times by fit_linear, its quality and verdict against
 // `limits`. Too few points, or
