@@ -291,9 +291,13 @@ Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession
   if (runs[0].seconds.size() < size_t(request_.repetitions)) return ok_status();  // cut short
   std::vector<Measurement>& list = *into.list;
   auto [it, fresh] = into.index.try_emplace({n, width}, list.size());
-  for (const Run& held : list[it->second].runs)
-    RVR_DCHECK(held.session != session.index, "one run per session and point: session ",
-               session.index, " measured ", family.name, ":", n, " twice");
+  if (!fresh) {
+    // A point seen before: none of its runs is this session's (a fresh one is not in the list
+    // yet).
+    for (const Run& held : list[it->second].runs)
+      RVR_DCHECK(held.session != session.index, "one run per session and point: session ",
+                 session.index, " measured ", family.name, ":", n, " twice");
+  }
   for (size_t i = 0; i < runs.size(); ++i) {
     runs[i].busy = runs[i].reference_ratio > kBusyRatio || session.other_work;
     if (fresh) {
