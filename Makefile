@@ -93,7 +93,11 @@ SANITIZE_PYTHON ?= python_|lazy_loading
 # brute-force path in test_bvh.
 # python_wheel (packaging: the wheel installed into a venv) is left out too: pip and the venv's
 # python would run under the preloaded ASan runtime for no memory check of rvr's own.
-SANITIZE_EXCLUDE ?= Conformance[.]AgreesWithTheOtherLoopOrder/raytrace_none_|python_wheel
+# MemoryEstimate.WithinTenPercentOfASessionsMeasuredPeak compares the memory estimate with a
+# session's peak resident set at 10^7 triangles: under ASan the shadow memory and quarantine
+# change that peak (the comparison means nothing there) and the session takes tens of minutes;
+# the study's memory code still runs under ASan in the other MemoryEstimate tests.
+SANITIZE_EXCLUDE ?= Conformance[.]AgreesWithTheOtherLoopOrder/raytrace_none_|python_wheel|MemoryEstimate[.]WithinTenPercentOfASessionsMeasuredPeak
 # LeakSanitizer's exit-time scan (gcc 12's libsanitizer) can crash ("Tracer caught signal 11")
 # on a garbage dynamic-TLS entry of a Mesa library opened with dlopen. RVR_LINK_OSMESA=ON loads
 # libOSMesa and LLVM at start-up (static TLS), which avoids it, but Mesa's EGL driver is still
