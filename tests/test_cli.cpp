@@ -1192,10 +1192,17 @@ TEST_F(Cli, CtrlCDuringAStudyWritesThePartialStudy) {
 // measured keeps the runs of each, each run a session of its own); with the SIMD kernels of one
 // edited, they are not pooled: one study per machine type and comparison.md.
 TEST_F(Cli, StudyMergePoolsOneMachineTypeAndComparesTwo) {
+  // A 3 s study may measure too few points to conclude on a slow machine (ASan, a loaded CI
+  // runner): then it exits 1 saying why, with its study.json written, which is all a merge
+  // needs; any other failure fails the test.
+  auto written = [](const RunResult& r) {
+    return r.status == 0 ||
+           (r.status == 1 && r.err.find("rvr study: no conclusion: ") != std::string::npos);
+  };
   const std::string tiny = "study builtin:tessphere --width 32 --budget 3 -q -o ";
   for (const char* name : {"a", "b"}) {
     RunResult r = run(tiny + (dir_ / name).string() + (name[0] == 'b' ? " --shard 1/2" : ""));
-    ASSERT_EQ(r.status, 0) << r.err;
+    ASSERT_TRUE(written(r)) << r.status << ": " << r.err;
   }
   nlohmann::json a = nlohmann::json::parse(slurp(dir_ / "a" / "study.json"));
   nlohmann::json b = nlohmann::json::parse(slurp(dir_ / "b" / "study.json"));
@@ -1205,7 +1212,7 @@ TEST_F(Cli, StudyMergePoolsOneMachineTypeAndComparesTwo) {
   fs::path pooled = dir_ / "pooled";
   RunResult merged = run("study --merge " + (dir_ / "a").string() + " " + (dir_ / "b").string() +
                          " -o " + pooled.string());
-  ASSERT_EQ(merged.status, 0) << merged.err;
+  ASSERT_TRUE(written(merged)) << merged.status << ": " << merged.err;
   nlohmann::json p = nlohmann::json::parse(slurp(pooled / "study.json"));
   EXPECT_TRUE(fs::exists(pooled / "study.md"));
   // A point both measured keeps every run of each, and the sessions of both studies.
@@ -1231,7 +1238,7 @@ TEST_F(Cli, StudyMergePoolsOneMachineTypeAndComparesTwo) {
   fs::path compared = dir_ / "compared";
   RunResult apart = run("study --merge " + (dir_ / "a").string() + " " + (dir_ / "b_sse").string() +
                         " -o " + compared.string());
-  ASSERT_EQ(apart.status, 0) << apart.err;
+  ASSERT_TRUE(written(apart)) << apart.status << ": " << apart.err;
   ASSERT_TRUE(fs::exists(compared / "comparison.md"));
   EXPECT_NE(slurp(compared / "comparison.md").find("sse (edited"), std::string::npos);
   int studies = 0;
