@@ -181,6 +181,12 @@ def test_mesh_errors_name_the_array():
         rvr.Scene.from_mesh(vertices, [0, 1, 2], up_axis="x")
 
 
+# Under make sanitize, python3 runs with ASan's runtime preloaded: its operator new comes before
+# the module's in symbol lookup, so the module's counting operator new (the budget) never runs
+# and the import is stopped by its CPU limit instead. The command line keeps its own operator
+# new under ASan (an executable's symbols come first) and is checked there.
+@pytest.mark.skipif("libasan" in os.environ.get("LD_PRELOAD", ""),
+                    reason="ASan's preloaded operator new replaces the module's budget")
 @pytest.mark.parametrize("name,ext", [("dae_triangle_count_past_the_file_oom", "dae"),
                                       ("off_vertex_count_past_the_file_oom", "off"),
                                       ("ply_ascii_vertex_count_past_the_file_oom", "ply")])
