@@ -2,11 +2,12 @@
 """Checks bench/paste_study.py, which `make study` runs to paste a study's study.md into
 bench/README.md, and that the README stays a reference page.
 
-1. A synthetic study.md (a title, Crossovers, Scaling, Cost per triangle and per ray, Cost models)
-   pasted into a synthetic README: the headings moved down two levels, the Scaling and Cost per
-   triangle sections left out with a line pointing to study.md, every other line of the study
-   kept in order, the README's text before the marker and from the next `## ` heading on kept
-   byte for byte; pasting again changes nothing.
+1. A synthetic study.md (a title, the headline crossover, Crossovers, Scaling, Cost per triangle
+   and per ray, Cost models, Predictions checked) pasted into a synthetic README: the headings
+   moved down two levels, the Scaling, Cost per triangle and Cost models sections left out with
+   a line pointing to study.md, every other line of the study kept in order, the README's text
+   before the marker and from the next `## ` heading on kept byte for byte; pasting again
+   changes nothing.
 2. The repository's bench/README.md: at most 150 lines, and what paste_study.py makes of it with
    bench/study/study.md is the file itself (the README shows that study as generated).
 
@@ -25,6 +26,10 @@ STUDY = """# rvr study
 
 tessphere at 64×48; 3 repetitions per point.
 
+## Where the pixel-major loop overtakes the triangle-major one
+
+- at 64×48 on tessphere, the headline.
+
 ## Crossovers
 
 - at 64×48 on tessphere, A is faster than B below 10 triangles.
@@ -40,6 +45,10 @@ tessphere at 64×48; 3 repetitions per point.
 ## Cost models
 
 - A on tessphere: t = a + b·P.
+
+## Predictions checked
+
+- at 30 triangles the check holds.
 """
 
 BEFORE = "# bench\n\nReference text.\n\n## The study\n\n<!-- study.md -->\n"
@@ -76,16 +85,18 @@ def main():
         failures.append("synthetic: the text from the next section on changed")
     if "stale line" in once:
         failures.append("synthetic: the previous study was not replaced")
-    for heading in ("### rvr study", "#### Crossovers", "#### Cost models"):
+    for heading in ("### rvr study", "#### Where the pixel-major loop overtakes the "
+                    "triangle-major one", "#### Crossovers", "#### Predictions checked"):
         if "\n" + heading + "\n" not in once:
             failures.append(f"synthetic: no '{heading}' (headings moved down two levels)")
-    for gone in ("Scaling", "grows as", "Cost per triangle", "1 ms a frame"):
+    for gone in ("Scaling", "grows as", "Cost per triangle", "1 ms a frame", "Cost models",
+                 "t = a + b·P."):
         if gone in once:
             failures.append(f"synthetic: '{gone}' should stay in study.md only")
     if "`bench/study/study.md`" not in once:
         failures.append("synthetic: no line pointing to study.md for the lists left out")
-    kept = ["tessphere at 64×48; 3 repetitions per point.", "A is faster than B below 10",
-            "t = a + b·P."]
+    kept = ["tessphere at 64×48; 3 repetitions per point.", "the headline.",
+            "A is faster than B below 10", "the check holds."]
     positions = [once.find(k) for k in kept]
     if -1 in positions or positions != sorted(positions):
         failures.append("synthetic: the study's other lines are not all kept, in order")
