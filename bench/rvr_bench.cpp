@@ -48,6 +48,14 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/camera.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
+#include "rvr/image_codec/image_io.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/primary_rays.h"
@@ -57,15 +65,7 @@
 #include "rvr/raytrace/wide_bvh_layout.h"
 #include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/texture.h"
+#include "rvr/scene_io/scene_loader.h"
 
 using namespace rvr;
 
@@ -144,7 +144,7 @@ RenderOutput time_frames(benchmark::State& state, FrameRenderer& renderer, Phase
   RenderOutput out = renderer.frame();
   for (auto _ : state) {
     out = renderer.frame();
-    benchmark::DoNotOptimize(out.buffers.color.data());
+    benchmark::DoNotOptimize(out.buffers.colour.data());
     phases.add(out);
   }
   return out;
@@ -299,7 +299,7 @@ void BM_Effects(benchmark::State& state, const std::string& effect) {
   RenderOutput out = tracer.render(scene, options).value();
   for (auto _ : state) {
     out = tracer.render(scene, options).value();
-    benchmark::DoNotOptimize(out.buffers.color.data());
+    benchmark::DoNotOptimize(out.buffers.colour.data());
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
 }
@@ -330,7 +330,7 @@ void BM_WriteAovs(benchmark::State& state, const std::vector<std::string>& aovs)
   const fs::path dir = fs::temp_directory_path() / ("rvr_bench_aovs_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string image = (dir / "cornell.png").string();
-  const Image colour = color_image(out.buffers);
+  const Image colour = colour_image(out.buffers);
   double seconds = 0.0;
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
@@ -364,7 +364,7 @@ void BM_EffectsWith(benchmark::State& state, const std::string& renderer_name,
   PhaseTimes phases;
   for (auto _ : state) {
     out = renderer->render(scene, options).value();
-    benchmark::DoNotOptimize(out.buffers.color.data());
+    benchmark::DoNotOptimize(out.buffers.colour.data());
     phases.add(out);
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 
 namespace rvr::python {
 

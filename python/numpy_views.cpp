@@ -2,7 +2,7 @@
 
 #include <utility>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 
 namespace py = pybind11;
 

@@ -19,13 +19,13 @@
 #include "render_stats.h"
 #include "report.h"
 #include "report_input.h"
+#include "rvr/compare/compare.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
+#include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/compare_renderers.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/texture.h"
 #include "stub_docs.h"
 
 namespace py = pybind11;
@@ -157,7 +157,7 @@ py::object compare(const PyRender& a, const PyRender& b, bool allow_different) {
 // An image from a file, an array (H x W or H x W x C) or a render's colour.
 Image image_of(const char* name, const py::object& value) {
   if (py::isinstance<PyRender>(value))
-    return color_image(py::cast<const PyRender&>(value).result->output.buffers);
+    return colour_image(py::cast<const PyRender&>(value).result->output.buffers);
   if (py::isinstance<py::str>(value) || py::hasattr(value, "__fspath__"))
     return take(read_image(path_of(name, value)));
   using Floats = py::array_t<float, py::array::c_style | py::array::forcecast>;

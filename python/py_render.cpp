@@ -27,11 +27,11 @@
 #include "py_scene.h"
 #include "render_job.h"
 #include "render_kwargs.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/limits.h"
+#include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/limits.h"
 #include "stub_docs.h"
 #include "suggest.h"
 
@@ -79,7 +79,7 @@ py::bytes png_bytes(const PyRender& r) {
       (dir / ("rvr-python-" + std::to_string(::getpid()) + "-" +
               std::to_string(reinterpret_cast<uintptr_t>(r.result.get())) + ".png"))
           .string();
-  check(write_image(path, color_image(r.result->output.buffers)));
+  check(write_image(path, colour_image(r.result->output.buffers)));
   std::ifstream in(path, std::ios::binary);
   std::stringstream bytes;
   bytes << in.rdbuf();
@@ -116,7 +116,7 @@ void save(const PyRender& r, const py::object& where, const py::object& aovs) {
                           "'");
   }
   const FrameBuffers& fb = r.result->output.buffers;
-  check(write_image(path, color_image(fb)));
+  check(write_image(path, colour_image(fb)));
   if (!names.empty()) check(write_aovs(path, fb, names));
 }
 
@@ -140,7 +140,7 @@ void bind_render_class(py::module_& m) {
       .def_property_readonly(
           "color",
           [=](const PyRender& r) {
-            return view(owner(r), &buffers(r).color.data()->x, 3 * buffers(r).color.size(),
+            return view(owner(r), &buffers(r).colour.data()->x, 3 * buffers(r).colour.size(),
                         shape(r, 3));
           },
           docs::Render_color)

@@ -6,8 +6,8 @@
 #include <string>
 
 #include "render_stats.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 
 namespace rvr::python {
 

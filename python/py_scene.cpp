@@ -22,14 +22,14 @@
 #include "arguments.h"
 #include "bindings.h"
 #include "errors.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene_for_render.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/scene_writer.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/image_codec/image_io.h"
+#include "rvr/scene_io/scene_for_render.h"
+#include "rvr/scene_io/scene_loader.h"
+#include "rvr/scene_io/scene_writer.h"
 #include "stub_docs.h"
 
 namespace py = pybind11;
@@ -223,15 +223,16 @@ std::vector<glm::uvec3> triangles_of(const py::object& value) {
 }
 
 PyScene from_mesh(const py::object& vertices, const py::object& indices,
-                  const std::optional<py::object>& normals, const std::optional<py::object>& colors,
-                  std::optional<int> width, std::optional<int> height, std::optional<int> spp,
-                  std::optional<float> exposure, std::optional<py::sequence> camera_from,
-                  const std::string& up_axis, std::optional<py::dict> camera) {
+                  const std::optional<py::object>& normals,
+                  const std::optional<py::object>& colours, std::optional<int> width,
+                  std::optional<int> height, std::optional<int> spp, std::optional<float> exposure,
+                  std::optional<py::sequence> camera_from, const std::string& up_axis,
+                  std::optional<py::dict> camera) {
   TriangleMesh mesh;
   mesh.positions = rows_of<glm::vec3, float>("vertices", vertices);
   mesh.triangles = triangles_of(indices);
   if (normals) mesh.normals = rows_of<glm::vec3, float>("normals", *normals);
-  if (colors) mesh.colours = rows_of<glm::vec3, float>("colors", *colors);
+  if (colours) mesh.colours = rows_of<glm::vec3, float>("colors", *colours);
   if (up_axis != "y" && up_axis != "z")
     throw BadInputError("up_axis: expected y or z, got '" + up_axis + "'");
   SceneRequest request;

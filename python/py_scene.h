@@ -4,8 +4,8 @@
 
 #include <memory>
 
-#include "rvr/shared/limits.h"
-#include "rvr/shared/scene.h"
+#include "rvr/core/limits.h"
+#include "rvr/core/scene.h"
 
 namespace rvr::python {
 

@@ -13,8 +13,8 @@
 #include <thread>
 #include <utility>
 
-#include "rvr/shared/progress.h"
-#include "rvr/shared/timer.h"
+#include "rvr/core/progress.h"
+#include "rvr/core/timer.h"
 
 namespace py = pybind11;
 

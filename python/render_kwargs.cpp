@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "errors.h"
-#include "rvr/shared/gl_backend.h"
+#include "rvr/core/gl_backend.h"
 
 namespace py = pybind11;
 

@@ -7,8 +7,8 @@
 
 #include <string>
 
+#include "rvr/core/renderer.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/renderer.h"
 
 namespace rvr::python {
 

@@ -20,7 +20,7 @@ EMBREE = "libembree3.so"
 MODEL_PLUGIN = "librvr_model_import.so"
 EMBREE_PLUGIN = "librvr_embree.so"
 PLUGINS = {MODEL_PLUGIN: {"rvr_model_import_get"}, EMBREE_PLUGIN: {"rvr_embree_get"}}
-# The model importer's operator new and delete forms (shared/src/allocation_budget_plugin.cpp).
+# The model importer's operator new and delete forms (scene_io/src/allocation_budget_plugin.cpp).
 OPERATORS = {"_Znwm", "_Znam", "_ZnwmRKSt9nothrow_t", "_ZnamRKSt9nothrow_t", "_ZdlPv", "_ZdaPv",
              "_ZdlPvm", "_ZdaPvm", "_ZdlPvRKSt9nothrow_t", "_ZdaPvRKSt9nothrow_t"}
 

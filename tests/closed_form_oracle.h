@@ -1,6 +1,6 @@
 // The shading equation of docs/design.md and the pinhole camera, written out again in double
 // precision for tests whose expected values must not come from the code under test
-// (rvr/shared/shading.h, rvr/shared/camera.h, rvr/shared/tessellate.h are not used here).
+// (rvr/core/shading.h, rvr/core/camera.h, rvr/core/tessellate.h are not used here).
 #pragma once
 
 #include <algorithm>
@@ -9,7 +9,7 @@
 #include <optional>
 #include <vector>
 
-#include "rvr/shared/scene.h"
+#include "rvr/core/scene.h"
 
 namespace rvr::oracle {
 
@@ -48,7 +48,7 @@ inline std::optional<double> hit_sphere(const Ray& r, const Sphere& s, double t_
 // The square of side 2 * half_size centred at point, facing normal, with its edges along the
 // axes tessellate.h documents for it (world y, or x when the normal is near y, crossed with the
 // normal). The tests keep pixels near its edges out, so only its interior matters.
-inline std::optional<double> hit_square(const Ray& r, const Plane& p, double t_min = 1e-9) {
+inline std::optional<double> hit_square(const Ray& r, const Square& p, double t_min = 1e-9) {
   dvec3 n(p.normal);
   double denom = glm::dot(n, r.direction);
   if (std::abs(denom) < 1e-12) return std::nullopt;

@@ -164,7 +164,7 @@ inline std::string off_cube_with_comments() {
 // perspective camera and a KHR_lights_punctual point light on nodes of their own. The buffer
 // is embedded as base64 (.gltf) or is the GLB's BIN chunk.
 struct GltfExtras {
-  std::array<float, 4> base_color{0.1f, 0.2f, 0.9f, 1.0f};
+  std::array<float, 4> base_colour{0.1f, 0.2f, 0.9f, 1.0f};
   std::array<float, 3> emissive{0.0f, 0.0f, 0.0f};
   bool camera = false;
   std::array<float, 3> camera_at{0.5f, 0.5f, 4.0f};  // looking down -z, y up
@@ -172,7 +172,7 @@ struct GltfExtras {
   float aspect = 1.5f;
   bool light = false;
   std::array<float, 3> light_at{2.0f, 3.0f, 2.5f};
-  std::array<float, 3> light_color{1.0f, 0.9f, 0.8f};
+  std::array<float, 3> light_colour{1.0f, 0.9f, 0.8f};
   float light_intensity = 20.0f;
   bool texture = false;  // a baseColorTexture (an image file that need not exist)
 };
@@ -222,10 +222,10 @@ inline std::string gltf_json(const GltfExtras& e, bool glb) {
     scene_nodes += e.camera ? ",2" : ",1";
     extensions = R"("extensionsUsed":["KHR_lights_punctual"],"extensions":{"KHR_lights_punctual":)"
                  R"({"lights":[{"type":"point","color":)" +
-                 vec(e.light_color) + R"(,"intensity":)" + num(e.light_intensity) + "}]}},";
+                 vec(e.light_colour) + R"(,"intensity":)" + num(e.light_intensity) + "}]}},";
   }
   std::string material = R"({"name":"paint","pbrMetallicRoughness":{"baseColorFactor":)" +
-                         vec(e.base_color) + R"(,"metallicFactor":0)" +
+                         vec(e.base_colour) + R"(,"metallicFactor":0)" +
                          (e.texture ? R"(,"baseColorTexture":{"index":0})" : "") +
                          R"(},"emissiveFactor":)" + vec(e.emissive) + "}";
   std::string s = R"({"asset":{"version":"2.0","generator":"rvr test corpus"},)" + extensions +
@@ -317,7 +317,7 @@ struct DaeExtras {
   float yfov_deg = 40.0f;
   float aspect = 1.5f;
   std::array<float, 3> light_at{3.0f, 4.0f, 5.0f};
-  std::array<float, 3> light_color{1.0f, 1.0f, 1.0f};
+  std::array<float, 3> light_colour{1.0f, 1.0f, 1.0f};
 };
 
 inline std::string dae_cube(const DaeExtras& e) {
@@ -341,7 +341,7 @@ inline std::string dae_cube(const DaeExtras& e) {
   </perspective></technique_common></optics></camera></library_cameras>
   <library_lights><light id="lamp" name="lamp"><technique_common><point>
     <color>)" +
-         three(e.light_color) +
+         three(e.light_colour) +
          R"(</color><constant_attenuation>1</constant_attenuation>
     <linear_attenuation>0</linear_attenuation><quadratic_attenuation>0</quadratic_attenuation>
   </point></technique_common></light></library_lights>

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "rvr/shared/scene.h"
+#include "rvr/core/scene.h"
 
 namespace rvr::test {
 

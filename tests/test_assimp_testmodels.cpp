@@ -23,10 +23,10 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/texture.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
+#include "rvr/scene_io/scene_loader.h"
 
 namespace fs = std::filesystem;
 

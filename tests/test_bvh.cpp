@@ -18,18 +18,17 @@
 #include <tuple>
 #include <vector>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/texture.h"
+#include "rvr/scene_io/scene_loader.h"
 
 using namespace rvr;
 

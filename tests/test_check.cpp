@@ -1,10 +1,10 @@
-// RVR_CHECK and RVR_DCHECK (rvr/shared/check.h): a broken invariant aborts with a message naming
+// RVR_CHECK and RVR_DCHECK (rvr/core/check.h): a broken invariant aborts with a message naming
 // the condition, the caller's message and file:line; a kept one costs nothing visible.
 #include <gtest/gtest.h>
 
 #include <memory>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 
 namespace {
 

@@ -26,9 +26,9 @@
 #include <vector>
 
 #include "model_corpus.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/html_escape.h"
-#include "rvr/shared/image_io.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/html_escape.h"
+#include "rvr/image_codec/image_io.h"
 
 namespace fs = std::filesystem;
 

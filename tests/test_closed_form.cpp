@@ -2,7 +2,7 @@
 // renders one analytic sphere over a square plane, and every pixel away from an edge must
 // equal the shading equation of docs/design.md evaluated here, in double precision, from a
 // camera ray and a ray-sphere / ray-plane intersection the test computes itself
-// (closed_form_oracle.h). Nothing of rvr/shared/shading.h, camera.h or tessellate.h is used for
+// (closed_form_oracle.h). Nothing of rvr/core/shading.h, camera.h or tessellate.h is used for
 // the expected values, so a wrong term shared by the C++ and the GLSL fails here even though
 // every renderer agrees with every other.
 #include <gtest/gtest.h>
@@ -24,13 +24,13 @@
 #include <vector>
 
 #include "closed_form_oracle.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/tessellate.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/tessellate.h"
 
 namespace rvr {
 namespace {
@@ -307,7 +307,7 @@ TEST_P(ClosedForm, PointLightsMatchTheShadingEquation) {
                    " lights");
       Scene s = sphere_on_plane(shininess, light_count);
       RenderedFrame f = render(choice, s, RenderMode::Local);
-      ASSERT_EQ(f.buffers.color.size(), size_t(s.image.width * s.image.height));
+      ASSERT_EQ(f.buffers.colour.size(), size_t(s.image.width * s.image.height));
       std::vector<PointLight> lights = point_lights(s);
       auto surface = [&](double px, double py) { return trace(s, px, py).object; };
       Check check;
@@ -318,7 +318,7 @@ TEST_P(ClosedForm, PointLightsMatchTheShadingEquation) {
           size_t i = size_t(y) * s.image.width + x;
           if (sp.object < 0) {
             EXPECT_EQ(f.buffers.object_id[i], kNoId) << x << ", " << y;
-            check.pixel(x, y, false, f.buffers.color[i], dvec3(s.image.background), kTolerance);
+            check.pixel(x, y, false, f.buffers.colour[i], dvec3(s.image.background), kTolerance);
             continue;
           }
           EXPECT_EQ(f.buffers.object_id[i], uint32_t(sp.object)) << x << ", " << y;
@@ -334,7 +334,7 @@ TEST_P(ClosedForm, PointLightsMatchTheShadingEquation) {
             if (!b) continue;
             tol = tessellation_tolerance(sp, *b, colour);
           }
-          check.pixel(x, y, sphere, f.buffers.color[i], colour(sp.P, sp.N), tol);
+          check.pixel(x, y, sphere, f.buffers.colour[i], colour(sp.P, sp.N), tol);
         }
       }
       // Enough of each surface is checked for the comparison to mean something.
@@ -369,7 +369,7 @@ void check_shadow_scene(const Scene& s, const RenderedFrame& f, const Label& lab
     for (int x = 0; x < s.image.width; ++x) {
       if (!away_from_edges(x, y, label)) continue;
       SurfacePoint sp = trace(s, x + 0.5, y + 0.5);
-      const glm::vec3& got = f.buffers.color[size_t(y) * s.image.width + x];
+      const glm::vec3& got = f.buffers.colour[size_t(y) * s.image.width + x];
       if (sp.object != 0) {
         dvec3 want = sp.object < 0 ? dvec3(s.image.background) : dvec3(0.9, 0.3, 0.1);
         check.pixel(x, y, sp.object == 1, got, want, kTolerance);
@@ -386,7 +386,7 @@ TEST_P(ClosedForm, PointLightShadowOfASphereOnAPlane) {
   const RendererChoice choice = this->choice();
   Scene s = shadow_scene(0.0f);
   RenderedFrame f = render(choice, s, RenderMode::Full);
-  ASSERT_EQ(f.buffers.color.size(), size_t(s.image.width * s.image.height));
+  ASSERT_EQ(f.buffers.colour.size(), size_t(s.image.width * s.image.height));
   std::vector<PointLight> lights = point_lights(s);
   const Sphere& occluder = s.objects[1].sphere;
   auto label = [&](double px, double py) {
@@ -418,7 +418,7 @@ TEST_P(ClosedForm, MirrorPlaneReflectsAnEmissiveSphere) {
   const RendererChoice choice = this->choice();
   Scene s = shadow_scene(0.75f);
   RenderedFrame f = render(choice, s, RenderMode::Full);
-  ASSERT_EQ(f.buffers.color.size(), size_t(s.image.width * s.image.height));
+  ASSERT_EQ(f.buffers.colour.size(), size_t(s.image.width * s.image.height));
   bool traces_mirrors = choice.info->order != LoopOrder::TriangleMajor;
   if (!traces_mirrors) {
     EXPECT_FALSE(f.warnings.empty()) << "the unrendered mirror is named";
@@ -479,7 +479,7 @@ TEST_P(ClosedForm, SquareAreaLightOnAPlaneIsItsSolidAngle) {
   area.samples = n;
   s.lights = {area};
   RenderedFrame f = render(choice, s, RenderMode::Local);
-  ASSERT_EQ(f.buffers.color.size(), size_t(s.image.width * s.image.height));
+  ASSERT_EQ(f.buffers.colour.size(), size_t(s.image.width * s.image.height));
   const double delta = a / n;
   const double midpoint_bound = double(kd.x) * I * delta * delta / (4 * H * H * H * H);
   auto surface = [&](double px, double py) { return trace(s, px, py).object; };
@@ -494,7 +494,7 @@ TEST_P(ClosedForm, SquareAreaLightOnAPlaneIsItsSolidAngle) {
       dvec3 want =
           dvec3(0.01, 0, 0) + dvec3(s.ambient) * dvec3(kd) + dvec3(kd) * (I / (a * a)) * omega;
       size_t i = size_t(y) * s.image.width + x;
-      check.pixel(x, y, false, f.buffers.color[i], want, kTolerance + midpoint_bound);
+      check.pixel(x, y, false, f.buffers.colour[i], want, kTolerance + midpoint_bound);
     }
   }
   EXPECT_GT(check.checked_plane, 2000u);

@@ -1,4 +1,4 @@
-// rvr's inferno colour map (shared/src/image_io.cpp: the cost pictures, the heat maps of
+// rvr's inferno colour map (image_codec/src/image_io.cpp: the cost pictures, the heat maps of
 // compare) against OpenImageIO's ImageBufAlgo::color_map(..., "inferno"): the same values must
 // give the same colours, bit for bit. This test links OpenImageIO itself as the oracle; rvr
 // computes the map without loading it.
@@ -17,10 +17,10 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/check.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/srgb.h"
+#include "rvr/core/check.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/srgb.h"
+#include "rvr/image_codec/image_io.h"
 
 using namespace rvr;
 

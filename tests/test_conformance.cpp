@@ -24,19 +24,20 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/camera.h"
+#include "rvr/core/check.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/surface_colour.h"
+#include "rvr/core/tessellate.h"
+#include "rvr/core/texture.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/surface_colour.h"
-#include "rvr/shared/tessellate.h"
-#include "rvr/shared/texture.h"
+#include "rvr/scene_io/scene_loader.h"
 
 using namespace rvr;
 
@@ -243,7 +244,8 @@ std::map<uint32_t, RegionError> colour_error_by_object(const FrameBuffers& a,
         }
       if (near_edge) continue;
       double d = 0;
-      for (int c = 0; c < 3; ++c) d = std::max(d, double(std::abs(a.color[i][c] - b.color[i][c])));
+      for (int c = 0; c < 3; ++c)
+        d = std::max(d, double(std::abs(a.colour[i][c] - b.colour[i][c])));
       if (std::isnan(d)) d = 1.0;
       RegionError& r = regions[a.object_id[i]];
       ++r.pixels;
@@ -332,7 +334,7 @@ TEST_P(Conformance, AgreesWithTheOtherLoopOrder) {
   EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
   EXPECT_LE(m.depth.max_rel_error, kMaxDepthRelError) << worst_depth(a.buffers, b.buffers);
   EXPECT_EQ(m.depth.outliers_elsewhere, 0u) << worst_depth(a.buffers, b.buffers);
-  EXPECT_GE(m.color.psnr_db, kMinPsnr);
+  EXPECT_GE(m.colour.psnr_db, kMinPsnr);
 
   // SSIM: a window without a mismatched pixel sees the same structure in both images, and
   // its luminance term differs from 1 by about (colour error)^2 / (2 mean^2): below 1e-3
@@ -341,7 +343,7 @@ TEST_P(Conformance, AgreesWithTheOtherLoopOrder) {
   // 121 windows per mismatched pixel.
   const double windows_with_a_mismatch =
       std::min(1.0, 121.0 * double(m.visibility.mismatched_pixels) / double(m.visibility.pixels));
-  EXPECT_GE(m.color.ssim, 1.0 - windows_with_a_mismatch - kSsimSlack)
+  EXPECT_GE(m.colour.ssim, 1.0 - windows_with_a_mismatch - kSsimSlack)
       << m.visibility.mismatched_pixels << " mismatched pixels";
 
   // Colour per object, away from edges: the whole-image PSNR lets a wrong region of 1% of the
@@ -376,8 +378,8 @@ TEST_P(Conformance, AgreesWithTheOtherLoopOrder) {
   EXPECT_EQ(drawn_a.reported, drawn_a.expected) << r.choice.name;
   EXPECT_EQ(drawn_b.reported, drawn_b.expected) << r.reference;
   RecordProperty("id_agreement", std::to_string(m.visibility.id_agreement));
-  RecordProperty("psnr_db", std::to_string(m.color.psnr_db));
-  RecordProperty("ssim", std::to_string(m.color.ssim));
+  RecordProperty("psnr_db", std::to_string(m.colour.psnr_db));
+  RecordProperty("ssim", std::to_string(m.colour.ssim));
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryRendererEveryScene, Conformance,
@@ -411,7 +413,7 @@ TEST_P(GlBackends, OsMesaAndEglRenderIdenticalBuffers) {
   for (size_t i = 0; i < a.pixel_count(); ++i) {
     bool same = a.object_id[i] == b.object_id[i] && a.primitive_id[i] == b.primitive_id[i] &&
                 std::memcmp(&a.depth[i], &b.depth[i], sizeof(float)) == 0 &&
-                std::memcmp(&a.color[i], &b.color[i], sizeof(a.color[i])) == 0 &&
+                std::memcmp(&a.colour[i], &b.colour[i], sizeof(a.colour[i])) == 0 &&
                 std::memcmp(&a.normal[i], &b.normal[i], sizeof(a.normal[i])) == 0;
     differing += !same;
   }

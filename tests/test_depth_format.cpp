@@ -18,13 +18,13 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
 #include "scene_builders.h"
 
 namespace rvr {

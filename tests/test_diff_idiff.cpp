@@ -17,8 +17,8 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/image_io.h"
+#include "rvr/core/expected.h"
+#include "rvr/image_codec/image_io.h"
 
 namespace fs = std::filesystem;
 

@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "fuzz/fuzz_common.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/scene.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/scene.h"
 
 namespace fs = std::filesystem;
 

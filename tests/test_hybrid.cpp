@@ -16,16 +16,17 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/check.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/texture.h"
+#include "rvr/scene_io/scene_loader.h"
 
 using namespace rvr;
 
@@ -119,7 +120,7 @@ TEST_P(HybridFullMode, IsTheTracersImageButOnEdges) {
       continue;
     }
     untextured_same =
-        untextured_same && std::memcmp(&a.color[i], &b.color[i], sizeof(a.color[i])) == 0;
+        untextured_same && std::memcmp(&a.colour[i], &b.colour[i], sizeof(a.colour[i])) == 0;
   }
   if (m.visibility.mismatched_pixels == 0) {
     EXPECT_TRUE(untextured_same) << "ids agree everywhere";
@@ -130,13 +131,13 @@ TEST_P(HybridFullMode, IsTheTracersImageButOnEdges) {
   // The colour of the whole image; with GL's level of detail on a textured surface the texels
   // themselves differ (up to 0.6 of a level's blend, checked above per pixel), not the shading.
   if (hybrid != std::string("hybrid") || textured == 0) {
-    EXPECT_GE(m.color.psnr_db, kMinPsnr);
+    EXPECT_GE(m.colour.psnr_db, kMinPsnr);
   }
   size_t differing = 0;
   for (size_t i = 0; i < a.pixel_count(); ++i) {
     if (a.object_id[i] != b.object_id[i] || a.primitive_id[i] != b.primitive_id[i]) continue;
     const bool colour_differs =
-        !textured_pixel(a, i) && std::memcmp(&a.color[i], &b.color[i], sizeof(a.color[i])) != 0;
+        !textured_pixel(a, i) && std::memcmp(&a.colour[i], &b.colour[i], sizeof(a.colour[i])) != 0;
     differing += colour_differs || std::memcmp(&a.depth[i], &b.depth[i], sizeof(float)) != 0;
   }
   // Pixels whose ids agree but whose colour or depth bytes do not: a shared edge between two
@@ -158,12 +159,12 @@ TEST_P(HybridFullMode, IsTheTracersImageButOnEdges) {
   EXPECT_GT(mixed.stats.at("time.trace"), 0.0);
   EXPECT_EQ(mixed.stats.at("rays.shadow") > 0, traced.stats.at("rays.shadow") > 0);
   RecordProperty("id_agreement", std::to_string(m.visibility.id_agreement));
-  RecordProperty("psnr_db", std::to_string(m.color.psnr_db));
+  RecordProperty("psnr_db", std::to_string(m.colour.psnr_db));
   std::printf(
       "%s %s: id agreement %.6f, %zu mismatched, PSNR %.2f dB, rebuilt %.0f, traced %.0f "
       "(missed %.0f), csg %.0f, zbuffer %.2f ms, trace %.2f ms (raytrace render %.2f ms)\n",
       hybrid, scene_name.c_str(), m.visibility.id_agreement, m.visibility.mismatched_pixels,
-      m.color.psnr_db, mixed.stats.at("hybrid.rebuilt"), mixed.stats.at("hybrid.fallback_traced"),
+      m.colour.psnr_db, mixed.stats.at("hybrid.rebuilt"), mixed.stats.at("hybrid.fallback_traced"),
       mixed.stats.at("hybrid.fallback_missed"), mixed.stats.at("hybrid.csg_pixels"),
       1e3 * mixed.stats.at("time.zbuffer"), 1e3 * mixed.stats.at("time.trace"),
       1e3 * traced.stats.at("time.render"));
@@ -195,7 +196,7 @@ TEST(Hybrid, SameBytesForAnyThreadCount) {
   for (const char* hybrid : {"hybrid", "hybrid_soft"}) {
     RenderOutput one = render_full(hybrid, scene, 1);
     RenderOutput all = render_full(hybrid, scene, 0);
-    EXPECT_TRUE(same_bytes(one.buffers.color, all.buffers.color)) << hybrid;
+    EXPECT_TRUE(same_bytes(one.buffers.colour, all.buffers.colour)) << hybrid;
     EXPECT_EQ(one.buffers.object_id, all.buffers.object_id) << hybrid;
   }
 }
@@ -223,7 +224,7 @@ TEST(Hybrid, SupersamplesComeFromZBufferPassesThroughTheirLensPoints) {
     EXPECT_LE(out.stats.at("hybrid.fallback_missed"), 1e-4 * samples) << hybrid;
     EXPECT_GT(out.stats.at("hybrid.rebuilt"), 0.5 * samples) << hybrid;
     ComparisonMetrics m = compare_buffers(out.buffers, traced.buffers);
-    EXPECT_GE(m.color.psnr_db, 60.0) << hybrid;  // the tracer's own samples but on rare edges
+    EXPECT_GE(m.colour.psnr_db, 60.0) << hybrid;  // the tracer's own samples but on rare edges
     for (const std::string& w : out.warnings)
       EXPECT_EQ(w.find("traced, not z-buffered"), std::string::npos) << w;
   }

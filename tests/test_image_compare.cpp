@@ -17,11 +17,12 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/mismatch_classes.h"
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/check.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/image_codec/image_io.h"
 
 namespace fs = std::filesystem;
 using namespace rvr;
@@ -81,7 +82,7 @@ FrameBuffers flat(int w, int h, glm::vec3 colour = glm::vec3(0.5f)) {
     fb.object_id[i] = 0;
     fb.primitive_id[i] = 0;
     fb.depth[i] = 5.0f;
-    fb.color[i] = colour;
+    fb.colour[i] = colour;
     fb.normal[i] = glm::vec3(0, 0, 1);
   }
   return fb;
@@ -235,8 +236,8 @@ TEST(ImageIo, ReadingMissingOrBadFilesFails) {
 
 TEST(ImageIo, ColorImageCopiesTheLinearColour) {
   FrameBuffers fb = flat(3, 2, glm::vec3(0.1f, 0.2f, 0.3f));
-  fb.color[fb.index(2, 1)] = glm::vec3(2.0f, -1.0f, 0.0f);
-  Image img = color_image(fb);
+  fb.colour[fb.index(2, 1)] = glm::vec3(2.0f, -1.0f, 0.0f);
+  Image img = colour_image(fb);
   ASSERT_EQ(img.channels, 3);
   EXPECT_FLOAT_EQ(img.at(0, 0, 1), 0.2f);
   EXPECT_FLOAT_EQ(img.at(2, 1, 0), 2.0f);
@@ -354,7 +355,7 @@ TEST(Compare, IdBoundariesMarkBothSidesOfAnEdge) {
 
 TEST(Compare, IdenticalBuffersAgreeCompletely) {
   FrameBuffers a = two_halves(32, 24);
-  for (size_t i = 0; i < a.pixel_count(); ++i) a.color[i] = glm::vec3(float(i % 7) / 7.0f);
+  for (size_t i = 0; i < a.pixel_count(); ++i) a.colour[i] = glm::vec3(float(i % 7) / 7.0f);
   auto m = compare_buffers(a, a);
   EXPECT_EQ(m.visibility.pixels, 32u * 24u);
   EXPECT_EQ(m.visibility.id_agreement, 1.0);
@@ -362,10 +363,10 @@ TEST(Compare, IdenticalBuffersAgreeCompletely) {
   EXPECT_EQ(m.visibility.classes.not_edge(), 0u);
   EXPECT_EQ(m.depth.max_rel_error, 0.0);
   EXPECT_EQ(m.depth.mean_rel_error, 0.0);
-  EXPECT_EQ(m.color.rmse, 0.0);
-  EXPECT_EQ(m.color.max_abs, 0.0);
-  EXPECT_TRUE(std::isinf(m.color.psnr_db) && m.color.psnr_db > 0);
-  EXPECT_NEAR(m.color.ssim, 1.0, 1e-12);
+  EXPECT_EQ(m.colour.rmse, 0.0);
+  EXPECT_EQ(m.colour.max_abs, 0.0);
+  EXPECT_TRUE(std::isinf(m.colour.psnr_db) && m.colour.psnr_db > 0);
+  EXPECT_NEAR(m.colour.ssim, 1.0, 1e-12);
 }
 
 TEST(Compare, LodDifferenceOverThePixelsTexturedInBoth) {
@@ -492,11 +493,11 @@ TEST(Compare, DepthRelativeErrorOnACraftedExample) {
 TEST(Compare, ConstantOffsetGivesKnownRmseAndPsnr) {
   FrameBuffers a = flat(40, 30, glm::vec3(0.25f)), b = flat(40, 30, glm::vec3(0.26f));
   auto m = compare_buffers(a, b);
-  EXPECT_NEAR(m.color.rmse, 0.01, 1e-6);
-  EXPECT_NEAR(m.color.psnr_db, 40.0, 1e-3);
-  EXPECT_NEAR(m.color.max_abs, 0.01, 1e-6);
-  EXPECT_LT(m.color.ssim, 1.0);
-  EXPECT_GT(m.color.ssim, 0.99);  // a tiny shift of the mean barely changes the structure
+  EXPECT_NEAR(m.colour.rmse, 0.01, 1e-6);
+  EXPECT_NEAR(m.colour.psnr_db, 40.0, 1e-3);
+  EXPECT_NEAR(m.colour.max_abs, 0.01, 1e-6);
+  EXPECT_LT(m.colour.ssim, 1.0);
+  EXPECT_GT(m.colour.ssim, 0.99);  // a tiny shift of the mean barely changes the structure
 }
 
 // SSIM (Wang et al. 2004) of two constant images is the luminance term alone, the same in every
@@ -508,14 +509,14 @@ TEST(Compare, SsimOfConstantImagesIsTheLuminanceTerm) {
     double expected = (2 * a * b + C1) / (a * a + b * b + C1);
     double ssim =
         compare_buffers(flat(40, 30, glm::vec3(float(a))), flat(40, 30, glm::vec3(float(b))))
-            .color.ssim;
+            .colour.ssim;
     EXPECT_NEAR(ssim, expected, 1e-6) << a << " vs " << b;
   }
   // Identical images with structure: every window's two terms are exactly 1.
   FrameBuffers a = flat(64, 48);
   for (size_t i = 0; i < a.pixel_count(); ++i)
-    a.color[i] = glm::vec3(float((i * 37) % 101) / 100.0f);
-  EXPECT_NEAR(compare_buffers(a, a).color.ssim, 1.0, 1e-12);
+    a.colour[i] = glm::vec3(float((i * 37) % 101) / 100.0f);
+  EXPECT_NEAR(compare_buffers(a, a).colour.ssim, 1.0, 1e-12);
 }
 
 // Depth percentiles and outliers on a crafted frame: 100x100 pixels, column 0 another object,
@@ -569,31 +570,31 @@ TEST(Compare, SsimDropsForNoise) {
   FrameBuffers a = flat(64, 48), b = a;
   std::mt19937 rng(42);
   std::normal_distribution<float> noise(0.0f, 0.1f);
-  for (auto& c : b.color) c += glm::vec3(noise(rng));
+  for (auto& c : b.colour) c += glm::vec3(noise(rng));
   auto m = compare_buffers(a, b);
-  EXPECT_LT(m.color.ssim, 0.5);
-  EXPECT_GT(m.color.ssim, -1.0);
+  EXPECT_LT(m.colour.ssim, 0.5);
+  EXPECT_GT(m.colour.ssim, -1.0);
   FrameBuffers c = a;
-  for (size_t i = 0; i < c.pixel_count(); i += 5) c.color[i] += glm::vec3(0.02f);
-  double mild = compare_buffers(a, c).color.ssim;
+  for (size_t i = 0; i < c.pixel_count(); i += 5) c.colour[i] += glm::vec3(0.02f);
+  double mild = compare_buffers(a, c).colour.ssim;
   EXPECT_LT(mild, 1.0);
-  EXPECT_GT(mild, m.color.ssim);
+  EXPECT_GT(mild, m.colour.ssim);
 }
 
 TEST(Compare, SsimOnImagesSmallerThanTheWindow) {
   for (auto [w, h] : {std::pair{1, 1}, std::pair{3, 2}, std::pair{2, 20}}) {
     FrameBuffers a = flat(w, h), b = flat(w, h, glm::vec3(0.4f));
-    b.color[0] = glm::vec3(0.9f);
-    double s = compare_buffers(a, b).color.ssim;
+    b.colour[0] = glm::vec3(0.9f);
+    double s = compare_buffers(a, b).colour.ssim;
     EXPECT_TRUE(std::isfinite(s)) << w << "x" << h;
     EXPECT_LT(s, 1.0);
-    EXPECT_NEAR(compare_buffers(a, a).color.ssim, 1.0, 1e-12);
+    EXPECT_NEAR(compare_buffers(a, a).colour.ssim, 1.0, 1e-12);
   }
 }
 
 TEST(Compare, FastOnALargeFrame) {
   FrameBuffers a = two_halves(2048, 1536), b = a;
-  for (size_t i = 0; i < b.pixel_count(); i += 3) b.color[i] += glm::vec3(0.01f);
+  for (size_t i = 0; i < b.pixel_count(); i += 3) b.colour[i] += glm::vec3(0.01f);
   auto t0 = std::chrono::steady_clock::now();
   auto m = compare_buffers(a, b);
   double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -672,8 +673,8 @@ TEST(HeatMap, InfernoFromBlackToYellow) {
 
 TEST(IdMismatchImage, RedWhereObjectsDifferGreyElsewhere) {
   FrameBuffers a = two_halves(4, 2), b = a;
-  a.color[a.index(0, 0)] = glm::vec3(1.0f);
-  a.color[a.index(1, 0)] = glm::vec3(0.0f);
+  a.colour[a.index(0, 0)] = glm::vec3(1.0f);
+  a.colour[a.index(1, 0)] = glm::vec3(0.0f);
   b.object_id[b.index(2, 1)] = 0;     // object differs
   b.primitive_id[b.index(3, 1)] = 9;  // only the primitive differs: not red
   Image img = id_mismatch_image(a, b);

@@ -21,10 +21,11 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_io.h"
+#include "rvr/compare/compare.h"
+#include "rvr/core/check.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/image_codec/image_io.h"
 
 namespace fs = std::filesystem;
 using namespace rvr;
@@ -162,7 +163,7 @@ TEST_F(ImageWriter, ColourMapsDoNotLoadOpenImageIO) {
   }
   ASSERT_TRUE(write_aovs(path("r.png"), a, {"depth", "id", "normal", "cost"}).ok());
   EXPECT_TRUE(fs::exists(path("r.cost.png")));
-  const Image heat = diff_heat_map(color_image(a), color_image(b), 0.1f);
+  const Image heat = diff_heat_map(colour_image(a), colour_image(b), 0.1f);
   EXPECT_GT(heat.pixels.at(0), 0.5f);  // a difference of 0.25 is at the top of the map
   const Image depth = depth_diff_image(a, b, DepthDiffScale{});
   EXPECT_EQ(depth.width, 24);

@@ -8,10 +8,10 @@
 #include <random>
 #include <string>
 
+#include "rvr/core/scene.h"
+#include "rvr/core/tessellate.h"
+#include "rvr/core/texture.h"
 #include "rvr/raytrace/intersect.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/tessellate.h"
-#include "rvr/shared/texture.h"
 
 using namespace rvr;
 
@@ -73,7 +73,7 @@ TEST(Sphere, RespectsTmaxAndTmin) {
 }
 
 TEST(Square, HitInsideAndMissOutside) {
-  Plane p{{0, 0, 0}, {0, 1, 0}, 1.0f};
+  Square p{{0, 0, 0}, {0, 1, 0}, 1.0f};
   auto [u, v] = plane_axes(p.normal);
   float t;
   ASSERT_TRUE(intersect_square(make_ray({0.5f, 2, 0.5f}, {0, -1, 0}), p, u, v, t));
@@ -84,7 +84,7 @@ TEST(Square, HitInsideAndMissOutside) {
 }
 
 TEST(Square, ParallelAndBehindAreMissed) {
-  Plane p{{0, 0, 0}, {0, 1, 0}, 1.0f};
+  Square p{{0, 0, 0}, {0, 1, 0}, 1.0f};
   auto [u, v] = plane_axes(p.normal);
   float t;
   EXPECT_FALSE(intersect_square(make_ray({0, 1, 0}, {1, 0, 0}), p, u, v, t));

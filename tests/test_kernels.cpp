@@ -21,14 +21,14 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/scene_loader.h"
 #include "soft/fill_dispatch.h"
 #include "soft/fill_kernel.h"
 #include "soft/setup_kernel.h"
@@ -50,7 +50,7 @@ std::string first_difference(const FrameBuffers& a, const FrameBuffers& b) {
   if (!same_bytes(a.primitive_id, b.primitive_id)) return "primitive id";
   if (!same_bytes(a.depth, b.depth)) return "depth";
   if (!same_bytes(a.normal, b.normal)) return "normal";
-  if (!same_bytes(a.color, b.color)) return "colour";
+  if (!same_bytes(a.colour, b.colour)) return "colour";
   if (!same_bytes(a.cost, b.cost)) return "cost";
   return "";
 }

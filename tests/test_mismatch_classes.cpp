@@ -16,12 +16,12 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/tessellate.h"
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/check.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/tessellate.h"
 
 using namespace rvr;
 
@@ -76,7 +76,7 @@ void put(FrameBuffers& fb, int x, int y, uint32_t object, uint32_t primitive, fl
   fb.object_id[i] = object;
   fb.primitive_id[i] = primitive;
   fb.depth[i] = depth;
-  fb.color[i] = glm::vec3(0.5f);
+  fb.colour[i] = glm::vec3(0.5f);
 }
 
 // The full square [-0.5, 0.5]^2 covers pixels 4..11; its diagonal from pixel position (4, 12)

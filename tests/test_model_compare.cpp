@@ -21,10 +21,10 @@
 #include <vector>
 
 #include "model_corpus.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/scene.h"
+#include "rvr/image_codec/image_io.h"
+#include "rvr/scene_io/scene_loader.h"
 
 namespace fs = std::filesystem;
 namespace corpus = rvr::test::corpus;
@@ -116,7 +116,7 @@ TEST_F(ModelCompare, BarePlyFromBlender) {
 
 TEST_F(ModelCompare, BareGltf) {
   corpus::GltfExtras e;
-  e.base_color = {0.1f, 0.2f, 0.9f, 1.0f};
+  e.base_colour = {0.1f, 0.2f, 0.9f, 1.0f};
   expect_compare_works(write("cube.gltf", corpus::gltf_json(e, false)), {0.1f, 0.2f, 0.9f});
 }
 

@@ -24,16 +24,16 @@
 #include <vector>
 
 #include "model_corpus.h"
+#include "rvr/core/camera.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/camera_framing.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/camera_framing.h"
+#include "rvr/scene_io/scene_loader.h"
 
 namespace fs = std::filesystem;
 namespace corpus = rvr::test::corpus;
@@ -232,7 +232,7 @@ TEST_F(ModelFiles, OffWithComments) {
 // aspectRatio) and a KHR_lights_punctual point light (node translation, colour x intensity).
 void expect_gltf_contents(const rvr::Scene& s, const corpus::GltfExtras& e) {
   const rvr::Material& m = material_of(s);
-  expect_near3(m.diffuse, {e.base_color[0], e.base_color[1], e.base_color[2]}, kTextTolerance);
+  expect_near3(m.diffuse, {e.base_colour[0], e.base_colour[1], e.base_colour[2]}, kTextTolerance);
   expect_near3(m.emission, {e.emissive[0], e.emissive[1], e.emissive[2]}, kTextTolerance);
   expect_near3(s.camera.eye, {e.camera_at[0], e.camera_at[1], e.camera_at[2]}, kTextTolerance);
   // A glTF camera looks down its node's -z with +y up.
@@ -246,7 +246,7 @@ void expect_gltf_contents(const rvr::Scene& s, const corpus::GltfExtras& e) {
   expect_near3(s.lights[0].position, {e.light_at[0], e.light_at[1], e.light_at[2]}, kTextTolerance);
   // glTF point lights fall off with the inverse square, as rvr's: intensity in candela.
   glm::vec3 want =
-      glm::vec3(e.light_color[0], e.light_color[1], e.light_color[2]) * e.light_intensity;
+      glm::vec3(e.light_colour[0], e.light_colour[1], e.light_colour[2]) * e.light_intensity;
   expect_near3(s.lights[0].intensity, want, 1e-4f);
 }
 
@@ -262,7 +262,7 @@ TEST_F(ModelFiles, GltfBaseColourCameraAndPunctualLight) {
 TEST_F(ModelFiles, GlbBaseColourCameraAndPunctualLight) {
   corpus::GltfExtras e;
   e.camera = e.light = true;
-  e.base_color = {0.9f, 0.8f, 0.1f, 1.0f};
+  e.base_colour = {0.9f, 0.8f, 0.1f, 1.0f};
   std::string p = write("cube.glb", corpus::glb(e));
   expect_loads_like_assimp(p, 12);
   expect_gltf_contents(rvr::load_scene(p).value(), e);
@@ -276,7 +276,7 @@ TEST_F(ModelFiles, TexturedMaterialWithoutTextureCoordinatesUsesItsFactorAndWarn
   std::string p = write("textured.gltf", corpus::gltf_json(e, false));
   expect_loads_like_assimp(p, 12);
   rvr::Scene s = rvr::load_scene(p).value();
-  expect_near3(material_of(s).diffuse, {e.base_color[0], e.base_color[1], e.base_color[2]},
+  expect_near3(material_of(s).diffuse, {e.base_colour[0], e.base_colour[1], e.base_colour[2]},
                kTextTolerance);
   EXPECT_EQ(material_of(s).texture, -1);
   bool warned = false;
@@ -715,10 +715,10 @@ TEST_F(ModelFiles, AutomaticExposureClipsUnderOnePercentOfEveryCorpusModel) {
     ASSERT_TRUE(s.ok()) << s.error().message;
     rvr::FrameBuffers b = renderer->render(*s, {}).value().buffers;
     size_t model = 0, clipped = 0;
-    for (size_t i = 0; i < b.color.size(); ++i) {
+    for (size_t i = 0; i < b.colour.size(); ++i) {
       if (b.object_id[i] == rvr::kNoId) continue;
       ++model;
-      clipped += b.color[i].r > 1.0f || b.color[i].g > 1.0f || b.color[i].b > 1.0f;
+      clipped += b.colour[i].r > 1.0f || b.colour[i].g > 1.0f || b.colour[i].b > 1.0f;
     }
     EXPECT_GT(model, 100u);
     EXPECT_LT(clipped * 100, model) << clipped << " of " << model << " pixels clip";
@@ -743,10 +743,10 @@ TEST_F(ModelFiles, AutomaticExposureClipsUnderOnePercentOfTheModel) {
     rvr::FrameBuffers b = r->render(scene, {}).value().buffers;
     size_t clipped = 0;
     *model = 0;
-    for (size_t i = 0; i < b.color.size(); ++i) {
+    for (size_t i = 0; i < b.colour.size(); ++i) {
       if (b.object_id[i] == rvr::kNoId) continue;
       ++*model;
-      clipped += b.color[i].r > 1.0f || b.color[i].g > 1.0f || b.color[i].b > 1.0f;
+      clipped += b.colour[i].r > 1.0f || b.colour[i].g > 1.0f || b.colour[i].b > 1.0f;
     }
     return clipped;
   };

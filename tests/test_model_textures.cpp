@@ -19,13 +19,13 @@
 #include <vector>
 
 #include "model_corpus.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/scene_writer.h"
-#include "rvr/shared/surface_colour.h"
-#include "rvr/shared/texture.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/surface_colour.h"
+#include "rvr/core/texture.h"
+#include "rvr/image_codec/image_io.h"
+#include "rvr/scene_io/scene_loader.h"
+#include "rvr/scene_io/scene_writer.h"
 
 namespace fs = std::filesystem;
 namespace corpus = rvr::test::corpus;

@@ -14,12 +14,12 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/scene_loader.h"
 #include "scene_builders.h"
 
 using namespace rvr;
@@ -47,7 +47,7 @@ Scene degenerate_mesh_scene() {
 void expect_no_nan(const FrameBuffers& fb, const std::string& what) {
   size_t bad = 0;
   for (size_t i = 0; i < fb.pixel_count(); ++i) {
-    const glm::vec3 &c = fb.color[i], &n = fb.normal[i];
+    const glm::vec3 &c = fb.colour[i], &n = fb.normal[i];
     bool ok = std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) &&
               std::isfinite(n.x) && std::isfinite(n.y) && std::isfinite(n.z) &&
               !std::isnan(fb.depth[i]) &&  // +inf is the background's depth, by the format

@@ -1,4 +1,4 @@
-// Frame memory recycled between frames (rvr/shared/pixel_memory.h): a released block comes back
+// Frame memory recycled between frames (rvr/core/pixel_memory.h): a released block comes back
 // for the next request of its size and alignment, the pool stays within its limit, and every
 // renderer writes every pixel of every buffer, so what a recycled block held before (here:
 // poison) never reaches an image.
@@ -12,14 +12,14 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/pixel_memory.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/pixel_memory.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/scene_loader.h"
 
 using namespace rvr;
 
@@ -120,7 +120,7 @@ TEST(PixelMemory, EveryRendererWritesEveryPixelOfRecycledBuffers) {
       const FrameBuffers &a = zeros.buffers, &b = ones.buffers;
       const std::string label =
           c.name + " " + to_string(mode) + (cost_aov ? "" : " without the cost AOV");
-      EXPECT_TRUE(same_bytes(a.color, b.color)) << label;
+      EXPECT_TRUE(same_bytes(a.colour, b.colour)) << label;
       EXPECT_TRUE(same_bytes(a.depth, b.depth)) << label;
       EXPECT_TRUE(same_bytes(a.object_id, b.object_id)) << label;
       EXPECT_TRUE(same_bytes(a.primitive_id, b.primitive_id)) << label;

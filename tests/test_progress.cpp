@@ -27,14 +27,14 @@
 #include <thread>
 #include <vector>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/progress.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/progress.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/scene_loader.h"
 #include "terminal_progress.h"
 
 namespace fs = std::filesystem;
@@ -151,7 +151,7 @@ TEST(ProgressSink, EveryRendererAndRasterOnEglDrawsTheSameWhenWatched) {
     ProgressSink sink;
     options.progress = &sink;
     RenderOutput watched = renderer->render(scene, options).value();
-    EXPECT_EQ(plain.buffers.color, watched.buffers.color) << label;
+    EXPECT_EQ(plain.buffers.colour, watched.buffers.colour) << label;
     EXPECT_EQ(plain.buffers.object_id, watched.buffers.object_id) << label;
     ProgressSnapshot s = sink.snapshot();  // the last phase
     if (c.info->name == "raster") {

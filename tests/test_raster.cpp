@@ -16,18 +16,18 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/camera.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/shading.h"
+#include "rvr/core/tessellate.h"
 #include "rvr/raster/gl_rasterizer.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/shading.h"
-#include "rvr/shared/tessellate.h"
+#include "rvr/scene_io/scene_loader.h"
 #include "visibility_frame.h"
 
 namespace rvr {
@@ -142,7 +142,7 @@ TEST(GlRaster, SingleTriangleCentroidMatchesAnalyticDepthAndShading) {
   const FrameBuffers& fb = out.buffers;
   ASSERT_EQ(fb.width, kW);
   ASSERT_EQ(fb.height, kH);
-  ASSERT_EQ(fb.color.size(), size_t(kW * kH));
+  ASSERT_EQ(fb.colour.size(), size_t(kW * kH));
 
   glm::ivec2 px = pixel_of(s, (a + b + c) / 3.0f);
   size_t i = fb.index(px.x, px.y);
@@ -154,7 +154,7 @@ TEST(GlRaster, SingleTriangleCentroidMatchesAnalyticDepthAndShading) {
   glm::vec3 N = face_viewer(glm::normalize(h.geometric_normal), h.geometric_normal, h.V);
   expect_vec_near(fb.normal[i], N, 1e-4f, "normal");
   glm::vec3 want = shade_local(s.materials[1], h.P, N, h.V, s.ambient, light_samples(s.lights));
-  expect_vec_near(fb.color[i], want, 1e-3f, "colour");
+  expect_vec_near(fb.colour[i], want, 1e-3f, "colour");
 }
 
 TEST(GlRaster, PixelsOutsideAreBackground) {
@@ -168,7 +168,7 @@ TEST(GlRaster, PixelsOutsideAreBackground) {
     EXPECT_EQ(fb.object_id[i], kNoId);
     EXPECT_EQ(fb.primitive_id[i], kNoId);
     EXPECT_EQ(fb.depth[i], kInf);
-    EXPECT_EQ(fb.color[i], s.image.background);
+    EXPECT_EQ(fb.colour[i], s.image.background);
     EXPECT_EQ(fb.normal[i], glm::vec3(0.0f));
     EXPECT_EQ(fb.cost[i], 0.0f);
   }
@@ -339,7 +339,7 @@ TEST(GlRaster, PlaneIsTessellatedAndFacesTheViewer) {
     expect_vec_near(fb.normal[i], {0, 0, 1}, 1e-5f, "normal flipped to the viewer");
     glm::vec3 N = face_viewer(o.plane.normal, o.plane.normal, h.V);
     glm::vec3 want = shade_local(s.materials[1], h.P, N, h.V, s.ambient, light_samples(s.lights));
-    expect_vec_near(fb.color[i], want, 1e-3f, "colour");
+    expect_vec_near(fb.colour[i], want, 1e-3f, "colour");
   }
 }
 
@@ -361,7 +361,7 @@ TEST(GlRaster, SmoothNormalsFlipByTheGeometricNormal) {
   Hit h = hit_plane(s, p, a, b, c);
   glm::vec3 N = face_viewer(n, h.geometric_normal, h.V);
   glm::vec3 want = shade_local(s.materials[1], h.P, N, h.V, s.ambient, light_samples(s.lights));
-  expect_vec_near(fb.color[i], want, 1e-3f, "colour");
+  expect_vec_near(fb.colour[i], want, 1e-3f, "colour");
 }
 
 TEST(GlRaster, ThousandsOfAreaLightSamplesMatchCpuShading) {
@@ -386,7 +386,7 @@ TEST(GlRaster, ThousandsOfAreaLightSamplesMatchCpuShading) {
   auto samples = light_samples(s.lights);
   ASSERT_EQ(samples.size(), 2501u);
   glm::vec3 want = shade_local(s.materials[1], h.P, N, h.V, s.ambient, samples);
-  expect_vec_near(fb.color[i], want, 1e-3f * std::max(1.0f, want.x), "colour");
+  expect_vec_near(fb.colour[i], want, 1e-3f * std::max(1.0f, want.x), "colour");
 }
 
 TEST(GlRaster, CsgIsSkippedWithAWarning) {
@@ -427,9 +427,9 @@ TEST(GlRaster, SceneWithoutMaterialsIsDrawnInTheBuiltInGrey) {
   ASSERT_EQ(a.pixel_count(), b.pixel_count());
   const size_t centre = a.index(kW / 2, kH / 2);
   EXPECT_EQ(a.object_id[centre], 0u);
-  EXPECT_NE(a.color[centre], listed.image.background);
+  EXPECT_NE(a.colour[centre], listed.image.background);
   size_t differing = 0;
-  for (size_t i = 0; i < a.pixel_count(); ++i) differing += a.color[i] != b.color[i] ? 1 : 0;
+  for (size_t i = 0; i < a.pixel_count(); ++i) differing += a.colour[i] != b.colour[i] ? 1 : 0;
   EXPECT_EQ(differing, 0u);
 }
 
@@ -441,7 +441,7 @@ TEST(GlRaster, VisibilityModeKeepsBackgroundColour) {
   size_t i = fb.index(kW / 2, kH / 2);
   EXPECT_EQ(fb.object_id[i], 0u);
   EXPECT_NEAR(fb.depth[i], 5.0f, 5e-5f);
-  EXPECT_EQ(fb.color[i], s.image.background);
+  EXPECT_EQ(fb.colour[i], s.image.background);
   EXPECT_TRUE(out.warnings.empty());
 }
 
@@ -504,7 +504,7 @@ TEST(GlRaster, FullModeWithoutMirrorGlassOrApertureDoesNotWarn) {
   // One point light, nothing between it and the quad: shadows change nothing.
   RenderOutput local = render_ok(s, RenderMode::Local);
   for (size_t i = 0; i < full.buffers.pixel_count(); ++i)
-    expect_vec_near(full.buffers.color[i], local.buffers.color[i], 1e-6f, "lit quad");
+    expect_vec_near(full.buffers.colour[i], local.buffers.colour[i], 1e-6f, "lit quad");
   EXPECT_EQ(full.stats.at("shadow_map.maps"), 1.0);
   EXPECT_EQ(full.stats.at("shadow_map.texels"), 6.0 * 1024.0 * 1024.0);
   EXPECT_TRUE(full.stats.count("time.shadow_maps"));
@@ -550,9 +550,9 @@ TEST(GlRaster, ReusesTheContextAcrossSizes) {
   EXPECT_EQ(a.buffers.width, kW);
   EXPECT_EQ(b.buffers.width, 33);
   EXPECT_EQ(b.buffers.height, 17);
-  EXPECT_EQ(b.buffers.color.size(), size_t(33 * 17));
+  EXPECT_EQ(b.buffers.colour.size(), size_t(33 * 17));
   EXPECT_EQ(b.buffers.object_id, c.buffers.object_id);
-  EXPECT_EQ(b.buffers.color, c.buffers.color);
+  EXPECT_EQ(b.buffers.colour, c.buffers.colour);
   EXPECT_EQ(b.buffers.object_id[b.buffers.index(16, 8)], 0u);
 }
 
@@ -658,7 +658,7 @@ TEST(GlRaster, ShadowMapMatchesTheAnalyticShadowOfASphere) {
       size_t i = fb.index(x, y);
       if (analytic[i] < 0 || fb.object_id[i] != 0u || near_edge(x, y)) continue;
       ++compared;
-      bool black = fb.color[i] == glm::vec3(0.0f);
+      bool black = fb.colour[i] == glm::vec3(0.0f);
       EXPECT_EQ(black, analytic[i] == 1) << "pixel " << x << "," << y;
       (black ? shadowed : lit) += 1;
     }
@@ -678,7 +678,7 @@ TEST(GlRaster, ShadowMapMatchesTheAnalyticShadowOfASphere) {
     for (int x = 0; x < w; ++x) {
       size_t i = fb.index(x, y);
       if (analytic[i] < 0 || fb.object_id[i] != 0u || near_edge(x, y)) continue;
-      bool black = pcf->buffers.color[i] == glm::vec3(0.0f);
+      bool black = pcf->buffers.colour[i] == glm::vec3(0.0f);
       differs += black != (analytic[i] == 1) ? 1 : 0;
     }
   EXPECT_LE(differs, compared / 100);
@@ -707,8 +707,8 @@ TEST(GlRaster, AreaLightSamplesEachGetAShadowMap) {
   glm::ivec2 under = pixel_of(s, {0.0f, 0.0f, 0.0f});
   glm::ivec2 far_out = pixel_of(s, {2.0f, 0.0f, 2.0f});
   ASSERT_EQ(fb.object_id[fb.index(under.x, under.y)], 0u);
-  EXPECT_EQ(fb.color[fb.index(under.x, under.y)], glm::vec3(0.0f));
-  glm::vec3 lit = fb.color[fb.index(far_out.x, far_out.y)];
+  EXPECT_EQ(fb.colour[fb.index(under.x, under.y)], glm::vec3(0.0f));
+  glm::vec3 lit = fb.colour[fb.index(far_out.x, far_out.y)];
   EXPECT_GT(lit.x, 0.0f);
   // Many samples: maps shrink to the texel budget (with a warning) and still work in batches.
   area.samples = 15;  // 225 samples
@@ -720,9 +720,9 @@ TEST(GlRaster, AreaLightSamplesEachGetAShadowMap) {
   EXPECT_LT(many->stats.at("shadow_map.size"), 1024.0);
   ASSERT_EQ(many->warnings.size(), 1u);
   EXPECT_NE(many->warnings[0].find("shadow maps of"), std::string::npos);
-  EXPECT_EQ(many->buffers.color[fb.index(under.x, under.y)], glm::vec3(0.0f));
+  EXPECT_EQ(many->buffers.colour[fb.index(under.x, under.y)], glm::vec3(0.0f));
   // The lit pixel sees every sample in both renders: same light, same colour.
-  expect_vec_near(many->buffers.color[fb.index(far_out.x, far_out.y)], lit * 1.0f,
+  expect_vec_near(many->buffers.colour[fb.index(far_out.x, far_out.y)], lit * 1.0f,
                   1e-2f * std::max(lit.x, 1.0f), "lit floor");
 }
 
@@ -760,8 +760,8 @@ TEST(GlRaster, MultisamplingBlendsEdgesAndKeepsPerPixelIds) {
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) {
       size_t i = fb.index(x, y);
-      const glm::vec3 c = fb.color[i];
-      EXPECT_TRUE(one.buffers.color[i] == bg || one.buffers.color[i] == inside);
+      const glm::vec3 c = fb.colour[i];
+      EXPECT_TRUE(one.buffers.colour[i] == bg || one.buffers.colour[i] == inside);
       if (uniform_id(x, y)) {
         EXPECT_EQ(c, fb.object_id[i] == 0u ? inside : bg) << x << "," << y;
         interior += fb.object_id[i] == 0u ? 1 : 0;
@@ -795,9 +795,9 @@ TEST(GlRaster, MultisampledFullModeMatchesSingleSampleInside) {
   glm::ivec2 far_out = pixel_of(s, {2.0f, 0.0f, 2.0f});
   size_t i = one.buffers.index(far_out.x, far_out.y);
   // Samples spread over the pixel: the shading differs slightly from the centre's.
-  expect_vec_near(four.buffers.color[i], one.buffers.color[i], 2e-2f, "lit floor");
+  expect_vec_near(four.buffers.colour[i], one.buffers.colour[i], 2e-2f, "lit floor");
   glm::ivec2 under = pixel_of(s, {0.0f, 0.0f, 0.0f});
-  EXPECT_EQ(four.buffers.color[one.buffers.index(under.x, under.y)], glm::vec3(0.0f));
+  EXPECT_EQ(four.buffers.colour[one.buffers.index(under.x, under.y)], glm::vec3(0.0f));
 }
 
 TEST(GlRaster, FullModeWarnsOnlyAboutWhatTheSceneUses) {

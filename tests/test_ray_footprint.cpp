@@ -10,7 +10,7 @@
 #include <memory>
 
 #include "ray_footprint.h"
-#include "rvr/shared/texture.h"
+#include "rvr/core/texture.h"
 
 using namespace rvr;
 

@@ -16,20 +16,22 @@
 #include <set>
 #include <string>
 #include <system_error>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "base64.h"
 #include "render_stats.h"
 #include "report.h"
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/stats.h"
+#include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/scene_loader.h"
 
 namespace fs = std::filesystem;
 using namespace rvr;
@@ -92,7 +94,7 @@ ReportInput sample_input(const std::string& out_dir) {
       {5, 4, 7, 0.0035, 2.5f, 2.51f, DepthOutlierCause::Elsewhere},
       {1, 2, 3, 0.0012, 6.0f, 6.0075f, DepthOutlierCause::Silhouette},
       {3, 3, 6, 0.0011, 4.0f, 4.0044f, DepthOutlierCause::AnalyticSphere}};
-  in.metrics.color = {0.004, 47.9, 0.21, 0.998};
+  in.metrics.colour = {0.004, 47.9, 0.21, 0.998};
   in.heat_map_scale = 0.1f;
   return in;
 }
@@ -286,7 +288,7 @@ TEST(StatsJson, EveryRendererCountsInWholeNumbers) {
 
 TEST(MetricsJson, InfiniteAndNanValuesStayValidJson) {
   ReportInput in = sample_input("out");
-  in.metrics.color.psnr_db = std::numeric_limits<double>::infinity();
+  in.metrics.colour.psnr_db = std::numeric_limits<double>::infinity();
   in.metrics.depth.max_rel_error = std::numeric_limits<double>::quiet_NaN();
   in.renderers[0].stats["weird"] = std::numeric_limits<double>::infinity();
   std::string text = metrics_json(in);

@@ -21,16 +21,16 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
+#include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/scene_writer.h"
-#include "rvr/shared/texture.h"
+#include "rvr/scene_io/scene_loader.h"
+#include "rvr/scene_io/scene_writer.h"
 
 namespace fs = std::filesystem;
 using rvr::Expected;
@@ -985,19 +985,19 @@ TEST_F(SceneLoader, ExposureDoublesTheColourInEveryRenderer) {
       Expected<rvr::RenderOutput> b =
           prepared ? prepared_bright.value()->render() : renderer.value()->render(bright, options);
       ASSERT_TRUE(a.ok() && b.ok());
-      glm::vec3 c0 = a->buffers.color[centre], c1 = b->buffers.color[centre];
+      glm::vec3 c0 = a->buffers.colour[centre], c1 = b->buffers.colour[centre];
       EXPECT_NEAR(c0.g, 0.4f, 1e-4f);
       EXPECT_EQ(c1, 2.0f * c0);  // a power of two: exact
       EXPECT_LT(c1.g, 1.0f);
       // Every pixel, background included, is the same transform of the one at exposure 0.
-      for (size_t i = 0; i < a->buffers.color.size(); ++i) {
-        ASSERT_EQ(b->buffers.color[i], 2.0f * a->buffers.color[i]) << i;
+      for (size_t i = 0; i < a->buffers.colour.size(); ++i) {
+        ASSERT_EQ(b->buffers.colour[i], 2.0f * a->buffers.colour[i]) << i;
       }
     }
     Expected<rvr::RenderOutput> d = renderer.value()->render(dim, options);
     ASSERT_TRUE(d.ok());
     Expected<rvr::RenderOutput> a = renderer.value()->render(dark, options);
-    EXPECT_EQ(d->buffers.color[centre], 0.25f * a->buffers.color[centre]);
+    EXPECT_EQ(d->buffers.colour[centre], 0.25f * a->buffers.colour[centre]);
   }
 }
 

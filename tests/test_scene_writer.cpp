@@ -17,12 +17,12 @@
 #include <variant>
 #include <vector>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/scene_writer.h"
-#include "rvr/shared/texture.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
+#include "rvr/image_codec/image_io.h"
+#include "rvr/scene_io/scene_loader.h"
+#include "rvr/scene_io/scene_writer.h"
 
 namespace fs = std::filesystem;
 using namespace rvr;

@@ -1,4 +1,4 @@
-// The shading kernels (rvr/shared/shade_kernel.h), each this CPU can run, against the scalar
+// The shading kernels (rvr/core/shade_kernel.h), each this CPU can run, against the scalar
 // shading code they replace: softraster's surface_at glm formulas, the tracer's viewer and
 // face_viewer, and rvr::shade_local. Bit for bit, on random pixels and on the equation's special
 // cases, so an image cannot depend on the kernel, and softraster and the tracer compute the same
@@ -17,12 +17,12 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/shade_batch.h"
-#include "rvr/shared/shade_kernel.h"
-#include "rvr/shared/shading.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/shade_batch.h"
+#include "rvr/core/shade_kernel.h"
+#include "rvr/core/shading.h"
 
 using namespace rvr;
 

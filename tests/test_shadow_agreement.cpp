@@ -15,16 +15,16 @@
 #include <vector>
 
 #include "closed_form_oracle.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/scene_loader.h"
 
 namespace rvr {
 namespace {
@@ -67,8 +67,8 @@ Classified classify_renders(const Scene& s, const FrameBuffers& full, const Fram
     const Material& m = s.materials[s.objects[id].material];
     float base = luminance(m.emission + s.ambient * m.diffuse);
     // No direct light even without shadows (facing away): nothing to classify.
-    if (luminance(local.color[i]) - base < 1e-4f) continue;
-    c.state[i] = classify(luminance(full.color[i]), luminance(local.color[i]), base);
+    if (luminance(local.colour[i]) - base < 1e-4f) continue;
+    c.state[i] = classify(luminance(full.colour[i]), luminance(local.colour[i]), base);
     c.valid[i] = true;
   }
   return c;

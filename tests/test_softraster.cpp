@@ -15,18 +15,18 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/scene_loader.h"
 #include "scene_builders.h"
 #include "visibility_frame.h"
 
@@ -118,7 +118,7 @@ TEST(SoftRasterizer, NearPlaneClippingHasNoArtefacts) {
   const FrameBuffers& fb = soft.buffers;
   size_t covered = 0;
   for (size_t i = 0; i < fb.pixel_count(); ++i) {
-    ASSERT_TRUE(std::isfinite(fb.color[i].x + fb.color[i].y + fb.color[i].z)) << i;
+    ASSERT_TRUE(std::isfinite(fb.colour[i].x + fb.colour[i].y + fb.colour[i].z)) << i;
     if (fb.object_id[i] == kNoId) continue;
     ++covered;
     EXPECT_GE(fb.depth[i], s.camera.near) << i;
@@ -148,7 +148,7 @@ TEST(SoftRasterizer, SameBytesWithOneAndTwoThreads) {
   auto same = [](const auto& x, const auto& y) {
     return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
   };
-  EXPECT_TRUE(same(fa.color, fb.color));
+  EXPECT_TRUE(same(fa.colour, fb.colour));
   EXPECT_TRUE(same(fa.depth, fb.depth));
   EXPECT_TRUE(same(fa.object_id, fb.object_id));
   EXPECT_TRUE(same(fa.primitive_id, fb.primitive_id));
@@ -213,7 +213,7 @@ TEST(SoftRasterizer, HierarchicalZChangesNothingSeen) {
     ASSERT_TRUE(scene.ok());
     RenderOutput on = render_soft(*scene, RenderMode::Local, 0, true);
     RenderOutput off = render_soft(*scene, RenderMode::Local, 0, false);
-    EXPECT_TRUE(same(on.buffers.color, off.buffers.color)) << name;
+    EXPECT_TRUE(same(on.buffers.colour, off.buffers.colour)) << name;
     EXPECT_TRUE(same(on.buffers.depth, off.buffers.depth)) << name;
     EXPECT_TRUE(same(on.buffers.object_id, off.buffers.object_id)) << name;
     EXPECT_TRUE(same(on.buffers.primitive_id, off.buffers.primitive_id)) << name;
@@ -296,7 +296,7 @@ TEST(SoftRasterizer, ManyChunksSameBytesBoundedMemory) {
     for (bool hiz : {true, false}) {
       RenderOutput a = render_soft(*scene, RenderMode::Local, 1, hiz);
       RenderOutput b = render_soft(*scene, RenderMode::Local, 2, hiz);
-      EXPECT_EQ(a.buffers.color, b.buffers.color) << name;
+      EXPECT_EQ(a.buffers.colour, b.buffers.colour) << name;
       EXPECT_EQ(a.buffers.object_id, b.buffers.object_id) << name;
       EXPECT_EQ(a.buffers.cost, b.buffers.cost) << name;
       memory[k] = std::max(memory[k], a.stats.at("memory.raster_bytes"));
@@ -315,7 +315,7 @@ TEST(SoftRasterizer, ReusedRendererDrawsWhatAFreshOneDraws) {
     auto eq = [](const auto& x, const auto& y) {
       return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
     };
-    return eq(a.buffers.color, b.buffers.color) && eq(a.buffers.depth, b.buffers.depth) &&
+    return eq(a.buffers.colour, b.buffers.colour) && eq(a.buffers.depth, b.buffers.depth) &&
            eq(a.buffers.object_id, b.buffers.object_id) &&
            eq(a.buffers.primitive_id, b.buffers.primitive_id) &&
            eq(a.buffers.normal, b.buffers.normal) && eq(a.buffers.cost, b.buffers.cost);

@@ -11,7 +11,7 @@
 #include <initializer_list>
 #include <memory>
 
-#include "rvr/shared/srgb.h"
+#include "rvr/core/srgb.h"
 
 namespace {
 

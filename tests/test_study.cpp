@@ -25,10 +25,10 @@
 #include <vector>
 
 #include "loglog_chart.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/core/camera.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/scene.h"
+#include "rvr/scene_io/scene_loader.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/counted_work.h"

@@ -26,7 +26,7 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/measurement.h"
 #include "rvr/study/memory_estimate.h"

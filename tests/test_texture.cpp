@@ -1,4 +1,4 @@
-// shared/texture.h against closed forms worked out here: the mip chain's box reductions (odd
+// rvr/core/texture.h against closed forms worked out here: the mip chain's box reductions (odd
 // sizes too), GL's LINEAR and LINEAR_MIPMAP_LINEAR at texel centres and half-way between them,
 // the three wrap modes outside [0, 1], the GL specification's level of detail for known
 // derivatives, the ray-cone formulas on a square of known size, and KHR_texture_transform's
@@ -14,8 +14,8 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/scene.h"
-#include "rvr/shared/texture.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
 
 namespace {
 

@@ -20,18 +20,18 @@
 #include <vector>
 
 #include "closed_form_oracle.h"
+#include "rvr/compare/compare.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/texture.h"
+#include "rvr/scene_io/scene_loader.h"
 
 namespace rvr {
 namespace {
@@ -364,7 +364,7 @@ TEST(VertexColours, BothZBuffersInterpolatePerspectiveCorrectly) {
         const std::optional<dvec3> b = barycentrics(x + 0.5, y + 0.5, 0.02);
         if (!b) continue;
         ++checked;
-        const glm::vec3 got = out.buffers.color[out.buffers.index(x, y)];
+        const glm::vec3 got = out.buffers.colour[out.buffers.index(x, y)];
         for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(double(got[c]) - (*b)[c]));
       }
     EXPECT_GT(checked, 2000u) << r->name();
@@ -387,9 +387,9 @@ TEST(TextureLod, BuiltinTexturedSoftrasterAndGlSeeTheSameSurfaces) {
   ASSERT_EQ(a.buffers.pixel_count(), b.buffers.pixel_count());
   const ComparisonMetrics m = compare_buffers(a.buffers, b.buffers);
   std::cout << "builtin:textured softraster vs raster: id agreement " << m.visibility.id_agreement
-            << ", colour PSNR " << m.color.psnr_db << " dB\n";
+            << ", colour PSNR " << m.colour.psnr_db << " dB\n";
   EXPECT_EQ(m.visibility.id_agreement, 1.0);
-  EXPECT_GT(m.color.psnr_db, 30.0);
+  EXPECT_GT(m.colour.psnr_db, 30.0);
   // The target for the two z-buffers' levels of detail: a mean within 0.1 levels.
   std::cout << "lod |soft - gl| mean " << m.lod.mean_abs << " p99 " << m.lod.p99_abs << " over "
             << m.lod.pixels << " pixels\n";

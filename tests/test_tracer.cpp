@@ -17,20 +17,20 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/camera.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/shading.h"
+#include "rvr/core/texture.h"
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/shading.h"
-#include "rvr/shared/texture.h"
+#include "rvr/scene_io/scene_loader.h"
 #include "scene_builders.h"
 
 using namespace rvr;
@@ -73,9 +73,9 @@ TEST(Tracer, SameBytesWithOneAndTwoThreads) {
   s.image.samples_per_pixel = 4;
   RenderOutput one = trace(s, RenderMode::Full, 1);
   RenderOutput two = trace(s, RenderMode::Full, 2);
-  ASSERT_EQ(one.buffers.color.size(), two.buffers.color.size());
-  EXPECT_EQ(std::memcmp(one.buffers.color.data(), two.buffers.color.data(),
-                        one.buffers.color.size() * sizeof(glm::vec3)),
+  ASSERT_EQ(one.buffers.colour.size(), two.buffers.colour.size());
+  EXPECT_EQ(std::memcmp(one.buffers.colour.data(), two.buffers.colour.data(),
+                        one.buffers.colour.size() * sizeof(glm::vec3)),
             0);
   EXPECT_EQ(one.buffers.object_id, two.buffers.object_id);
   EXPECT_EQ(one.buffers.cost, two.buffers.cost);
@@ -113,7 +113,7 @@ TEST(Tracer, HardShadowIsTheProjectedSphere) {
   for (size_t i = 0; i < expected.size(); ++i) {
     if (expected[i] < 0 || boundary[i]) continue;
     ++compared;
-    bool dark = fb.color[i] == glm::vec3(0.0f);
+    bool dark = fb.colour[i] == glm::vec3(0.0f);
     EXPECT_EQ(dark, expected[i] == 1) << "pixel " << i % w << "," << i / w;
     shadow += expected[i];
   }
@@ -159,9 +159,9 @@ TEST(Tracer, MirrorShowsTheQuadWhereReflectionGeometryPredicts) {
     if (boundary[i]) continue;
     if (expected[i]) {
       ++red_pixels;
-      EXPECT_EQ(fb.color[i], glm::vec3(1, 0, 0)) << "pixel " << i % w << "," << i / w;
+      EXPECT_EQ(fb.colour[i], glm::vec3(1, 0, 0)) << "pixel " << i % w << "," << i / w;
     } else {
-      EXPECT_NE(fb.color[i], glm::vec3(1, 0, 0)) << "pixel " << i % w << "," << i / w;
+      EXPECT_NE(fb.colour[i], glm::vec3(1, 0, 0)) << "pixel " << i % w << "," << i / w;
     }
   }
   EXPECT_GT(red_pixels, 200u);
@@ -200,7 +200,7 @@ TEST(Tracer, CsgDifferenceShowsTheBiteWithInnerSurfacesFacingTheViewer) {
   ASSERT_EQ(fb.object_id[centre], 0u);
   EXPECT_NEAR(fb.depth[centre], 5.0f - 0.4f, 1e-4f);  // the bite's bottom at z = 0.4
   EXPECT_GT(fb.normal[centre].z, 0.99f);
-  EXPECT_GT(fb.color[centre].x, 0.1f);  // lit: the inner wall faces the light at the eye
+  EXPECT_GT(fb.colour[centre].x, 0.1f);  // lit: the inner wall faces the light at the eye
   // Away from the bite, the big sphere's own front: at the pixel row through y = 0.8 the
   // surface is the outer sphere (|y| > 0.6 leaves the small sphere).
   CameraFrame frame = make_camera_frame(s.camera, 101, 101);
@@ -288,7 +288,7 @@ TEST(Tracer, NoShadowAcneOnConvexSurfaces) {
       float band = mode == SphereMode::Mesh ? 0.06f : 0.0f;
       if (glm::dot(full.buffers.normal[i], glm::normalize(light - p)) <= band) continue;
       ++lit;
-      differ += full.buffers.color[i] != local.buffers.color[i];
+      differ += full.buffers.colour[i] != local.buffers.colour[i];
     }
     EXPECT_GT(lit, 1500u);
     EXPECT_EQ(differ, 0u) << (mode == SphereMode::Mesh ? "tessellated" : "analytic") << " sphere";
@@ -347,12 +347,12 @@ TEST(Tracer, BatchedShadingGivesTheScalarShadingBitForBit) {
               object = sh.object;
               ++covered;
             }
-            const bool same = std::memcmp(&fb.color[i], &colour, sizeof colour) == 0 &&
+            const bool same = std::memcmp(&fb.colour[i], &colour, sizeof colour) == 0 &&
                               std::memcmp(&fb.normal[i], &normal, sizeof normal) == 0 &&
                               fb.object_id[i] == object && vis.object_id[i] == object &&
                               vis.primitive_id[i] == fb.primitive_id[i] &&
                               std::memcmp(&vis.depth[i], &fb.depth[i], sizeof(float)) == 0 &&
-                              vis.color[i] == s.image.background &&
+                              vis.colour[i] == s.image.background &&
                               vis.normal[i] == glm::vec3(0.0f);
             if (!same && ++wrong <= 3)
               ADD_FAILURE() << name << " " << to_string(isa) << " pixel (" << x << ", " << y

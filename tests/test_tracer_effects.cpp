@@ -13,13 +13,13 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/raytrace/primary_visibility.h"
+#include "rvr/core/camera.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
 #include "rvr/raytrace/ray_tracer.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
 #include "scene_builders.h"
 
 using namespace rvr;
@@ -69,7 +69,7 @@ TEST(Refraction, GlassSlabDisplacesAnEdgeBySnellsLaw) {
     float t = (-3.0f - origin.z) / d.z;
     float x_hit = origin.x + t * d.x;
     if (predicted_edge < 0 && x_hit > 0) predicted_edge = x;
-    glm::vec3 c = out.buffers.color[out.buffers.index(x, y)];
+    glm::vec3 c = out.buffers.colour[out.buffers.index(x, y)];
     if (rendered_edge < 0 && c.z > c.x) rendered_edge = x;
   }
   ASSERT_GT(predicted_edge, 0);
@@ -99,7 +99,7 @@ TEST(Refraction, TotalInternalReflectionBeyondTheCriticalAngle) {
       if (std::abs(on_face.x) > 0.98f || std::abs(on_face.y) > 0.98f) continue;  // other faces
       float angle = std::acos(-d.z);
       if (std::abs(angle - critical) < 0.01f) continue;  // a pixel on the boundary
-      glm::vec3 c = out.buffers.color[out.buffers.index(x, y)];
+      glm::vec3 c = out.buffers.colour[out.buffers.index(x, y)];
       if (angle < critical) {
         EXPECT_EQ(c, glm::vec3(1, 0, 0)) << x << "," << y;
         ++red;
@@ -121,7 +121,7 @@ Blob measure(const FrameBuffers& fb) {
   Blob b;
   for (int y = 0; y < fb.height; ++y)
     for (int x = 0; x < fb.width; ++x) {
-      double v = fb.color[fb.index(x, y)].x;
+      double v = fb.colour[fb.index(x, y)].x;
       b.total += v;
       b.cx += v * (x + 0.5);
       b.cy += v * (y + 0.5);
@@ -130,7 +130,7 @@ Blob measure(const FrameBuffers& fb) {
   b.cy /= b.total;
   for (int y = 0; y < fb.height; ++y)
     for (int x = 0; x < fb.width; ++x) {
-      double v = fb.color[fb.index(x, y)].x, dx = x + 0.5 - b.cx, dy = y + 0.5 - b.cy;
+      double v = fb.colour[fb.index(x, y)].x, dx = x + 0.5 - b.cx, dy = y + 0.5 - b.cy;
       b.r2 += v * (dx * dx + dy * dy);
     }
   b.r2 /= b.total;
@@ -214,8 +214,8 @@ ShadowRow render_soft_shadow(float size, int samples, float H, float h_occ, int 
         s.camera.eye + out.buffers.depth[i] * camera_ray_direction(frame, x + 0.5f, h / 2 + 0.5f);
     row.p.push_back(p);
     row.x.push_back(p.x);
-    row.brightness.push_back(out.buffers.color[i].x);
-    row.visible.push_back(out.buffers.color[i].x / unshadowed.buffers.color[i].x);
+    row.brightness.push_back(out.buffers.colour[i].x);
+    row.visible.push_back(out.buffers.colour[i].x / unshadowed.buffers.colour[i].x);
   }
   return row;
 }

@@ -20,15 +20,14 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/raytrace/primary_visibility.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/surface_colour.h"
+#include "rvr/core/texture.h"
 #include "rvr/raytrace/ray_tracer.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/surface_colour.h"
-#include "rvr/shared/texture.h"
+#include "rvr/scene_io/scene_loader.h"
 #include "scene_builders.h"
 
 using namespace rvr;
@@ -261,7 +260,7 @@ TEST(TracerTexture, NoneSamplesLevelZeroBilinearly) {
         // Colour slope: at most 0.8 per texel; uv error: under 1e-3 texels here.
         const glm::dvec3 want = exact_bilinear(h.uv);
         for (int a = 0; a < 3; ++a)
-          EXPECT_NEAR(out.buffers.color[i][a], want[a], 1e-3) << x << "," << y << " channel " << a;
+          EXPECT_NEAR(out.buffers.colour[i][a], want[a], 1e-3) << x << "," << y << " channel " << a;
         ++checked;
       }
     EXPECT_GT(checked, 64 * 40);
@@ -310,7 +309,7 @@ TEST(TracerTexture, VertexColoursAreInterpolatedPerPixel) {
       for (int x = 0; x < c.width; ++x) {
         const std::optional<glm::dvec3> want = exact_vertex_colour(c.eye, c.direction(x, y));
         if (!want) continue;
-        const glm::vec3 got = out.buffers.color[out.buffers.index(x, y)];
+        const glm::vec3 got = out.buffers.colour[out.buffers.index(x, y)];
         for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], (*want)[a], 1e-5) << x << "," << y;
         ++checked;
       }
@@ -324,7 +323,7 @@ TEST(TracerTexture, VertexColoursAreInterpolatedPerPixel) {
     const std::optional<glm::dvec3> at = exact_vertex_colour(c.eye, c.direction(30, y));
     ASSERT_TRUE(at.has_value());
     for (int a = 0; a < 3; ++a) EXPECT_NEAR((*at)[a], 1.0 / 3.0, 0.02);
-    const glm::vec3 got = out.buffers.color[out.buffers.index(30, y)];
+    const glm::vec3 got = out.buffers.colour[out.buffers.index(30, y)];
     for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], 1.0 / 3.0, 0.02);
   }
 }
@@ -351,7 +350,7 @@ TEST(TracerTexture, MirrorRaysShadeVertexColours) {
       const size_t i = out.buffers.index(x, y);
       if (!want) continue;
       if (exact_vertex_colour(c.eye, D)) continue;  // the triangle itself in front
-      const glm::vec3 got = out.buffers.color[i];
+      const glm::vec3 got = out.buffers.colour[i];
       for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], (*want)[a], 1e-4) << x << "," << y;
       ++checked;
     }
@@ -375,7 +374,7 @@ TEST(TracerTexture, EmbreeFindsTheSameSurfacesColoursAndLevels) {
       ++same_id;
       // The same base colour at barycentrics that differ by roundings.
       for (int a = 0; a < 3; ++a)
-        EXPECT_NEAR(ours.buffers.color[i][a], embree.buffers.color[i][a], 1e-3) << i;
+        EXPECT_NEAR(ours.buffers.colour[i][a], embree.buffers.colour[i][a], 1e-3) << i;
       if (std::isnan(ours.buffers.lod[i])) {
         EXPECT_TRUE(std::isnan(embree.buffers.lod[i])) << i;
         continue;
@@ -477,7 +476,7 @@ TEST(TracerTexture, ReflectedRaysCarryTheirFootprintToTheTexture) {
         // or per level, and the float uv and level stray by far less than 1e-3 of either.
         const glm::vec3 want = sample_trilinear(mips, TextureWrap::Repeat, TextureWrap::Repeat,
                                                 glm::vec2(w->uv), float(lod));
-        const glm::vec3 got = out.buffers.color[out.buffers.index(x, y)];
+        const glm::vec3 got = out.buffers.colour[out.buffers.index(x, y)];
         for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], want[a], 1e-3) << x << "," << y;
         ++checked;
       }
@@ -504,7 +503,7 @@ TEST(TracerTexture, EveryMethodAndModeGivesFiniteColoursAndALevelExactlyWhereTex
       const RenderOutput out = trace(s, mode, kind);
       ASSERT_EQ(out.buffers.lod.size(), out.buffers.pixel_count());
       for (size_t i = 0; i < out.buffers.pixel_count(); ++i) {
-        const glm::vec3 c = out.buffers.color[i];
+        const glm::vec3 c = out.buffers.colour[i];
         EXPECT_TRUE(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z)) << i;
         EXPECT_EQ(std::isnan(out.buffers.lod[i]), out.buffers.object_id[i] != floor) << i;
       }
@@ -531,7 +530,7 @@ TEST(TracerTexture, SameBytesWithOneAndTwoThreads) {
       out[threads - 1] = std::move(r).value();
     }
     const size_t n = out[0].buffers.pixel_count();
-    EXPECT_EQ(std::memcmp(out[0].buffers.color.data(), out[1].buffers.color.data(),
+    EXPECT_EQ(std::memcmp(out[0].buffers.colour.data(), out[1].buffers.colour.data(),
                           n * sizeof(glm::vec3)),
               0);
     EXPECT_EQ(std::memcmp(out[0].buffers.lod.data(), out[1].buffers.lod.data(), n * sizeof(float)),

@@ -9,7 +9,7 @@
 #include <limits>
 #include <string>
 
-#include "rvr/shared/renderer.h"
+#include "rvr/core/renderer.h"
 
 namespace rvr::test {
 
@@ -42,7 +42,7 @@ inline void expect_visibility_frame(const Scene& scene, const FrameBuffers& loca
   };
   for (size_t i = 0; i < visibility.pixel_count(); ++i) {
     background +=
-        std::memcmp(&visibility.color[i], &scene.image.background, sizeof(glm::vec3)) == 0;
+        std::memcmp(&visibility.colour[i], &scene.image.background, sizeof(glm::vec3)) == 0;
     const glm::vec3 zero(0.0f);
     zero_normal += std::memcmp(&visibility.normal[i], &zero, sizeof(glm::vec3)) == 0;
     const float no_work = 0.0f;
@@ -77,7 +77,7 @@ inline void expect_visibility_frame(const Scene& scene, const FrameBuffers& loca
   EXPECT_TRUE(same_bytes(no_cost.depth, visibility.depth)) << label;
   EXPECT_TRUE(same_bytes(no_cost.object_id, visibility.object_id)) << label;
   EXPECT_TRUE(same_bytes(no_cost.primitive_id, visibility.primitive_id)) << label;
-  EXPECT_TRUE(same_bytes(no_cost.color, visibility.color)) << label;
+  EXPECT_TRUE(same_bytes(no_cost.colour, visibility.colour)) << label;
   EXPECT_TRUE(same_bytes(no_cost.normal, visibility.normal)) << label;
 }
 
@@ -85,7 +85,7 @@ inline void expect_visibility_frame(const Scene& scene, const FrameBuffers& loca
 // buffer the same bytes, the cost +0 everywhere without, and work counted with.
 inline void expect_only_the_cost_left_out(const FrameBuffers& with, const FrameBuffers& without,
                                           const std::string& what) {
-  EXPECT_TRUE(same_bytes(with.color, without.color)) << what;
+  EXPECT_TRUE(same_bytes(with.colour, without.colour)) << what;
   EXPECT_TRUE(same_bytes(with.normal, without.normal)) << what;
   EXPECT_TRUE(same_bytes(with.depth, without.depth)) << what;
   EXPECT_TRUE(same_bytes(with.object_id, without.object_id)) << what;

@@ -4,7 +4,7 @@
 
 #include <utility>  // IWYU pragma: keep (std::move in take(), a template)
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 
 namespace rvr::cli {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "report_text.h"
-#include "rvr/shared/html_escape.h"
+#include "rvr/core/html_escape.h"
 
 namespace rvr::report {
 namespace {

@@ -11,14 +11,14 @@
 #include "commands.h"
 #include "report.h"
 #include "report_input.h"
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/compare_renderers.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
 #include "terminal_progress.h"
 
 namespace rvr::cli {
@@ -44,8 +44,8 @@ void print_pair(const ReportPair& p, const std::string& name_a, const std::strin
         "elsewhere\n",
         m.depth.outliers, kDepthOutlierThreshold, m.depth.outliers_at_silhouettes,
         m.depth.outliers_on_analytic_spheres, m.depth.outliers_elsewhere);
-  std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.color.rmse,
-              m.color.psnr_db, m.color.max_abs, m.color.ssim);
+  std::printf("  colour            rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f\n", m.colour.rmse,
+              m.colour.psnr_db, m.colour.max_abs, m.colour.ssim);
   if (m.lod.pixels > 0)
     std::printf("  texture lod       |a - b| mean %.3g  p99 %.3g levels over %zu pixels\n",
                 m.lod.mean_abs, m.lod.p99_abs, m.lod.pixels);

@@ -10,8 +10,8 @@
 
 #include "cli_exit.h"
 #include "commands.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/image_io.h"
+#include "rvr/compare/compare.h"
+#include "rvr/image_codec/image_io.h"
 
 namespace rvr::cli {
 

@@ -8,12 +8,12 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "cpu_probe.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/isa.h"
+#include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/environment.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/isa.h"
 
 namespace rvr::cli {
 

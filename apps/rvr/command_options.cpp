@@ -14,14 +14,14 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "one_of.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/limits.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_for_render.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/texture.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/limits.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
+#include "rvr/scene_io/scene_for_render.h"
+#include "rvr/scene_io/scene_loader.h"
 
 namespace rvr::cli {
 

@@ -10,11 +10,11 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "render_stats.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/timer.h"
+#include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/timer.h"
 #include "terminal_progress.h"
 
 namespace rvr::cli {
@@ -45,7 +45,7 @@ int run_render(const RenderArgs& a) {
 
   progress.begin(a.renderer, "write");
   auto write_start = Clock::now();
-  check(write_image(a.out, color_image(out.buffers)));
+  check(write_image(a.out, colour_image(out.buffers)));
   if (!a.aovs.empty()) check(write_aovs(a.out, out.buffers, a.aovs));
   double write_seconds = seconds_since(write_start);
   progress.stop();  // before the warnings and the summary

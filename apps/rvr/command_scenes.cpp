@@ -11,11 +11,11 @@
 
 #include "cli_exit.h"
 #include "commands.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
-#include "rvr/shared/scene_writer.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/scene.h"
+#include "rvr/image_codec/image_io.h"
+#include "rvr/scene_io/scene_loader.h"
+#include "rvr/scene_io/scene_writer.h"
 
 namespace rvr::cli {
 

@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/compare.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/limits.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/timer.h"
+#include "rvr/compare/compare.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/limits.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/timer.h"
 
 namespace rvr::cli {
 

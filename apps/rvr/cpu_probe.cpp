@@ -20,7 +20,7 @@ std::string cpu_model() {
 }
 
 // The vector instructions the baseline code is built for; the SIMD kernels are compiled for
-// several and picked at run time (shared/isa.h), as Embree picks its own.
+// several and picked at run time (rvr/core/isa.h), as Embree picks its own.
 const char* built_simd() {
 #if defined(__AVX512F__)
   return "AVX-512 (512-bit)";

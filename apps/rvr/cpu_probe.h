@@ -8,7 +8,7 @@ namespace rvr::cli {
 
 std::string cpu_model();
 // The vector instructions the baseline code is built for; the SIMD kernels are compiled for
-// several and picked at run time (shared/isa.h), as Embree picks its own.
+// several and picked at run time (rvr/core/isa.h), as Embree picks its own.
 const char* built_simd();
 // Vector extensions the CPU reports in /proc/cpuinfo.
 std::string cpu_simd();

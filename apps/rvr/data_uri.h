@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 
 namespace rvr::report {
 

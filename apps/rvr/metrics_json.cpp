@@ -17,8 +17,8 @@
 #include "render_stats.h"
 #include "report.h"
 #include "report_text.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/mismatch_classes.h"
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
 
 namespace rvr {
 namespace {
@@ -83,7 +83,7 @@ ordered_json pair_metrics(const ComparisonMetrics& m) {
                   {"outliers_on_analytic_spheres", d.outliers_on_analytic_spheres},
                   {"outliers_elsewhere", d.outliers_elsewhere},
                   {"outlier_pixels", outliers}};
-  const auto& c = m.color;
+  const auto& c = m.colour;
   doc["color"] = {{"rmse", number(c.rmse)},
                   {"psnr_db", psnr_number(c.psnr_db)},
                   {"max_abs", number(c.max_abs)},

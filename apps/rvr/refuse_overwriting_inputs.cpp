@@ -6,7 +6,7 @@
 
 #include "cli_exit.h"
 #include "commands.h"
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 
 namespace rvr::cli {
 

@@ -7,8 +7,9 @@
 #include <cstdint>
 #include <string>
 
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/stats.h"
+#include "rvr/core/scene.h"
 
 namespace rvr {
 

@@ -5,8 +5,8 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
+#include "rvr/compare/compare.h"
+#include "rvr/core/expected.h"
 
 namespace rvr {
 

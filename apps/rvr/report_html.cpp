@@ -23,11 +23,11 @@
 #include "report_css.h"
 #include "report_script.h"
 #include "report_text.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/html_escape.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/renderer.h"
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/html_escape.h"
+#include "rvr/core/stats.h"
 #include "timing_chart.h"
 
 namespace rvr {
@@ -172,7 +172,7 @@ std::string other_pairs(const std::vector<ReportPair>& pairs, const std::vector<
        "<tbody>\n";
   for (const ReportPair& p : pairs) {
     const auto& v = p.metrics.visibility;
-    const double psnr = p.metrics.color.psnr_db;
+    const double psnr = p.metrics.colour.psnr_db;
     h << "<tr><td><b>" << escape_html(names[p.a]) << "</b> vs <b>" << escape_html(names[p.b])
       << "</b></td><td class=\"num\">" << fmt("%.5f", v.id_agreement) << "</td><td class=\"num\">"
       << fmt("%.4f", v.covered_fraction) << "</td><td class=\"num\">"
@@ -216,8 +216,7 @@ Expected<ReportImages> embed_images(const ReportInput& input,
                                     const std::vector<ReportPair>& pairs) {
   ReportImages images;
   for (const auto& r : input.renderers) {
-    auto uri = data_uri(input.out_dir, r.image_file);
-    if (!uri) return uri.error();
+    RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, r.image_file));
     images.renders.push_back(std::move(uri.value()));
   }
   for (const auto& r : input.renderers) {
@@ -225,21 +224,18 @@ Expected<ReportImages> embed_images(const ReportInput& input,
       images.costs.emplace_back();
       continue;
     }
-    auto uri = data_uri(input.out_dir, r.cost_file);
-    if (!uri) return uri.error();
+    RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, r.cost_file));
     images.costs.push_back(std::move(uri.value()));
   }
   const ReportPair& first = pairs.front();
   for (auto [file, to] :
        {std::pair{"diff", &images.diff}, std::pair{"id_mismatch", &images.id_mismatch},
         std::pair{"depth_diff", &images.depth_diff}}) {
-    auto uri = data_uri(input.out_dir, first.file(file));
-    if (!uri) return uri.error();
+    RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, first.file(file)));
     *to = std::move(uri.value());
   }
   for (const ReportPair& p : pairs) {
-    auto uri = data_uri(input.out_dir, p.file("mismatch_classes"));
-    if (!uri) return uri.error();
+    RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, p.file("mismatch_classes")));
     images.classes.push_back(std::move(uri.value()));
   }
   return images;
@@ -257,7 +253,7 @@ std::string page_head(const std::string& title) {
 // The title, what was rendered, the command line and the verdict badges of the first pair.
 std::string summary(const ReportInput& input, const std::string& title, const ReportPair& first) {
   const auto& vis = first.metrics.visibility;
-  const auto& col = first.metrics.color;
+  const auto& col = first.metrics.colour;
   std::ostringstream h;
   h << "<h1>" << escape_html(title) << "</h1>\n";
   h << "<div class=\"meta\"><span><b>scene</b> " << escape_html(input.scene)
@@ -409,7 +405,7 @@ std::string work_per_pixel(const ReportInput& input, const ReportImages& images)
 std::vector<MetricRow> metric_rows(const ComparisonMetrics& m) {
   const auto& vis = m.visibility;
   const auto& dep = m.depth;
-  const auto& col = m.color;
+  const auto& col = m.colour;
   const bool identical = std::isinf(col.psnr_db) && col.psnr_db > 0;
   std::vector<MetricRow> rows = {
       {"visibility", "pixels", std::to_string(vis.pixels), "width &times; height."},
@@ -573,8 +569,7 @@ Expected<std::string> report_html(const ReportInput& input) {
     const std::vector<std::string> names = renderer_names(input, pairs);
     const std::string& name_a = names[first.a];
     const std::string& name_b = names[first.b];
-    Expected<ReportImages> images = embed_images(input, pairs);
-    if (!images) return images.error();
+    RVR_TRY_ASSIGN(images, embed_images(input, pairs));
 
     const std::string title = "rvr compare: " + name_a + " vs " + name_b + " on " + input.scene;
     std::ostringstream h;

@@ -6,9 +6,9 @@
 #include <map>
 #include <memory>
 
-#include "rvr/shared/compare.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/renderer.h"
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/renderer.h"
 
 namespace rvr {
 

@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "report.h"
+#include "rvr/core/scene.h"
 #include "rvr/renderers/compare_renderers.h"
-#include "rvr/shared/scene.h"
 
 namespace rvr {
 

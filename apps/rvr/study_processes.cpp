@@ -24,7 +24,7 @@
 #include <utility>
 
 #include "commands.h"
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 #include "rvr/study/memory_estimate.h"
 #include "rvr/study/renderer_frames.h"
 #include "rvr/study/sweep_plan.h"
@@ -174,8 +174,7 @@ class ProcessFrames : public study::FrameSource {
     return counters_.at(index);
   }
   Expected<study::FrameTime> time_frame(size_t index) override {
-    Expected<json> reply = worker_->call({{"op", "frame"}, {"id", id_}, {"renderer", index}});
-    if (!reply) return reply.error();
+    RVR_TRY_ASSIGN(reply, worker_->call({{"op", "frame"}, {"id", id_}, {"renderer", index}}));
     study::FrameTime t;
     t.seconds = reply->at("seconds").get<double>();
     t.phases = reply->at("phases").get<std::map<std::string, double>>();
@@ -197,12 +196,11 @@ class ProcessSession : public study::Session {
   Expected<std::unique_ptr<study::FrameSource>> prepare(const study::Family& family, size_t n,
                                                         int width) override {
     const int id = next_id_++;
-    Expected<json> reply = worker_->call({{"op", "prepare"},
-                                          {"id", id},
-                                          {"family", family_json(family)},
-                                          {"n", n},
-                                          {"width", width}});
-    if (!reply) return reply.error();
+    RVR_TRY_ASSIGN(reply, worker_->call({{"op", "prepare"},
+                                         {"id", id},
+                                         {"family", family_json(family)},
+                                         {"n", n},
+                                         {"width", width}}));
     return std::unique_ptr<study::FrameSource>(
         std::make_unique<ProcessFrames>(worker_, id, *reply));
   }
@@ -267,8 +265,7 @@ std::string own_executable() {
 study::StartSession process_sessions(const std::string& executable,
                                      const std::vector<std::string>& renderers, RenderMode mode) {
   return [=]() -> Expected<std::unique_ptr<study::Session>> {
-    Expected<std::shared_ptr<Worker>> worker = Worker::start(executable, renderers, mode);
-    if (!worker) return worker.error();
+    RVR_TRY_ASSIGN(worker, Worker::start(executable, renderers, mode));
     return std::unique_ptr<study::Session>(std::make_unique<ProcessSession>(*worker));
   };
 }
@@ -277,11 +274,12 @@ study::ProbeMemory process_memory_probes(const std::string& executable,
                                          const std::vector<std::string>& renderers,
                                          RenderMode mode) {
   return [=](const study::Family& family, size_t n, int width) -> Expected<study::MemoryProbe> {
-    Expected<std::shared_ptr<Worker>> worker = Worker::start(executable, renderers, mode);
-    if (!worker) return worker.error();
-    Expected<json> reply = (*worker)->call(
-        {{"op", "memory"}, {"id", 0}, {"family", family_json(family)}, {"n", n}, {"width", width}});
-    if (!reply) return reply.error();
+    RVR_TRY_ASSIGN(worker, Worker::start(executable, renderers, mode));
+    RVR_TRY_ASSIGN(reply, (*worker)->call({{"op", "memory"},
+                                           {"id", 0},
+                                           {"family", family_json(family)},
+                                           {"n", n},
+                                           {"width", width}}));
     return study::parse_memory_probe(reply->at("probe").dump());
   };
 }

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/renderer.h"
+#include "rvr/core/renderer.h"
 #include "rvr/study/memory_estimate.h"
 #include "rvr/study/run_study.h"
 

@@ -5,8 +5,8 @@
 #include <thread>
 
 #include "cpu_probe.h"
+#include "rvr/core/isa.h"
 #include "rvr/renderers/environment.h"
-#include "rvr/shared/isa.h"
 
 namespace rvr {
 

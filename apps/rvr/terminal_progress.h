@@ -1,5 +1,5 @@
 // The command line's progress line: one line on stderr, redrawn in place while long work runs,
-// erased before anything else is printed. Renderers only count (rvr/shared/progress.h).
+// erased before anything else is printed. Renderers only count (rvr/core/progress.h).
 #pragma once
 
 #include <unistd.h>
@@ -10,7 +10,7 @@
 #include <string>
 #include <thread>
 
-#include "rvr/shared/progress.h"
+#include "rvr/core/progress.h"
 
 namespace rvr {
 

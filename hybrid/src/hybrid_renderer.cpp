@@ -12,16 +12,16 @@
 #include <variant>
 #include <vector>
 
+#include "rvr/core/check.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/progress.h"
+#include "rvr/core/timer.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/ray_tracer.h"
-#include "rvr/shared/check.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/progress.h"
-#include "rvr/shared/timer.h"
 
 namespace rvr {
 
@@ -116,7 +116,7 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
       for (const auto& [key, value] : pass_stats.value()) o.stats[key] += value;
     }
     // The tracer's own average: the same float operations in the same order.
-    for (size_t i = 0; i < sum.size(); ++i) fb.color[i] = sum[i] / float(spp);
+    for (size_t i = 0; i < sum.size(); ++i) fb.colour[i] = sum[i] / float(spp);
     o.stats["hybrid.zbuffer_passes"] = double(spp + 1);
   } else {
     o.stats["hybrid.zbuffer_passes"] = 1.0;

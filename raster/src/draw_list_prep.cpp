@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <glm/glm.hpp>
 
-#include "rvr/shared/check.h"
-#include "rvr/shared/tessellate.h"
+#include "rvr/core/check.h"
+#include "rvr/core/tessellate.h"
 
 namespace rvr {
 
@@ -64,8 +64,7 @@ Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
     PreparedObject& p = prepared.objects[i];
-    Expected<const Material*> material = object_material(scene, o, *prepared.fallback);
-    if (!material) return material.error();
+    RVR_TRY_ASSIGN(material, object_material(scene, o, *prepared.fallback));
     p.material = *material;
     switch (o.type) {
       case ObjectType::Triangles:
@@ -84,7 +83,7 @@ Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
         prepared.skipped_csg.push_back(object_label(o, i));
         continue;
     }
-    if (Status checked = check_mesh(*p.mesh, o.name); !checked) return checked.error();
+    RVR_TRY(check_mesh(*p.mesh, o.name));
     p.smooth = p.mesh->smooth();
   }
   RVR_CHECK(prepared.objects.size() == scene.objects.size(),

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 
 namespace rvr {
 

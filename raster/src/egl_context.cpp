@@ -17,9 +17,8 @@
 #include <type_traits>
 #include <utility>
 
-#include "gl_check.h"
 #include "gl_context.h"
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 
 namespace rvr {
 

@@ -8,7 +8,7 @@
 
 #include <glad/gl.h>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 
 namespace rvr {
 
@@ -28,10 +28,4 @@ Status gl_check(const char* what, const char* file, int line);
   do {                                                                                             \
     if (::rvr::Status rvr_gl_status_ = ::rvr::gl_check(what, __FILE__, __LINE__); !rvr_gl_status_) \
       return rvr_gl_status_.error();                                                               \
-  } while (0)
-
-// Propagates the error of an Expected/Status expression.
-#define RVR_TRY(expr)                                                                    \
-  do {                                                                                   \
-    if (auto rvr_try_result_ = (expr); !rvr_try_result_) return rvr_try_result_.error(); \
   } while (0)

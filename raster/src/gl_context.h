@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/gl_backend.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/gl_backend.h"
 
 namespace rvr {
 

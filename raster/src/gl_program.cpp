@@ -49,8 +49,7 @@ Expected<GLuint> compile(const char* name, GLenum stage, const char* source) {
 
 Expected<GLuint> build_program(const char* name, const char* vertex_source,
                                const char* fragment_source) {
-  auto vs = compile(name, GL_VERTEX_SHADER, vertex_source);
-  if (!vs) return vs.error();
+  RVR_TRY_ASSIGN(vs, compile(name, GL_VERTEX_SHADER, vertex_source));
   auto fs = compile(name, GL_FRAGMENT_SHADER, fragment_source);
   if (!fs) {
     gl().DeleteShader(*vs);

@@ -3,7 +3,7 @@
 
 #include <glad/gl.h>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 
 namespace rvr {
 

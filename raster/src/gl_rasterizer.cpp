@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -28,15 +27,17 @@
 #include "draw_list_prep.h"
 #include "gl_check.h"
 #include "gl_context.h"
+#include "gl_objects.h"
 #include "gl_program.h"
 #include "gl_shaders.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/progress.h"
-#include "rvr/shared/surface_colour.h"
-#include "rvr/shared/texture.h"
-#include "rvr/shared/timer.h"
+#include "rvr/core/camera.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/progress.h"
+#include "rvr/core/surface_colour.h"
+#include "rvr/core/texture.h"
+#include "rvr/core/timer.h"
+#include "shadow_plan.h"
 
 namespace rvr {
 
@@ -94,8 +95,8 @@ constexpr GLint kTextureUnit = 2;
 // light's plane still cast and receive correctly).
 //
 // Memory: the maps of all samples at once would be 6 * size^2 * 4 bytes each (24 MiB at 1024),
-// so the samples go in batches that fit kShadowBatchBytes; each batch renders its maps and then
-// adds its samples' light to the colour in an extra lighting pass (depth test GL_EQUAL against
+// so the samples go in batches (shadow_plan.h: plan_shadow_maps); each batch renders its maps and
+// then adds its samples' light to the colour in an extra lighting pass (depth test GL_EQUAL against
 // the first pass's depth: same program, same vertices, so the depths are bit-identical).
 //
 // Resolution and bias: options.shadow_map_size (default 1024) texels per 90 degree face, so a
@@ -106,27 +107,6 @@ constexpr GLint kTextureUnit = 2;
 // also moved one texel footprint along the normal towards the light (normal offset). Without
 // the last two, grazing surfaces (the Cornell ceiling, just above the lamp's samples) show
 // acne rings; with them the classification agrees with shadow rays on >99% of pixels.
-// Batches of 64 MiB hold 2 samples at 1024^2 (~60 MB more peak memory than local mode).
-constexpr size_t kShadowBatchBytes = size_t(64) << 20;
-// Work: every face is cleared and rasterised, so the texels per frame grow with the sample
-// count. Above this budget (16 samples at 1024^2 fit) the side shrinks, with a warning.
-constexpr double kShadowTexelBudget = 6.0 * 16.0 * 1024.0 * 1024.0 * 1.25;
-constexpr int kShadowMinSize = 64;
-
-// Face f of every shadow cube looks along kFaceDirections[f] (0 +x, 1 -x, 2 +y, 3 -y, 4 +z,
-// 5 -z: cube_face() in the shader uses the same order).
-const std::array<glm::vec3, 6> kFaceDirections = {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0),
-                                                  glm::vec3(0, 1, 0), glm::vec3(0, -1, 0),
-                                                  glm::vec3(0, 0, 1), glm::vec3(0, 0, -1)};
-
-std::array<glm::mat3, 6> face_rotations() {
-  std::array<glm::mat3, 6> r;
-  for (size_t f = 0; f < 6; ++f) {
-    glm::vec3 up = std::abs(kFaceDirections[f].y) > 0.5f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
-    r[f] = glm::mat3(glm::lookAt(glm::vec3(0.0f), kFaceDirections[f], up));
-  }
-  return r;
-}
 
 // "name1, name2" of the materials drawn by `draws` for which `uses` holds, each once.
 template <class Draws, class Pred>
@@ -269,8 +249,7 @@ const char* to_string(GlBackend backend) {
 
 Expected<GlInfo> query_gl_info(GlBackend backend) {
   GlInfo info;
-  auto context = create_gl_context(backend, info.warnings);
-  if (!context) return context.error();
+  RVR_TRY_ASSIGN(context, create_gl_context(backend, info.warnings));
   auto strings = current_gl_strings();
   info.backend = (*context)->backend();
   (*context)->destroy();
@@ -286,15 +265,18 @@ struct GlRasterizer::Impl {
   GlBackend backend = GlBackend::Default;
   std::unique_ptr<GlContext> context;
   std::vector<std::string> context_warnings;  // e.g. the default fell back to EGL
-  GLuint scene_program = 0, cost_program = 0, shadow_program = 0;
+  GlProgram scene_program, cost_program, shadow_program;
   SceneUniforms su;
   GLint cost_view = -1, cost_projection = -1;
   GLint shadow_light = -1, shadow_rotation = -1, shadow_projection = -1;
-  GLuint vao = 0, vertex_buffer = 0, light_buffer = 0, light_texture = 0, query = 0;
-  GLuint surface_buffer = 0;  // SurfaceVertex per corner, when some object varies in colour
+  GlVertexArray vao;
+  GlBuffer vertex_buffer, light_buffer;
+  GlTexture light_texture;
+  GlQuery query;
+  GlBuffer surface_buffer;  // SurfaceVertex per corner, when some object varies in colour
   // The scene's textures as GL textures (0: not used by a drawn object), and the mip chains they
   // hold, so a render of the same scene uploads none again.
-  std::vector<GLuint> textures;
+  std::vector<GlTexture> textures;
   std::vector<std::shared_ptr<const MipChain>> texture_sources;
   bool query_lod = false;   // ARB_texture_query_lod: the lod AOV is the driver's own
   bool lod_target = false;  // this render draws the lod target
@@ -304,15 +286,18 @@ struct GlRasterizer::Impl {
 
   // Render targets, re-made when the image size changes.
   int width = 0, height = 0;
-  GLuint scene_fbo = 0, cost_fbo = 0, depth_buffer = 0;
+  GlFramebuffer scene_fbo, cost_fbo;
+  GlRenderbuffer depth_buffer;
   GLenum depth_format = GL_DEPTH_COMPONENT32F;  // of depth_buffer and msaa_depth
   GLint depth_bits = 0;                         // of depth_buffer, as the driver allocated it
-  std::array<GLuint, kTargetCount> targets{};
+  std::array<GlRenderbuffer, kTargetCount> targets;
   // Multisampled colour + depth (spp > 1), re-made when size or sample count change.
-  GLuint msaa_fbo = 0, msaa_colour = 0, msaa_depth = 0;
+  GlFramebuffer msaa_fbo;
+  GlRenderbuffer msaa_colour, msaa_depth;
   int msaa_samples = 0;
   // Shadow maps of one batch: size x size x layers (6 per sample).
-  GLuint shadow_fbo = 0, shadow_texture = 0;
+  GlFramebuffer shadow_fbo;
+  GlTexture shadow_texture;
   int shadow_size = 0, shadow_layers = 0;
 
   // Kept to reuse their capacity across renders.
@@ -337,8 +322,10 @@ struct GlRasterizer::Impl {
   void release_msaa();
   void release_shadow_maps();
   void release_targets();
-  void release_textures();
   void release();
+  // Every GL object held, each once: f(handle) for release() to delete or forget them all.
+  template <class F>
+  void for_each_object(F f);
   Status upload_textures(const Scene& scene);
 
   // One frame, in the order render() runs them.
@@ -367,19 +354,15 @@ Status GlRasterizer::Impl::create_resources() {
       create_gl_context(backend, context_warnings);  // 1x1: every pixel we keep goes to an FBO
   if (!created) return created.error();
   context = std::move(created.value());
-  auto strings = current_gl_strings();
-  if (!strings) return strings.error();
+  RVR_TRY_ASSIGN(strings, current_gl_strings());
   RVR_TRY(check_gl_driver(*strings));
 
-  auto scene = build_program("scene", shaders::kSceneVertex, shaders::kSceneFragment);
-  if (!scene) return scene.error();
-  scene_program = *scene;
-  auto cost = build_program("cost", shaders::kCostVertex, shaders::kCostFragment);
-  if (!cost) return cost.error();
-  cost_program = *cost;
-  auto shadow = build_program("shadow", shaders::kShadowVertex, shaders::kShadowFragment);
-  if (!shadow) return shadow.error();
-  shadow_program = *shadow;
+  RVR_TRY_ASSIGN(scene, build_program("scene", shaders::kSceneVertex, shaders::kSceneFragment));
+  scene_program = GlProgram(*scene);
+  RVR_TRY_ASSIGN(cost, build_program("cost", shaders::kCostVertex, shaders::kCostFragment));
+  cost_program = GlProgram(*cost);
+  RVR_TRY_ASSIGN(shadow, build_program("shadow", shaders::kShadowVertex, shaders::kShadowFragment));
+  shadow_program = GlProgram(*shadow);
   shadow_light = gl().GetUniformLocation(shadow_program, "u_light");
   shadow_rotation = gl().GetUniformLocation(shadow_program, "u_rotation");
   shadow_projection = gl().GetUniformLocation(shadow_program, "u_projection");
@@ -414,8 +397,8 @@ Status GlRasterizer::Impl::create_resources() {
   cost_view = gl().GetUniformLocation(cost_program, "u_view");
   cost_projection = gl().GetUniformLocation(cost_program, "u_projection");
 
-  gl().GenVertexArrays(1, &vao);
-  gl().GenBuffers(1, &vertex_buffer);
+  vao = GlVertexArray::generate();
+  vertex_buffer = GlBuffer::generate();
   gl().BindVertexArray(vao);
   gl().BindBuffer(GL_ARRAY_BUFFER, vertex_buffer);
   auto attrib = [](GLuint index, size_t offset) {
@@ -426,7 +409,7 @@ Status GlRasterizer::Impl::create_resources() {
   attrib(shaders::kAttribPosition, offsetof(Vertex, position));
   attrib(shaders::kAttribNormal, offsetof(Vertex, normal));
   attrib(shaders::kAttribGeometricNormal, offsetof(Vertex, geometric_normal));
-  gl().GenBuffers(1, &surface_buffer);
+  surface_buffer = GlBuffer::generate();
   gl().BindBuffer(GL_ARRAY_BUFFER, surface_buffer);
   gl().VertexAttribPointer(shaders::kAttribUv, 2, GL_FLOAT, GL_FALSE, sizeof(SurfaceVertex),
                            reinterpret_cast<const void*>(offsetof(SurfaceVertex, uv)));
@@ -442,9 +425,9 @@ Status GlRasterizer::Impl::create_resources() {
     if (name && std::string_view(name) == "GL_ARB_texture_query_lod") query_lod = true;
   }
 
-  gl().GenBuffers(1, &light_buffer);
-  gl().GenTextures(1, &light_texture);
-  gl().GenQueries(1, &query);
+  light_buffer = GlBuffer::generate();
+  light_texture = GlTexture::generate();
+  query = GlQuery::generate();
 
   GLint max_renderbuffer = 0;
   GLint max_viewport[2] = {0, 0};
@@ -471,12 +454,12 @@ Status GlRasterizer::Impl::resize(int w, int h, GLenum depth) {
     return internal_error(fmt::format(
         "image {}x{} exceeds the GL driver's largest framebuffer ({} per side)", w, h, max_size));
   release_targets();
-  gl().GenRenderbuffers(kTargetCount, targets.data());
   for (int i = 0; i < kTargetCount; ++i) {
+    targets[size_t(i)] = GlRenderbuffer::generate();
     gl().BindRenderbuffer(GL_RENDERBUFFER, targets[size_t(i)]);
     gl().RenderbufferStorage(GL_RENDERBUFFER, kTargetFormats[size_t(i)], w, h);
   }
-  gl().GenRenderbuffers(1, &depth_buffer);
+  depth_buffer = GlRenderbuffer::generate();
   gl().BindRenderbuffer(GL_RENDERBUFFER, depth_buffer);
   gl().RenderbufferStorage(GL_RENDERBUFFER, depth, w, h);
   depth_format = depth;
@@ -484,7 +467,7 @@ Status GlRasterizer::Impl::resize(int w, int h, GLenum depth) {
   gl().GetRenderbufferParameteriv(GL_RENDERBUFFER, GL_RENDERBUFFER_DEPTH_SIZE, &depth_bits);
   RVR_GL_CHECK("allocating render targets");
 
-  gl().GenFramebuffers(1, &scene_fbo);
+  scene_fbo = GlFramebuffer::generate();
   gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
   std::array<GLenum, kCost> draw_buffers{};
   for (int i = 0; i < kCost; ++i) {
@@ -499,7 +482,7 @@ Status GlRasterizer::Impl::resize(int w, int h, GLenum depth) {
     return internal_error(fmt::format("scene framebuffer incomplete (0x{:04x})", status));
 
   // The overdraw pass has its own FBO: it blends and ignores depth.
-  gl().GenFramebuffers(1, &cost_fbo);
+  cost_fbo = GlFramebuffer::generate();
   gl().BindFramebuffer(GL_FRAMEBUFFER, cost_fbo);
   gl().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
                                targets[kCost]);
@@ -517,13 +500,13 @@ Status GlRasterizer::Impl::resize(int w, int h, GLenum depth) {
 Status GlRasterizer::Impl::ensure_msaa(int samples) {
   if (msaa_fbo != 0 && msaa_samples == samples) return ok_status();
   release_msaa();
-  gl().GenRenderbuffers(1, &msaa_colour);
+  msaa_colour = GlRenderbuffer::generate();
   gl().BindRenderbuffer(GL_RENDERBUFFER, msaa_colour);
   gl().RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA32F, width, height);
-  gl().GenRenderbuffers(1, &msaa_depth);
+  msaa_depth = GlRenderbuffer::generate();
   gl().BindRenderbuffer(GL_RENDERBUFFER, msaa_depth);
   gl().RenderbufferStorageMultisample(GL_RENDERBUFFER, samples, depth_format, width, height);
-  gl().GenFramebuffers(1, &msaa_fbo);
+  msaa_fbo = GlFramebuffer::generate();
   gl().BindFramebuffer(GL_FRAMEBUFFER, msaa_fbo);
   gl().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, msaa_colour);
   gl().FramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, msaa_depth);
@@ -539,17 +522,16 @@ Status GlRasterizer::Impl::ensure_msaa(int samples) {
 }
 
 void GlRasterizer::Impl::release_msaa() {
-  if (msaa_fbo) gl().DeleteFramebuffers(1, &msaa_fbo);
-  if (msaa_colour) gl().DeleteRenderbuffers(1, &msaa_colour);
-  if (msaa_depth) gl().DeleteRenderbuffers(1, &msaa_depth);
-  msaa_fbo = msaa_colour = msaa_depth = 0;
+  msaa_fbo.reset();
+  msaa_colour.reset();
+  msaa_depth.reset();
   msaa_samples = 0;
 }
 
 Status GlRasterizer::Impl::ensure_shadow_maps(int size, int layers) {
   if (shadow_texture != 0 && shadow_size == size && shadow_layers == layers) return ok_status();
   release_shadow_maps();
-  gl().GenTextures(1, &shadow_texture);
+  shadow_texture = GlTexture::generate();
   gl().ActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
   gl().BindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
   gl().TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_R32F, size, size, layers, 0, GL_RED, GL_FLOAT,
@@ -559,7 +541,7 @@ Status GlRasterizer::Impl::ensure_shadow_maps(int size, int layers) {
   gl().TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   gl().TexParameteri(GL_TEXTURE_2D_ARRAY, GL_TEXTURE_MAX_LEVEL, 0);
   gl().ActiveTexture(GL_TEXTURE0);
-  gl().GenFramebuffers(1, &shadow_fbo);
+  shadow_fbo = GlFramebuffer::generate();
   gl().BindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
   gl().FramebufferTextureLayer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, shadow_texture, 0, 0);
   GLenum colour_buffer = GL_COLOR_ATTACHMENT0;
@@ -574,9 +556,8 @@ Status GlRasterizer::Impl::ensure_shadow_maps(int size, int layers) {
 }
 
 void GlRasterizer::Impl::release_shadow_maps() {
-  if (shadow_fbo) gl().DeleteFramebuffers(1, &shadow_fbo);
-  if (shadow_texture) gl().DeleteTextures(1, &shadow_texture);
-  shadow_fbo = shadow_texture = 0;
+  shadow_fbo.reset();
+  shadow_texture.reset();
   shadow_size = shadow_layers = 0;
 }
 
@@ -585,7 +566,7 @@ void GlRasterizer::Impl::release_shadow_maps() {
 Status GlRasterizer::Impl::render_shadow_maps(const std::vector<LightSample>& samples, size_t first,
                                               size_t end, const glm::mat4& projection,
                                               GLsizei vertex_count) {
-  static const std::array<glm::mat3, 6> rotations = face_rotations();
+  const std::array<glm::mat3, 6>& rotations = cube_face_rotations();
   gl().BindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
   gl().Viewport(0, 0, shadow_size, shadow_size);
   gl().Disable(GL_DEPTH_TEST);
@@ -615,45 +596,41 @@ Status GlRasterizer::Impl::render_shadow_maps(const std::vector<LightSample>& sa
 
 void GlRasterizer::Impl::release_targets() {
   release_msaa();
-  if (scene_fbo) gl().DeleteFramebuffers(1, &scene_fbo);
-  if (cost_fbo) gl().DeleteFramebuffers(1, &cost_fbo);
-  if (depth_buffer) gl().DeleteRenderbuffers(1, &depth_buffer);
-  if (targets[0]) gl().DeleteRenderbuffers(kTargetCount, targets.data());
-  scene_fbo = cost_fbo = depth_buffer = 0;
-  targets.fill(0);
+  scene_fbo.reset();
+  cost_fbo.reset();
+  depth_buffer.reset();
+  for (GlRenderbuffer& target : targets) target.reset();
   width = height = 0;
+}
+
+template <class F>
+void GlRasterizer::Impl::for_each_object(F f) {
+  for (GlProgram* p : {&scene_program, &cost_program, &shadow_program}) f(*p);
+  f(vao);
+  for (GlBuffer* b : {&vertex_buffer, &light_buffer, &surface_buffer}) f(*b);
+  f(light_texture);
+  f(query);
+  for (GlTexture& texture : textures) f(texture);
+  for (GlFramebuffer* fbo : {&scene_fbo, &cost_fbo, &msaa_fbo, &shadow_fbo}) f(*fbo);
+  for (GlRenderbuffer* rb : {&depth_buffer, &msaa_colour, &msaa_depth}) f(*rb);
+  for (GlRenderbuffer& target : targets) f(target);
+  f(shadow_texture);
 }
 
 void GlRasterizer::Impl::release() {
   if (!context) return;
-  // Deleting needs the context current; if that fails, destroying the context frees it all.
-  if (context->make_current()) {
-    release_targets();
-    if (scene_program) gl().DeleteProgram(scene_program);
-    if (cost_program) gl().DeleteProgram(cost_program);
-    if (shadow_program) gl().DeleteProgram(shadow_program);
-    release_shadow_maps();
-    release_textures();
-    if (surface_buffer) gl().DeleteBuffers(1, &surface_buffer);
-    if (vao) gl().DeleteVertexArrays(1, &vao);
-    if (vertex_buffer) gl().DeleteBuffers(1, &vertex_buffer);
-    if (light_buffer) gl().DeleteBuffers(1, &light_buffer);
-    if (light_texture) gl().DeleteTextures(1, &light_texture);
-    if (query) gl().DeleteQueries(1, &query);
-  }
+  // Deleting needs the context current; if that fails, destroying the context frees it all and
+  // the names are forgotten.
+  if (context->make_current())
+    for_each_object([](auto& object) { object.reset(); });
+  else
+    for_each_object([](auto& object) { object.forget(); });
   context->destroy();
   context.reset();
-  // Names belong to the destroyed context: forget them so a later init() starts clean.
-  scene_program = cost_program = shadow_program = 0;
-  msaa_fbo = msaa_colour = msaa_depth = 0;
   msaa_samples = 0;
-  shadow_fbo = shadow_texture = 0;
   shadow_size = shadow_layers = 0;
-  vao = vertex_buffer = light_buffer = light_texture = query = surface_buffer = 0;
   textures.clear();
   texture_sources.clear();
-  scene_fbo = cost_fbo = depth_buffer = 0;
-  targets.fill(0);
   width = height = 0;
 }
 
@@ -666,9 +643,7 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
   bool varies = false;
   for (const Object& o : scene.objects) varies = varies || varies_in_colour(scene, o);
   if (varies) RVR_TRY(upload_textures(scene));
-  Expected<PreparedScene> prepared =
-      prepare_objects(scene, options.spheres, options.sphere_segments);
-  if (!prepared) return prepared.error();
+  RVR_TRY_ASSIGN(prepared, prepare_objects(scene, options.spheres, options.sphere_segments));
   up.prepared = std::move(*prepared);
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
@@ -732,7 +707,7 @@ Status GlRasterizer::Impl::upload_textures(const Scene& scene) {
   std::vector<bool> used(scene.textures.size(), false);
   for (const Object& o : scene.objects)
     if (textured(scene, o)) used[size_t(scene.materials[o.material].texture)] = true;
-  textures.resize(scene.textures.size(), 0);
+  textures.resize(scene.textures.size());
   texture_sources.resize(scene.textures.size(), nullptr);
   auto wrap_mode = [](TextureWrap w) -> GLint {
     switch (w) {
@@ -753,7 +728,7 @@ Status GlRasterizer::Impl::upload_textures(const Scene& scene) {
     if (t.mips->width() > max_texture_size || t.mips->height() > max_texture_size)
       return bad_input(fmt::format("texture '{}' is {}x{}: this GL's largest is {} per side",
                                    t.file, t.mips->width(), t.mips->height(), max_texture_size));
-    if (!textures[i]) gl().GenTextures(1, &textures[i]);
+    if (!textures[i]) textures[i] = GlTexture::generate();
     gl().BindTexture(GL_TEXTURE_2D, textures[i]);
     const std::vector<TextureLevel>& levels = t.mips->levels;
     for (size_t k = 0; k < levels.size(); ++k)
@@ -772,13 +747,6 @@ Status GlRasterizer::Impl::upload_textures(const Scene& scene) {
   return ok_status();
 }
 
-void GlRasterizer::Impl::release_textures() {
-  for (GLuint& t : textures)
-    if (t) gl().DeleteTextures(1, &t);
-  textures.clear();
-  texture_sources.clear();
-}
-
 // --- shadow-map plan (full mode): resolution, batches, light-space projection
 Expected<ShadowPlan> GlRasterizer::Impl::plan_shadows(const RenderOptions& options,
                                                       const std::vector<LightSample>& samples,
@@ -787,47 +755,26 @@ Expected<ShadowPlan> GlRasterizer::Impl::plan_shadows(const RenderOptions& optio
   plan.enabled = options.mode == RenderMode::Full && !samples.empty();
   plan.batch = std::max<size_t>(samples.size(), 1);
   if (!plan.enabled) return plan;
-  if (options.shadow_map_size < 1)
-    return bad_input(fmt::format("shadow map size {} must be positive", options.shadow_map_size));
-  if (!(options.shadow_bias >= 0.0f) || !std::isfinite(options.shadow_bias))
-    return bad_input(fmt::format("shadow bias {} must be >= 0", options.shadow_bias));
-  int map_size = std::min(options.shadow_map_size, max_texture_size);
-  const double texels = 6.0 * double(samples.size()) * double(map_size) * double(map_size);
-  if (texels > kShadowTexelBudget) {
-    const int fit = int(std::sqrt(kShadowTexelBudget / (6.0 * double(samples.size()))));
-    map_size = std::max(std::min(map_size, kShadowMinSize), fit);
-  }
-  if (map_size < options.shadow_map_size)
-    out.warnings.push_back(
-        fmt::format("shadow maps of {} texels per side for {} light samples ({} requested)",
-                    map_size, samples.size(), options.shadow_map_size));
-  const size_t per_sample = 6 * size_t(map_size) * size_t(map_size) * sizeof(float);
-  size_t batch = std::clamp<size_t>(kShadowBatchBytes / per_sample, 1, samples.size());
-  batch = std::min(batch, size_t(std::max(max_layers / 6, 1)));
-  // Near and far only clip: distances are stored exactly and nearest-kept by GL_MIN, so a
-  // near plane far below any feature size (1e-6 of the scene) costs no precision.
   glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
   for (const Vertex& v : vertices) {
     lo = glm::min(lo, v.position);
     hi = glm::max(hi, v.position);
   }
-  float reach = 0.0f;
-  for (const LightSample& ls : samples)
-    reach = std::max(reach,
-                     glm::length(glm::max(glm::abs(ls.position - lo), glm::abs(ls.position - hi))));
-  if (vertices.empty()) reach = 1.0f;
-  reach = std::max(reach, 1e-3f);
-  plan.light_projection = glm::perspective(glm::radians(90.0f), 1.0f, 1e-6f * reach, 2.0f * reach);
-  plan.map_size = map_size;
-  plan.batch = batch;
-  RVR_TRY(ensure_shadow_maps(map_size, int(6 * batch)));
+  RVR_TRY_ASSIGN(maps, plan_shadow_maps(options, samples, max_texture_size,
+                                        size_t(std::max(max_layers / 6, 1)), lo, hi,
+                                        !vertices.empty(), out.warnings));
+  plan.light_projection =
+      glm::perspective(glm::radians(90.0f), 1.0f, maps->near_plane, maps->far_plane);
+  plan.map_size = maps->size;
+  plan.batch = maps->batch;
+  RVR_TRY(ensure_shadow_maps(plan.map_size, int(6 * plan.batch)));
   return plan;
 }
 
 // One draw of every object with the scene program; the caller sets the pass's state.
 void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size_t first,
                                     size_t end, bool base) {
-  static const std::array<glm::mat3, 6> rotations = face_rotations();
+  const std::array<glm::mat3, 6>& rotations = cube_face_rotations();
   const Scene& scene = pass.scene;
   gl().UseProgram(scene_program);
   gl().UniformMatrix4fv(su.view, 1, GL_FALSE, glm::value_ptr(pass.view));
@@ -1032,7 +979,7 @@ Status GlRasterizer::Impl::readback(int w, int h, const ScenePass& pass, FrameBu
   fb.width = w;
   fb.height = h;
   const size_t n = fb.pixel_count();
-  fb.color.resize(n);
+  fb.colour.resize(n);
   fb.depth.resize(n);
   fb.object_id.resize(n);
   fb.primitive_id.resize(n);
@@ -1064,10 +1011,10 @@ Status GlRasterizer::Impl::readback(int w, int h, const ScenePass& pass, FrameBu
     }
   };
   if (pass.options.mode == RenderMode::Visibility) {
-    std::fill(fb.color.begin(), fb.color.end(), pass.scene.image.background);
+    std::fill(fb.colour.begin(), fb.colour.end(), pass.scene.image.background);
     std::fill(fb.normal.begin(), fb.normal.end(), glm::vec3(0.0f));
   } else {
-    read_rgb(kColour, fb.color);
+    read_rgb(kColour, fb.colour);
     read_rgb(kNormal, fb.normal);
   }
   read_scalar(scene_fbo, kObjectId, GL_RED_INTEGER, GL_UNSIGNED_INT, fb.object_id);
@@ -1113,8 +1060,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
 
   if (progress) progress->begin("upload");  // mostly one glBufferData: time only
   t = Clock::now();
-  Expected<SceneUpload> uploaded = upload(scene, options);
-  if (!uploaded) return uploaded.error();
+  RVR_TRY_ASSIGN(uploaded, upload(scene, options));
   out.stats["time.upload"] = seconds_since(t);
 
   lod_target =
@@ -1122,8 +1068,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
   if (lod_target)
     out.info["lod"] = query_lod ? "textureQueryLOD (ARB_texture_query_lod)"
                                 : "log2 of the longer of dFdx, dFdy in texels";
-  Expected<ShadowPlan> shadows = plan_shadows(options, uploaded->samples, out);
-  if (!shadows) return shadows.error();
+  RVR_TRY_ASSIGN(shadows, plan_shadows(options, uploaded->samples, out));
 
   // --- multisampling: colour into a multisampled FBO, resolved into the colour target
   int msaa = 1;

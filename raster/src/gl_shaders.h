@@ -1,5 +1,5 @@
 // GLSL of the raster renderer. The fragment shader's shade_local mirrors
-// shared/include/rvr/shared/shading.h operation for operation; change both together.
+// core/include/rvr/core/shading.h operation for operation; change both together.
 #pragma once
 
 namespace rvr::shaders {
@@ -73,7 +73,7 @@ uniform vec3 u_specular;
 uniform vec3 u_emission;
 uniform float u_shininess;
 
-// The base colour (rvr/shared/surface_colour.h): u_diffuse times the texture (trilinear, the
+// The base colour (rvr/core/surface_colour.h): u_diffuse times the texture (trilinear, the
 // object's mip chain as every renderer builds it) times the interpolated vertex colour.
 uniform bool u_textured;
 uniform bool u_coloured;

@@ -16,9 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "gl_check.h"
 #include "gl_context.h"
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 
 namespace rvr {
 

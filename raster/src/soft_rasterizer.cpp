@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -21,15 +20,16 @@
 #include <vector>
 
 #include "draw_list_prep.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/progress.h"
-#include "rvr/shared/shade_kernel.h"
-#include "rvr/shared/shading.h"
-#include "rvr/shared/surface_colour.h"
-#include "rvr/shared/timer.h"
+#include "rvr/core/camera.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/progress.h"
+#include "rvr/core/shade_kernel.h"
+#include "rvr/core/shading.h"
+#include "rvr/core/surface_colour.h"
+#include "rvr/core/timer.h"
+#include "shadow_plan.h"
 #include "soft/deferred_shading.h"
 #include "soft/draw_triangles.h"
 #include "soft/fill_dispatch.h"
@@ -45,11 +45,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// Shadow maps as the GL raster plans them (gl_rasterizer.cpp): batches of cubes of at most
-// kShadowBatchBytes, and a texel budget above which the maps shrink, with a warning.
-constexpr size_t kShadowBatchBytes = size_t(64) << 20;
-constexpr double kShadowTexelBudget = 6.0 * 16.0 * 1024.0 * 1024.0 * 1.25;
-constexpr int kShadowMinSize = 64;
 using soft::DepthTarget;
 using soft::DrawList;
 using soft::DrawObject;
@@ -169,32 +164,11 @@ Surface surface_at(const VisibleFrame& frame, size_t o) {
   return s;
 }
 
-// The shadow maps' side (shrunk, with a warning, when the samples' cubes exceed the texel
-// budget), bias and filter; their projection is set by shadow_projection.
-Expected<soft::ShadowSettings> shadow_settings(const RenderOptions& options, size_t samples,
+// The shadow cubes' plan (shadow_plan.h) for the scene's meshes, as this z-buffer's settings.
+Expected<soft::ShadowSettings> shadow_settings(const RenderOptions& options, const DrawList& list,
+                                               const std::vector<LightSample>& samples,
+                                               ShadowMapPlan& plan,
                                                std::vector<std::string>& warnings) {
-  if (options.shadow_map_size < 1)
-    return bad_input(fmt::format("shadow map size {} must be positive", options.shadow_map_size));
-  if (!(options.shadow_bias >= 0.0f) || !std::isfinite(options.shadow_bias))
-    return bad_input(fmt::format("shadow bias {} must be >= 0", options.shadow_bias));
-  soft::ShadowSettings settings;
-  settings.size = std::min(options.shadow_map_size, soft::kMaxImageSide);
-  const double texels = 6.0 * double(samples) * double(settings.size) * double(settings.size);
-  if (texels > kShadowTexelBudget) {
-    const int fit = int(std::sqrt(kShadowTexelBudget / (6.0 * double(samples))));
-    settings.size = std::max(std::min(settings.size, kShadowMinSize), fit);
-  }
-  if (settings.size < options.shadow_map_size)
-    warnings.push_back(
-        fmt::format("shadow maps of {} texels per side for {} light samples ({} requested)",
-                    settings.size, samples, options.shadow_map_size));
-  settings.bias = options.shadow_bias;
-  settings.pcf = options.shadow_pcf;
-  return settings;
-}
-
-// How far the scene reaches from the light samples (at least 1e-3; 1 for an empty scene).
-float light_reach(const DrawList& list, const std::vector<LightSample>& samples) {
   glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
   bool any = false;
   for (const DrawObject& d : list.objects)
@@ -204,12 +178,16 @@ float light_reach(const DrawList& list, const std::vector<LightSample>& samples)
         hi = glm::max(hi, p);
         any = true;
       }
-  float reach = 0.0f;
-  for (const LightSample& ls : samples)
-    reach = std::max(reach,
-                     glm::length(glm::max(glm::abs(ls.position - lo), glm::abs(ls.position - hi))));
-  if (!any) reach = 1.0f;
-  return std::max(reach, 1e-3f);
+  RVR_TRY_ASSIGN(planned, plan_shadow_maps(options, samples, soft::kMaxImageSide, samples.size(),
+                                           lo, hi, any, warnings));
+  plan = *planned;
+  soft::ShadowSettings settings;
+  settings.size = plan.size;
+  settings.bias = options.shadow_bias;
+  settings.pcf = options.shadow_pcf;
+  settings.projection =
+      glm::dmat4(glm::perspective(glm::radians(90.0f), 1.0f, plan.near_plane, plan.far_plane));
+  return settings;
 }
 
 // Full mode's shadows: a cube of distance maps per light sample, drawn by this z-buffer, in
@@ -218,18 +196,13 @@ float light_reach(const DrawList& list, const std::vector<LightSample>& samples)
 Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSample>& samples,
                           const RenderOptions& options, const soft::FillKernels& kernels,
                           tbb::task_arena& arena, FrameBuffers& fb, RenderOutput& out) {
-  Expected<soft::ShadowSettings> planned = shadow_settings(options, samples.size(), out.warnings);
-  if (!planned) return planned.error();
+  ShadowMapPlan plan;
+  RVR_TRY_ASSIGN(planned, shadow_settings(options, frame.list, samples, plan, out.warnings));
   const auto t = Clock::now();
-  soft::ShadowSettings settings = *planned;
-  // Near and far only clip: the maps hold distances, so a near plane far below any feature size
-  // (1e-6 of the scene's reach from the lights) costs no precision.
-  const float reach = light_reach(frame.list, samples);
-  const float near_plane = 1e-6f * reach, far_plane = 2.0f * reach;
-  settings.projection =
-      glm::dmat4(glm::perspective(glm::radians(90.0f), 1.0f, near_plane, far_plane));
+  const soft::ShadowSettings settings = *planned;
+  const float near_plane = plan.near_plane, far_plane = plan.far_plane;
   const size_t per_sample = 6 * size_t(settings.size) * size_t(settings.size) * sizeof(float);
-  const size_t batch = std::clamp<size_t>(kShadowBatchBytes / per_sample, 1, samples.size());
+  const size_t batch = plan.batch;
   std::optional<DepthTarget> scratch_built;
   arena.execute([&] {
     scratch_built.emplace(settings.size, settings.size, near_plane, far_plane, options.hiz, kernels,
@@ -260,7 +233,7 @@ Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSamp
                                 [&](size_t i, const glm::vec3& P, const glm::vec3& L) {
                                   return cubes[i - first].visibility(P, L, s.geometric, settings);
                                 },
-                                fb.color[o]);
+                                fb.colour[o]);
                           }
                         });
     });
@@ -321,12 +294,11 @@ void note_what_is_left_out(const Scene& scene, const RenderOptions& options,
 Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options,
                                    std::optional<DepthTarget>& kept) {
   const int w = scene.image.width, h = scene.image.height;
-  if (Status size = check_image_size(w, h); !size) return size.error();
+  RVR_TRY(check_image_size(w, h));
   RenderOutput out;
   ProgressSink* const progress = options.progress;
   // The per-pixel kernels: RenderOptions::isa, else RVR_ISA, else the best this CPU runs.
-  const Expected<Isa> resolved_isa = resolve_isa(options.isa);
-  if (!resolved_isa) return resolved_isa.error();
+  RVR_TRY_ASSIGN(resolved_isa, resolve_isa(options.isa));
   const Isa isa = *resolved_isa;
   const soft::FillKernels& kernels = soft::fill_kernels(isa);
   out.info["kernel"] = kernels.isa;
@@ -335,9 +307,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   // Setup: the objects' meshes and materials (the tessellations live until shading ends).
   auto t = Clock::now();
   const auto t_visibility = t;
-  Expected<PreparedScene> prepared =
-      prepare_objects(scene, options.spheres, options.sphere_segments);
-  if (!prepared) return prepared.error();
+  RVR_TRY_ASSIGN(prepared, prepare_objects(scene, options.spheres, options.sphere_segments));
   const SceneDraws draws = scene_draws(*prepared);
   const DrawList& list = draws.list;
   const glm::dmat4 view_projection = camera_view_projection(scene, options, w, h);
@@ -398,8 +368,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   // Shadows (full mode): the lights, seen through this z-buffer's shadow cubes.
   if (shadows) {
     const VisibleFrame frame{scene, list, target, surfaces ? &*surfaces : nullptr, fb};
-    if (Status lit = add_shadowed_light(frame, samples, options, kernels, arena, fb, out); !lit)
-      return lit.error();
+    RVR_TRY(add_shadowed_light(frame, samples, options, kernels, arena, fb, out));
   }
 
   record_draw_stats(drawn, target, submitted, shade, fb, out);

@@ -9,7 +9,7 @@
 #include <memory>
 #include <utility>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 
 #ifdef __linux__
 #include <sys/mman.h>

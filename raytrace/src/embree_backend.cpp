@@ -8,11 +8,11 @@
 #include <vector>
 
 #include "embree_abi.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/plugin.h"
+#include "rvr/core/scene.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/ray_tracer.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/plugin.h"
-#include "rvr/shared/scene.h"
 
 namespace rvr {
 namespace {

@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "embree_abi.h"
+#include "rvr/core/check.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/check.h"
 
 namespace rvr {
 

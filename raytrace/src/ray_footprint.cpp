@@ -4,8 +4,8 @@
 #include <cmath>
 #include <vector>
 
-#include "rvr/shared/check.h"
-#include "rvr/shared/surface_colour.h"
+#include "rvr/core/check.h"
+#include "rvr/core/surface_colour.h"
 
 namespace rvr {
 

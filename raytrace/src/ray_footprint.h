@@ -15,9 +15,9 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 
-#include "rvr/shared/camera.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/texture.h"
+#include "rvr/core/camera.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
 
 namespace rvr {
 

@@ -21,24 +21,25 @@
 #include <variant>
 #include <vector>
 
+#include "ray_counters.h"
 #include "ray_footprint.h"
+#include "rvr/core/camera.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/progress.h"
+#include "rvr/core/shade_batch.h"
+#include "rvr/core/shade_kernel.h"
+#include "rvr/core/shading.h"
+#include "rvr/core/surface_colour.h"
+#include "rvr/core/texture.h"
+#include "rvr/core/timer.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/camera.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/image_sample.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/progress.h"
-#include "rvr/shared/shade_batch.h"
-#include "rvr/shared/shade_kernel.h"
-#include "rvr/shared/shading.h"
-#include "rvr/shared/surface_colour.h"
-#include "rvr/shared/texture.h"
-#include "rvr/shared/timer.h"
 #include "screen_bounds.h"
 #include "tile_output.h"
 
@@ -80,37 +81,6 @@ class PixelRng {
 
  private:
   uint64_t state_;
-};
-
-struct RayCounters {
-  uint64_t primary = 0, shadow = 0, reflection = 0, refraction = 0;
-  // render_visible: pixels whose hit was rebuilt from the given ids, traced instead (missed or
-  // empty), and won by a CSG object.
-  // Of those traced, the ones whose named primitive the ray missed (silhouettes, edges).
-  uint64_t rebuilt = 0, fallback_traced = 0, fallback_missed = 0, csg_pixels = 0;
-  // render_visible: empty pixels left as background without a ray (may_hide_a_surface).
-  uint64_t background = 0;
-  TraversalCounters traversal;
-  // Thread time spent on tiles, and of it after the primary hits were known (surfaces, AOVs,
-  // shading): how a frame's time divides between visibility and shading.
-  double busy_seconds = 0, shade_seconds = 0;
-
-  uint64_t rays() const { return primary + shadow + reflection + refraction; }
-  void add(const RayCounters& o) {
-    primary += o.primary;
-    shadow += o.shadow;
-    reflection += o.reflection;
-    refraction += o.refraction;
-    rebuilt += o.rebuilt;
-    fallback_traced += o.fallback_traced;
-    fallback_missed += o.fallback_missed;
-    csg_pixels += o.csg_pixels;
-    background += o.background;
-    traversal.nodes_visited += o.traversal.nodes_visited;
-    traversal.primitive_tests += o.traversal.primitive_tests;
-    busy_seconds += o.busy_seconds;
-    shade_seconds += o.shade_seconds;
-  }
 };
 
 // The lod AOV where the visible surface is not textured.
@@ -378,7 +348,7 @@ class FrameTracer {
         } else if (mode == RenderMode::Visibility) {
           // Visibility is the hit's distance and ids: no surface, no shading.
           const auto [object, primitive] = geometry_.hit_ids(hit);
-          out.color[i] = scene_.image.background;
+          out.colour[i] = scene_.image.background;
           out.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
           out.object_id[i] = object;
           out.primitive_id[i] = primitive;
@@ -424,11 +394,11 @@ class FrameTracer {
           out.object_id[i] = s.object;
           out.primitive_id[i] = s.primitive;
           out.normal[i] = N;
-          out.color[i] =
+          out.colour[i] =
               shade(ray, s, N, V, 0, counters, nullptr, textured_footprint(),
                     textured_ ? &out.lod[i] : nullptr, given && given[k] ? &given_lod[k] : nullptr);
         }
-        if (supersampled) out.color[i] = supersample(x, y, counters);
+        if (supersampled) out.colour[i] = supersample(x, y, counters);
         // Work for this pixel: its centre ray and every ray its shading traced.
         out.cost[i] = options_.cost_aov ? float(work[k].nodes_visited + work[k].primitive_tests +
                                                 counters.traversal.nodes_visited +
@@ -444,7 +414,7 @@ class FrameTracer {
         out.normal[i] = {batch.shading_normal[0][slot], batch.shading_normal[1][slot],
                          batch.shading_normal[2][slot]};
         if (!supersampled)
-          out.color[i] = {batch.colour[0][slot], batch.colour[1][slot], batch.colour[2][slot]};
+          out.colour[i] = {batch.colour[0][slot], batch.colour[1][slot], batch.colour[2][slot]};
       }
     }
     counters.shade_seconds += seconds_since(start);
@@ -776,8 +746,7 @@ Expected<std::map<std::string, double>> RayTracer::add_visible_sample(
                  ErrorKind::Internal};
   RenderOptions resolved = options;
   resolved.accel = geometry.accel();
-  const Expected<Isa> isa = resolve_isa(options.isa);
-  if (!isa) return isa.error();
+  RVR_TRY_ASSIGN(isa, resolve_isa(options.isa));
   FrameTracer tracer(scene, resolved, geometry, shade_kernels(*isa));
   const ImageSample sample =
       image_sample(scene.camera, options.seed, k, spp, options.mode == RenderMode::Full);
@@ -785,17 +754,9 @@ Expected<std::map<std::string, double>> RayTracer::add_visible_sample(
       for_each_tile(w, h, options.threads, [&](int x0, int y0, int x1, int y1, RayCounters& c) {
         tracer.sample_block_visible(x0, y0, x1, y1, visible, k, sample, sum.data(), c);
       });
-  return std::map<std::string, double>{
-      {"rays.primary", double(total.primary)},
-      {"rays.shadow", double(total.shadow)},
-      {"rays.reflection", double(total.reflection)},
-      {"rays.refraction", double(total.refraction)},
-      {"hybrid.rebuilt", double(total.rebuilt)},
-      {"hybrid.fallback_traced", double(total.fallback_traced)},
-      {"hybrid.fallback_missed", double(total.fallback_missed)},
-      {"hybrid.csg_pixels", double(total.csg_pixels)},
-      {"bvh.nodes_visited", double(total.traversal.nodes_visited)},
-      {"primitive_tests", double(total.traversal.primitive_tests)}};
+  std::map<std::string, double> stats;
+  total.report(stats, /*visible=*/true, /*own_traversal=*/resolved.accel != AccelKind::Embree);
+  return stats;
 }
 
 Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderOptions& requested,
@@ -808,8 +769,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   if (w <= 0 || h <= 0) return bad_input("image size must be positive");
 
   // The shading kernels: chosen as the wide BVH's kernels are.
-  const Expected<Isa> isa = resolve_isa(options.isa);
-  if (!isa) return isa.error();
+  RVR_TRY_ASSIGN(isa, resolve_isa(options.isa));
   auto t_render = Clock::now();
   out.buffers.allocate(w, h);  // every pixel is written below, in parallel
   if (std::any_of(scene.objects.begin(), scene.objects.end(),
@@ -860,23 +820,9 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   out.stats["time.visibility"] = render_seconds - out.stats["time.shade"];
   out.info["shade_kernel"] = shade_kernels(*isa).isa;
 
-  out.stats["rays.primary"] = double(total.primary);
-  out.stats["rays.shadow"] = double(total.shadow);
-  out.stats["rays.reflection"] = double(total.reflection);
-  out.stats["rays.refraction"] = double(total.refraction);
-  if (visible) {
-    out.stats["hybrid.rebuilt"] = double(total.rebuilt);
-    out.stats["hybrid.fallback_traced"] = double(total.fallback_traced);
-    out.stats["hybrid.fallback_missed"] = double(total.fallback_missed);
-    out.stats["hybrid.csg_pixels"] = double(total.csg_pixels);
-    out.stats["hybrid.background"] = double(total.background);
-  }
-  if (options.accel != AccelKind::Embree) {  // Embree does not count its traversal steps
-    out.stats["bvh.nodes_visited"] = double(total.traversal.nodes_visited);
-    out.stats["primitive_tests"] = double(total.traversal.primitive_tests);
-  } else {
+  total.report(out.stats, visible != nullptr, options.accel != AccelKind::Embree);
+  if (options.accel == AccelKind::Embree)  // Embree does not count its traversal steps
     out.warnings.push_back("embree does not report traversal work: the cost AOV is 0");
-  }
   out.stats["primitives"] = double(geometry.primitive_count());
   out.stats["triangles"] = double(geometry.triangle_count());
   out.info["accel"] = to_string(options.accel);

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <glm/glm.hpp>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 
 namespace rvr {
 

@@ -1,8 +1,8 @@
 // Where a box can appear on screen: the pixels whose centre rays may meet it.
 #pragma once
 
+#include "rvr/core/camera.h"
 #include "rvr/raytrace/bvh.h"
-#include "rvr/shared/camera.h"
 
 namespace rvr {
 

@@ -9,7 +9,7 @@
 #include <glm/glm.hpp>
 #include <limits>
 
-#include "rvr/shared/framebuffers.h"
+#include "rvr/core/framebuffers.h"
 
 namespace rvr {
 
@@ -27,7 +27,7 @@ class TileOutput {
   size_t index(int x, int y) const { return size_t(y - y0_) * kMaxWidth + size_t(x - x0_); }
 
   void set_background(size_t i, const glm::vec3& background) {
-    color[i] = background;
+    colour[i] = background;
     depth[i] = std::numeric_limits<float>::infinity();
     object_id[i] = kNoId;
     primitive_id[i] = kNoId;
@@ -37,7 +37,7 @@ class TileOutput {
 
   // Every staged pixel into fb.
   void write_to(FrameBuffers& fb) const {
-    copy_rows(color, fb.color.data(), fb);
+    copy_rows(colour, fb.colour.data(), fb);
     copy_rows(normal, fb.normal.data(), fb);
     copy_rows(depth, fb.depth.data(), fb);
     copy_rows(object_id, fb.object_id.data(), fb);
@@ -46,7 +46,7 @@ class TileOutput {
     if (!fb.lod.empty()) copy_rows(lod, fb.lod.data(), fb);
   }
 
-  glm::vec3 color[kMaxWidth * kMaxHeight];
+  glm::vec3 colour[kMaxWidth * kMaxHeight];
   glm::vec3 normal[kMaxWidth * kMaxHeight];
   float depth[kMaxWidth * kMaxHeight];
   uint32_t object_id[kMaxWidth * kMaxHeight];

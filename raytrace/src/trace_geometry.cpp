@@ -5,9 +5,9 @@
 #include <type_traits>
 
 #include "embree_backend.h"
+#include "rvr/core/check.h"
+#include "rvr/core/tessellate.h"
 #include "rvr/raytrace/traversal_kernels.h"
-#include "rvr/shared/check.h"
-#include "rvr/shared/tessellate.h"
 
 namespace rvr {
 namespace {

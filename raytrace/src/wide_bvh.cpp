@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 
 namespace rvr {
 namespace {

@@ -11,9 +11,9 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/timer.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/timer.h"
 
 namespace rvr {
 
@@ -81,8 +81,7 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
   // Every name is checked before the first, possibly long, render.
   std::vector<std::unique_ptr<Renderer>> made;
   for (const std::string& name : names) {
-    Expected<std::unique_ptr<Renderer>> r = make_renderer(name, compare.config);
-    if (!r) return r.error();
+    RVR_TRY_ASSIGN(r, make_renderer(name, compare.config));
     made.push_back(std::move(r).value());
   }
 
@@ -90,8 +89,7 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
   for (size_t i = 0; i < made.size(); ++i) {
     phase(std::to_string(i + 1) + "/" + std::to_string(made.size()) + " " + names[i], "render");
     auto start = Clock::now();
-    Expected<RenderOutput> out = made[i]->render(scene, options);
-    if (!out) return out.error();
+    RVR_TRY_ASSIGN(out, made[i]->render(scene, options));
     ComparedRenderer r;
     r.name = names[i];
     r.seconds = seconds_since(start);
@@ -114,7 +112,7 @@ CompareResult compare_rendered(const Scene& scene, std::vector<ComparedRenderer>
   result.renderers = std::move(rendered);
   for (ComparedRenderer& r : result.renderers) {
     const FrameBuffers& fb = r.output.buffers;
-    r.image = color_image(fb);
+    r.image = colour_image(fb);
     double total = 0;
     for (float c : fb.cost) total += c;
     r.has_cost = total > 0;

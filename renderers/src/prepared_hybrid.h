@@ -4,12 +4,12 @@
 
 #include <memory>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/hybrid/hybrid_renderer.h"
 #include "rvr/renderers/prepared_renderer.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
 
 namespace rvr {
 

@@ -6,9 +6,9 @@
 #include <memory>
 #include <utility>
 
+#include "rvr/core/framebuffers.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/renderers/prepared_renderer.h"
-#include "rvr/shared/framebuffers.h"
 
 namespace rvr {
 

@@ -4,8 +4,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "rvr/core/scene.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/scene.h"
 
 namespace rvr {
 
@@ -32,8 +32,7 @@ Expected<std::unique_ptr<PreparedRenderer>> prepare_renderer(const RendererChoic
                                                              RenderOptions options) {
   choice.apply(config, options);
   if (choice.info->prepare) return choice.info->prepare(scene, config, options);
-  Expected<std::unique_ptr<Renderer>> renderer = choice.info->create(config);
-  if (!renderer) return renderer.error();
+  RVR_TRY_ASSIGN(renderer, choice.info->create(config));
   return std::unique_ptr<PreparedRenderer>(
       std::make_unique<RenderAfresh>(std::move(renderer).value(), scene, options));
 }

@@ -10,12 +10,12 @@
 
 #include "prepared_hybrid.h"
 #include "prepared_tracer.h"
+#include "rvr/core/check.h"
+#include "rvr/core/framebuffers.h"
 #include "rvr/hybrid/hybrid_renderer.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
-#include "rvr/shared/check.h"
-#include "rvr/shared/framebuffers.h"
 
 namespace rvr {
 

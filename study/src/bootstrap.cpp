@@ -6,7 +6,7 @@
 #include <limits>
 #include <utility>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 
 namespace rvr::study {
 

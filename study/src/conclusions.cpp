@@ -15,8 +15,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "rvr/core/expected.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
 #include "rvr/study/counted_work.h"
 #include "rvr/study/crossover.h"
 #include "rvr/study/fit.h"

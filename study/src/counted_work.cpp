@@ -13,7 +13,7 @@
 #include <type_traits>
 #include <utility>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 #include "rvr/study/least_squares.h"
 
 namespace rvr::study {

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "html_text.h"
-#include "rvr/shared/html_escape.h"
+#include "rvr/core/html_escape.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/counted_work.h"
 #include "rvr/study/crossover.h"

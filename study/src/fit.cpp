@@ -120,8 +120,7 @@ Expected<LinearFit> fit_linear(const std::vector<std::vector<double>>& rows,
   std::vector<double> times;
   times.reserve(n);
   for (const Measurement& p : points) times.push_back(typical_seconds(p));
-  Expected<std::vector<double>> fitted = fit_rows(rows, times, use);
-  if (!fitted) return fitted.error();
+  RVR_TRY_ASSIGN(fitted, fit_rows(rows, times, use));
   LinearFit out;
   out.values = *fitted;
   out.quality = fit_quality(rows, times, out.values, use);

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <limits>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 #include "rvr/study/fit.h"
 #include "rvr/study/measurement.h"
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/camera_framing.h"
+#include "rvr/scene_io/camera_framing.h"
 
 namespace rvr::study {
 namespace {

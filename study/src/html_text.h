@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "rvr/shared/html_escape.h"
+#include "rvr/core/html_escape.h"
 
 namespace rvr::study {
 

@@ -9,7 +9,7 @@
 #include <memory>
 #include <string>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 
 namespace rvr::study {
 namespace {
@@ -178,8 +178,7 @@ std::vector<double> lawson_hanson(const Matrix& a, const std::vector<double>& b)
 Expected<std::vector<double>> weighted_least_squares(const Matrix& x, const std::vector<double>& y,
                                                      const std::vector<double>& w,
                                                      const std::vector<bool>& use) {
-  Expected<std::vector<size_t>> cols = used_columns(x, y, w, use);
-  if (!cols) return cols.error();
+  RVR_TRY_ASSIGN(cols, used_columns(x, y, w, use));
   Matrix a;
   std::vector<double> b, scale, beta;
   weighted_system(x, y, w, *cols, a, b, scale);
@@ -195,8 +194,7 @@ Expected<std::vector<double>> nonnegative_least_squares(const Matrix& x,
                                                         const std::vector<double>& y,
                                                         const std::vector<double>& w,
                                                         const std::vector<bool>& use) {
-  Expected<std::vector<size_t>> cols = used_columns(x, y, w, use);
-  if (!cols) return cols.error();
+  RVR_TRY_ASSIGN(cols, used_columns(x, y, w, use));
   Matrix a;
   std::vector<double> b, scale;
   weighted_system(x, y, w, *cols, a, b, scale);

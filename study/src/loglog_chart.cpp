@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "html_text.h"
-#include "rvr/shared/html_escape.h"
+#include "rvr/core/html_escape.h"
 
 namespace rvr::study {
 namespace {

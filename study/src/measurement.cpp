@@ -5,7 +5,7 @@
 #include <cmath>
 #include <memory>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 
 namespace rvr::study {
 

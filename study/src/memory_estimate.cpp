@@ -14,10 +14,10 @@
 #include <tuple>
 #include <utility>
 
+#include "rvr/core/check.h"
+#include "rvr/core/scene.h"
 #include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/check.h"
-#include "rvr/shared/scene.h"
 #include "rvr/study/renderer_frames.h"
 #include "rvr/study/run_study.h"
 #include "rvr/study/study_markdown.h"
@@ -188,8 +188,7 @@ Expected<MemoryProbe> probe_memory_here(const std::vector<std::string>& renderer
                                         const Family& family, size_t n, int width) {
   std::vector<RendererChoice> choices;
   for (const std::string& name : renderers) {
-    Expected<RendererChoice> c = find_renderer_choice(name);
-    if (!c) return c.error();
+    RVR_TRY_ASSIGN(c, find_renderer_choice(name));
     choices.push_back(*c);
   }
   // Every block of 1 MiB or more mapped on its own and unmapped when freed, as glibc does by
@@ -198,9 +197,7 @@ Expected<MemoryProbe> probe_memory_here(const std::vector<std::string>& renderer
   // so that the parts grow with N alike at both.
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
   // What every session holds beside its point.
-  Expected<std::unique_ptr<FrameSource>> reference =
-      prepare_frames(renderers, mode, family, family.low, width);
-  if (!reference) return reference.error();
+  RVR_TRY_ASSIGN(reference, prepare_frames(renderers, mode, family, family.low, width));
   // What a session leaves behind from the point it measured before (the planned N below: the
   // first session goes up in N), still resident when the next is prepared.
   Family all = family;
@@ -209,9 +206,7 @@ Expected<MemoryProbe> probe_memory_here(const std::vector<std::string>& renderer
   for (size_t planned : sweep_ns(all))
     if (planned < n && planned > family.low) before = planned;
   if (before > 0) {
-    Expected<std::unique_ptr<FrameSource>> earlier =
-        prepare_frames(renderers, mode, family, before, width);
-    if (!earlier) return earlier.error();
+    RVR_TRY_ASSIGN(earlier, prepare_frames(renderers, mode, family, before, width));
     for (size_t k = 0; k < renderers.size(); ++k)
       if (Expected<FrameTime> t = (*earlier)->time_frame(k); !t) return t.error();
   }
@@ -222,8 +217,7 @@ Expected<MemoryProbe> probe_memory_here(const std::vector<std::string>& renderer
   {
     Part part(reset_ok);
     p.baseline_bytes = part.before();
-    Expected<Scene> built = family_scene(family, n, width);
-    if (!built) return built.error();
+    RVR_TRY_ASSIGN(built, family_scene(family, n, width));
     scene = std::make_unique<Scene>(std::move(*built));
     std::tie(p.scene_bytes, p.scene_peak_bytes) = part.end(p.baseline_bytes, p.peak_bytes);
   }
@@ -232,8 +226,7 @@ Expected<MemoryProbe> probe_memory_here(const std::vector<std::string>& renderer
   std::vector<std::unique_ptr<PreparedRenderer>> prepared;
   for (const RendererChoice& choice : choices) {
     Part part(reset_ok);
-    Expected<std::unique_ptr<PreparedRenderer>> r = prepare_renderer(choice, *scene, {}, options);
-    if (!r) return r.error();
+    RVR_TRY_ASSIGN(r, prepare_renderer(choice, *scene, {}, options));
     if (Expected<RenderOutput> first = (*r)->render(); !first) return first.error();
     prepared.push_back(std::move(*r));
     auto [grown, peak] = part.end(part.before(), p.peak_bytes);
@@ -257,8 +250,7 @@ Expected<FamilyMemory> check_family_memory(const Family& family,
   m.scene = family.name;
   m.renderers = renderers;
   for (size_t n : memory_probe_ns(family)) {
-    Expected<MemoryProbe> p = probe(family, n, width);
-    if (!p) return p.error();
+    RVR_TRY_ASSIGN(p, probe(family, n, width));
     if (p->retained_bytes.size() != renderers.size())
       return internal_error(fmt::format("study: a memory probe of {} measured {} renderers, not {}",
                                         family.name, p->retained_bytes.size(), renderers.size()));

@@ -224,10 +224,9 @@ std::string merged_run_id(const std::vector<std::string>& runs) {
 
 Expected<StudyResult> pool(const std::vector<const StudySource*>& sources) {
   StudyResult r;
-  if (Status s = pool_request(sources, r); !s) return s.error();
+  RVR_TRY(pool_request(sources, r));
   PointPool points;
-  for (const StudySource* s : sources)
-    if (Status added = points.add(*s, r); !added) return added.error();
+  for (const StudySource* s : sources) RVR_TRY(points.add(*s, r));
   r.run_id = merged_run_id(r.merged_runs);
   r.points = points.sorted(r);
   std::vector<std::string> names;
@@ -259,8 +258,7 @@ Expected<std::vector<MachineGroup>> merge_studies(const std::vector<StudySource>
   std::set<std::string> slugs;
   for (const GroupKey& key : keys) {
     const std::vector<const StudySource*>& group = members[key];
-    Expected<StudyResult> study = pool(group);
-    if (!study) return study.error();
+    RVR_TRY_ASSIGN(study, pool(group));
     MachineGroup g;
     const MachineInfo& m = study->machine;
     g.label = fmt::format("{}, {} threads, kernels {}, {} mode", m.cpu, m.threads, m.kernels,

@@ -8,10 +8,10 @@
 #include <utility>
 #include <variant>
 
+#include "rvr/core/scene.h"
 #include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/scene_loader.h"
 #include "rvr/study/grid_of_copies.h"
 
 namespace rvr::study {
@@ -35,17 +35,14 @@ class RendererFrames : public FrameSource {
       : scene_(std::move(scene)), axis_(axis) {}
 
   Status add(const std::string& name, const RenderOptions& options) {
-    Expected<RendererChoice> choice = find_renderer_choice(name);
-    if (!choice) return choice.error();
+    RVR_TRY_ASSIGN(choice, find_renderer_choice(name));
     const auto start = std::chrono::steady_clock::now();
-    Expected<std::unique_ptr<PreparedRenderer>> p = prepare_renderer(*choice, *scene_, {}, options);
-    if (!p) return p.error();
+    RVR_TRY_ASSIGN(p, prepare_renderer(*choice, *scene_, {}, options));
     prepare_seconds_.push_back(seconds_since(start));
     prepared_.push_back(std::move(*p));
     // The first frame (thread start, first touch of the frame buffers) is not timed; its
     // counters are every frame's.
-    Expected<RenderOutput> first = prepared_.back()->render();
-    if (!first) return first.error();
+    RVR_TRY_ASSIGN(first, prepared_.back()->render());
     std::map<std::string, double> work;
     for (const auto& [stat, value] : first->stats)
       if (is_work_counter(stat)) work[stat] = value;
@@ -99,8 +96,7 @@ class InProcessSession : public Session {
 
 Expected<Scene> family_scene(const Family& family, size_t n, int width) {
   if (family.source.empty()) {
-    Expected<Scene> scene = make_builtin_scene(family.name + ":" + std::to_string(n));
-    if (!scene) return scene.error();
+    RVR_TRY_ASSIGN(scene, make_builtin_scene(family.name + ":" + std::to_string(n)));
     scene->image.width = width;
     scene->image.height = width * 3 / 4;
     return scene;
@@ -108,8 +104,7 @@ Expected<Scene> family_scene(const Family& family, size_t n, int width) {
   SceneOverrides size;
   size.width = width;
   size.height = width * 3 / 4;
-  Expected<Scene> base = load_scene(family.source, size);
-  if (!base) return base.error();
+  RVR_TRY_ASSIGN(base, load_scene(family.source, size));
   return grid_of_copies(*base, n);
 }
 
@@ -125,14 +120,12 @@ bool is_work_counter(const std::string& stat) {
 Expected<std::unique_ptr<FrameSource>> prepare_frames(const std::vector<std::string>& renderers,
                                                       RenderMode mode, const Family& family,
                                                       size_t n, int width) {
-  Expected<Scene> scene = family_scene(family, n, width);
-  if (!scene) return scene.error();
+  RVR_TRY_ASSIGN(scene, family_scene(family, n, width));
   double axis = axis_value_of(*scene, family, n);
   auto frames = std::make_unique<RendererFrames>(std::make_unique<Scene>(std::move(*scene)), axis);
   RenderOptions options;
   options.mode = mode;
-  for (const std::string& name : renderers)
-    if (Status s = frames->add(name, options); !s) return s.error();
+  for (const std::string& name : renderers) RVR_TRY(frames->add(name, options));
   return std::unique_ptr<FrameSource>(std::move(frames));
 }
 

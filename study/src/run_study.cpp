@@ -12,8 +12,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "rvr/core/check.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/check.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/crossover.h"
@@ -184,27 +184,22 @@ Expected<OpenSession> Sweep::open_session(const Family& family) {
   info.system = probe();
   info.study = result_.run_id;
   open.other_work = shows_other_work(info.system);
-  Expected<std::unique_ptr<Session>> session = hooks_.start_session();
-  if (!session) return session.error();
+  RVR_TRY_ASSIGN(session, hooks_.start_session());
   open.session = std::move(*session);
   info.kind = open.session->kind();
   open.index = int(result_.sessions.size());
   result_.sessions.push_back(info);
-  Expected<std::unique_ptr<FrameSource>> reference =
-      open.session->prepare(family, family.low, request_.width);
-  if (!reference) return reference.error();
+  RVR_TRY_ASSIGN(reference, open.session->prepare(family, family.low, request_.width));
   open.reference = std::move(*reference);
   if (f_->quickest_reference == kInfinity) {
     f_->reference_frames = 1;
-    Expected<FrameTime> one = open.reference->time_frame(0);
-    if (!one) return one.error();
+    RVR_TRY_ASSIGN(one, open.reference->time_frame(0));
     f_->reference_frames =
         int(std::clamp(std::ceil(kReferenceSeconds / one->seconds), 1.0, 1000.0));
   }
   std::vector<double> times;
   for (int k = 0; k < 5 && !stopped(); ++k) {
-    Expected<double> t = time_reference(*open.reference);
-    if (!t) return t.error();
+    RVR_TRY_ASSIGN(t, time_reference(*open.reference));
     times.push_back(*t);
   }
   if (!times.empty()) f_->quickest_reference = std::min(f_->quickest_reference, median(times));
@@ -215,8 +210,7 @@ Expected<OpenSession> Sweep::open_session(const Family& family) {
 Expected<double> Sweep::time_reference(FrameSource& reference) {
   double total = 0;
   for (int k = 0; k < f_->reference_frames; ++k) {
-    Expected<FrameTime> t = reference.time_frame(0);
-    if (!t) return t.error();
+    RVR_TRY_ASSIGN(t, reference.time_frame(0));
     total += t->seconds;
   }
   return total;
@@ -278,8 +272,7 @@ Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession
                                        width, width * 3 / 4, session.index + 1);
   if (stopped()) return ok_status();
   progress(what + ": preparing");
-  Expected<std::unique_ptr<FrameSource>> frames = session.session->prepare(family, n, width);
-  if (!frames) return frames.error();
+  RVR_TRY_ASSIGN(frames, session.session->prepare(family, n, width));
   std::vector<Run> runs(request_.renderers.size());
   for (size_t i = 0; i < runs.size(); ++i) {
     runs[i].session = session.index;
@@ -364,10 +357,10 @@ Expected<bool> Sweep::try_first_run(const Family& family, size_t n, int width, d
     return false;
   // Up to the largest probe's N a session holds no more than the probe did.
   if (!f_->memory_checked && hooks_.probe_memory && n > memory_probe_ns(family).back())
-    if (Status s = check_memory(family); !s) return s.error();
+    RVR_TRY(check_memory(family));
   if (f_->max_n > 0 && n > f_->max_n) return false;
   double before = elapsed();
-  if (Status s = measure_run(family, n, width, session, f_->points); !s) return s.error();
+  RVR_TRY(measure_run(family, n, width, session, f_->points));
   if (!f_->points.index.count({n, width})) return false;  // cut short
   if (width == request_.width) f_->cost.add(n, elapsed() - before);
   f_->first_session_order.push_back({n, width});
@@ -379,8 +372,7 @@ Status Sweep::sweep_n(const Family& family, double limit, OpenSession& session) 
   for (size_t n : sweep_ns(family)) {
     if (stopped()) return ok_status();
     if (!in_this_shard(n, request_.width)) continue;
-    Expected<bool> done = try_first_run(family, n, request_.width, limit, session);
-    if (!done) return done.error();
+    RVR_TRY_ASSIGN(done, try_first_run(family, n, request_.width, limit, session));
     if (!*done) {
       if (f_->max_n == 0 || n <= f_->max_n)  // else the memory's note says why
         result_.notes.push_back(
@@ -405,8 +397,7 @@ Status Sweep::sweep_pixels(const Family& family, double limit, OpenSession& sess
     for (int width : pixel_sweep_widths(request_.width)) {
       if (stopped()) return ok_status();
       if (!in_this_shard(n, width)) continue;
-      Expected<bool> done = try_first_run(family, n, width, limit, session);
-      if (!done) return done.error();
+      RVR_TRY_ASSIGN(done, try_first_run(family, n, width, limit, session));
       if (!*done && !f_->points.index.count({n, width})) {
         result_.notes.push_back(fmt::format(
             "{}: the pixel sweep stopped at {}, {} wide (it would have overrun the budget)",
@@ -422,8 +413,7 @@ Status Sweep::more_sessions(const Family& family, double limit) {
   size_t skipped = 0;
   for (int s = 1; s < request_.sessions; ++s) {
     if (stopped()) return ok_status();
-    Expected<OpenSession> session = open_session(family);
-    if (!session) return session.error();
+    RVR_TRY_ASSIGN(session, open_session(family));
     std::vector<PointKey> order = f_->first_session_order;
     for (size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng_.below(i)]);
     for (PointKey p : order) {
@@ -432,7 +422,7 @@ Status Sweep::more_sessions(const Family& family, double limit) {
         ++skipped;
         continue;
       }
-      if (Status st = measure_run(family, p.first, p.second, *session, f_->points); !st) return st;
+      RVR_TRY(measure_run(family, p.first, p.second, *session, f_->points));
     }
   }
   if (skipped > 0)
@@ -459,13 +449,11 @@ Status Sweep::refine_near_crossovers(const Family& family, double share_end) {
     if (mids.empty()) return ok_status();
     for (int s = 0; s < request_.sessions; ++s) {
       if (stopped()) return ok_status();
-      Expected<OpenSession> session = open_session(family);
-      if (!session) return session.error();
+      RVR_TRY_ASSIGN(session, open_session(family));
       for (size_t i = mids.size(); i > 1; --i) std::swap(mids[i - 1], mids[rng_.below(i)]);
       for (size_t mid : mids) {
         if (stopped()) return ok_status();
-        if (Status st = measure_run(family, mid, request_.width, *session, f_->points); !st)
-          return st;
+        RVR_TRY(measure_run(family, mid, request_.width, *session, f_->points));
       }
     }
   }
@@ -488,14 +476,12 @@ Status Sweep::measure_busy_runs_again(const Family& family, double share_end) {
           break;
         }
     if (busy.empty() || stopped() || elapsed() + f_->cost.predict(busy[0].first) > share_end) break;
-    Expected<OpenSession> session = open_session(family);
-    if (!session) return session.error();
+    RVR_TRY_ASSIGN(session, open_session(family));
     for (PointKey point : busy) {
       if (stopped() || elapsed() + f_->cost.predict(point.first) > share_end) break;
       const size_t first = f_->points.index.at(point);
       const size_t before = result_.points[first].runs.size();
-      if (Status s = measure_run(family, point.first, point.second, *session, f_->points); !s)
-        return s;
+      RVR_TRY(measure_run(family, point.first, point.second, *session, f_->points));
       if (result_.points[first].runs.size() == before) break;  // cut short
       if (result_.points[first].runs.back().busy) continue;    // busy again: both kept
       // The first busy run goes, for every renderer (their runs of a session go together).
@@ -568,15 +554,13 @@ Status Sweep::run_family(const Family& family, double share_end) {
   f_->plan_offset = plan_size_;
   plan_size_ += f_->plan.size();
   {
-    Expected<OpenSession> first = open_session(family);
-    if (!first) return first.error();
-    if (Status s = sweep_n(family, share_start + kBaseShare * length, *first); !s) return s;
-    if (Status s = sweep_pixels(family, share_start + kPixelShare * length, *first); !s) return s;
+    RVR_TRY_ASSIGN(first, open_session(family));
+    RVR_TRY(sweep_n(family, share_start + kBaseShare * length, *first));
+    RVR_TRY(sweep_pixels(family, share_start + kPixelShare * length, *first));
   }
-  if (Status s = more_sessions(family, share_start + kPixelShare * length); !s) return s;
+  RVR_TRY(more_sessions(family, share_start + kPixelShare * length));
   // A shard adds none near crossovers: where they go depends on the other shards' points.
-  if (!request_.shard)
-    if (Status s = refine_near_crossovers(family, share_end); !s) return s;
+  if (!request_.shard) RVR_TRY(refine_near_crossovers(family, share_end));
   return measure_busy_runs_again(family, share_end);
 }
 
@@ -592,8 +576,7 @@ Status Sweep::measure_checks(const std::vector<Family>& families) {
           points.push_back({p.scene_n, p.width});
       if (points.empty() || stopped()) continue;
       f_ = &families_[family.name];
-      Expected<OpenSession> session = open_session(family);
-      if (!session) return session.error();
+      RVR_TRY_ASSIGN(session, open_session(family));
       for (size_t i = points.size(); i > 1; --i) std::swap(points[i - 1], points[rng_.below(i)]);
       for (PointKey p : points) {
         if (stopped()) break;
@@ -608,8 +591,7 @@ Status Sweep::measure_checks(const std::vector<Family>& families) {
           ++skipped;
           continue;
         }
-        if (Status st = measure_run(family, p.first, p.second, *session, f_->checks); !st)
-          return st;
+        RVR_TRY(measure_run(family, p.first, p.second, *session, f_->checks));
       }
     }
   if (skipped > 0)
@@ -627,7 +609,7 @@ Status Sweep::measure_checks(const std::vector<Family>& families) {
 }  // namespace
 
 Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& hooks) {
-  if (Status s = validate(request); !s) return s.error();
+  RVR_TRY(validate(request));
   StudyResult result;
   result.renderers = request.renderers;
   result.width = request.width;
@@ -660,7 +642,7 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
     double left = sweep_budget - sweep.elapsed();
     double share_end = sweep.elapsed() + left / double(request.scenes.size() - i);
     if (sweep.stopped()) continue;
-    if (Status s = sweep.run_family(family, share_end); !s) return s.error();
+    RVR_TRY(sweep.run_family(family, share_end));
   }
   if (sweep.cancelled()) {
     result.interrupted = true;
@@ -677,7 +659,7 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   conclude(result, boot);
   sweep.exclude(sweep.elapsed() - before_fits);
   if (!result.interrupted && checks && !sweep.stopped() && !result.crossovers.empty()) {
-    if (Status s = sweep.measure_checks(families); !s) return s.error();
+    RVR_TRY(sweep.measure_checks(families));
     // Checks cut short are evaluated from the points they measured.
     evaluate_checks(result, CompareOptions{boot, request.noise_threshold});
     if (sweep.cancelled()) {

@@ -15,8 +15,8 @@
 #include <utility>
 
 #include "html_text.h"
-#include "rvr/shared/check.h"
-#include "rvr/shared/html_escape.h"
+#include "rvr/core/check.h"
+#include "rvr/core/html_escape.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/cost_model.h"
 #include "rvr/study/study.h"

@@ -17,7 +17,7 @@
 #include "counted_work_text.h"
 #include "html_text.h"
 #include "loglog_chart.h"
-#include "rvr/shared/html_escape.h"
+#include "rvr/core/html_escape.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/cost_model.h"
 #include "rvr/study/crossover.h"

@@ -17,8 +17,8 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/expected.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/expected.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/measurement.h"
 #include "rvr/study/study.h"

@@ -11,9 +11,9 @@
 #include <system_error>
 #include <utility>
 
-#include "rvr/shared/check.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/scene_loader.h"
+#include "rvr/core/check.h"
+#include "rvr/core/scene.h"
+#include "rvr/scene_io/scene_loader.h"
 
 namespace rvr::study {
 
@@ -21,8 +21,7 @@ namespace {
 
 // A scene or model file as a family: copies of it, as many as hold kFileFamilyTriangles.
 Expected<Family> file_family(const std::string& path) {
-  Expected<Scene> scene = load_scene(path);
-  if (!scene) return scene.error();
+  RVR_TRY_ASSIGN(scene, load_scene(path));
   double per_copy = 0;
   for (const Object& o : scene->objects)
     if (o.type == ObjectType::Triangles)

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 
 namespace rvr::study {
 

@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <string>
 
-#include "rvr/shared/scene_loader.h"
+#include "rvr/scene_io/scene_loader.h"
 
 namespace rvr::fuzz {
 

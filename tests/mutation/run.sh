@@ -82,18 +82,18 @@ build_and_test() {  # $1: name for the log; prints the failed cases, one per lin
 mutate() {  # $1 name
   case $1 in
     ambient)  # emission + ambient * diffuse -> emission, in C++ and GLSL
-      apply shared/include/rvr/shared/shading.h 's/return m.emission + ambient \* m.diffuse;/return m.emission;/'
+      apply core/include/rvr/core/shading.h 's/return m.emission + ambient \* m.diffuse;/return m.emission;/'
       apply raster/src/gl_shaders.h 's/u_emission + u_ambient \* u_diffuse/u_emission/' ;;
     shininess)  # the exponent halved, in C++ and GLSL
-      apply shared/include/rvr/shared/shading.h 's/specular_power(n_dot_h, m.shininess)/specular_power(n_dot_h, 0.5f * m.shininess)/'
+      apply core/include/rvr/core/shading.h 's/specular_power(n_dot_h, m.shininess)/specular_power(n_dot_h, 0.5f * m.shininess)/'
       apply raster/src/gl_shaders.h 's/specular_power(n_dot_h, u_shininess)/specular_power(n_dot_h, 0.5 * u_shininess)/' ;;
     falloff)  # I / d instead of I / d^2, in C++ and GLSL
-      apply shared/include/rvr/shared/shading.h 's|lights\[i\].intensity / dist2;|lights[i].intensity / std::sqrt(dist2);|'
+      apply core/include/rvr/core/shading.h 's|lights\[i\].intensity / dist2;|lights[i].intensity / std::sqrt(dist2);|'
       apply raster/src/gl_shaders.h 's|light_intensity / dist2;|light_intensity / sqrt(dist2);|' ;;
     psnr)  # 10 log10 instead of 20 log10 of 1 / RMSE
-      apply shared/src/compare.cpp 's/20.0 \* std::log10(1.0 \/ rmse)/10.0 * std::log10(1.0 \/ rmse)/' ;;
+      apply compare/src/compare.cpp 's/20.0 \* std::log10(1.0 \/ rmse)/10.0 * std::log10(1.0 \/ rmse)/' ;;
     triangle)  # the last triangle of every tessellated mesh (spheres, squares) dropped
-      apply shared/src/tessellate.cpp 's/^  return mesh;$/  mesh.triangles.pop_back();\n  return mesh;/' ;;
+      apply core/src/tessellate.cpp 's/^  return mesh;$/  mesh.triangles.pop_back();\n  return mesh;/' ;;
     halfpixel)  # softraster's vertices shifted half a pixel right: it samples at x, not x + 0.5
       apply raster/src/soft/triangle_setup.cpp 's/\* 0.5 + 0.5) \* width_;/* 0.5 + 0.5) * width_ + 0.5;/' ;;
     *) echo "unknown mutation $1" >&2; exit 2 ;;

@@ -192,7 +192,7 @@ def test_mesh_errors_name_the_array():
                                       ("ply_ascii_vertex_count_past_the_file_oom", "ply")])
 def test_model_files_that_overstate_their_size_are_refused_as_by_the_command_line(
         name, ext, run_cli, tmp_path):
-    # The import's allocation budget (shared/src/allocation_budget.h) holds in the module as in
+    # The import's allocation budget (scene_io/src/allocation_budget.h) holds in the module as in
     # the command line: Assimp lives in the model-import plugin, whose operator new forwards
     # to the module's, where the budget is counted. The fuzzers' inputs, first byte dropped.
     source = pathlib.Path(os.environ["RVR_SOURCE_DIR"]) / "tests/fuzz/regressions/mesh" / name

@@ -10,9 +10,9 @@
 #include <limits>
 #include <memory>
 
-#include "rvr/shared/check.h"
-#include "rvr/shared/shade_batch.h"
-#include "rvr/shared/surface_colour.h"
+#include "rvr/core/check.h"
+#include "rvr/core/shade_batch.h"
+#include "rvr/core/surface_colour.h"
 
 namespace rvr::soft {
 
@@ -52,7 +52,7 @@ void fill_vec3(glm::vec3* p, size_t n, const glm::vec3& v) {
 // Sizes fb to w x h; its pixels are left for the caller to write, every one of them.
 void allocate_frame(int w, int h, FrameBuffers& fb) {
   fb.allocate(w, h);
-  ask_for_huge_pages(fb.color);
+  ask_for_huge_pages(fb.colour);
   ask_for_huge_pages(fb.normal);
   ask_for_huge_pages(fb.depth);
   ask_for_huge_pages(fb.object_id);
@@ -188,7 +188,7 @@ class RowShader {
       const size_t o = pixel_[i];
       fb.normal[o] = {batch_.shading_normal[0][i], batch_.shading_normal[1][i],
                       batch_.shading_normal[2][i]};
-      fb.color[o] = {batch_.colour[0][i], batch_.colour[1][i], batch_.colour[2][i]};
+      fb.colour[o] = {batch_.colour[0][i], batch_.colour[1][i], batch_.colour[2][i]};
     }
     batch_.count = 0;
     mixed_ = false;
@@ -197,7 +197,7 @@ class RowShader {
  private:
   // Pixels [o, o + n): the background colour and a zero normal.
   void fill_background(size_t o, size_t n) {
-    fill_vec3(frame_.fb.color.data() + o, n, frame_.settings.background);
+    fill_vec3(frame_.fb.colour.data() + o, n, frame_.settings.background);
     std::memset(static_cast<void*>(frame_.fb.normal.data() + o), 0,
                 n * sizeof(glm::vec3));  // +0.0f is all zero bits
   }
@@ -318,7 +318,7 @@ void write_visibility(const DrawList& list, const DepthTarget& target, const glm
       for (int y = r.begin(); y != r.end(); ++y) {
         const size_t row = fb.index(0, y);
         visibility.write(y, fb);
-        fill_vec3(fb.color.data() + row, size_t(w), background);
+        fill_vec3(fb.colour.data() + row, size_t(w), background);
         std::memset(static_cast<void*>(fb.normal.data() + row), 0,
                     size_t(w) * sizeof(glm::vec3));  // +0.0f is all zero bits
         if (fb.lod.empty()) continue;

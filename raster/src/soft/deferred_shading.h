@@ -1,7 +1,7 @@
 // softraster's deferred shading pass: after the z-buffer pass, every pixel of the frame buffers
 // is written once: the background where nothing was drawn, else depth, ids, the shading normal
 // and the colour, the visible pixels shaded a batch at a time by a SIMD shading kernel
-// (rvr/shared/shade_kernel.h). Visibility mode writes depth, ids and cost only
+// (rvr/core/shade_kernel.h). Visibility mode writes depth, ids and cost only
 // (write_visibility), with the same code for those buffers.
 #pragma once
 
@@ -10,10 +10,10 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/progress.h"
-#include "rvr/shared/scene.h"
-#include "rvr/shared/shade_kernel.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/progress.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/shade_kernel.h"
 #include "soft/draw_triangles.h"
 #include "soft/surface_texture.h"
 #include "soft/tile_raster.h"

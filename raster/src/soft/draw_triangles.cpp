@@ -11,8 +11,8 @@
 #include <memory>
 #include <utility>
 
-#include "rvr/shared/check.h"
-#include "rvr/shared/timer.h"
+#include "rvr/core/check.h"
+#include "rvr/core/timer.h"
 #include "soft/fill_kernel.h"
 #include "soft/huge_page_allocator.h"
 #include "soft/setup_kernel.h"

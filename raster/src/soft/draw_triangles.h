@@ -9,8 +9,8 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "rvr/shared/progress.h"
-#include "rvr/shared/scene.h"
+#include "rvr/core/progress.h"
+#include "rvr/core/scene.h"
 #include "soft/tile_raster.h"
 
 namespace rvr::soft {

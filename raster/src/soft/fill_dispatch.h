@@ -1,7 +1,7 @@
-// The per-pixel kernels of one instruction set (shared/isa.h picks which).
+// The per-pixel kernels of one instruction set (rvr/core/isa.h picks which).
 #pragma once
 
-#include "rvr/shared/isa.h"
+#include "rvr/core/isa.h"
 #include "soft/fill_kernel.h"
 
 namespace rvr::soft {

@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/shared/pixel_memory.h"
+#include "rvr/core/pixel_memory.h"
 
 #if defined(__linux__)
 #include <sys/mman.h>

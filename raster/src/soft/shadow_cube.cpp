@@ -7,29 +7,13 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
 
+#include "shadow_plan.h"
+
 namespace rvr::soft {
 namespace {
 
-// Face f looks along kFaceDirections[f] (0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z), as in the GL
-// raster (gl_rasterizer.cpp), with the same up vectors.
-const std::array<glm::vec3, 6> kFaceDirections = {glm::vec3(1, 0, 0), glm::vec3(-1, 0, 0),
-                                                  glm::vec3(0, 1, 0), glm::vec3(0, -1, 0),
-                                                  glm::vec3(0, 0, 1), glm::vec3(0, 0, -1)};
-
-const std::array<glm::mat3, 6>& face_rotations() {
-  static const std::array<glm::mat3, 6> r = [] {
-    std::array<glm::mat3, 6> m;
-    for (size_t f = 0; f < 6; ++f) {
-      glm::vec3 up =
-          std::abs(kFaceDirections[f].y) > 0.5f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
-      m[f] = glm::mat3(glm::lookAt(glm::vec3(0.0f), kFaceDirections[f], up));
-    }
-    return m;
-  }();
-  return r;
-}
-
-// The major axis of d; ties go to the first (the faces' frusta overlap on their shared edges).
+// The face d falls on, in cube_face_rotations() order: the major axis of d; ties go to the
+// first (the faces' frusta overlap on their shared edges).
 int cube_face(const glm::vec3& d) {
   glm::vec3 a = glm::abs(d);
   if (a.x >= a.y && a.x >= a.z) return d.x >= 0.0f ? 0 : 1;
@@ -46,7 +30,7 @@ void ShadowCube::build(const DrawList& list, const glm::vec3& light, const Shado
   const glm::dmat4 to_light = glm::translate(glm::dmat4(1.0), -glm::dvec3(light));
   for (int f = 0; f < 6; ++f) {
     arena.execute([&] { scratch.clear(); });
-    const glm::dmat4 view = glm::dmat4(glm::mat4(face_rotations()[size_t(f)])) * to_light;
+    const glm::dmat4 view = glm::dmat4(glm::mat4(cube_face_rotations()[size_t(f)])) * to_light;
     DrawResult r = draw_triangles(list, settings.projection * view, scratch, arena, nullptr);
     work.set_up += r.set_up;
     work.counters.generated += r.counters.generated;
@@ -83,7 +67,8 @@ float ShadowCube::visibility(const glm::vec3& P, const glm::vec3& L,
   const glm::vec3 d = P + n * (texel * true_dist) - L;
   const float dist = glm::length(d);
   const int face = cube_face(d);
-  const glm::vec3 e = face_rotations()[size_t(face)] * d;  // eye space of the face, looking down -z
+  const glm::vec3 e =
+      cube_face_rotations()[size_t(face)] * d;  // eye space of the face, looking down -z
   const glm::vec2 uv = glm::vec2(e.x, e.y) / std::max(-e.z, 1e-30f) * 0.5f + 0.5f;
   // Row 0 of a face as drawn is its top (uv.y = 1).
   const int tx = std::clamp(int(std::floor(uv.x * float(size_))), 0, size_ - 1);

@@ -6,8 +6,8 @@
 #include <limits>
 #include <memory>
 
-#include "rvr/shared/surface_colour.h"
-#include "rvr/shared/texture.h"
+#include "rvr/core/surface_colour.h"
+#include "rvr/core/texture.h"
 
 namespace rvr::soft {
 

@@ -10,7 +10,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
-#include "rvr/shared/scene.h"
+#include "rvr/core/scene.h"
 
 namespace rvr::soft {
 

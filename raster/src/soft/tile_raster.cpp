@@ -8,7 +8,7 @@
 #include <cstddef>
 #include <limits>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 #include "soft/triangle_setup.h"
 
 namespace rvr::soft {

@@ -13,7 +13,7 @@
 #include <limits>
 #include <vector>
 
-#include "rvr/shared/framebuffers.h"
+#include "rvr/core/framebuffers.h"
 #include "soft/fill_kernel.h"
 #include "soft/setup_triangle.h"
 

@@ -7,7 +7,7 @@
 #include <memory>
 #include <utility>
 
-#include "rvr/shared/check.h"
+#include "rvr/core/check.h"
 #include "soft/setup_kernel.h"
 
 namespace rvr::soft {

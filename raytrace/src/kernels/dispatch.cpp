@@ -1,6 +1,6 @@
+#include "rvr/core/isa.h"
 #include "rvr/raytrace/traversal_kernels.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/isa.h"
 
 namespace rvr {
 

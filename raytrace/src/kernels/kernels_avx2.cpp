@@ -1,4 +1,5 @@
-// The wide-BVH traversal kernels compiled for avx2 (flags in raytrace/CMakeLists.txt).
+// The wide-BVH traversal kernels compiled for avx2 (flags: RVR_KERNEL_FLAGS_avx2 in the top-level
+// CMakeLists.txt).
 #define RVR_KERNEL_NS isa_avx2
 #define RVR_KERNEL_NAME "avx2"
 #include "wide_kernels.inl"

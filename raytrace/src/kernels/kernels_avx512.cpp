@@ -1,4 +1,5 @@
-// The wide-BVH traversal kernels compiled for avx512 (flags in raytrace/CMakeLists.txt).
+// The wide-BVH traversal kernels compiled for avx512 (flags: RVR_KERNEL_FLAGS_avx512 in the
+// top-level CMakeLists.txt).
 #define RVR_KERNEL_NS isa_avx512
 #define RVR_KERNEL_NAME "avx512"
 #include "wide_kernels.inl"

@@ -1,4 +1,5 @@
-// The wide-BVH traversal kernels compiled for sse (flags in raytrace/CMakeLists.txt).
+// The wide-BVH traversal kernels compiled for sse (flags: RVR_KERNEL_FLAGS_sse in the top-level
+// CMakeLists.txt).
 #define RVR_KERNEL_NS isa_sse
 #define RVR_KERNEL_NAME "sse"
 #include "wide_kernels.inl"

@@ -11,14 +11,14 @@
 // order of traversal.
 #include <cstdint>
 
+#include "rvr/core/check.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/check.h"
 
 #ifndef RVR_KERNEL_NS
 #error "define RVR_KERNEL_NS (isa_sse, isa_avx2 or isa_avx512) before including this file"
 #endif
 
-#include "rvr/shared/simd/simd.h"
+#include "rvr/core/simd/simd.h"
 
 namespace rvr {
 namespace RVR_KERNEL_NS {

@@ -7,11 +7,11 @@
 #include <memory>
 #include <string>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/gl_backend.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/raytrace/trace_geometry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/gl_backend.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
 
 namespace rvr {
 

@@ -1,7 +1,7 @@
 // The C interface of rvr's image codec module (librvr_image_codec.so): OpenImageIO behind a
 // table of plain functions, so that the rvr binaries do not link OpenImageIO and its ~260
 // shared libraries. Runs that read or write no image (rvr --version, rvr scenes, every
-// bad-input error) start without them; shared/src/image_codec_loader.cpp loads the module on
+// bad-input error) start without them; image_codec/src/image_codec_loader.cpp loads the module on
 // the first image read or write. Plain C types only: the module and its host need not agree
 // on any C++ type.
 #pragma once

@@ -7,9 +7,9 @@
 #include <memory>
 #include <string>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 
 namespace rvr {
 

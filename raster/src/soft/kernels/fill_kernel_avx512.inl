@@ -2,13 +2,13 @@
 // pixels a group, so an 8x8 block's row is one group, and the depth test, fragment counts and
 // writes as masked loads and stores instead of a scalar loop over the group's lanes. AVX-512's
 // masks make the uncovered lanes and a row's ragged end free (the AVX2 kernel keeps the scalar
-// loop over the group's lanes: its masked stores do not pay off). Per lane the same double operations as the narrower
-// kernels, in the same order, so the bytes do not depend on the kernel.
+// loop over the group's lanes: its masked stores do not pay off). Per lane the same double
+// operations as the narrower kernels, in the same order, so the bytes do not depend on the kernel.
 #include <immintrin.h>
 
 #include <cstdint>
 
-#include "rvr/shared/simd/simd.h"
+#include "rvr/core/simd/simd.h"
 #include "soft/fill_kernel.h"
 
 namespace rvr::soft {

@@ -13,7 +13,7 @@
 #else
 #include <cstdint>
 
-#include "rvr/shared/simd/simd.h"
+#include "rvr/core/simd/simd.h"
 #include "soft/fill_kernel.h"
 
 namespace rvr::soft {

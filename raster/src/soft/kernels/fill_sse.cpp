@@ -1,4 +1,5 @@
-// softraster's per-pixel and setup kernels compiled for sse (flags in raster/CMakeLists.txt).
+// softraster's per-pixel and setup kernels compiled for sse (flags: RVR_KERNEL_FLAGS_sse in the
+// top-level CMakeLists.txt and raster/CMakeLists.txt's own).
 #define RVR_KERNEL_NS isa_sse
 #define RVR_KERNEL_NAME "sse"
 #include "fill_kernels.inl"

@@ -8,7 +8,7 @@
 #include <glm/glm.hpp>
 #include <utility>
 
-#include "rvr/shared/scene.h"
+#include "rvr/core/scene.h"
 
 namespace rvr {
 
@@ -159,7 +159,7 @@ inline bool intersect_sphere(const Ray& ray, const Sphere& s, float& t_hit) {
 
 // Ray-plane: the plane equation N.(P - point) = 0, then the square's bounds along the
 // plane's axes (u, v from plane_axes).
-inline bool intersect_square(const Ray& ray, const Plane& plane, const glm::vec3& u,
+inline bool intersect_square(const Ray& ray, const Square& plane, const glm::vec3& u,
                              const glm::vec3& v, float& t_hit) {
   float denom = glm::dot(plane.normal, ray.dir);
   if (denom == 0.0f) return false;  // parallel

@@ -1,5 +1,5 @@
 // The rays through the pixel centres of one frame, from the camera's eye. camera_ray_direction
-// (rvr/shared/camera.h) divides twice per ray; here the horizontal term of each column and the
+// (rvr/core/camera.h) divides twice per ray; here the horizontal term of each column and the
 // vertical term of each row are computed once per frame with the same float operations, and a
 // ray's direction is forward + right * column + up * row, glm's order: the same bits, with no
 // division per ray.
@@ -10,9 +10,9 @@
 #include <glm/glm.hpp>
 #include <vector>
 
+#include "rvr/core/camera.h"
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/camera.h"
 
 namespace rvr {
 

@@ -6,11 +6,11 @@
 #include <span>
 #include <string>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/trace_geometry.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
 
 namespace rvr {
 

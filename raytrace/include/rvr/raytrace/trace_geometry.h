@@ -20,15 +20,15 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/isa.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/wide_bvh.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/framebuffers.h"
-#include "rvr/shared/isa.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
 
 namespace rvr {
 
@@ -155,7 +155,7 @@ class TraceGeometry {
     Kind kind;
     uint32_t object;
     Sphere sphere;
-    Plane plane;
+    Square plane;
     glm::vec3 axis_u{0.0f}, axis_v{0.0f};
     const CsgNode* csg = nullptr;
     std::vector<Sphere> csg_leaves;  // depth-first, as HitRecord::csg_leaf numbers them

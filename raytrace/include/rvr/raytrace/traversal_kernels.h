@@ -1,8 +1,8 @@
-// The wide BVH's traversal kernels of one instruction set, picked once (shared/isa.h).
+// The wide BVH's traversal kernels of one instruction set, picked once (rvr/core/isa.h).
 #pragma once
 
+#include "rvr/core/isa.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/isa.h"
 
 namespace rvr {
 

@@ -10,10 +10,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "rvr/core/expected.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "rvr/shared/expected.h"
 
 namespace rvr {
 

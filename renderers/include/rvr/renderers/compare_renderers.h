@@ -8,13 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/shared/compare.h"
-#include "rvr/shared/expected.h"
-#include "rvr/shared/image_io.h"
-#include "rvr/shared/mismatch_classes.h"
-#include "rvr/shared/renderer.h"
-#include "rvr/shared/scene.h"
 
 namespace rvr {
 

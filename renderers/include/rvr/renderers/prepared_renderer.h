@@ -1,8 +1,8 @@
 // A renderer bound to one scene, with what depends only on the scene and options built already.
 #pragma once
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/renderer.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/renderer.h"
 
 namespace rvr {
 

@@ -9,7 +9,7 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/cost_model.h"
 #include "rvr/study/fit_quality.h"

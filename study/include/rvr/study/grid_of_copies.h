@@ -4,8 +4,8 @@
 
 #include <cstddef>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/scene.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/scene.h"
 
 namespace rvr::study {
 

@@ -19,9 +19,9 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/pixel_memory.h"
-#include "rvr/shared/renderer.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/pixel_memory.h"
+#include "rvr/core/renderer.h"
 #include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 #include "rvr/study/study.h"
 
 namespace rvr::study {

@@ -26,8 +26,8 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/expected.h"
-#include "rvr/shared/renderer.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/renderer.h"
 #include "rvr/study/memory_estimate.h"
 #include "rvr/study/study.h"
 #include "rvr/study/sweep_plan.h"

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 #include "rvr/study/study.h"
 
 namespace rvr::study {

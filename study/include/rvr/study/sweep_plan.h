@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "rvr/shared/expected.h"
+#include "rvr/core/expected.h"
 
 namespace rvr::study {
 

@@ -1,0 +1,103 @@
+// The local term of docs/design.md's shading equation as SIMD kernels, shared by every loop
+// order: softraster's deferred pass shades its visible pixels with them, the tracer and the
+// hybrid their primary hits. Compiled once per instruction set (core/src/kernels/shade_*.cpp)
+// and chosen at run time like every kernel: 4 (SSE), 8 (AVX2) or 16 (AVX-512) pixels at once.
+// Each lane does the float operations of rvr::shade_local and the glm calls it makes, in the
+// same order (no FMA: -ffp-contract=off), and x^shininess with the C library's powf, so every
+// kernel, and the scalar shade_local, give the same bits. Plain data only: a kernel translation
+// unit must not instantiate inline code that baseline code also uses.
+#pragma once
+
+#include <cstdint>
+
+#include "rvr/core/isa.h"
+
+namespace rvr {
+
+// Lanes of the widest kernel: batches are padded to a multiple of it.
+constexpr int kShadeMaxLanes = 16;
+
+// The material terms the kernel reads, of one object.
+struct ShadeMaterial {
+  float diffuse[3], specular[3], base[3];  // base: shade_base, emission + ambient * diffuse
+  float shininess;
+};
+
+// Up to kShadeBatch pixels in structure-of-arrays form: [i] is the i-th pixel. What every batch
+// has: the materials and the outputs.
+constexpr int kShadeBatch = 128;
+struct ShadeLanes {
+  int count = 0;  // pixels filled; lanes [count, padded count) repeat the last pixel
+  // Not null: every pixel has this material (a batch of one object, the common case), and the
+  // per-pixel material arrays below are not read. The same floats, so the same bits.
+  const ShadeMaterial* material = nullptr;
+  // Per pixel, when material is null:
+  alignas(64) float diffuse[3][kShadeBatch];
+  alignas(64) float specular[3][kShadeBatch];
+  alignas(64) float shininess[kShadeBatch];
+  alignas(64) float base[3][kShadeBatch];  // shade_base: emission + ambient * diffuse
+  // Outputs: the shading normal facing the viewer, and base plus the light samples.
+  alignas(64) float shading_normal[3][kShadeBatch];
+  alignas(64) float colour[3][kShadeBatch];
+};
+
+// A z-buffer's visible pixels: the surface point and normals are interpolated from the
+// triangle's corners with the pixel's barycentrics, the viewer is the eye.
+struct ShadeBatch : ShadeLanes {
+  alignas(64) float bary[3][kShadeBatch];
+  alignas(64) float vertex[3][3][kShadeBatch];  // [corner][axis]: the triangle's positions
+  // [corner][axis]: its vertex normals if smooth; not read (may be anything) where flat.
+  alignas(64) float normal[3][3][kShadeBatch];
+  alignas(64) uint32_t smooth[kShadeBatch];  // ~0u: interpolate normals, 0: flat
+};
+
+// A tracer's hits. The kernel computes the surface as the tracer's scalar code does: the point
+// origin + t direction; for a triangle the geometric normal normalize(cross(edge1, edge2)) and,
+// where smooth, the vertex normals weighted by (1 - u - v, u, v) and divided by their length
+// (kept geometric where that length is 0); where `given`, the normals below (other shapes). The
+// viewer lies along the ray: V = -normalize(direction).
+struct SurfaceBatch : ShadeLanes {
+  float origin[3];  // every lane's ray starts here (primary rays)
+  alignas(64) float t[kShadeBatch];
+  alignas(64) float direction[3][kShadeBatch];
+  alignas(64) float u[kShadeBatch];
+  alignas(64) float v[kShadeBatch];
+  alignas(64) float edge1[3][kShadeBatch];
+  alignas(64) float edge2[3][kShadeBatch];
+  // [corner][axis]: the triangle's vertex normals if smooth; not read (may be anything) where
+  // flat or given.
+  alignas(64) float vertex_normal[3][3][kShadeBatch];
+  alignas(64) uint32_t smooth[kShadeBatch];     // ~0u: interpolate vertex normals, 0: flat
+  alignas(64) uint32_t given[kShadeBatch];      // ~0u: the normals are geometric and shading
+  alignas(64) float geometric[3][kShadeBatch];  // unit, as modelled; read where given
+  alignas(64) float shading[3][kShadeBatch];    // unit; read where given
+};
+
+// The light samples, structure of arrays, in the order they are summed.
+struct ShadeLights {
+  const float* position[3];
+  const float* intensity[3];
+  int count;
+};
+
+struct ShadeKernels {
+  const char* isa;
+  // Fill batch.shading_normal and batch.colour for pixels [0, count) (and the padding).
+  void (*shade)(ShadeBatch& batch, const float eye[3], const ShadeLights& lights);
+  void (*shade_surfaces)(SurfaceBatch& batch, const ShadeLights& lights);
+};
+
+// The kernels of one instruction set; the caller must have checked cpu_supports(isa).
+const ShadeKernels& shade_kernels(Isa isa);
+
+namespace isa_sse {
+extern const ShadeKernels kShadeKernels;
+}
+namespace isa_avx2 {
+extern const ShadeKernels kShadeKernels;
+}
+namespace isa_avx512 {
+extern const ShadeKernels kShadeKernels;
+}
+
+}  // namespace rvr

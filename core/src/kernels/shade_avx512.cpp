@@ -1,0 +1,14 @@
+// The shading kernels compiled for avx512 (flags: RVR_KERNEL_FLAGS_avx512 in the top-level
+// CMakeLists.txt).
+#define RVR_KERNEL_NS isa_avx512
+#define RVR_KERNEL_NAME "avx512"
+#include "rvr/core/shade_kernel.h"
+#include "shade_kernels.inl"
+
+namespace rvr {
+namespace RVR_KERNEL_NS {
+
+extern const ShadeKernels kShadeKernels = {RVR_KERNEL_NAME, shade, shade_surfaces};
+
+}  // namespace RVR_KERNEL_NS
+}  // namespace rvr
