@@ -19,6 +19,7 @@
 #endif
 
 #include "rvr/core/simd/simd.h"
+#include "rvr/core/simd/vec3v.h"
 
 namespace rvr {
 namespace RVR_KERNEL_NS {
@@ -32,6 +33,9 @@ using M8 = vboolf8;
 using I8 = vint8;  // primitive indices and child references, as bits
 using V4 = vfloat4;
 using M4 = vboolf4;
+using Vec3v8 = Vec3vf8;
+using Vec3v4 = Vec3vf4;
+using Vec3f = Vec3v<float>;  // one triangle's vectors, shared by a packet's lanes
 
 // a * b - c, rounded twice in every kernel: a fused multiply-subtract would let traversal
 // counts, hence the cost AOV, differ between SSE and FMA kernels. The margins of RayBox cover
@@ -117,14 +121,10 @@ struct RayBox {
 constexpr float kEdgeBand = 1e-3f;
 
 struct BlockRay {
-  V4 o[3], d[3], tmin;
-  explicit BlockRay(const KernelRay& r) {
-    for (int a = 0; a < 3; ++a) {
-      o[a] = V4::splat(r.origin[a]);
-      d[a] = V4::splat(r.dir[a]);
-    }
-    tmin = V4::splat(r.tmin);
-  }
+  Vec3v4 o, d;
+  V4 tmin;
+  explicit BlockRay(const KernelRay& r)
+      : o(Vec3v4::splat(r.origin)), d(Vec3v4::splat(r.dir)), tmin(V4::splat(r.tmin)) {}
 };
 
 // Moller-Trumbore for four triangles: the same operations, in the same order, as the scalar
@@ -135,30 +135,17 @@ struct BlockCandidates {
   alignas(16) float t[4], u[4], v[4];
 };
 
-inline V4 dot3(V4 ax, V4 ay, V4 az, V4 bx, V4 by, V4 bz) {
-  return (ax * bx + ay * by) + az * bz;
-}
-
 inline void intersect_block(const TriangleBlock& b, const BlockRay& r, V4 t_limit,
                             BlockCandidates& out) {
-  const V4 e1x = V4::load(b.e1[0]), e1y = V4::load(b.e1[1]), e1z = V4::load(b.e1[2]);
-  const V4 e2x = V4::load(b.e2[0]), e2y = V4::load(b.e2[1]), e2z = V4::load(b.e2[2]);
-  // p = cross(d, e2)
-  V4 px = r.d[1] * e2z - e2y * r.d[2];
-  V4 py = r.d[2] * e2x - e2z * r.d[0];
-  V4 pz = r.d[0] * e2y - e2x * r.d[1];
-  V4 det = dot3(e1x, e1y, e1z, px, py, pz);
+  const Vec3v4 E1 = Vec3v4::load(b.e1), E2 = Vec3v4::load(b.e2);
+  const Vec3v4 P = cross(r.d, E2);
+  V4 det = dot(E1, P);
   V4 sign = signbits(det);  // x * (+-1) is x with its sign bit flipped
   V4 abs_det = abs(det);
-  V4 sx = r.o[0] - V4::load(b.v0[0]);
-  V4 sy = r.o[1] - V4::load(b.v0[1]);
-  V4 sz = r.o[2] - V4::load(b.v0[2]);
-  V4 su = dot3(sx, sy, sz, px, py, pz);
-  // q = cross(s, e1)
-  V4 qx = sy * e1z - e1y * sz;
-  V4 qy = sz * e1x - e1z * sx;
-  V4 qz = sx * e1y - e1x * sy;
-  V4 sv = dot3(r.d[0], r.d[1], r.d[2], qx, qy, qz);
+  const Vec3v4 S = r.o - Vec3v4::load(b.v0);
+  V4 su = dot(S, P);
+  const Vec3v4 Q = cross(S, E1);
+  V4 sv = dot(r.d, Q);
   V4 U = su ^ sign, V = sv ^ sign, UV = U + V;
   V4 outer_lo = V4::splat(-kEdgeBand) * abs_det;
   V4 outer_hi = V4::splat(1.0f + kEdgeBand) * abs_det;
@@ -176,7 +163,7 @@ inline void intersect_block(const TriangleBlock& b, const BlockRay& r, V4 t_limi
   unsigned inner = keep & ~edge_bits;
   if (!inner) return;
   V4 inv = V4::splat(1.0f) / det;
-  V4 t = dot3(e2x, e2y, e2z, qx, qy, qz) * inv;
+  V4 t = dot(E2, Q) * inv;
   M4 in_range = (t > r.tmin) & (t <= t_limit);
   out.inner = inner & movemask(in_range);
   if (out.inner) {
@@ -373,11 +360,11 @@ bool occluded_counted(const WideBvhView& bvh, const KernelRay& ray, KernelCounte
 // each lane keeps its own nearest hit, found with the same triangle arithmetic as a single ray,
 // so every lane ends with exactly the hit a single ray would find.
 struct Packet8 {
-  V8 d[3];
+  Vec3v8 d;
   V8 rdir[3], org_rdir[3];
   V8 margin;  // per lane, absolute: covers the rounding of org * rdir (as RayBox's margins)
   V8 tmin;
-  float o[3];
+  Vec3f o;
   unsigned valid;
   KernelRay ray[8];  // the same rays one by one: edge rechecks, single-ray fallback
 };
@@ -433,19 +420,13 @@ void finish_lane(const WideBvhView& bvh, const Packet8& p, unsigned lane, uint32
 // q depend only on the shared origin, so they are computed once, in the same float operations).
 inline void intersect_triangle8(const TriangleBlock& b, unsigned j, const Packet8& p,
                                 unsigned active, PacketBest8& best) {
-  const float e1x = b.e1[0][j], e1y = b.e1[1][j], e1z = b.e1[2][j];
-  const float e2x = b.e2[0][j], e2y = b.e2[1][j], e2z = b.e2[2][j];
-  const V8 E1x = V8::splat(e1x), E1y = V8::splat(e1y), E1z = V8::splat(e1z);
-  const V8 E2x = V8::splat(e2x), E2y = V8::splat(e2y), E2z = V8::splat(e2z);
-  // p = cross(d, e2), det = dot(e1, p)
-  V8 px = p.d[1] * E2z - E2y * p.d[2];
-  V8 py = p.d[2] * E2x - E2z * p.d[0];
-  V8 pz = p.d[0] * E2y - E2x * p.d[1];
-  V8 det = (E1x * px + E1y * py) + E1z * pz;
-  const float sx = p.o[0] - b.v0[0][j], sy = p.o[1] - b.v0[1][j], sz = p.o[2] - b.v0[2][j];
-  const float qx = sy * e1z - e1y * sz, qy = sz * e1x - e1z * sx, qz = sx * e1y - e1x * sy;
-  V8 su = (V8::splat(sx) * px + V8::splat(sy) * py) + V8::splat(sz) * pz;
-  V8 sv = (p.d[0] * V8::splat(qx) + p.d[1] * V8::splat(qy)) + p.d[2] * V8::splat(qz);
+  const Vec3f e1 = column(b.e1, int(j)), e2 = column(b.e2, int(j));
+  const Vec3v8 P = cross(p.d, Vec3v8::splat(e2));
+  V8 det = dot(Vec3v8::splat(e1), P);
+  const Vec3f s = p.o - column(b.v0, int(j));
+  const Vec3f q = cross(s, e1);
+  V8 su = dot(Vec3v8::splat(s), P);
+  V8 sv = dot(p.d, Vec3v8::splat(q));
   V8 sign = signbits(det);
   V8 abs_det = abs(det);
   V8 U = su ^ sign, V = sv ^ sign, UV = U + V;
@@ -460,8 +441,7 @@ inline void intersect_triangle8(const TriangleBlock& b, unsigned j, const Packet
   const I8 prim = I8::splat(int32_t(b.primitive[j]));
   if (inner) {
     V8 inv = V8::splat(1.0f) / det;
-    const float tnum = e2x * qx + e2y * qy + e2z * qz;  // dot(e2, q), as (x + y) + z
-    V8 t = V8::splat(tnum) * inv;
+    V8 t = V8::splat(dot(e2, q)) * inv;
     // Primitive indices are below 2^31: the signed comparison orders them.
     M8 better = (t < best.t) | ((t == best.t) & (prim < best.primitive));
     M8 take = (M8::from_bits(inner) & (t > p.tmin)) & better;
@@ -671,20 +651,15 @@ void intersect_named(const RayPacket& packet, const NamedTriangles& named, Kerne
                      NamedOutcome* outcome) {
   const V8 tmin = V8::splat(packet.tmin), tmax = V8::splat(packet.tmax);
   for (int first = 0; first < named.count; first += 8) {
-    auto row = [&](const float(&a)[3][kPacketRays], int axis) { return V8::load(a[axis] + first); };
-    const V8 dx = row(named.dir, 0), dy = row(named.dir, 1), dz = row(named.dir, 2);
-    const V8 e1x = row(named.e1, 0), e1y = row(named.e1, 1), e1z = row(named.e1, 2);
-    const V8 e2x = row(named.e2, 0), e2y = row(named.e2, 1), e2z = row(named.e2, 2);
-    // p = cross(d, e2), det = dot(e1, p)
-    const V8 px = dy * e2z - e2y * dz, py = dz * e2x - e2z * dx, pz = dx * e2y - e2x * dy;
-    const V8 det = (e1x * px + e1y * py) + e1z * pz;
-    // s = origin - v0, su = dot(s, p), q = cross(s, e1), sv = dot(d, q); U, V: times sign(det)
-    const V8 sx = V8::splat(packet.origin[0]) - row(named.v0, 0);
-    const V8 sy = V8::splat(packet.origin[1]) - row(named.v0, 1);
-    const V8 sz = V8::splat(packet.origin[2]) - row(named.v0, 2);
-    const V8 su = (sx * px + sy * py) + sz * pz;
-    const V8 qx = sy * e1z - e1y * sz, qy = sz * e1x - e1z * sx, qz = sx * e1y - e1x * sy;
-    const V8 sv = (dx * qx + dy * qy) + dz * qz;
+    const Vec3v8 D = Vec3v8::load(named.dir, first);
+    const Vec3v8 E1 = Vec3v8::load(named.e1, first), E2 = Vec3v8::load(named.e2, first);
+    const Vec3v8 P = cross(D, E2);
+    const V8 det = dot(E1, P);
+    // U, V: su, sv times sign(det)
+    const Vec3v8 S = Vec3v8::splat(packet.origin) - Vec3v8::load(named.v0, first);
+    const V8 su = dot(S, P);
+    const Vec3v8 Q = cross(S, E1);
+    const V8 sv = dot(D, Q);
     const V8 sign = signbits(det) | V8::splat(1.0f);
     const V8 abs_det = abs(det);
     const V8 U = su * sign, V = sv * sign, UV = U + V;
@@ -697,7 +672,7 @@ void intersect_named(const RayPacket& packet, const NamedTriangles& named, Kerne
     const unsigned near_edge =
         ~rejected & movemask(((U < inner_lo) | (V < inner_lo)) | (UV > inner_hi));
     const V8 inv_det = V8::splat(1.0f) / det;
-    const V8 t = ((e2x * qx + e2y * qy) + e2z * qz) * inv_det;
+    const V8 t = dot(E2, Q) * inv_det;
     const unsigned hit = ~rejected & ~near_edge & movemask((t > tmin) & (t < tmax));
     alignas(32) float ts[8], us[8], vs[8];
     store(ts, t);

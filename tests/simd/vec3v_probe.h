@@ -1,0 +1,53 @@
+// Vec3v (rvr/core/simd/vec3v.h) compiled in one unit per instruction set, like the kernels, so
+// that test_vec3v can hold every operation of every ISA and vector width to the scalar
+// computation: each unit evaluates the operations on sixteen lanes of inputs.
+#pragma once
+
+namespace rvr {
+
+constexpr int kProbeLanes = 16;
+
+struct Vec3vProbeInput {
+  alignas(64) float a[3][kProbeLanes];
+  alignas(64) float b[3][kProbeLanes];
+  alignas(64) float s[kProbeLanes];  // the scalar factor and divisor
+};
+
+// Lane k of every result from lane k of the inputs; select takes a where a.x < b.x.
+struct Vec3vProbeOutput {
+  alignas(64) float sum[3][kProbeLanes];
+  alignas(64) float difference[3][kProbeLanes];
+  alignas(64) float negated[3][kProbeLanes];
+  alignas(64) float product[3][kProbeLanes];
+  alignas(64) float scaled[3][kProbeLanes];
+  alignas(64) float quotient[3][kProbeLanes];
+  alignas(64) float cross[3][kProbeLanes];
+  alignas(64) float normalized[3][kProbeLanes];
+  alignas(64) float selected[3][kProbeLanes];
+  alignas(64) float dot[kProbeLanes];
+  alignas(64) float length_squared[kProbeLanes];
+};
+
+// The vector types Vec3v is instantiated with: float (one lane at a time; no normalize or
+// select, which the kernels use on vectors only), vfloat4,
+// vfloat8 and the ISA's native vfloatx.
+enum class ProbeWidth { Scalar, Four, Eight, Native };
+inline constexpr ProbeWidth kAllProbeWidths[] = {ProbeWidth::Scalar, ProbeWidth::Four,
+                                                 ProbeWidth::Eight, ProbeWidth::Native};
+
+struct Vec3vProbe {
+  const char* isa;
+  void (*run)(ProbeWidth width, const Vec3vProbeInput& in, Vec3vProbeOutput& out);
+};
+
+namespace isa_sse {
+extern const Vec3vProbe kVec3vProbe;
+}
+namespace isa_avx2 {
+extern const Vec3vProbe kVec3vProbe;
+}
+namespace isa_avx512 {
+extern const Vec3vProbe kVec3vProbe;
+}
+
+}  // namespace rvr
