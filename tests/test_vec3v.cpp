@@ -8,11 +8,12 @@
 
 #include <cmath>
 #include <cstring>
-#include <glm/geometric.hpp>
-#include <glm/vec3.hpp>
+#include <glm/glm.hpp>
+#include <ios>
 #include <random>
 #include <string>
 
+#include "rvr/core/expected.h"
 #include "rvr/core/isa.h"
 #include "simd/vec3v_probe.h"
 

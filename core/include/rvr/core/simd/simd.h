@@ -8,7 +8,8 @@
 //   simd_avx2.h    vfloat8, vboolf8, vint8, vdouble4, vllong4             (AVX2, AVX-512)
 //   simd_avx512.h  vfloat16, vboolf16, vdouble8, vboold8, vllong8, masked loads and stores
 //
-// and the native widths below (vfloatx: 4, 8 or 16 floats; vdoublex: 2, 4 or 8 doubles).
+// and the native widths below (vfloatx: 4, 8 or 16 floats; vdoublex: 2, 4 or 8 doubles). On top
+// of them, for every ISA, vec3v.h: Vec3v<V>, 3-vectors of these vectors (dot, cross, ...).
 // Operators and functions are the IEEE operations of their scalar forms, lane by lane: + - * /
 // and sqrt round as the scalar ones do, min / max return their second operand when either is
 // NaN (MINPS / MAXPS), comparisons are ordered but != (unordered), and nothing fuses a multiply

@@ -11,9 +11,9 @@
 //   cross(a, b) = (a.y * b.z - b.y * a.z, a.z * b.x - b.z * a.x, a.x * b.y - b.x * a.y)
 //   normalize   = v * (1 / sqrt(dot(v, v)))
 //   a * s, a / s: each component times (divided by) s, the component first
-// Operand order matters even where the value does not: of two NaN operands, x86 returns the
-// first one's payload. Nothing here fuses a multiply and an add (the kernel units build with
-// -ffp-contract=off).
+// A sum's association and a difference's order change the bits; a product's operand order
+// cannot, but follows glm all the same. Nothing here fuses a multiply and an add (the kernel
+// units build with -ffp-contract=off), so the bits are the same in every ISA.
 //
 // Only kernel translation units (which define RVR_KERNEL_NS) may include this; like the rest of
 // the layer it has internal linkage (see simd.h).
