@@ -33,8 +33,6 @@ using M8 = vboolf8;
 using I8 = vint8;  // primitive indices and child references, as bits
 using V4 = vfloat4;
 using M4 = vboolf4;
-using Vec3v8 = Vec3vf8;
-using Vec3v4 = Vec3vf4;
 using Vec3f = Vec3v<float>;  // one triangle's vectors, shared by a packet's lanes
 
 // a * b - c, rounded twice in every kernel: a fused multiply-subtract would let traversal
@@ -121,10 +119,10 @@ struct RayBox {
 constexpr float kEdgeBand = 1e-3f;
 
 struct BlockRay {
-  Vec3v4 o, d;
+  Vec3vf4 o, d;
   V4 tmin;
   explicit BlockRay(const KernelRay& r)
-      : o(Vec3v4::splat(r.origin)), d(Vec3v4::splat(r.dir)), tmin(V4::splat(r.tmin)) {}
+      : o(Vec3vf4::splat(r.origin)), d(Vec3vf4::splat(r.dir)), tmin(V4::splat(r.tmin)) {}
 };
 
 // Moller-Trumbore for four triangles: the same operations, in the same order, as the scalar
@@ -137,14 +135,14 @@ struct BlockCandidates {
 
 inline void intersect_block(const TriangleBlock& b, const BlockRay& r, V4 t_limit,
                             BlockCandidates& out) {
-  const Vec3v4 E1 = Vec3v4::load(b.e1), E2 = Vec3v4::load(b.e2);
-  const Vec3v4 P = cross(r.d, E2);
+  const Vec3vf4 E1 = Vec3vf4::load(b.e1), E2 = Vec3vf4::load(b.e2);
+  const Vec3vf4 P = cross(r.d, E2);
   V4 det = dot(E1, P);
   V4 sign = signbits(det);  // x * (+-1) is x with its sign bit flipped
   V4 abs_det = abs(det);
-  const Vec3v4 S = r.o - Vec3v4::load(b.v0);
+  const Vec3vf4 S = r.o - Vec3vf4::load(b.v0);
   V4 su = dot(S, P);
-  const Vec3v4 Q = cross(S, E1);
+  const Vec3vf4 Q = cross(S, E1);
   V4 sv = dot(r.d, Q);
   V4 U = su ^ sign, V = sv ^ sign, UV = U + V;
   V4 outer_lo = V4::splat(-kEdgeBand) * abs_det;
@@ -360,7 +358,7 @@ bool occluded_counted(const WideBvhView& bvh, const KernelRay& ray, KernelCounte
 // each lane keeps its own nearest hit, found with the same triangle arithmetic as a single ray,
 // so every lane ends with exactly the hit a single ray would find.
 struct Packet8 {
-  Vec3v8 d;
+  Vec3vf8 d;
   V8 rdir[3], org_rdir[3];
   V8 margin;  // per lane, absolute: covers the rounding of org * rdir (as RayBox's margins)
   V8 tmin;
@@ -421,12 +419,12 @@ void finish_lane(const WideBvhView& bvh, const Packet8& p, unsigned lane, uint32
 inline void intersect_triangle8(const TriangleBlock& b, unsigned j, const Packet8& p,
                                 unsigned active, PacketBest8& best) {
   const Vec3f e1 = column(b.e1, int(j)), e2 = column(b.e2, int(j));
-  const Vec3v8 P = cross(p.d, Vec3v8::splat(e2));
-  V8 det = dot(Vec3v8::splat(e1), P);
+  const Vec3vf8 P = cross(p.d, Vec3vf8::splat(e2));
+  V8 det = dot(Vec3vf8::splat(e1), P);
   const Vec3f s = p.o - column(b.v0, int(j));
   const Vec3f q = cross(s, e1);
-  V8 su = dot(Vec3v8::splat(s), P);
-  V8 sv = dot(p.d, Vec3v8::splat(q));
+  V8 su = dot(Vec3vf8::splat(s), P);
+  V8 sv = dot(p.d, Vec3vf8::splat(q));
   V8 sign = signbits(det);
   V8 abs_det = abs(det);
   V8 U = su ^ sign, V = sv ^ sign, UV = U + V;
@@ -651,14 +649,14 @@ void intersect_named(const RayPacket& packet, const NamedTriangles& named, Kerne
                      NamedOutcome* outcome) {
   const V8 tmin = V8::splat(packet.tmin), tmax = V8::splat(packet.tmax);
   for (int first = 0; first < named.count; first += 8) {
-    const Vec3v8 D = Vec3v8::load(named.dir, first);
-    const Vec3v8 E1 = Vec3v8::load(named.e1, first), E2 = Vec3v8::load(named.e2, first);
-    const Vec3v8 P = cross(D, E2);
+    const Vec3vf8 D = Vec3vf8::load(named.dir, first);
+    const Vec3vf8 E1 = Vec3vf8::load(named.e1, first), E2 = Vec3vf8::load(named.e2, first);
+    const Vec3vf8 P = cross(D, E2);
     const V8 det = dot(E1, P);
     // U, V: su, sv times sign(det)
-    const Vec3v8 S = Vec3v8::splat(packet.origin) - Vec3v8::load(named.v0, first);
+    const Vec3vf8 S = Vec3vf8::splat(packet.origin) - Vec3vf8::load(named.v0, first);
     const V8 su = dot(S, P);
-    const Vec3v8 Q = cross(S, E1);
+    const Vec3vf8 Q = cross(S, E1);
     const V8 sv = dot(D, Q);
     const V8 sign = signbits(det) | V8::splat(1.0f);
     const V8 abs_det = abs(det);
