@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "rvr/core/camera.h"
+#include "rvr/raytrace/bvh.h"
 #include "screen_bounds.h"
 
 namespace rvr {

@@ -1,6 +1,7 @@
 #include "rvr/hybrid/hybrid_renderer.h"
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include <chrono>
 #include <glm/glm.hpp>
@@ -13,6 +14,7 @@
 #include <vector>
 
 #include "approximated_pixels.h"
+#include "hybrid_counters.h"
 #include "primary_visibility.h"
 #include "rvr/core/check.h"
 #include "rvr/core/framebuffers.h"

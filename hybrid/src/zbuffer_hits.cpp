@@ -1,8 +1,15 @@
 #include "zbuffer_hits.h"
 
-#include <algorithm>
+#include <stddef.h>
 
+#include <algorithm>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "rvr/core/framebuffers.h"
 #include "rvr/raytrace/primary_rays.h"
+#include "rvr/raytrace/wide_bvh_layout.h"
 
 namespace rvr {
 namespace {

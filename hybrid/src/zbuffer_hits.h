@@ -13,6 +13,8 @@
 #include "hybrid_counters.h"
 #include "primary_visibility.h"
 #include "rvr/core/scene.h"
+#include "rvr/raytrace/bvh.h"
+#include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/primary_hit_source.h"
 #include "rvr/raytrace/trace_geometry.h"
 

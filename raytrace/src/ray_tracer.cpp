@@ -17,7 +17,6 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <utility>
 #include <variant>
 #include <vector>
 
@@ -82,7 +81,7 @@ class PixelRng {
   uint64_t state_;
 };
 
-// The lod AOV where the visible surface is not textured.
+// The lod AOV where the surface hit is not textured.
 constexpr float kNoLod = std::numeric_limits<float>::quiet_NaN();
 
 // Offset for secondary ray origins: large enough to leave the surface at this position's
