@@ -546,7 +546,7 @@ TEST(Packets, SameHitsAsSingleRays) {
 
 // The hybrid's rebuild, a packet at a time: every ray names an object and primitive (the triangle
 // it hits, a neighbour, one far away, a tessellated sphere, an analytic shape, ids out of range),
-// and intersect_visible_packet finds what intersect_visible finds ray by ray, to the bit, with
+// and intersect_named_packet finds what intersect_named finds ray by ray, to the bit, with
 // the same counted tests, whichever kernel tests the named triangles eight at a time.
 TEST(Packets, RebuiltHitsAreIntersectVisiblesOwn) {
   int hits = 0, misses = 0;
@@ -597,7 +597,7 @@ TEST(Packets, RebuiltHitsAreIntersectVisiblesOwn) {
         HitRecord packet_hits[kPacketRays];
         bool found[kPacketRays];
         TraversalCounters work[kPacketRays];
-        geometry.intersect_visible_packet(p, object, primitive, wanted, packet_hits, found, work);
+        geometry.intersect_named_packet(p, object, primitive, wanted, packet_hits, found, work);
         for (int k = 0; k < p.count; ++k) {
           const std::string what = std::string(to_string(isa)) + " tile " + std::to_string(tile) +
                                    " ray " + std::to_string(k);
@@ -609,7 +609,7 @@ TEST(Packets, RebuiltHitsAreIntersectVisiblesOwn) {
           TraversalCounters single_work;
           const Ray ray{o, {p.dir[0][k], p.dir[1][k], p.dir[2][k]}, p.tmin, p.tmax};
           const bool want =
-              geometry.intersect_visible(ray, object[k], primitive[k], single, single_work);
+              geometry.intersect_named(ray, object[k], primitive[k], single, single_work);
           ASSERT_EQ(found[k], want) << what;
           EXPECT_EQ(work[k].primitive_tests, single_work.primitive_tests) << what;
           (want ? hits : misses)++;

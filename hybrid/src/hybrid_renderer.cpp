@@ -1,6 +1,7 @@
 #include "rvr/hybrid/hybrid_renderer.h"
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include <chrono>
 #include <glm/glm.hpp>
@@ -12,6 +13,9 @@
 #include <variant>
 #include <vector>
 
+#include "approximated_pixels.h"
+#include "hybrid_counters.h"
+#include "primary_visibility.h"
 #include "rvr/core/check.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/image_sample.h"
@@ -20,8 +24,8 @@
 #include "rvr/core/timer.h"
 #include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
-#include "rvr/raytrace/primary_visibility.h"
 #include "rvr/raytrace/ray_tracer.h"
+#include "zbuffer_hits.h"
 
 namespace rvr {
 
@@ -77,23 +81,25 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
                 ids.object_id.size() == ids.pixel_count() &&
                 ids.primitive_id.size() == ids.pixel_count(),
             "the z-buffer pass fills an id per pixel of the scene's frame");
-  PrimaryVisibility visible{ids.width, ids.height, ids.object_id, ids.primitive_id, ids.lod};
+  const PrimaryVisibility visible{ids.width, ids.height, ids.object_id, ids.primitive_id, ids.lod};
+
+  // The tracer shades the hits the z-buffer's ids give (ZBufferHits), the centre's colour only.
+  auto t_trace = Clock::now();
+  RayTracer tracer;
+  const std::vector<uint8_t> approximated = approximated_pixels(scene, geometry);
+  const ZBufferHits centre(scene, geometry, visible, approximated);
+  Expected<RenderOutput> out = tracer.render(scene, options, geometry, centre);
+  double trace_seconds = seconds_since(t_trace);
+  double zbuffer_pass_seconds = zbuffer_seconds;
+  if (!out) return out;
+  RenderOutput& o = out.value();
+  centre.counters().add_to(o.stats);
 
   // Several samples per pixel: one more z-buffer pass per sample (the accumulation buffer),
   // each drawn through that sample's place in the pixel and lens point, its hits rebuilt and
   // shaded by the tracer and summed; the centre pass gives the AOVs, as in the tracer.
   const int spp = scene.image.samples_per_pixel;
-  const bool passes = spp > 1 && options.mode != RenderMode::Visibility;
-  auto t_trace = Clock::now();
-  RayTracer tracer;
-  Expected<RenderOutput> out =
-      tracer.render_visible(scene, options, geometry, visible,
-                            passes ? VisibleSamples::FromPasses : VisibleSamples::Traced);
-  double trace_seconds = seconds_since(t_trace);
-  double zbuffer_pass_seconds = zbuffer_seconds;
-  if (!out) return out;
-  RenderOutput& o = out.value();
-  if (passes) {
+  if (spp > 1 && options.mode != RenderMode::Visibility) {
     FrameBuffers& fb = o.buffers;
     std::vector<glm::vec3> sum(fb.pixel_count(), glm::vec3(0.0f));
     for (int k = 0; k < spp; ++k) {
@@ -105,15 +111,20 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
       zbuffer_pass_seconds += seconds_since(t_pass);
       if (!pass) return pass.error();
       const FrameBuffers& pass_ids = pass->buffers;
-      RVR_CHECK(pass_ids.width == ids.width && pass_ids.height == ids.height,
+      RVR_CHECK(pass_ids.width == ids.width && pass_ids.height == ids.height &&
+                    pass_ids.object_id.size() == ids.pixel_count() &&
+                    pass_ids.primitive_id.size() == ids.pixel_count(),
                 "every sample's z-buffer pass has the centre pass's frame");
-      const PrimaryVisibility pass_visible{pass_ids.width, pass_ids.height, pass_ids.object_id,
-                                           pass_ids.primitive_id, pass_ids.lod};
+      const ZBufferHits sample_hits(
+          scene, geometry,
+          PrimaryVisibility{pass_ids.width, pass_ids.height, pass_ids.object_id,
+                            pass_ids.primitive_id, pass_ids.lod});
       t_pass = Clock::now();
-      auto pass_stats = tracer.add_visible_sample(scene, options, geometry, pass_visible, k, sum);
+      auto pass_stats = tracer.add_samples(scene, options, geometry, sample_hits, k, sum);
       trace_seconds += seconds_since(t_pass);
       if (!pass_stats) return pass_stats.error();
       for (const auto& [key, value] : pass_stats.value()) o.stats[key] += value;
+      sample_hits.counters().add_to(o.stats);
     }
     // The tracer's own average: the same float operations in the same order.
     for (size_t i = 0; i < sum.size(); ++i) fb.colour[i] = sum[i] / float(spp);

@@ -12,25 +12,16 @@
 
 namespace rvr {
 
-// Which frames report a counter: every frame; frames over a z-buffer's visibility buffer (the
-// hybrids: render_visible, add_visible_sample); frames over rvr's own BVHs (Embree does not
-// count its traversal steps).
-enum class ReportedIn { EveryFrame, VisibleFrames, OwnTraversal };
+// Which frames report a counter: every frame; frames over rvr's own BVHs (Embree does not count
+// its traversal steps).
+enum class ReportedIn { EveryFrame, OwnTraversal };
 
 // X(field, stat, reported in) for the counts RayCounters holds itself.
-#define RVR_RAY_COUNTS(X)                                                                    \
-  X(primary, "rays.primary", EveryFrame)                                                     \
-  X(shadow, "rays.shadow", EveryFrame)                                                       \
-  X(reflection, "rays.reflection", EveryFrame)                                               \
-  X(refraction, "rays.refraction", EveryFrame)                                               \
-  /* Pixels whose hit was rebuilt from the z-buffer's ids, traced instead (missed or empty), \
-     and won by a CSG object; of those traced, the ones whose named primitive the ray missed \
-     (silhouettes, edges); empty pixels left as background without a ray. */                 \
-  X(rebuilt, "hybrid.rebuilt", VisibleFrames)                                                \
-  X(fallback_traced, "hybrid.fallback_traced", VisibleFrames)                                \
-  X(fallback_missed, "hybrid.fallback_missed", VisibleFrames)                                \
-  X(csg_pixels, "hybrid.csg_pixels", VisibleFrames)                                          \
-  X(background, "hybrid.background", VisibleFrames)
+#define RVR_RAY_COUNTS(X)                      \
+  X(primary, "rays.primary", EveryFrame)       \
+  X(shadow, "rays.shadow", EveryFrame)         \
+  X(reflection, "rays.reflection", EveryFrame) \
+  X(refraction, "rays.refraction", EveryFrame)
 
 // X(field, stat, reported in) for the counts of TraversalCounters (bvh.h), which the traversal
 // kernels fill.
@@ -62,12 +53,11 @@ struct RayCounters {
     shade_seconds += o.shade_seconds;
   }
 
-  // Writes every counter the frame reports into `stats` under its stat's name: `visible` for a
-  // frame over a z-buffer's visibility buffer, `own_traversal` for one over rvr's own BVH.
-  void report(std::map<std::string, double>& stats, bool visible, bool own_traversal) const {
+  // Writes every counter the frame reports into `stats` under its stat's name: `own_traversal`
+  // for a frame over rvr's own BVH.
+  void report(std::map<std::string, double>& stats, bool own_traversal) const {
     const auto reported = [&](ReportedIn in) {
-      return in == ReportedIn::EveryFrame || (in == ReportedIn::VisibleFrames && visible) ||
-             (in == ReportedIn::OwnTraversal && own_traversal);
+      return in == ReportedIn::EveryFrame || (in == ReportedIn::OwnTraversal && own_traversal);
     };
 #define RVR_REPORT_COUNT(field, stat, reported_in) \
   if (reported(ReportedIn::reported_in)) stats[stat] = double(field);

@@ -17,7 +17,6 @@
 #include <limits>
 #include <memory>
 #include <optional>
-#include <utility>
 #include <variant>
 #include <vector>
 
@@ -36,11 +35,11 @@
 #include "rvr/core/timer.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
+#include "rvr/raytrace/primary_hit_source.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
-#include "screen_bounds.h"
 #include "tile_output.h"
 
 namespace rvr {
@@ -52,8 +51,6 @@ constexpr int kTileWidth = TileOutput::kMaxWidth, kTileHeight = TileOutput::kMax
 // Primary rays go as packets of kPacketSide x kPacketSide pixel-centre rays (kPacketRays).
 constexpr int kPacketSide = 8;
 static_assert(kPacketSide * kPacketSide == kPacketRays);
-// render_visible: a block with at least this many pixels to trace traces them as one packet.
-constexpr int kPacketFallbacks = 8;
 
 using Clock = std::chrono::steady_clock;
 
@@ -66,7 +63,8 @@ class PixelRng {
     next();
   }
   // Sample k's own stream: a sample's random numbers do not depend on the samples before it,
-  // so the hybrid can trace sample k of every pixel in its own pass and draw the same numbers.
+  // so a caller can have sample k of every pixel traced in its own pass (add_samples) and draw
+  // the same numbers.
   PixelRng(uint64_t seed, int x, int y, int k) : PixelRng(seed, x, y) {
     state_ ^= (uint64_t(uint32_t(k)) + 1) * 0xD1B54A32D192ED03ull;
     next();
@@ -83,7 +81,7 @@ class PixelRng {
   uint64_t state_;
 };
 
-// The lod AOV where the visible surface is not textured.
+// The lod AOV where the surface hit is not textured.
 constexpr float kNoLod = std::numeric_limits<float>::quiet_NaN();
 
 // Offset for secondary ray origins: large enough to leave the surface at this position's
@@ -120,48 +118,32 @@ class FrameTracer {
     }
   }
 
-  // render_visible for the hybrid's accumulation-buffer passes: the pixel-centre pass keeps the
-  // centre's colour; the passes add the samples (add_visible_sample).
+  // A frame whose primary hits come from a PrimaryHitSource: the colour is the centre hit's,
+  // the caller adds the samples (add_sample_block).
   void keep_centre_colour() { centre_only_ = true; }
 
-  // render_block_visible: pixels a z-buffer may leave empty where the scene is not (1 inside the
-  // screen bounds of the shapes it draws approximately or not at all), row-major; null: none.
-  void set_approximated_mask(const uint8_t* mask) { approximated_mask_ = mask; }
-
-  // Sample k of each pixel of [x0, x1) x [y0, y1): its ray intersected with the primitive that
-  // `visible` (a z-buffer drawn through image_sample k) names there, else traced; the CSG
-  // objects intersected besides, as in render_block_visible. Its colour is added to sum.
-  void sample_block_visible(int x0, int y0, int x1, int y1, const PrimaryVisibility& visible, int k,
-                            const ImageSample& sample, glm::vec3* sum,
-                            RayCounters& counters) const {
-    for (int y = y0; y < y1; ++y)
-      for (int x = x0; x < x1; ++x) {
-        const size_t i = size_t(y) * size_t(visible.width) + size_t(x);
-        const Ray ray = sample_ray(x, y, sample);
+  // Sample k (image_sample `sample`) of each pixel of [x0, x1) x [y0, y1) (at most kPacketRays):
+  // its hit from `source`, shaded with the pixel's stream k, its colour added to sum
+  // (row-major, the image's width).
+  void add_sample_block(int x0, int y0, int x1, int y1, const PrimaryHitSource& source, int k,
+                        const ImageSample& sample, glm::vec3* sum, RayCounters& counters) const {
+    Ray rays[kPacketRays];
+    HitRecord hits[kPacketRays];
+    float given_lod[kPacketRays];
+    bool given[kPacketRays];
+    for (int y = y0, j = 0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x, ++j) rays[j] = sample_ray(x, y, sample);
+    SampleBlock block{x0, y0, x1, y1, rays, hits, given_lod, given, {}};
+    source.sample_hits(block);
+    add_traversal(counters, block.work);
+    const size_t width = size_t(scene_.image.width);
+    for (int y = y0, j = 0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x, ++j) {
         PixelRng rng(options_.seed, x, y, k);
         counters.primary++;
-        HitRecord hit;
-        const bool rebuilt =
-            visible.object_id[i] != kNoId &&
-            geometry_.intersect_visible(ray, visible.object_id[i], visible.primitive_id[i], hit,
-                                        counters.traversal);
-        // A hit rebuilt from the z-buffer samples its texture at the z-buffer's level.
-        const float* given_lod = rebuilt && !visible.lod.empty() ? &visible.lod[i] : nullptr;
-        if (rebuilt) {
-          counters.rebuilt++;
-          HitRecord csg;
-          if (geometry_.has_csg() && geometry_.closest_csg(ray, csg, counters.traversal) &&
-              (csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive))) {
-            hit = csg;
-            given_lod = nullptr;
-            counters.csg_pixels++;
-          }
-        } else {
-          counters.fallback_traced++;
-          counters.fallback_missed += visible.object_id[i] != kNoId;
-          if (!geometry_.closest(ray, hit, counters.traversal)) hit = HitRecord{};
-        }
-        sum[i] += shade_hit(ray, hit, 0, counters, &rng, textured_footprint(), given_lod);
+        sum[size_t(y) * width + size_t(x)] +=
+            shade_hit(rays[j], hits[j], 0, counters, &rng, textured_footprint(),
+                      given[j] ? &given_lod[j] : nullptr);
       }
   }
 
@@ -176,141 +158,33 @@ class FrameTracer {
     finish_block(x0, y0, x1 - x0, packet, hits, work, out, counters);
   }
 
-  // The same pixels with their primary hits rebuilt from `visible`'s ids (render_visible).
-  void render_block_visible(int x0, int y0, int x1, int y1, const PrimaryVisibility& visible,
-                            TileOutput& out, RayCounters& counters) const {
-    if (shows_only_background(x0, y0, x1, y1, visible)) {
+  // The same pixels with their primary hits from `source`.
+  void render_block_from(int x0, int y0, int x1, int y1, const PrimaryHitSource& source,
+                         TileOutput& out, RayCounters& counters) const {
+    if (source.only_background(x0, y0, x1, y1)) {
       for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
           out.set_background(out.index(x, y), scene_.image.background);
           if (textured_) out.lod[out.index(x, y)] = kNoLod;
         }
-      counters.background += uint64_t(x1 - x0) * uint64_t(y1 - y0);
       return;
     }
-    const int w = x1 - x0;
-    // The very rays render_block traces.
-    const RayPacket packet = rays_.packet(x0, y0, w, y1 - y0);
-    const int n = packet.count;
+    const RayPacket packet = rays_.packet(x0, y0, x1 - x0, y1 - y0);
     HitRecord hits[kPacketRays];
     TraversalCounters work[kPacketRays];
-    bool traced[kPacketRays];
-    int n_traced = 0;
-    const uint64_t background_before = counters.background;
-    // The ids the z-buffer drew, and which pixels need a ray at all.
-    uint32_t object[kPacketRays], primitive[kPacketRays];
-    bool drawn[kPacketRays], rebuilt[kPacketRays];
-    // The z-buffer's texture level of detail, taken by the hits rebuilt from it (given).
-    float zbuffer_lod[kPacketRays];
+    float given_lod[kPacketRays];
     bool given[kPacketRays];
-    for (int y = y0, k = 0; y < y1; ++y)
-      for (int x = x0; x < x1; ++x, ++k) {  // ray k is pixel (x, y)
-        const size_t i = size_t(y) * size_t(visible.width) + size_t(x);
-        given[k] = false;
-        zbuffer_lod[k] = visible.lod.empty() ? kNoLod : visible.lod[i];
-        object[k] = visible.object_id[i];
-        primitive[k] = visible.primitive_id[i];
-        drawn[k] = object[k] != kNoId;
-        hits[k] = HitRecord{};
-        work[k] = TraversalCounters{};
-        traced[k] = !drawn[k] && may_hide_a_surface(x, y, visible);
-        // Otherwise background to the z-buffer, away from every edge it drew and from every
-        // shape it could not draw exactly: background to the tracer too, without a ray.
-        if (!drawn[k] && !traced[k]) counters.background++;
-      }
-    geometry_.intersect_visible_packet(packet, object, primitive, drawn, hits, rebuilt, work);
-    for (int k = 0; k < n; ++k) {
-      if (!drawn[k]) {
-        n_traced += traced[k];
-        continue;
-      }
-      if (!rebuilt[k]) {
-        // The z-buffer's polygon covers the centre where the exact surface does not
-        // (silhouettes, shared edges): the tracer decides, below.
-        traced[k] = true;
-        n_traced++;
-        counters.fallback_missed++;
-        continue;
-      }
-      counters.rebuilt++;
-      given[k] = !visible.lod.empty();
-      if (geometry_.has_csg()) {
-        // No z-buffer draws CSG: the ray meets the CSG objects alone; the nearer hit wins, ties
-        // by primitive index as in closest().
-        HitRecord csg;
-        if (geometry_.closest_csg(PrimaryRays::ray_of(packet, k), csg, work[k]) &&
-            (csg.t < hits[k].t || (csg.t == hits[k].t && csg.primitive < hits[k].primitive))) {
-          hits[k] = csg;
-          given[k] = false;
-          counters.csg_pixels++;
-        }
-      }
-    }
-    counters.fallback_traced += uint64_t(n_traced);
-    if (n_traced >= kPacketFallbacks) {
-      // Many to trace (an empty background): the whole block as one packet, as render_block
-      // traces it; its hits are closest()'s, so which way is taken changes no pixel.
-      HitRecord packet_hits[kPacketRays];
-      TraversalCounters packet_work[kPacketRays];
-      geometry_.closest_packet(packet, packet_hits, packet_work);
-      for (int k = 0; k < n; ++k) {
-        if (traced[k]) {
-          hits[k] = packet_hits[k];
-          work[k] = packet_work[k];
-        } else {  // traversed for nothing, but traversed: counted, not charged to the pixel
-          counters.traversal.nodes_visited += packet_work[k].nodes_visited;
-          counters.traversal.primitive_tests += packet_work[k].primitive_tests;
-        }
-      }
-    } else if (n_traced > 0) {
-      for (int k = 0; k < n; ++k) {
-        if (!traced[k]) continue;
-        hits[k] = HitRecord{};
-        geometry_.closest(PrimaryRays::ray_of(packet, k), hits[k], work[k]);
-      }
-    }
-    if (geometry_.has_csg())
-      for (int k = 0; k < n; ++k)
-        if (traced[k] && hits[k].primitive != kNoPrimitive &&
-            scene_.objects[geometry_.hit_ids(hits[k]).first].type == ObjectType::Csg)
-          counters.csg_pixels++;
-    counters.primary += uint64_t(n) - (counters.background - background_before);
-    finish_block(x0, y0, w, packet, hits, work, out, counters, zbuffer_lod, given);
+    CentreBlock block{x0, y0, x1, y1, packet, hits, work, given_lod, given, 0, {}};
+    source.centre_hits(block);
+    counters.primary += block.rays;
+    add_traversal(counters, block.unattributed);
+    finish_block(x0, y0, x1 - x0, packet, hits, work, out, counters, given_lod, given);
   }
 
  private:
-  // Whether no pixel of [x0, x1) x [y0, y1) can show anything to the tracer: the z-buffer
-  // covered none of them nor of their neighbours, and none lies where a shape it draws
-  // approximately or not at all may appear (may_hide_a_surface for the whole block at once).
-  bool shows_only_background(int x0, int y0, int x1, int y1,
-                             const PrimaryVisibility& visible) const {
-    const size_t width = size_t(visible.width);
-    if (approximated_mask_)
-      for (int y = y0; y < y1; ++y) {
-        const uint8_t* row = approximated_mask_ + size_t(y) * width;
-        for (int x = x0; x < x1; ++x)
-          if (row[x]) return false;
-      }
-    const int nx0 = std::max(x0 - 1, 0), nx1 = std::min(x1 + 1, visible.width);
-    for (int y = std::max(y0 - 1, 0); y < std::min(y1 + 1, visible.height); ++y) {
-      const uint32_t* row = visible.object_id.data() + size_t(y) * width;
-      uint32_t all = ~0u;  // kNoId where every id is kNoId
-      for (int x = nx0; x < nx1; ++x) all &= row[x];
-      if (all != kNoId) return false;
-    }
-    return true;
-  }
-
-  // Whether the tracer may see a surface at empty pixel (x, y) of a z-buffer's ids: next to a
-  // pixel it covered (a silhouette or shared edge may fall either way at a centre), or where a
-  // shape it draws approximately or not at all may appear.
-  bool may_hide_a_surface(int x, int y, const PrimaryVisibility& visible) const {
-    const size_t width = size_t(visible.width);
-    if (approximated_mask_ && approximated_mask_[size_t(y) * width + size_t(x)]) return true;
-    for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, visible.height - 1); ++ny)
-      for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, visible.width - 1); ++nx)
-        if (visible.object_id[size_t(ny) * width + size_t(nx)] != kNoId) return true;
-    return false;
+  static void add_traversal(RayCounters& counters, const TraversalCounters& work) {
+    counters.traversal.nodes_visited += work.nodes_visited;
+    counters.traversal.primitive_tests += work.primitive_tests;
   }
 
   // The pixels of one block once the closest hits of their centre rays are known: hits[k] (for
@@ -319,7 +193,7 @@ class FrameTracer {
   // local mode the surface and colour computed by the shading kernels, the block's hits as one
   // batch; in full mode (shadow, reflection and refraction rays) one pixel at a time.
   // given_lod[k], where given[k] (both may be null: none), is the texture level of detail ray
-  // k's hit samples at instead of its own footprint's (a hybrid's z-buffer's).
+  // k's hit samples at instead of its own footprint's (a PrimaryHitSource's).
   void finish_block(int x0, int y0, int w, const RayPacket& packet, const HitRecord* hits,
                     const TraversalCounters* work, TileOutput& out, RayCounters& counters,
                     const float* given_lod = nullptr, const bool* given = nullptr) const {
@@ -539,7 +413,7 @@ class FrameTracer {
 
   // The base colour at barycentrics (u, v) of `triangle` of object o, whose colour varies
   // (varies_in_colour), and in lod the texture's level of detail there (NaN: not textured):
-  // `given` when not null (a hybrid's primary hit takes its z-buffer's), else the footprint's.
+  // `given` when not null (a PrimaryHitSource's, for its primary hit), else the footprint's.
   glm::vec3 varying_base_colour(const Object& o, uint32_t triangle, float u, float v,
                                 const glm::vec3& D, float t, const RayFootprint* footprint,
                                 float& lod, const float* given = nullptr) const {
@@ -554,7 +428,7 @@ class FrameTracer {
   // rng is the pixel's stream when it takes several samples (area lights are then jittered
   // inside their strata), null for one sample at the pixel centre. footprint: the ray's, when
   // the scene has a texture; lod, when not null, receives the texture's level of detail at s;
-  // given_lod, when not null, is the level to sample at s (a z-buffer's, for a hybrid's hit).
+  // given_lod, when not null, is the level to sample at s (a PrimaryHitSource's, for its hit).
   glm::vec3 shade(const Ray& ray, const SurfaceHit& s, const glm::vec3& N, const glm::vec3& V,
                   int depth, RayCounters& counters, PixelRng* rng, const RayFootprint* footprint,
                   float* lod, const float* given_lod = nullptr) const {
@@ -626,7 +500,6 @@ class FrameTracer {
   const bool thin_lens_;  // full mode with an aperture: samples look through the lens
   bool centre_only_ = false;
   const ShadeKernels& kernels_;
-  const uint8_t* approximated_mask_ = nullptr;
   std::vector<ShadeMaterial> materials_;  // scene_.materials as the kernels read them
   ShadeLightArrays light_arrays_;         // lights_ likewise
   // Colour that varies over a surface (textures, vertex colours): per object, and whether any.
@@ -668,36 +541,10 @@ Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions
 
 Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& options,
                                          const TraceGeometry& geometry) {
-  return render_frame(scene, options, geometry, nullptr, false);
+  return render_frame(scene, options, geometry, nullptr);
 }
 
 namespace {
-
-std::optional<Error> check_visibility_size(const Scene& scene, const PrimaryVisibility& visible) {
-  const size_t n = size_t(std::max(scene.image.width, 0)) * size_t(std::max(scene.image.height, 0));
-  if (visible.width != scene.image.width || visible.height != scene.image.height ||
-      visible.object_id.size() != n || visible.primitive_id.size() != n)
-    return Error{"visibility buffer is " + std::to_string(visible.width) + "x" +
-                     std::to_string(visible.height) + ", the image " +
-                     std::to_string(scene.image.width) + "x" + std::to_string(scene.image.height),
-                 ErrorKind::Internal};
-  return std::nullopt;
-}
-
-// 1 at the pixels inside the screen bounds of a shape that a z-buffer draws approximately or not
-// at all (TraceGeometry::approximated_bounds), row-major.
-std::vector<uint8_t> approximated_mask(const Scene& scene, const TraceGeometry& geometry) {
-  const int w = scene.image.width, h = scene.image.height;
-  const CameraFrame frame = make_camera_frame(scene.camera, w, h);
-  std::vector<uint8_t> mask(size_t(w) * size_t(h), 0);
-  for (const Aabb& box : geometry.approximated_bounds()) {
-    const PixelRect r = screen_bounds(frame, scene.camera.near, box);
-    for (int y = r.y0; y < r.y1; ++y)
-      if (r.x1 > r.x0)
-        std::memset(mask.data() + size_t(y) * size_t(w) + size_t(r.x0), 1, size_t(r.x1 - r.x0));
-  }
-  return mask;
-}
 
 // Runs tile(x0, y0, x1, y1, counters) over the image's tiles in parallel on `threads`
 // (0: all), and returns the counters of every thread added up.
@@ -726,21 +573,20 @@ RayCounters for_each_tile(int w, int h, int threads, const Tile& tile) {
 
 }  // namespace
 
-Expected<RenderOutput> RayTracer::render_visible(const Scene& scene, const RenderOptions& options,
-                                                 const TraceGeometry& geometry,
-                                                 const PrimaryVisibility& visible,
-                                                 VisibleSamples samples) {
-  if (auto error = check_visibility_size(scene, visible)) return *error;
-  return render_frame(scene, options, geometry, &visible, samples == VisibleSamples::FromPasses);
+Expected<RenderOutput> RayTracer::render(const Scene& scene, const RenderOptions& options,
+                                         const TraceGeometry& geometry,
+                                         const PrimaryHitSource& source) {
+  return render_frame(scene, options, geometry, &source);
 }
 
-Expected<std::map<std::string, double>> RayTracer::add_visible_sample(
-    const Scene& scene, const RenderOptions& options, const TraceGeometry& geometry,
-    const PrimaryVisibility& visible, int k, std::span<glm::vec3> sum) {
-  if (auto error = check_visibility_size(scene, visible)) return *error;
+Expected<std::map<std::string, double>> RayTracer::add_samples(const Scene& scene,
+                                                               const RenderOptions& options,
+                                                               const TraceGeometry& geometry,
+                                                               const PrimaryHitSource& source,
+                                                               int k, std::span<glm::vec3> sum) {
   const int w = scene.image.width, h = scene.image.height;
   const int spp = scene.image.samples_per_pixel;
-  if (sum.size() != size_t(w) * size_t(h) || k < 0 || k >= spp)
+  if (w <= 0 || h <= 0 || sum.size() != size_t(w) * size_t(h) || k < 0 || k >= spp)
     return Error{"sample " + std::to_string(k) + " of " + std::to_string(spp) + " into " +
                      std::to_string(sum.size()) + " pixels",
                  ErrorKind::Internal};
@@ -752,16 +598,20 @@ Expected<std::map<std::string, double>> RayTracer::add_visible_sample(
       image_sample(scene.camera, options.seed, k, spp, options.mode == RenderMode::Full);
   const RayCounters total =
       for_each_tile(w, h, options.threads, [&](int x0, int y0, int x1, int y1, RayCounters& c) {
-        tracer.sample_block_visible(x0, y0, x1, y1, visible, k, sample, sum.data(), c);
+        for (int by = y0; by < y1; by += kPacketSide)
+          for (int bx = x0; bx < x1; bx += kPacketSide)
+            tracer.add_sample_block(bx, by, std::min(bx + kPacketSide, x1),
+                                    std::min(by + kPacketSide, y1), source, k, sample, sum.data(),
+                                    c);
       });
   std::map<std::string, double> stats;
-  total.report(stats, /*visible=*/true, /*own_traversal=*/resolved.accel != AccelKind::Embree);
+  total.report(stats, /*own_traversal=*/resolved.accel != AccelKind::Embree);
   return stats;
 }
 
 Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderOptions& requested,
                                                const TraceGeometry& geometry,
-                                               const PrimaryVisibility* visible, bool centre_only) {
+                                               const PrimaryHitSource* source) {
   RenderOptions options = requested;
   options.accel = geometry.accel();
   RenderOutput out;
@@ -780,12 +630,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
                                                                                  : "none";
   }
   FrameTracer tracer(scene, options, geometry, shade_kernels(*isa));
-  if (centre_only) tracer.keep_centre_colour();
-  std::vector<uint8_t> approximated;
-  if (visible) {
-    approximated = approximated_mask(scene, geometry);
-    tracer.set_approximated_mask(approximated.data());
-  }
+  if (source) tracer.keep_centre_colour();
   // The fraction in pixels (known up front), the speed in rays of every kind (known as they go).
   ProgressSink* const progress = options.progress;
   if (progress) progress->begin("trace", uint64_t(w) * uint64_t(h), "pixels", "rays");
@@ -799,8 +644,8 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
         for (int by = y0; by < y1; by += kPacketSide)
           for (int bx = x0; bx < x1; bx += kPacketSide) {
             int bx1 = std::min(bx + kPacketSide, x1), by1 = std::min(by + kPacketSide, y1);
-            if (visible)
-              tracer.render_block_visible(bx, by, bx1, by1, *visible, tile, local);
+            if (source)
+              tracer.render_block_from(bx, by, bx1, by1, *source, tile, local);
             else
               tracer.render_block(bx, by, bx1, by1, tile, local);
           }
@@ -813,14 +658,14 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   const double render_seconds = seconds_since(t_render);
   out.stats["time.render"] = render_seconds;
   // The frame's time divided as the threads' time divides: until the primary hits are known
-  // (rays generated and traced, or rebuilt from the z-buffer's ids) and after (surfaces, AOVs,
+  // (rays generated and traced, or found by the PrimaryHitSource) and after (surfaces, AOVs,
   // shading and every ray after the primary hit).
   const double shade_share = total.busy_seconds > 0 ? total.shade_seconds / total.busy_seconds : 0;
   out.stats["time.shade"] = render_seconds * shade_share;
   out.stats["time.visibility"] = render_seconds - out.stats["time.shade"];
   out.info["shade_kernel"] = shade_kernels(*isa).isa;
 
-  total.report(out.stats, visible != nullptr, options.accel != AccelKind::Embree);
+  total.report(out.stats, options.accel != AccelKind::Embree);
   if (options.accel == AccelKind::Embree)  // Embree does not count its traversal steps
     out.warnings.push_back("embree does not report traversal work: the cost AOV is 0");
   out.stats["primitives"] = double(geometry.primitive_count());

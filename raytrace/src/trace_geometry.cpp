@@ -569,8 +569,8 @@ TriangleSurfaceData TraceGeometry::triangle_surface_data(uint32_t p) const {
   return d;
 }
 
-bool TraceGeometry::intersect_visible(const Ray& ray, uint32_t object, uint32_t primitive,
-                                      HitRecord& hit, TraversalCounters& counters) const {
+bool TraceGeometry::intersect_named(const Ray& ray, uint32_t object, uint32_t primitive,
+                                    HitRecord& hit, TraversalCounters& counters) const {
   if (object >= object_analytic_.size()) return false;
   const uint32_t n_triangles = uint32_t(triangles_.size());
   hit = HitRecord{};
@@ -613,10 +613,10 @@ bool TraceGeometry::intersect_visible(const Ray& ray, uint32_t object, uint32_t 
   return found;
 }
 
-void TraceGeometry::intersect_visible_packet(const RayPacket& packet, const uint32_t* object,
-                                             const uint32_t* primitive, const bool* wanted,
-                                             HitRecord* hits, bool* found,
-                                             TraversalCounters* counters) const {
+void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32_t* object,
+                                           const uint32_t* primitive, const bool* wanted,
+                                           HitRecord* hits, bool* found,
+                                           TraversalCounters* counters) const {
   auto ray_of = [&](int k) {
     return Ray{{packet.origin[0], packet.origin[1], packet.origin[2]},
                {packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]},
@@ -637,7 +637,7 @@ void TraceGeometry::intersect_visible_packet(const RayPacket& packet, const uint
                               object_names_triangles_[o] &&
                               primitive[k] < object_mesh_[o]->triangles.size();
     if (!one_triangle) {
-      found[k] = intersect_visible(ray_of(k), o, primitive[k], hits[k], counters[k]);
+      found[k] = intersect_named(ray_of(k), o, primitive[k], hits[k], counters[k]);
       continue;
     }
     const int lane = named.count++;
@@ -665,8 +665,8 @@ void TraceGeometry::intersect_visible_packet(const RayPacket& packet, const uint
   kernels_->intersect_named(packet, named, kernel_hits, outcome);
   for (int lane = 0; lane < named.count; ++lane) {
     const int k = lane_ray[lane];
-    if (outcome[lane] == NamedOutcome::NearEdge) {  // decided in double, as intersect_visible does
-      found[k] = intersect_visible(ray_of(k), object[k], primitive[k], hits[k], counters[k]);
+    if (outcome[lane] == NamedOutcome::NearEdge) {  // decided in double, as intersect_named does
+      found[k] = intersect_named(ray_of(k), object[k], primitive[k], hits[k], counters[k]);
       continue;
     }
     counters[k].primitive_tests++;

@@ -9,7 +9,7 @@
 #include "rvr/core/expected.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
-#include "rvr/raytrace/primary_visibility.h"
+#include "rvr/raytrace/primary_hit_source.h"
 #include "rvr/raytrace/trace_geometry.h"
 
 namespace rvr {
@@ -21,10 +21,6 @@ std::string embree_version();
 // plugin cannot be loaded; it is loaded to tell).
 std::string embree_kernel_isa();
 std::string tbb_version();
-
-// Where render_visible takes a pixel's samples from when the scene asks for several: traced by
-// the tracer itself, or from the caller's accumulation-buffer passes (add_visible_sample).
-enum class VisibleSamples { Traced, FromPasses };
 
 class RayTracer : public Renderer {
  public:
@@ -41,35 +37,28 @@ class RayTracer : public Renderer {
   // frames only); its accelerator and sphere mode win over the options'.
   Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options,
                                 const TraceGeometry& geometry);
-  // A frame whose primary hits come from outside (the hybrid: a z-buffer's ids): each pixel's
-  // centre ray is intersected with the one object or triangle `visible` names there, then
-  // shaded exactly as render() shades its primary hit. Pixels where that misses or nothing was
-  // drawn are traced as render() traces them, and the CSG objects (no z-buffer draws them) are
-  // intersected for every pixel, the nearer hit kept: the same image as render() wherever the
-  // ids agree with its own. Stats add hybrid.rebuilt, hybrid.fallback_traced (of which
-  // hybrid.fallback_missed: the named primitive was missed) and hybrid.csg_pixels.
-  // With VisibleSamples::FromPasses and several samples per pixel, the colour is the centre
-  // ray's only; the caller adds the samples with add_visible_sample and divides by their count.
-  Expected<RenderOutput> render_visible(const Scene& scene, const RenderOptions& options,
-                                        const TraceGeometry& geometry,
-                                        const PrimaryVisibility& visible,
-                                        VisibleSamples samples = VisibleSamples::Traced);
-  // One pass of the hybrid's accumulation buffer: sample k (of image.samples_per_pixel) of every
-  // pixel, its ray (image_sample k: place in the pixel, lens point) intersected with what
-  // `visible` names there (a z-buffer drawn with RenderOptions::image_sample = that sample),
-  // else traced, CSG as render_visible. Each colour is added to sum (row-major per pixel): the
-  // sums of passes k = 0..spp-1 in order, divided by spp, are render()'s colours bit for bit
-  // wherever the ids agree with its own hits. Returns the pass's ray and hybrid counters.
-  Expected<std::map<std::string, double>> add_visible_sample(const Scene& scene,
-                                                             const RenderOptions& options,
-                                                             const TraceGeometry& geometry,
-                                                             const PrimaryVisibility& visible,
-                                                             int k, std::span<glm::vec3> sum);
+  // A frame whose primary hits come from `source` (the hybrid's z-buffer), block by block: each
+  // shaded exactly as render() shades its own primary hit, with the source's texture level of
+  // detail where it gives one; blocks it calls only_background are background without a ray.
+  // The colour is the centre hit's only, whatever the samples per pixel: the caller adds the
+  // samples with add_samples and divides by their count.
+  Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options,
+                                const TraceGeometry& geometry, const PrimaryHitSource& source);
+  // Sample k (of image.samples_per_pixel) of every pixel: its ray (image_sample k: place in the
+  // pixel, lens point) given to `source` for its hit, shaded with the pixel's random stream k and
+  // added to sum (row-major per pixel). The sums of k = 0..spp-1 in order, divided by spp, are
+  // render()'s colours bit for bit wherever the source's hits are closest()'s. Returns the
+  // pass's ray counters.
+  Expected<std::map<std::string, double>> add_samples(const Scene& scene,
+                                                      const RenderOptions& options,
+                                                      const TraceGeometry& geometry,
+                                                      const PrimaryHitSource& source, int k,
+                                                      std::span<glm::vec3> sum);
 
  private:
   Expected<RenderOutput> render_frame(const Scene& scene, const RenderOptions& options,
                                       const TraceGeometry& geometry,
-                                      const PrimaryVisibility* visible, bool centre_only);
+                                      const PrimaryHitSource* source);
 
   AccelKind forced_ = AccelKind::Bvh;
   bool has_forced_ = false;

@@ -115,19 +115,19 @@ class TraceGeometry {
   // (a sphere traced as its tessellation: the nearest of its triangles, since a z-buffer does
   // not report which). False when the ray misses it in (tmin, tmax) or the ids name nothing.
   // counters.primitive_tests counts the tests made.
-  bool intersect_visible(const Ray& ray, uint32_t object, uint32_t primitive, HitRecord& hit,
-                         TraversalCounters& counters) const;
+  bool intersect_named(const Ray& ray, uint32_t object, uint32_t primitive, HitRecord& hit,
+                       TraversalCounters& counters) const;
   // Bounds of the shapes a z-buffer draws only approximately or not at all: analytic spheres
   // (their tessellation lies inside the exact silhouette) and CSG solids.
   std::vector<Aabb> approximated_bounds() const;
-  // intersect_visible for the rays of a packet at once: for each ray k with wanted[k], the
+  // intersect_named for the rays of a packet at once: for each ray k with wanted[k], the
   // object[k] and primitive[k] a visibility buffer named; found[k] and hits[k] as
-  // intersect_visible gives them, counters[k] its tests. With the wide BVH's kernels, the rays
+  // intersect_named gives them, counters[k] its tests. With the wide BVH's kernels, the rays
   // naming one triangle each are tested eight at a time by the same operations (near an edge,
-  // by intersect_visible itself).
-  void intersect_visible_packet(const RayPacket& packet, const uint32_t* object,
-                                const uint32_t* primitive, const bool* wanted, HitRecord* hits,
-                                bool* found, TraversalCounters* counters) const;
+  // by intersect_named itself).
+  void intersect_named_packet(const RayPacket& packet, const uint32_t* object,
+                              const uint32_t* primitive, const bool* wanted, HitRecord* hits,
+                              bool* found, TraversalCounters* counters) const;
   // True when the scene holds CSG objects (which no z-buffer draws).
   bool has_csg() const { return !csg_primitives_.empty(); }
   // Closest hit among the CSG objects only, with closest()'s tie rule.

@@ -1,6 +1,6 @@
-// What another renderer saw first: per pixel the object and primitive id a visibility buffer
-// (a z-buffer's ids, FrameBuffers::object_id / primitive_id) holds. Plain data, no raster type:
-// the tracer rebuilds each pixel's primary hit from it (RayTracer::render_visible).
+// What the hybrid's z-buffer saw: per pixel the object and primitive id a visibility buffer
+// (FrameBuffers::object_id / primitive_id) holds, and its texture level of detail. Plain data,
+// no raster type: ZBufferHits rebuilds each pixel's primary hit from it for the tracer.
 #pragma once
 
 #include <cstdint>

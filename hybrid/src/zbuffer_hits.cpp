@@ -1,0 +1,184 @@
+#include "zbuffer_hits.h"
+
+#include <stddef.h>
+
+#include <algorithm>
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "rvr/core/framebuffers.h"
+#include "rvr/raytrace/primary_rays.h"
+#include "rvr/raytrace/wide_bvh_layout.h"
+
+namespace rvr {
+namespace {
+
+// A block with at least this many pixels to trace traces them as one packet.
+constexpr int kPacketFallbacks = 8;
+
+}  // namespace
+
+ZBufferHits::ZBufferHits(const Scene& scene, const TraceGeometry& geometry,
+                         const PrimaryVisibility& visible, std::span<const uint8_t> approximated)
+    : scene_(scene), geometry_(geometry), visible_(visible), approximated_(approximated) {}
+
+HybridCounters ZBufferHits::counters() const {
+  HybridCounters total;
+  counters_.combine_each([&](const HybridCounters& c) { total.add(c); });
+  return total;
+}
+
+// No pixel of the block can show anything to the tracer: the z-buffer covered none of them nor
+// of their neighbours, and none lies where a shape it draws approximately or not at all may
+// appear (may_hide_a_surface for the whole block at once).
+bool ZBufferHits::only_background(int x0, int y0, int x1, int y1) const {
+  const size_t width = size_t(visible_.width);
+  if (!approximated_.empty())
+    for (int y = y0; y < y1; ++y) {
+      const uint8_t* row = approximated_.data() + size_t(y) * width;
+      for (int x = x0; x < x1; ++x)
+        if (row[x]) return false;
+    }
+  const int nx0 = std::max(x0 - 1, 0), nx1 = std::min(x1 + 1, visible_.width);
+  for (int y = std::max(y0 - 1, 0); y < std::min(y1 + 1, visible_.height); ++y) {
+    const uint32_t* row = visible_.object_id.data() + size_t(y) * width;
+    uint32_t all = ~0u;  // kNoId where every id is kNoId
+    for (int x = nx0; x < nx1; ++x) all &= row[x];
+    if (all != kNoId) return false;
+  }
+  counters_.local().background += uint64_t(x1 - x0) * uint64_t(y1 - y0);
+  return true;
+}
+
+// Whether the tracer may see a surface at empty pixel (x, y): next to a pixel the z-buffer
+// covered (a silhouette or shared edge may fall either way at a centre), or where a shape it
+// draws approximately or not at all may appear.
+bool ZBufferHits::may_hide_a_surface(int x, int y) const {
+  const size_t width = size_t(visible_.width);
+  if (!approximated_.empty() && approximated_[size_t(y) * width + size_t(x)]) return true;
+  for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, visible_.height - 1); ++ny)
+    for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, visible_.width - 1); ++nx)
+      if (visible_.object_id[size_t(ny) * width + size_t(nx)] != kNoId) return true;
+  return false;
+}
+
+bool ZBufferHits::csg_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const {
+  HitRecord csg;
+  if (!geometry_.closest_csg(ray, csg, work) ||
+      !(csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive)))
+    return false;
+  hit = csg;
+  return true;
+}
+
+void ZBufferHits::centre_hits(CentreBlock& block) const {
+  HybridCounters& counters = counters_.local();
+  const RayPacket& packet = block.packet;
+  const int n = packet.count;
+  HitRecord* hits = block.hits;
+  TraversalCounters* work = block.work;
+  bool traced[kPacketRays];
+  int n_traced = 0;
+  uint64_t background = 0;
+  // The ids the z-buffer drew, and which pixels need a ray at all.
+  uint32_t object[kPacketRays], primitive[kPacketRays];
+  bool drawn[kPacketRays], rebuilt[kPacketRays];
+  for (int y = block.y0, k = 0; y < block.y1; ++y)
+    for (int x = block.x0; x < block.x1; ++x, ++k) {  // ray k is pixel (x, y)
+      const size_t i = size_t(y) * size_t(visible_.width) + size_t(x);
+      block.given[k] = false;
+      if (!visible_.lod.empty()) block.given_lod[k] = visible_.lod[i];
+      object[k] = visible_.object_id[i];
+      primitive[k] = visible_.primitive_id[i];
+      drawn[k] = object[k] != kNoId;
+      hits[k] = HitRecord{};
+      work[k] = TraversalCounters{};
+      traced[k] = !drawn[k] && may_hide_a_surface(x, y);
+      // Otherwise background to the z-buffer, away from every edge it drew and from every
+      // shape it could not draw exactly: background to the tracer too, without a ray.
+      if (!drawn[k] && !traced[k]) background++;
+    }
+  geometry_.intersect_named_packet(packet, object, primitive, drawn, hits, rebuilt, work);
+  for (int k = 0; k < n; ++k) {
+    if (!drawn[k]) {
+      n_traced += traced[k];
+      continue;
+    }
+    if (!rebuilt[k]) {
+      // The z-buffer's polygon covers the centre where the exact surface does not
+      // (silhouettes, shared edges): the tracer decides, below.
+      traced[k] = true;
+      n_traced++;
+      counters.fallback_missed++;
+      continue;
+    }
+    counters.rebuilt++;
+    // A hit rebuilt from the z-buffer samples its texture at the z-buffer's level.
+    block.given[k] = !visible_.lod.empty();
+    if (geometry_.has_csg() && csg_wins(PrimaryRays::ray_of(packet, k), hits[k], work[k])) {
+      block.given[k] = false;
+      counters.csg_pixels++;
+    }
+  }
+  counters.fallback_traced += uint64_t(n_traced);
+  if (n_traced >= kPacketFallbacks) {
+    // Many to trace (an empty background): the whole block as one packet, as the tracer traces
+    // it; its hits are closest()'s, so which way is taken changes no pixel.
+    HitRecord packet_hits[kPacketRays];
+    TraversalCounters packet_work[kPacketRays];
+    geometry_.closest_packet(packet, packet_hits, packet_work);
+    for (int k = 0; k < n; ++k) {
+      if (traced[k]) {
+        hits[k] = packet_hits[k];
+        work[k] = packet_work[k];
+      } else {  // traversed for nothing, but traversed: counted, not charged to the pixel
+        block.unattributed.nodes_visited += packet_work[k].nodes_visited;
+        block.unattributed.primitive_tests += packet_work[k].primitive_tests;
+      }
+    }
+  } else if (n_traced > 0) {
+    for (int k = 0; k < n; ++k) {
+      if (!traced[k]) continue;
+      hits[k] = HitRecord{};
+      geometry_.closest(PrimaryRays::ray_of(packet, k), hits[k], work[k]);
+    }
+  }
+  if (geometry_.has_csg())
+    for (int k = 0; k < n; ++k)
+      if (traced[k] && hits[k].primitive != kNoPrimitive &&
+          scene_.objects[geometry_.hit_ids(hits[k]).first].type == ObjectType::Csg)
+        counters.csg_pixels++;
+  counters.background += background;
+  block.rays = uint64_t(n) - background;
+}
+
+void ZBufferHits::sample_hits(SampleBlock& block) const {
+  HybridCounters& counters = counters_.local();
+  for (int y = block.y0, j = 0; y < block.y1; ++y)
+    for (int x = block.x0; x < block.x1; ++x, ++j) {
+      const size_t i = size_t(y) * size_t(visible_.width) + size_t(x);
+      const Ray& ray = block.rays[j];
+      HitRecord& hit = block.hits[j];
+      hit = HitRecord{};
+      const bool rebuilt = visible_.object_id[i] != kNoId &&
+                           geometry_.intersect_named(ray, visible_.object_id[i],
+                                                     visible_.primitive_id[i], hit, block.work);
+      // A hit rebuilt from the z-buffer samples its texture at the z-buffer's level.
+      block.given[j] = rebuilt && !visible_.lod.empty();
+      if (block.given[j]) block.given_lod[j] = visible_.lod[i];
+      if (rebuilt) {
+        counters.rebuilt++;
+        if (geometry_.has_csg() && csg_wins(ray, hit, block.work)) {
+          block.given[j] = false;
+          counters.csg_pixels++;
+        }
+      } else {
+        counters.fallback_traced++;
+        counters.fallback_missed += visible_.object_id[i] != kNoId;
+        if (!geometry_.closest(ray, hit, block.work)) hit = HitRecord{};
+      }
+    }
+}
+
+}  // namespace rvr

@@ -1,0 +1,50 @@
+// The hybrid's primary hits: each pixel's hit rebuilt from the one primitive the z-buffer's
+// visibility buffer names there, traced where the z-buffer cannot answer (empty pixels next to
+// what it drew or where it draws only approximately, named primitives the exact ray misses), and
+// background without a ray everywhere else. No z-buffer draws CSG: the CSG objects are
+// intersected besides for every rebuilt pixel, the nearer hit kept.
+#pragma once
+
+#include <tbb/combinable.h>
+
+#include <cstdint>
+#include <span>
+
+#include "hybrid_counters.h"
+#include "primary_visibility.h"
+#include "rvr/core/scene.h"
+#include "rvr/raytrace/bvh.h"
+#include "rvr/raytrace/intersect.h"
+#include "rvr/raytrace/primary_hit_source.h"
+#include "rvr/raytrace/trace_geometry.h"
+
+namespace rvr {
+
+class ZBufferHits : public PrimaryHitSource {
+ public:
+  // `approximated`: 1 at the pixels a z-buffer may leave empty where the scene is not
+  // (approximated_pixels), row-major; empty: none.
+  ZBufferHits(const Scene& scene, const TraceGeometry& geometry, const PrimaryVisibility& visible,
+              std::span<const uint8_t> approximated = {});
+
+  bool only_background(int x0, int y0, int x1, int y1) const override;
+  void centre_hits(CentreBlock& block) const override;
+  void sample_hits(SampleBlock& block) const override;
+
+  // Every thread's counters added up.
+  HybridCounters counters() const;
+
+ private:
+  bool may_hide_a_surface(int x, int y) const;
+  // Whether the hit a CSG object gives `ray` is nearer than `hit` (ties by primitive index, as
+  // closest() breaks them); if so `hit` becomes it.
+  bool csg_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const;
+
+  const Scene& scene_;
+  const TraceGeometry& geometry_;
+  PrimaryVisibility visible_;
+  std::span<const uint8_t> approximated_;
+  mutable tbb::combinable<HybridCounters> counters_;
+};
+
+}  // namespace rvr
