@@ -489,7 +489,7 @@ std::string timings(const ReportInput& input) {
       if (k.rfind("time.", 0) == 0) time_keys.insert(k);
   h << "<h2>Timings</h2>\n"
     << timing_chart(input.renderers)
-    << "<p class=\"why\">Each bar: the scene load "
+    << "<p class=\"why small\">Each bar: the scene load "
        "(shared, outside the render call), the phases the renderer reports (time.* below) "
        "and, as <i>other</i>, the rest of its render call.</p>\n"
     << "<div class=\"scroll\"><table class=\"timings\"><thead><tr><th></th>";
@@ -514,7 +514,7 @@ std::string timings(const ReportInput& input) {
   }
   h << "<tr><td><b>warnings</b></td>";
   for (const auto& r : input.renderers) h << "<td class=\"num\">" << r.warnings.size() << "</td>";
-  h << "</tr>\n</tbody></table></div>\n<p class=\"why\">"
+  h << "</tr>\n</tbody></table></div>\n<p class=\"why small\">"
        "seconds: wall-clock time of the render call; relative: divided by the first "
        "renderer's; time.*: the phases each renderer reports.</p>\n";
   return h.str();

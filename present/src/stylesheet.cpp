@@ -23,7 +23,7 @@ pre.cmd{background:#1d2330;color:#e8ecf3;padding:10px 12px;border-radius:6px;
 .warn{background:#fff4d6;border:1px solid #e6b400;border-left:6px solid #e6b400;
   padding:10px 14px;border-radius:6px;margin:14px 0}
 .warn h2{border:0;margin:0 0 6px;padding:0}
-p.why{color:#4a5366;font-size:13px}
+p.small{color:#4a5366;font-size:13px}
 details{margin:6px 0} summary{cursor:pointer;color:#2b3447}
 footer{margin-top:30px;color:#7a8394;font-size:12px}
 button{font:inherit;font-size:13px;padding:2px 10px;border-radius:4px;
@@ -62,7 +62,7 @@ b.tag{display:inline-block;min-width:16px;height:16px;border-radius:8px;border:1
 svg.bar{display:block;margin-top:4px;font-size:11px;fill:#4a5366}
 figure.chart-figure{max-width:1100px}
 svg.chart{display:block;width:100%;height:auto;font-size:13px}
-svg.chart text{fill:#1d2330} svg.chart .tick{fill:#4a5366;font-size:12px}
+svg.chart text:not([fill]){fill:#1d2330} svg.chart .tick{fill:#4a5366;font-size:12px}
 svg.chart .plot{fill:#fff;stroke:#9aa3b5}
 svg.chart .gridline{stroke:#d8dce3} svg.chart .minor{stroke:#eef0f4}
 svg.chart .axis-label{font-size:13px;fill:#2b3447}

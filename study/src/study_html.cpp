@@ -390,7 +390,7 @@ std::string header_html(const StudyResult& r) {
     o += "<div class=\"warn interrupted\"><b>Interrupted:</b> the sweep was stopped before its "
          "end; everything below is from the points measured until then.</div>\n";
   for (const std::string& note : r.notes)
-    o += "<div class=\"warn note\"><b>Note:</b> " + escape_html(note) + ".</div>\n";
+    o += "<div class=\"warn note\"><b>Note:</b> " + html_with_powers(note) + ".</div>\n";
   return o;
 }
 
