@@ -1,8 +1,10 @@
 // The pages' presentation kit (present/): escaping, the SVG elements, the charts' scales and
 // ticks, and the page skeleton, against values worked out by hand.
 #include <gtest/gtest.h>
+#include <stddef.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 

@@ -26,6 +26,7 @@
 #include "rvr/compare/mismatch_classes.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/stats.h"
+#include "rvr/present/html_escape.h"
 #include "rvr/present/legend.h"
 #include "rvr/present/page.h"
 #include "timing_chart.h"

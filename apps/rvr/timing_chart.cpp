@@ -4,12 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <initializer_list>
 #include <iterator>
 #include <map>
 #include <memory>
 #include <set>
-#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -75,7 +73,6 @@ std::vector<Phase> phases_of(const ReportRenderer& r) {
   });
   return phases;
 }
-
 
 // The colour of a phase's segments and of the label written on them: one colour per phase name
 // across every bar, colour blind safe (Okabe-Ito, then Tol); grey for "other".
@@ -172,6 +169,7 @@ std::string timing_chart(const std::vector<ReportRenderer>& renderers) {
     o += bar_row(renderers[i], bars[i], names, x, 14 + kRow * double(i));
   o += "</svg>";
   std::vector<std::string> keys;
+  keys.reserve(names.size());
   for (const auto& n : names)
     keys.push_back(present::swatch_key(phase_colour(names, n).fill, escape_html(n)));
   return "<figure class=\"chart-figure\">" + o + present::legend(keys) + "</figure>\n";

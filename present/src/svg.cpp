@@ -2,6 +2,10 @@
 #include "rvr/present/svg.h"
 
 #include <fmt/format.h>
+#include <stddef.h>
+
+#include <initializer_list>
+#include <memory>
 
 #include "rvr/present/html_escape.h"
 
