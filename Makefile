@@ -172,12 +172,12 @@ format:
 # less the checks listed there as noise) over the project's translation units in the build's
 # compile_commands.json, chosen by tools/lint_files.py: the paths matching LINT_FILES and not
 # LINT_EXCLUDE (regular expressions; LINT_EXCLUDE empty: none left out). Any finding fails.
-LINT_FILES ?= $(CURDIR)/(apps|core|scene_io|compare|raster|raytrace|hybrid|renderers|study|image_codec|bench)/
+LINT_FILES ?= $(CURDIR)/(apps|core|scene_io|compare|raster|raytrace|hybrid|renderers|study|present|image_codec|bench)/
 LINT_EXCLUDE ?=
 # Then include-what-you-use on LINT_IWYU_DIRS (tools/iwyu.imp maps the libraries' and libstdc++'s
 # internal headers to their public ones): any include to add or remove fails, and so does iwyu
 # failing on a file (a fatal error or an assertion leaves the file unchecked).
-LINT_IWYU_DIRS ?= apps core scene_io compare raster raytrace hybrid renderers study image_codec bench python tests
+LINT_IWYU_DIRS ?= apps core scene_io compare raster raytrace hybrid renderers study present image_codec bench python tests
 lint: build
 	run-clang-tidy-14 -p $(BUILD_DIR) -j $(JOBS) -quiet \
 		$$(/usr/bin/python3 tools/lint_files.py $(BUILD_DIR)/compile_commands.json '$(LINT_FILES)' '$(LINT_EXCLUDE)')

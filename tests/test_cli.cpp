@@ -27,8 +27,8 @@
 
 #include "model_corpus.h"
 #include "rvr/core/expected.h"
-#include "rvr/core/html_escape.h"
 #include "rvr/image_codec/image_io.h"
+#include "rvr/present/html_escape.h"
 
 namespace fs = std::filesystem;
 
@@ -418,7 +418,7 @@ TEST_F(Cli, LoaderWarningsReachMetricsReportAndStats) {
       };
       EXPECT_EQ(listed(metrics["warnings"]), 1) << metrics["warnings"];
       EXPECT_EQ(listed(stat["warnings"]), 1) << stat["warnings"];
-      EXPECT_NE(html.find("<li>" + rvr::escape_html(w)), std::string::npos) << w;
+      EXPECT_NE(html.find("<li>" + rvr::present::escape_html(w)), std::string::npos) << w;
       for (const std::string* err : {&cmp.err, &render.err}) {
         size_t first = err->find("warning: " + w);
         EXPECT_NE(first, std::string::npos) << *err;

@@ -470,8 +470,10 @@ TEST_F(ReportDir, MissingImageIsAnError) {
 
 // The SVG of an element with this id, from its opening tag to the next </svg>.
 std::string svg_with_id(const std::string& html, const std::string& id) {
-  size_t at = html.find("<svg id=\"" + id + "\"");
-  if (at == std::string::npos) return "";
+  const size_t named = html.find(" id=\"" + id + "\"");
+  if (named == std::string::npos) return "";
+  const size_t at = html.rfind("<svg", named);
+  if (at == std::string::npos || html.find('>', at) < named) return "";
   size_t end = html.find("</svg>", at);
   return end == std::string::npos ? "" : html.substr(at, end + 6 - at);
 }
@@ -521,7 +523,7 @@ TEST_F(ReportDir, TimingChartHasEveryPhaseOfEveryRenderer) {
   const std::string svg = svg_with_id(html.value(), "timing-chart");
   ASSERT_FALSE(svg.empty());
   EXPECT_NE(svg.find("role=\"img\""), std::string::npos);
-  EXPECT_NE(svg.find("<title id=\"timing-title\">"), std::string::npos);
+  EXPECT_NE(svg.find("<title id=\"timing-chart-title\">"), std::string::npos);
 
   auto row = [&](const std::string& name) {
     size_t at = svg.find("<g class=\"bar-row\" data-renderer=\"" + name + "\">");
@@ -553,7 +555,7 @@ TEST_F(ReportDir, TimingChartHasEveryPhaseOfEveryRenderer) {
     last = at;
   }
   // The same numbers as text for screen readers.
-  EXPECT_NE(svg.find("<desc id=\"timing-desc\">raster: load 0.002 s, setup 0.01 s"),
+  EXPECT_NE(svg.find("<desc id=\"timing-chart-desc\">raster: load 0.002 s, setup 0.01 s"),
             std::string::npos);
 }
 

@@ -702,8 +702,8 @@ size_t occurrences(const std::string& text, const std::string& what) {
 // The SVG of each chart, in page order.
 std::vector<std::string> charts_of(const std::string& html) {
   std::vector<std::string> out;
-  for (size_t at = html.find("<svg class=\"study-chart\""); at != std::string::npos;
-       at = html.find("<svg class=\"study-chart\"", at + 1))
+  for (size_t at = html.find("<svg class=\"chart study-chart\""); at != std::string::npos;
+       at = html.find("<svg class=\"chart study-chart\"", at + 1))
     out.push_back(html.substr(at, html.find("</svg>", at) - at));
   return out;
 }
@@ -823,7 +823,9 @@ TEST(StudyHtml, ChartsAgainstPixelsWhereASceneWasMeasuredAtSeveral) {
   for (const std::string& name : r.renderers) {
     EXPECT_EQ(marks_of(charts[0], name), per_scene) << "the main chart: one pixel count";
     EXPECT_EQ(marks_of(charts[1], name), 2u) << "against pixels: one point at each";
-    EXPECT_EQ(occurrences(charts[1], "data-renderer=\"" + name + "\" d=\""), 1u) << name;
+    EXPECT_EQ(occurrences(charts[1], "<path class=\"model fits\" data-renderer=\"" + name + "\""),
+              1u)
+        << name;
   }
 }
 

@@ -20,14 +20,15 @@
 #include "colour_bar.h"
 #include "data_uri.h"
 #include "report.h"
-#include "report_css.h"
 #include "report_script.h"
 #include "report_text.h"
 #include "rvr/compare/compare.h"
 #include "rvr/compare/mismatch_classes.h"
 #include "rvr/core/expected.h"
-#include "rvr/core/html_escape.h"
 #include "rvr/core/stats.h"
+#include "rvr/present/html_escape.h"
+#include "rvr/present/legend.h"
+#include "rvr/present/page.h"
 #include "timing_chart.h"
 
 namespace rvr {
@@ -37,11 +38,10 @@ using namespace report;
 
 // A colour swatch as the captions use it.
 std::string swatch(const float rgb[3]) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "<span class=\"sw\" style=\"background:#%02x%02x%02x\"></span>",
-                int(std::lround(rgb[0] * 255)), int(std::lround(rgb[1] * 255)),
-                int(std::lround(rgb[2] * 255)));
-  return buf;
+  char hex[8];
+  std::snprintf(hex, sizeof hex, "#%02x%02x%02x", int(std::lround(rgb[0] * 255)) & 0xff,
+                int(std::lround(rgb[1] * 255)) & 0xff, int(std::lround(rgb[2] * 255)) & 0xff);
+  return present::swatch(hex);
 }
 
 struct MetricRow {
@@ -92,9 +92,8 @@ std::string outlier_rows(const std::vector<DepthOutlier>& listed, size_t begin, 
       << "</td><td class=\"num\">" << o.object << "</td><td class=\"num\">"
       << fmt("%.7g", o.depth_a) << "</td><td class=\"num\">" << fmt("%.7g", o.depth_b)
       << "</td><td class=\"num" << (o.cause == DepthOutlierCause::Elsewhere ? " bad" : "") << "\">"
-      << fmt("%.3g", o.rel_error)
-      << "</td><td><span class=\"sw\" style=\"background:" << outlier_colour(o.cause)
-      << "\"></span>" << to_string(o.cause) << "</td></tr>\n";
+      << fmt("%.3g", o.rel_error) << "</td><td>" << present::swatch(outlier_colour(o.cause))
+      << to_string(o.cause) << "</td></tr>\n";
   }
   return h.str();
 }
@@ -239,15 +238,6 @@ Expected<ReportImages> embed_images(const ReportInput& input,
     images.classes.push_back(std::move(uri.value()));
   }
   return images;
-}
-
-std::string page_head(const std::string& title) {
-  std::ostringstream h;
-  h << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
-    << "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
-    << "<title>" << escape_html(title) << "</title>\n<style>" << kCss << "</style>\n"
-    << "</head>\n<body>\n<main>\n";
-  return h.str();
 }
 
 // The title, what was rendered, the command line and the verdict badges of the first pair.
@@ -500,7 +490,7 @@ std::string timings(const ReportInput& input) {
       if (k.rfind("time.", 0) == 0) time_keys.insert(k);
   h << "<h2>Timings</h2>\n"
     << timing_chart(input.renderers)
-    << "<p class=\"why\" style=\"color:#4a5366;font-size:13px\">Each bar: the scene load "
+    << "<p class=\"why small\">Each bar: the scene load "
        "(shared, outside the render call), the phases the renderer reports (time.* below) "
        "and, as <i>other</i>, the rest of its render call.</p>\n"
     << "<div class=\"scroll\"><table class=\"timings\"><thead><tr><th></th>";
@@ -525,7 +515,7 @@ std::string timings(const ReportInput& input) {
   }
   h << "<tr><td><b>warnings</b></td>";
   for (const auto& r : input.renderers) h << "<td class=\"num\">" << r.warnings.size() << "</td>";
-  h << "</tr>\n</tbody></table></div>\n<p class=\"why\" style=\"color:#4a5366;font-size:13px\">"
+  h << "</tr>\n</tbody></table></div>\n<p class=\"why small\">"
        "seconds: wall-clock time of the render call; relative: divided by the first "
        "renderer's; time.*: the phases each renderer reports.</p>\n";
   return h.str();
@@ -551,13 +541,10 @@ std::string all_statistics(const ReportInput& input) {
 }
 
 std::string page_end(const ReportInput& input) {
-  std::ostringstream h;
-  h << "<footer>Written by rvr compare. Colour metrics use linear RGB with peak 1; the "
-       "heat map scale is "
-    << fmt("%g", input.heat_map_scale) << ".</footer>\n</main>\n";
-  if (input.renderers.size() >= 2) h << "<script>" << kScript << "</script>\n";
-  h << "</body>\n</html>\n";
-  return h.str();
+  return "<footer>Written by rvr compare. Colour metrics use linear RGB with peak 1; the heat "
+         "map scale is " +
+         fmt("%g", input.heat_map_scale) + ".</footer>\n" +
+         present::page_end(input.renderers.size() >= 2 ? kScript : "");
 }
 
 }  // namespace
@@ -573,8 +560,8 @@ Expected<std::string> report_html(const ReportInput& input) {
 
     const std::string title = "rvr compare: " + name_a + " vs " + name_b + " on " + input.scene;
     std::ostringstream h;
-    h << page_head(title) << summary(input, title, first) << warnings(input)
-      << renders(input, *images, name_a, name_b)
+    h << present::page_start(title, present::PageWidth::Wide) << summary(input, title, first)
+      << warnings(input) << renders(input, *images, name_a, name_b)
       << differences(input, first, *images, name_a, name_b) << work_per_pixel(input, *images)
       << metrics_table(metric_rows(first.metrics))
       << outlier_table(first.metrics.depth, name_a, name_b)

@@ -3,11 +3,11 @@
 
 #include <string>
 
-#include "rvr/core/html_escape.h"
+#include "rvr/present/html_escape.h"
 
 namespace rvr::report {
 
-using ::rvr::escape_html;  // rvr/core/html_escape.h
+using ::rvr::present::escape_html;  // rvr/present/html_escape.h
 // printf of one number, with n/a and infinity spelt out for HTML.
 std::string fmt(const char* format, double v);
 std::string fmt_seconds(double s);

@@ -4,19 +4,20 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <initializer_list>
 #include <iterator>
 #include <map>
 #include <memory>
 #include <set>
-#include <sstream>
 #include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
 
 #include "report_text.h"
-#include "rvr/core/html_escape.h"
+#include "rvr/present/chart_axes.h"
+#include "rvr/present/html_escape.h"
+#include "rvr/present/legend.h"
+#include "rvr/present/svg.h"
 
 namespace rvr::report {
 namespace {
@@ -73,25 +74,73 @@ std::vector<Phase> phases_of(const ReportRenderer& r) {
   return phases;
 }
 
-// A round axis step giving about 5 ticks up to `top`.
-double nice_step(double top) {
-  const double raw = top / 5.0;
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  for (double m : {1.0, 2.0, 2.5, 5.0})
-    if (raw <= m * mag) return m * mag;
-  return 10.0 * mag;
+// The colour of a phase's segments and of the label written on them: one colour per phase name
+// across every bar, colour blind safe (Okabe-Ito, then Tol); grey for "other".
+struct PhaseColour {
+  const char* fill;
+  const char* label;
+};
+
+PhaseColour phase_colour(const std::vector<std::string>& names, const std::string& name) {
+  static const PhaseColour palette[] = {
+      {"#0072b2", "#fff"},    {"#e69f00", "#1d2330"}, {"#009e73", "#fff"},
+      {"#cc79a7", "#1d2330"}, {"#56b4e9", "#1d2330"}, {"#d55e00", "#fff"},
+      {"#f0e442", "#1d2330"}, {"#332288", "#fff"},    {"#882255", "#fff"},
+      {"#44aa99", "#1d2330"}, {"#999933", "#1d2330"}};
+  if (name == "other") return {"#9aa3b5", "#1d2330"};
+  const size_t i = std::find(names.begin(), names.end(), name) - names.begin();
+  return palette[i % std::size(palette)];
+}
+
+// The chart's layout in SVG units: the bars' left edge and length, a row's and a bar's height.
+constexpr double kLeft = 120, kBarLength = 640, kRow = 34, kBar = 22, kWidth = 880;
+
+// The same numbers as the bars, as text for screen readers.
+std::string description(const std::vector<ReportRenderer>& renderers,
+                        const std::vector<std::vector<Phase>>& bars) {
+  std::string desc;
+  for (size_t i = 0; i < renderers.size(); ++i) {
+    double total = 0.0;
+    desc += (i ? "; " : "") + renderers[i].name + ":";
+    for (const auto& p : bars[i]) {
+      desc += " " + p.name + " " + fmt_s(p.seconds) + ",";
+      total += p.seconds;
+    }
+    desc += " total " + fmt_s(total);
+  }
+  return desc;
+}
+
+// One renderer's bar at row `y`: its name, its phases stacked (each with a tooltip, and a label
+// where it fits) and its total.
+std::string bar_row(const ReportRenderer& r, const std::vector<Phase>& bar,
+                    const std::vector<std::string>& names, const present::Scale& x, double y) {
+  std::string o = present::text({{"class", "name"}, {"text-anchor", "end"}}, kLeft - 8,
+                                y + kBar / 2 + 5, escape_html(r.name));
+  double at = 0.0;
+  for (const auto& p : bar) {
+    const double x0 = x(at), x1 = x(at + p.seconds);
+    at += p.seconds;
+    const PhaseColour c = phase_colour(names, p.name);
+    std::string tip = r.name + ": " + p.name + " " + fmt_s(p.seconds);
+    for (const auto& [nested, parent] : kNestedPhases)
+      if (auto it = r.stats.find(nested); parent == "time." + p.name && it != r.stats.end())
+        tip += " (of which " + nested.substr(5) + " " + fmt_s(it->second) + ")";
+    o += present::rect({{"data-phase", p.name}, {"fill", c.fill}}, x0, y, std::max(0.0, x1 - x0),
+                       kBar, present::tooltip(tip));
+    // A label only where it fits (about 6.5 units per character at 11 px).
+    const std::string label = p.name + " " + fmt_s(p.seconds);
+    if (x1 - x0 > 6.5 * double(label.size()) + 6)
+      o += present::text({{"class", "seg"}, {"text-anchor", "middle"}, {"fill", c.label}},
+                         (x0 + x1) / 2, y + kBar / 2 + 4, escape_html(label));
+  }
+  o += present::text({{"class", "total"}}, x(at) + 6, y + kBar / 2 + 5, fmt_s(at));
+  return present::element("g", {{"class", "bar-row"}, {"data-renderer", r.name}}, o);
 }
 
 }  // namespace
 
 std::string timing_chart(const std::vector<ReportRenderer>& renderers) {
-  // Colour blind safe (Okabe-Ito, then Tol), one colour per phase name across every bar; grey =
-  // other.
-  static const char* palette[][2] = {
-      {"#0072b2", "#fff"},    {"#e69f00", "#1d2330"}, {"#009e73", "#fff"},
-      {"#cc79a7", "#1d2330"}, {"#56b4e9", "#1d2330"}, {"#d55e00", "#fff"},
-      {"#f0e442", "#1d2330"}, {"#332288", "#fff"},    {"#882255", "#fff"},
-      {"#44aa99", "#1d2330"}, {"#999933", "#1d2330"}};
   std::vector<std::vector<Phase>> bars;
   std::vector<std::string> names;  // every phase name, in pipeline order
   double top = 0.0;
@@ -107,81 +156,23 @@ std::string timing_chart(const std::vector<ReportRenderer>& renderers) {
   std::stable_sort(names.begin(), names.end(), [](const std::string& a, const std::string& b) {
     return phase_rank(a) < phase_rank(b);
   });
-  auto colour = [&](const std::string& name) -> const char* const* {
-    static const char* grey[2] = {"#9aa3b5", "#1d2330"};
-    if (name == "other") return grey;
-    size_t i = std::find(names.begin(), names.end(), name) - names.begin();
-    return palette[i % std::size(palette)];
-  };
   if (!(top > 0.0)) top = 1.0;
-  const double step = nice_step(top);
-  const double axis_top = std::ceil(top / step - 1e-9) * step;
 
-  constexpr double kLeft = 120, kBarWidth = 640, kRow = 34, kBar = 22;
-  const double height = 14 + kRow * double(renderers.size()) + 30;
-  auto x_of = [&](double s) { return kLeft + s / axis_top * kBarWidth; };
-
-  std::ostringstream desc;
-  for (size_t i = 0; i < renderers.size(); ++i) {
-    double total = 0.0;
-    desc << (i ? "; " : "") << renderers[i].name << ":";
-    for (const auto& p : bars[i]) {
-      desc << " " << p.name << " " << fmt_s(p.seconds) << ",";
-      total += p.seconds;
-    }
-    desc << " total " << fmt_s(total);
-  }
-
-  std::ostringstream o;
-  o << "<svg id=\"timing-chart\" class=\"chart\" viewBox=\"0 0 880 " << height
-    << "\" role=\"img\" aria-labelledby=\"timing-title timing-desc\">"
-    << "<title id=\"timing-title\">Time per phase of each renderer, in seconds</title>"
-    << "<desc id=\"timing-desc\">" << escape_html(desc.str()) << "</desc>";
-  // Axis: grid lines and tick labels in seconds.
-  const double axis_y = 14 + kRow * double(renderers.size());
-  for (int k = 0; k * step <= axis_top + 1e-12; ++k) {
-    const double x = x_of(k * step);
-    o << "<line x1=\"" << x << "\" x2=\"" << x << "\" y1=\"8\" y2=\"" << axis_y
-      << "\" stroke=\"#d8dce3\"/><text class=\"tick\" x=\"" << x << "\" y=\"" << axis_y + 16
-      << "\" text-anchor=\"middle\">" << fmt("%g", k * step) << "</text>";
-  }
-  o << "<text class=\"tick\" x=\"" << kLeft - 8 << "\" y=\"" << axis_y + 16
-    << "\" text-anchor=\"end\">seconds</text>";
-  for (size_t i = 0; i < renderers.size(); ++i) {
-    const double y = 14 + kRow * double(i);
-    const std::string name = escape_html(renderers[i].name);
-    o << "<g class=\"bar-row\" data-renderer=\"" << name << "\"><text class=\"name\" x=\""
-      << kLeft - 8 << "\" y=\"" << y + kBar / 2 + 5 << "\" text-anchor=\"end\">" << name
-      << "</text>";
-    double at = 0.0;
-    for (const auto& p : bars[i]) {
-      const double x0 = x_of(at), x1 = x_of(at + p.seconds);
-      at += p.seconds;
-      const char* const* c = colour(p.name);
-      std::string tip = renderers[i].name + ": " + p.name + " " + fmt_s(p.seconds);
-      for (const auto& [nested, parent] : kNestedPhases)
-        if (auto it = renderers[i].stats.find(nested);
-            parent == "time." + p.name && it != renderers[i].stats.end())
-          tip += " (of which " + nested.substr(5) + " " + fmt_s(it->second) + ")";
-      o << "<rect data-phase=\"" << escape_html(p.name) << "\" x=\"" << x0 << "\" y=\"" << y
-        << "\" width=\"" << std::max(0.0, x1 - x0) << "\" height=\"" << kBar << "\" fill=\"" << c[0]
-        << "\"><title>" << escape_html(tip) << "</title></rect>";
-      // A label only where it fits (about 6.5 px per character at 11 px).
-      const std::string label = p.name + " " + fmt_s(p.seconds);
-      if (x1 - x0 > 6.5 * double(label.size()) + 6)
-        o << "<text class=\"seg\" x=\"" << (x0 + x1) / 2 << "\" y=\"" << y + kBar / 2 + 4
-          << "\" text-anchor=\"middle\" fill=\"" << c[1] << "\">" << escape_html(label)
-          << "</text>";
-    }
-    o << "<text class=\"total\" x=\"" << x_of(at) + 6 << "\" y=\"" << y + kBar / 2 + 5 << "\">"
-      << fmt_s(at) << "</text></g>";
-  }
-  o << "</svg>\n<div class=\"legend\">";
+  const present::PlotArea area{kLeft, 8, kLeft + kBarLength, 14 + kRow * double(renderers.size())};
+  const present::Scale x = present::Scale::linear(0, present::nice_top(top), area.left, area.right);
+  std::string o = present::chart_open({"timing-chart", "timing", kWidth, area.bottom + 44,
+                                       "Time per phase of each renderer, in seconds",
+                                       description(renderers, bars)});
+  o += present::x_ticks(x, area, present::linear_ticks(top)) +
+       present::axis_names(area, area.bottom + 36, "seconds", "");
+  for (size_t i = 0; i < renderers.size(); ++i)
+    o += bar_row(renderers[i], bars[i], names, x, 14 + kRow * double(i));
+  o += "</svg>";
+  std::vector<std::string> keys;
+  keys.reserve(names.size());
   for (const auto& n : names)
-    o << "<span><span class=\"sw\" style=\"background:" << colour(n)[0] << "\"></span>"
-      << escape_html(n) << "</span>";
-  o << "</div>\n";
-  return o.str();
+    keys.push_back(present::swatch_key(phase_colour(names, n).fill, escape_html(n)));
+  return "<figure class=\"chart-figure\">" + o + present::legend(keys) + "</figure>\n";
 }
 
 }  // namespace rvr::report

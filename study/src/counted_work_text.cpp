@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "html_text.h"
-#include "rvr/core/html_escape.h"
+#include "rvr/present/html_escape.h"
+#include "rvr/present/powers_of_ten.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/counted_work.h"
 #include "rvr/study/crossover.h"
@@ -22,6 +22,9 @@
 
 namespace rvr::study {
 namespace {
+
+using present::escape_html;
+using present::html_with_powers;
 
 // A count grows "in proportion" to an axis from this log-log slope up, is "flat" up to this one.
 constexpr double kProportional = 0.9;

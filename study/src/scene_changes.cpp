@@ -14,9 +14,9 @@
 #include <type_traits>
 #include <utility>
 
-#include "html_text.h"
 #include "rvr/core/check.h"
-#include "rvr/core/html_escape.h"
+#include "rvr/present/html_escape.h"
+#include "rvr/present/powers_of_ten.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/cost_model.h"
 #include "rvr/study/study.h"
@@ -25,6 +25,9 @@
 
 namespace rvr::study {
 namespace {
+
+using present::escape_html;
+using present::html_with_powers;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 

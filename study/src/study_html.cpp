@@ -15,9 +15,11 @@
 #include <vector>
 
 #include "counted_work_text.h"
-#include "html_text.h"
 #include "loglog_chart.h"
-#include "rvr/core/html_escape.h"
+#include "rvr/present/html_escape.h"
+#include "rvr/present/legend.h"
+#include "rvr/present/page.h"
+#include "rvr/present/powers_of_ten.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/cost_model.h"
 #include "rvr/study/crossover.h"
@@ -31,53 +33,8 @@
 namespace rvr::study {
 namespace {
 
-const char* const kCss = R"(
-body{font:15px/1.45 system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;margin:0;
-  background:#f6f7f9;color:#1d2330}
-main{max-width:1100px;margin:0 auto;padding:24px}
-h1{font-size:24px;margin:0 0 4px} h2{font-size:19px;margin:34px 0 10px;
-  border-bottom:1px solid #d8dce3;padding-bottom:4px} h3{font-size:16px;margin:22px 0 8px}
-pre.cmd{background:#1d2330;color:#e8ecf3;padding:10px 12px;border-radius:6px;
-  white-space:pre-wrap;word-break:break-all}
-.warn{background:#fff4d6;border:1px solid #e6b400;border-left:6px solid #e6b400;
-  padding:10px 14px;border-radius:6px;margin:14px 0}
-figure{margin:0 0 14px;background:#fff;padding:10px;border-radius:6px;
-  box-shadow:0 1px 3px rgba(0,0,0,.12)}
-figcaption{font-size:13px;color:#4a5366;margin-top:6px}
-svg.study-chart{display:block;width:100%;height:auto;font-size:13px}
-svg.study-chart .plot{fill:#fff;stroke:#9aa3b5}
-svg.study-chart .grid{stroke:#d8dce3} svg.study-chart .minor{stroke:#eef0f4}
-svg.study-chart text{fill:#1d2330} svg.study-chart .tick{fill:#4a5366;font-size:12px}
-svg.study-chart .axis-label{font-size:13px;fill:#2b3447}
-svg.study-chart .unmeasured{fill:#eceef2}
-svg.study-chart .unmeasured-label{fill:#7a8394;font-size:12px}
-svg.study-chart .model{fill:none;stroke-width:2}
-svg.study-chart .model-label{font-size:12px;font-weight:600}
-svg.study-chart .spread{stroke-width:1.6}
-svg.study-chart .mark{stroke:#fff;stroke-width:1}
-svg.study-chart .ci-band{fill:#f0a500}
-svg.study-chart .crossover-line{stroke:#8a5a00;stroke-width:1.5}
-svg.study-chart .extrapolated .crossover-line{stroke:#7a8394;stroke-dasharray:4 3}
-svg.study-chart .crossover-tag{fill:#fff;stroke:#8a5a00;stroke-width:1.2}
-svg.study-chart .crossover-label{font-size:11px;font-weight:600;fill:#6b4600}
-svg.study-chart .extrapolated .crossover-tag{stroke:#7a8394;stroke-dasharray:3 2}
-svg.study-chart .extrapolated .crossover-label{fill:#4a5366}
-b.tag{display:inline-block;min-width:16px;height:16px;border-radius:8px;border:1.2px solid #8a5a00;
-  text-align:center;font-size:11px;line-height:16px;color:#6b4600;margin-right:3px}
-.legend{display:flex;flex-wrap:wrap;gap:6px 18px;margin:8px 0 2px;font-size:13px;color:#4a5366}
-.legend svg{vertical-align:-2px;margin-right:5px}
-table{border-collapse:collapse;background:#fff;box-shadow:0 1px 3px rgba(0,0,0,.12);
-  border-radius:6px;margin-bottom:8px;font-size:14px}
-th,td{padding:5px 10px;border-bottom:1px solid #e6e9ef;text-align:left;vertical-align:top}
-th{background:#eef1f6;font-weight:600}
-td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
-.scroll{overflow-x:auto;max-width:100%}
-.good{color:#135c2c;font-weight:600} .bad{color:#8a1616;font-weight:600}
-.sw{display:inline-block;width:11px;height:11px;border-radius:50%;margin-right:5px;
-  vertical-align:-1px}
-ul.coefs{margin:0;padding-left:16px} dl.machine{display:grid;grid-template-columns:max-content 1fr;
-  gap:3px 14px;margin:0} dl.machine dt{font-weight:600} dl.machine dd{margin:0}
-)";
+using present::escape_html;
+using present::html_with_powers;
 
 // Renderer colours, distinguishable for common colour-blindness (Okabe–Ito, then more).
 constexpr const char* kPalette[] = {"#0072b2", "#d55e00", "#009e73", "#cc79a7",
@@ -275,55 +232,47 @@ ChartSpec pixel_chart(const StudyResult& r, const std::string& scene, double n,
   return spec;
 }
 
-// A key of the legend: a small drawing and its words.
-std::string legend_key(const std::string& drawing, const std::string& words) {
-  return fmt::format(
-      "<span><svg width=\"30\" height=\"14\" aria-hidden=\"true\">{}</svg>{}"
-      "</span>",
-      drawing, words);
-}
-
 // What the chart's marks mean: each renderer's colour and whether its model fits, then the
 // crossovers' and the unmeasured range's marks.
 std::string legend_html(const ChartSpec& spec) {
-  std::string o = "<div class=\"legend\">";
+  std::vector<std::string> keys;
   for (const ChartSeries& s : spec.series) {
     const std::string dash = s.fits ? "" : " stroke-dasharray=\"5 3\"";
     const std::string state = !s.model ? "no model" : s.fits ? "model fits" : "model does not fit";
-    o += legend_key(
+    keys.push_back(present::drawing_key(
         fmt::format("<line x1=\"1\" x2=\"29\" y1=\"7\" y2=\"7\" stroke=\"{0}\" "
                     "stroke-width=\"2\"{1}/><circle cx=\"15\" cy=\"7\" r=\"3.5\" "
                     "fill=\"{0}\"/>",
-                    s.colour, s.model ? dash : " stroke-opacity=\"0\""),
-        fmt::format("<b>{}</b> ({} points; {})", escape_html(s.name), s.points.size(), state));
+                    escape_html(s.colour), s.model ? dash : " stroke-opacity=\"0\""),
+        fmt::format("<b>{}</b> ({} points; {})", escape_html(s.name), s.points.size(), state)));
   }
   auto any = [&](bool measured) {
     return std::any_of(spec.crossings.begin(), spec.crossings.end(),
                        [&](const ChartCrossing& c) { return c.measured == measured; });
   };
   if (any(true))
-    o += legend_key(
-        "<rect x=\"4\" y=\"0\" width=\"22\" height=\"14\" fill=\"#f0a500\" "
-        "fill-opacity=\".25\"/><line x1=\"15\" x2=\"15\" y1=\"0\" y2=\"14\" "
-        "stroke=\"#8a5a00\" stroke-width=\"1.5\"/>",
-        "crossover of the measured points, 95% interval shaded");
+    keys.push_back(
+        present::drawing_key("<rect x=\"4\" y=\"0\" width=\"22\" height=\"14\" fill=\"#f0a500\" "
+                             "fill-opacity=\".25\"/><line x1=\"15\" x2=\"15\" y1=\"0\" y2=\"14\" "
+                             "stroke=\"#8a5a00\" stroke-width=\"1.5\"/>",
+                             "crossover of the measured points, 95% interval shaded"));
   if (any(false))
-    o += legend_key(
+    keys.push_back(present::drawing_key(
         "<line x1=\"15\" x2=\"15\" y1=\"0\" y2=\"14\" stroke=\"#7a8394\" "
         "stroke-width=\"1.5\" stroke-dasharray=\"4 3\"/>",
-        "crossover of the fitted models outside the swept range (extrapolated)");
+        "crossover of the fitted models outside the swept range (extrapolated)"));
   for (const ChartCrossing& c : spec.crossings)
-    o += fmt::format("<span class=\"crossover-key\"><b class=\"tag\">{}</b> {}</span>",
-                     escape_html(c.tag), html_with_powers(c.label));
-  o += legend_key("<rect x=\"2\" y=\"0\" width=\"26\" height=\"14\" fill=\"#eceef2\"/>",
-                  "not measured");
-  return o + "</div>";
+    keys.push_back(present::custom_key("crossover-key", "<b class=\"tag\">" + escape_html(c.tag) +
+                                                            "</b> " + html_with_powers(c.label)));
+  keys.push_back(present::drawing_key(
+      "<rect x=\"2\" y=\"0\" width=\"26\" height=\"14\" fill=\"#eceef2\"/>", "not measured"));
+  return present::legend(keys);
 }
 
 // A chart in its figure, with its legend and what the marks are.
 std::string figure_html(const ChartSpec& spec, const std::string& caption) {
-  return fmt::format("<figure>{}{}<figcaption>{}</figcaption></figure>\n", loglog_chart_svg(spec),
-                     legend_html(spec), caption);
+  return fmt::format("<figure class=\"chart-figure\">{}{}<figcaption>{}</figcaption></figure>\n",
+                     loglog_chart_svg(spec), legend_html(spec), caption);
 }
 
 const char* const kMarksCaption =
@@ -344,11 +293,11 @@ std::string model_row(const RendererModels& m, const ModelFit& f, const Colours&
   const std::string form = f.formula.empty() ? formula(m.form) : f.formula;
   auto colour = colours.find(m.name);
   return fmt::format(
-      "<tr data-renderer=\"{0}\"><td><span class=\"sw\" style=\"background:{1}\"></span>{0}</td>"
+      "<tr data-renderer=\"{0}\"><td>{1}{0}</td>"
       "<td>{2}</td><td>{3}</td><td class=\"num\">{4:.3f}</td><td class=\"num\">{5:.0f}%</td>"
       "<td class=\"num\">{6:.0f}%</td><td class=\"num\">{7}</td><td class=\"{8}\">{9}</td></tr>\n",
-      escape_html(m.name), colour == colours.end() ? "#888" : colour->second, escape_html(form),
-      coefs, f.r2, 100 * f.max_rel_residual, 100 * f.loo_rel_error, f.points,
+      escape_html(m.name), present::swatch(colour == colours.end() ? "#888" : colour->second),
+      escape_html(form), coefs, f.r2, 100 * f.max_rel_residual, 100 * f.loo_rel_error, f.points,
       f.fits ? "good" : "bad", escape_html(f.verdict));
 }
 
@@ -441,7 +390,7 @@ std::string header_html(const StudyResult& r) {
     o += "<div class=\"warn interrupted\"><b>Interrupted:</b> the sweep was stopped before its "
          "end; everything below is from the points measured until then.</div>\n";
   for (const std::string& note : r.notes)
-    o += "<div class=\"warn note\"><b>Note:</b> " + escape_html(note) + ".</div>\n";
+    o += "<div class=\"warn note\"><b>Note:</b> " + html_with_powers(note) + ".</div>\n";
   return o;
 }
 
@@ -464,16 +413,12 @@ std::string study_html(const StudyResult& r) {
   const Colours colours = renderer_colours(r);
   std::string scenes;
   for (const std::string& s : r.scenes) scenes += (scenes.empty() ? "" : ", ") + s;
-  std::string o = fmt::format(
-      "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-      "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
-      "<title>rvr study: {}</title>\n<style>{}</style></head>\n<body><main>\n",
-      escape_html(scenes), kCss);
+  std::string o = present::page_start("rvr study: " + scenes, present::PageWidth::Reading);
   o += header_html(r);
   for (size_t i = 0; i < r.scenes.size(); ++i) o += scene_section(r, i, colours);
   o += counted_work_html(r);
   o += machine_html(r);
-  return o + "</main></body></html>\n";
+  return o + present::page_end();
 }
 
 }  // namespace rvr::study

@@ -4,9 +4,9 @@
 
 #include <string>
 
-namespace rvr {
+namespace rvr::present {
 
 // `s` with & < > " ' replaced by their character references: safe in text and attributes.
 std::string escape_html(const std::string& s);
 
-}  // namespace rvr
+}  // namespace rvr::present

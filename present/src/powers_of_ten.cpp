@@ -1,12 +1,14 @@
-// Text for study.html (see html_text.h).
-#include "html_text.h"
+// Powers of ten raised (see powers_of_ten.h).
+#include "rvr/present/powers_of_ten.h"
 
 #include <fmt/format.h>
 #include <stddef.h>
 
 #include <cctype>
 
-namespace rvr::study {
+#include "rvr/present/html_escape.h"
+
+namespace rvr::present {
 namespace {
 
 // Rewrites every "10^k" (k an optional minus and digits) of already escaped text through
@@ -52,4 +54,4 @@ std::string decade_svg(int k) {
   return "10" + raised_tspan(k < 0 ? fmt::format("−{}", -k) : fmt::format("{}", k));
 }
 
-}  // namespace rvr::study
+}  // namespace rvr::present

@@ -1,7 +1,7 @@
 // HTML escaping (see html_escape.h).
-#include "rvr/core/html_escape.h"
+#include "rvr/present/html_escape.h"
 
-namespace rvr {
+namespace rvr::present {
 
 std::string escape_html(const std::string& s) {
   std::string out;
@@ -30,4 +30,4 @@ std::string escape_html(const std::string& s) {
   return out;
 }
 
-}  // namespace rvr
+}  // namespace rvr::present
