@@ -40,7 +40,8 @@ void set_keyword(RenderOptions& options, const RenderOptionSpec& spec, const py:
   if (status) return;
   std::string message = status.error().message;
   if (spec.type == OptionType::Choice)
-    message = cli::not_one_of(text, std::vector<std::string>(spec.choices.begin(), spec.choices.end()));
+    message =
+        cli::not_one_of(text, std::vector<std::string>(spec.choices.begin(), spec.choices.end()));
   throw BadInputError(std::string(spec.name) + ": " + message);
 }
 
@@ -59,6 +60,7 @@ RenderSettings render_settings(const std::string& mode, int threads, const py::k
   RenderSettings s;
   set_keyword(s.options, *find_render_option("mode"), py::str(mode));
   set_keyword(s.options, *find_render_option("threads"), py::int_(threads));
+  if (threads != 0) s.given.emplace_back("threads");  // render's argument, given unless 0
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::cast<std::string>(key);
     if (name == "gl") {

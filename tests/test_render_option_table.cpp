@@ -2,8 +2,6 @@
 // outside each range or list, its readers are the renderers that read the option (a renderer it
 // does not name renders the same image whatever the option's value), and docs/cli.md's rows say
 // what the table says.
-#include "rvr/core/render_option_table.h"
-
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,6 +15,7 @@
 
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
+#include "rvr/core/render_option_table.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
 #include "rvr/renderers/registry.h"
@@ -35,9 +34,9 @@ TEST(RenderOptionTable, NamesAreSnakeCaseAndUnique) {
   std::set<std::string_view> names;
   for (const RenderOptionSpec& spec : render_option_table()) {
     EXPECT_TRUE(names.insert(spec.name).second) << spec.name;
-    EXPECT_TRUE(std::all_of(spec.name.begin(), spec.name.end(),
-                            [](char c) { return (c >= 'a' && c <= 'z') || c == '_'; }))
-        << spec.name;
+    EXPECT_TRUE(std::all_of(spec.name.begin(), spec.name.end(), [](char c) {
+      return (c >= 'a' && c <= 'z') || c == '_';
+    })) << spec.name;
     EXPECT_FALSE(spec.help.empty()) << spec.name;
     EXPECT_EQ(find_render_option(spec.name), &spec);
   }
@@ -202,28 +201,28 @@ TEST(RenderOptionTable, DocsRowsSayWhatTheTableSays) {
     const RenderOptionSpec* spec = find_render_option(snake);
     if (!spec) {
       static const std::set<std::string> cli_only = {
-          "width",      "image",       "camera-from",   "camera", "lights",
-          "up",         "exposure",    "spp",           "gl",     "max-samples",
-          "max-triangles", "max-memory-mb"};
-      EXPECT_TRUE(cli_only.count(name)) << "docs/cli.md documents --" << name
-                                        << ", which the render option table lacks";
+          "width",    "image", "camera-from", "camera",      "lights",        "up",
+          "exposure", "spp",   "gl",          "max-samples", "max-triangles", "max-memory-mb"};
+      EXPECT_TRUE(cli_only.count(name))
+          << "docs/cli.md documents --" << name << ", which the render option table lacks";
       continue;
     }
     SCOPED_TRACE(line);
     if (spec->type == OptionType::Choice) {
       std::string choices;
-      for (std::string_view c : spec->choices) choices += (choices.empty() ? " " : "\\|") + std::string(c);
+      for (std::string_view c : spec->choices)
+        choices += (choices.empty() ? " " : "\\|") + std::string(c);
       EXPECT_EQ(values, choices) << "--" << name << "'s choices";
     }
     if (spec->type == OptionType::Integer || spec->type == OptionType::Real) {
       EXPECT_NE(meaning.find(number(spec->min) + " … " + number(spec->max)), std::string::npos)
           << "--" << name << "'s range";
     }
-    const std::string expected_default =
-        spec->name == "mode"          ? "`full` (render), `local` (compare)"
-        : default_text(*spec).empty() ? "the most precise"
-        : spec->type == OptionType::Choice ? "`" + default_text(*spec) + "`"
-                                           : default_text(*spec);
+    const std::string expected_default = spec->name == "mode" ? "`full` (render), `local` (compare)"
+                                         : default_text(*spec).empty() ? "the most precise"
+                                         : spec->type == OptionType::Choice
+                                             ? "`" + default_text(*spec) + "`"
+                                             : default_text(*spec);
     EXPECT_EQ(standard, expected_default) << "--" << name << "'s default";
   }
   for (const RenderOptionSpec& spec : render_option_table()) {

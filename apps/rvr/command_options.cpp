@@ -16,7 +16,6 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "one_of.h"
-#include "suggest.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/gl_backend.h"
 #include "rvr/core/limits.h"
@@ -26,6 +25,7 @@
 #include "rvr/core/texture.h"
 #include "rvr/scene_io/scene_for_render.h"
 #include "rvr/scene_io/scene_loader.h"
+#include "suggest.h"
 
 namespace rvr::cli {
 
@@ -71,7 +71,8 @@ void add_render_option(CLI::App& cmd, CommonOptions& o, const RenderOptionSpec& 
   const std::string name = cli_option_name(spec);
   const std::string help(spec.help);
   if (spec.type == OptionType::Flag) {
-    cmd.add_flag_callback(name, [&text] { text = "on"; }, help);
+    cmd.add_flag_callback(
+        name, [&text] { text = "on"; }, help);
     return;
   }
   cmd.add_option(name, text, help)->type_name(type_name(spec.type))->check(table_check(spec));

@@ -32,7 +32,7 @@ struct CommonOptions {
   std::string up = "auto";        // --up auto | y | z (model files)
   std::string camera = "file";    // --camera file | auto | file-always (model files)
   std::string lights = "file";    // --lights file | auto (model files)
-  std::string gl;  // empty: osmesa, falling back to egl when OSMesa is missing
+  std::string gl;                 // empty: osmesa, falling back to egl when OSMesa is missing
   // The options of the render option table (rvr/core/render_option_table.h) by snake_case
   // name: the text typed, unset when not given (RenderOptions' default then holds).
   std::map<std::string, std::optional<std::string>> render_option_text;

@@ -23,18 +23,19 @@ enum class OptionType {
 };
 
 struct RenderOptionSpec {
-  std::string_view name;  // snake_case: the Python keyword; the command line's is --kebab-case
-  OptionType type;
-  double min = 0, max = 0;                 // Integer, Real: the range, both ends included
-  std::vector<std::string_view> choices;   // Choice: the names, in the order of their values
-  std::string_view help;                   // one line
-  std::vector<std::string_view> readers;   // the renderers (registry names) that read it
+  // snake_case: the Python keyword; the command line's is --kebab-case.
+  std::string_view name = {};
+  OptionType type = OptionType::Integer;
+  double min = 0, max = 0;                     // Integer, Real: the range, both ends included
+  std::vector<std::string_view> choices = {};  // Choice: the names, in the order of their values
+  std::string_view help = {};                  // one line
+  std::vector<std::string_view> readers = {};  // the renderers (registry names) that read it
   // Stores a value the table has checked: Integer, Unsigned and Flag (0 or 1) as `integer`, Real
   // as `real`, Choice as the index into `choices`.
-  void (*store)(RenderOptions& options, unsigned long long integer, double real);
+  void (*store)(RenderOptions& options, unsigned long long integer, double real) = nullptr;
   // The option's value in `options` as text ("" for an unset choice): RenderOptions{}'s is the
   // default.
-  std::string (*show)(const RenderOptions& options);
+  std::string (*show)(const RenderOptions& options) = nullptr;
 };
 
 // The table, in the order the command line's help lists the options.
