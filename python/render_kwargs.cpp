@@ -1,6 +1,7 @@
 #include "render_kwargs.h"
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "errors.h"

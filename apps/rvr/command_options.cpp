@@ -6,12 +6,16 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <glm/glm.hpp>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <tuple>
 #include <utility>
+#include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
@@ -22,7 +26,6 @@
 #include "rvr/core/render_option_table.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
-#include "rvr/core/texture.h"
 #include "rvr/scene_io/scene_for_render.h"
 #include "rvr/scene_io/scene_loader.h"
 #include "suggest.h"

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cmath>
 #include <cstddef>
+#include <initializer_list>
 #include <optional>
 #include <system_error>
 #include <utility>
 
+#include "rvr/core/image_sample.h"
+#include "rvr/core/isa.h"
 #include "rvr/core/texture.h"
 
 namespace rvr {
