@@ -30,6 +30,7 @@
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/limits.h"
+#include "rvr/core/render_option_table.h"
 #include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/registry.h"
 #include "stub_docs.h"
@@ -66,6 +67,8 @@ PyRender render(const PyScene& scene, const std::string& renderer, const std::st
   result->times.load = scene.load_seconds;
   RenderResultWithTime done = render_interruptibly(scene.scene, std::move(made), settings.options);
   result->output = take(std::move(done.output));
+  for (std::string& w : unread_option_warnings(settings.given, renderer, false))
+    result->output.warnings.push_back(std::move(w));
   result->times.render = done.seconds;
   result->stats_json = render_stats_json(result->renderer, *result->scene, result->mode,
                                          result->times, result->output);

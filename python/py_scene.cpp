@@ -37,11 +37,10 @@ namespace py = pybind11;
 namespace rvr::python {
 namespace {
 
-constexpr int kMaxImageSide = 16384;  // as the command line's --width and --height
-
 int checked_side(const char* name, int value) {
-  if (value < 1 || value > kMaxImageSide)
-    throw BadInputError(std::string(name) + ": must be 1 to 16384, got " + std::to_string(value));
+  if (value < 1 || value > kMaxImageSize)
+    throw BadInputError(std::string(name) + ": must be 1 to " + std::to_string(kMaxImageSize) +
+                        ", got " + std::to_string(value));
   return value;
 }
 

@@ -1,129 +1,81 @@
 #include "render_kwargs.h"
 
-#include <cstdint>
-#include <functional>
-#include <initializer_list>
-#include <map>
-#include <optional>
-#include <utility>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "errors.h"
+#include "rvr/core/expected.h"
 #include "rvr/core/gl_backend.h"
+#include "rvr/core/render_option_table.h"
+#include "suggest.h"
 
 namespace py = pybind11;
 
 namespace rvr::python {
 namespace {
 
-// One of `names`, else bad input naming the option and the choices.
-std::string choice(const std::string& option, const py::handle& value,
-                   std::initializer_list<const char*> names) {
-  const std::string s = py::cast<std::string>(value);
-  std::string known;
-  for (const char* n : names) {
-    if (s == n) return s;
-    known += (known.empty() ? "" : ", ") + std::string(n);
+// A keyword's Python value as the text the table checks: numbers as numbers, booleans as on/off
+// (hiz=True as hiz="on"), names as they are.
+std::string value_text(const RenderOptionSpec& spec, const py::handle& value) {
+  if (py::isinstance<py::bool_>(value)) return py::cast<bool>(value) ? "on" : "off";
+  switch (spec.type) {
+    case OptionType::Integer:
+      return std::to_string(py::cast<long long>(value));
+    case OptionType::Unsigned:
+      return std::to_string(py::cast<unsigned long long>(value));
+    case OptionType::Real:
+      return py::str(py::float_(py::cast<double>(value))).cast<std::string>();
+    case OptionType::Flag:
+    case OptionType::Choice:
+      break;
   }
-  throw BadInputError(option + ": expected one of " + known + ", got '" + s + "'");
+  return py::cast<std::string>(value);
 }
 
-int in_range(const std::string& option, const py::handle& value, int low, int high) {
-  const int v = py::cast<int>(value);
-  if (v < low || v > high)
-    throw BadInputError(option + ": must be " + std::to_string(low) + " to " +
-                        std::to_string(high) + ", got " + std::to_string(v));
-  return v;
+// Stores keyword `name`'s value, or raises rvr.BadInput naming the keyword (a choice's error
+// asks "did you mean", as the command line's).
+void set_keyword(RenderOptions& options, const RenderOptionSpec& spec, const py::handle& value) {
+  const std::string text = value_text(spec, value);
+  const Status status = set_render_option(options, spec, text);
+  if (status) return;
+  std::string message = status.error().message;
+  if (spec.type == OptionType::Choice)
+    message =
+        cli::not_one_of(text, std::vector<std::string>(spec.choices.begin(), spec.choices.end()));
+  throw BadInputError(std::string(spec.name) + ": " + message);
 }
 
-using Setter = std::function<void(RenderSettings&, const py::handle&)>;
-
-const std::map<std::string, Setter>& setters() {
-  static const std::map<std::string, Setter> table = {
-      {"accel",
-       [](RenderSettings& s, const py::handle& v) {
-         const std::string a = choice("accel", v, {"bvh", "bvh2", "none"});
-         s.options.accel = a == "none"   ? AccelKind::None
-                           : a == "bvh2" ? AccelKind::Bvh2
-                                         : AccelKind::Bvh;
-       }},
-      {"spheres",
-       [](RenderSettings& s, const py::handle& v) {
-         s.options.spheres = choice("spheres", v, {"analytic", "mesh"}) == "mesh"
-                                 ? SphereMode::Mesh
-                                 : SphereMode::Analytic;
-       }},
-      {"sphere_segments",
-       [](RenderSettings& s, const py::handle& v) {
-         s.options.sphere_segments = in_range("sphere_segments", v, 3, 4096);
-       }},
-      {"triangle_test",
-       [](RenderSettings& s, const py::handle& v) {
-         s.options.triangle_test = choice("triangle_test", v, {"mt", "chapter"}) == "chapter"
-                                       ? TriangleTest::Chapter
-                                       : TriangleTest::MollerTrumbore;
-       }},
-      {"max_depth",
-       [](RenderSettings& s, const py::handle& v) {
-         s.options.max_depth = in_range("max_depth", v, 0, 64);
-       }},
-      {"seed",
-       [](RenderSettings& s, const py::handle& v) { s.options.seed = py::cast<uint64_t>(v); }},
-      {"gl",
-       [](RenderSettings& s, const py::handle& v) {
-         s.config.gl =
-             choice("gl", v, {"osmesa", "egl"}) == "egl" ? GlBackend::Egl : GlBackend::OsMesa;
-       }},
-      {"shadow_map_size",
-       [](RenderSettings& s, const py::handle& v) {
-         s.options.shadow_map_size = in_range("shadow_map_size", v, 16, 8192);
-       }},
-      {"shadow_bias",
-       [](RenderSettings& s, const py::handle& v) {
-         const float bias = py::cast<float>(v);
-         if (!(bias >= 0.0f && bias <= 10.0f))
-           throw BadInputError("shadow_bias: must be 0 to 10, got " + std::to_string(bias));
-         s.options.shadow_bias = bias;
-       }},
-      {"shadow_pcf",
-       [](RenderSettings& s, const py::handle& v) { s.options.shadow_pcf = py::cast<bool>(v); }},
-      {"hiz",
-       [](RenderSettings& s, const py::handle& v) {
-         s.options.hiz = py::isinstance<py::str>(v) ? choice("hiz", v, {"on", "off"}) == "on"
-                                                    : py::cast<bool>(v);
-       }},
-      {"depth_format",
-       [](RenderSettings& s, const py::handle& v) {
-         s.options.depth_format =
-             parse_depth_format(choice("depth_format", v, {"d24", "d32f", "d32f_reversed"}));
-       }},
-  };
-  return table;
+// The keywords: the table's options (mode and threads are render's own arguments) and gl.
+std::string known_keywords() {
+  std::string known;
+  for (const RenderOptionSpec& spec : render_option_table())
+    if (spec.name != "mode" && spec.name != "threads")
+      known += (known.empty() ? "" : ", ") + std::string(spec.name);
+  return known + ", gl";
 }
 
 }  // namespace
 
 RenderSettings render_settings(const std::string& mode, int threads, const py::kwargs& kwargs) {
   RenderSettings s;
-  if (mode == "visibility")
-    s.options.mode = RenderMode::Visibility;
-  else if (mode == "local")
-    s.options.mode = RenderMode::Local;
-  else if (mode == "full")
-    s.options.mode = RenderMode::Full;
-  else
-    throw BadInputError("mode: expected one of visibility, local, full, got '" + mode + "'");
-  if (threads < 0 || threads > 1024)
-    throw BadInputError("threads: must be 0 to 1024, got " + std::to_string(threads));
-  s.options.threads = threads;
+  set_keyword(s.options, *find_render_option("mode"), py::str(mode));
+  set_keyword(s.options, *find_render_option("threads"), py::int_(threads));
+  if (threads != 0) s.given.emplace_back("threads");  // render's argument, given unless 0
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::cast<std::string>(key);
-    auto it = setters().find(name);
-    if (it == setters().end()) {
-      std::string known;
-      for (const auto& [k, setter] : setters()) known += (known.empty() ? "" : ", ") + k;
-      throw BadInputError("unknown option '" + name + "' (known: " + known + ")");
+    if (name == "gl") {
+      const std::string gl = py::cast<std::string>(value);
+      if (gl != "osmesa" && gl != "egl")
+        throw BadInputError("gl: " + cli::not_one_of(gl, {"osmesa", "egl"}));
+      s.config.gl = gl == "egl" ? GlBackend::Egl : GlBackend::OsMesa;
+      continue;
     }
-    it->second(s, value);
+    const RenderOptionSpec* spec = find_render_option(name);
+    if (!spec || name == "mode" || name == "threads")
+      throw BadInputError("unknown option '" + name + "' (known: " + known_keywords() + ")");
+    set_keyword(s.options, *spec, value);
+    s.given.push_back(name);
   }
   return s;
 }

@@ -1,11 +1,11 @@
-// rvr.render's keyword options, as the command line's common options of the same names
-// (docs/cli.md): accel, spheres, sphere_segments, triangle_test, max_depth, seed, gl,
-// shadow_map_size, shadow_bias, shadow_pcf, hiz, depth_format.
+// rvr.render's keyword options: the render option table's (rvr/core/render_option_table.h), as
+// the command line's options of the same names (docs/cli.md), and gl.
 #pragma once
 
 #include <pybind11/pybind11.h>
 
 #include <string>
+#include <vector>
 
 #include "rvr/core/renderer.h"
 #include "rvr/renderers/registry.h"
@@ -15,6 +15,7 @@ namespace rvr::python {
 struct RenderSettings {
   RenderOptions options;
   RendererConfig config;
+  std::vector<std::string> given;  // the table's keywords given (snake_case), for the warnings
 };
 
 // Raises rvr.BadInput for an unknown mode, option or value.

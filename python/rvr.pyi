@@ -16,8 +16,8 @@ __version__: str
 class BadInput(ValueError):
     """Bad input: a scene, an option or a file rvr refuses. The message is the one the command
     line prints after 'error: ', e.g. 'scene.json: objects[3].radius: must be > 0, got -1';
-    a bad keyword value names the keyword, e.g. "accel: expected one of bvh, bvh2, none, got
-    'kd'"."""
+    a bad keyword value names the keyword, e.g. "accel: 'kd' is not one of bvh, bvh2,
+    none"."""
 
 class RendererInfo(TypedDict):
     name: str
@@ -188,8 +188,9 @@ def render(
     """Renders SCENE (an rvr.Scene) with RENDERER (a name from rvr.renderers()) in MODE
     (visibility, local, full) on THREADS worker threads (0: every core). Other keyword options
     are the command line's of the same names: accel, spheres, sphere_segments, triangle_test,
-    max_depth, seed, gl, shadow_map_size, shadow_bias, shadow_pcf, hiz, depth_format. The GIL
-    is released while rendering; Ctrl-C cancels the render (it stops at its next tile or chunk)
+    texture_lod, max_depth, seed, shadow_map_size, shadow_bias, shadow_pcf, hiz,
+    depth_format, gl. One the renderer does not read is named in Render.warnings. The GIL is
+    released while rendering; Ctrl-C cancels the render (it stops at its next tile or chunk)
     and raises KeyboardInterrupt."""
 
 def _running_renders() -> int:

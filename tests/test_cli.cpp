@@ -27,6 +27,7 @@
 
 #include "model_corpus.h"
 #include "rvr/core/expected.h"
+#include "rvr/core/render_option_table.h"
 #include "rvr/image_codec/image_io.h"
 #include "rvr/present/html_escape.h"
 
@@ -1334,6 +1335,71 @@ TEST_F(Cli, ExportOfAMissingFileSaysTheFileIsMissing) {
       << r.err;
   EXPECT_EQ(run("scenes --export spheres").status, 0);  // a bare name: the built-in scene
   EXPECT_TRUE(outputs({}).empty());
+}
+
+// Every option of the render option table refuses, in one error line and exit 2, a value just
+// outside its range or not in its list, with the table's message after the option's name.
+TEST_F(Cli, RenderOptionsRefuseWhatTheTableRefuses) {
+  for (const rvr::RenderOptionSpec& spec : rvr::render_option_table()) {
+    const std::string name = rvr::cli_option_name(spec);
+    std::vector<std::pair<std::string, std::string>> cases;  // value, message after "name: "
+    auto text = [](double v) {
+      std::ostringstream s;
+      s << v;
+      return s.str();
+    };
+    const std::string range = "must be " + text(spec.min) + " to " + text(spec.max) + ", got ";
+    if (spec.type == rvr::OptionType::Integer || spec.type == rvr::OptionType::Real) {
+      cases.emplace_back(text(spec.min - 1), range + text(spec.min - 1));
+      cases.emplace_back(text(spec.max + 1), range + text(spec.max + 1));
+    }
+    if (spec.type == rvr::OptionType::Choice) {
+      std::string known;
+      for (std::string_view c : spec.choices) known += (known.empty() ? "" : ", ") + std::string(c);
+      cases.emplace_back("zzzz", "'zzzz' is not one of " + known);
+    }
+    for (const auto& [value, message] : cases) {
+      RunResult r =
+          run("render -r raytrace -q " + name + " " + value + " -o " + (dir_ / "out.png").string());
+      EXPECT_EQ(r.status, 2) << name << " " << value;
+      EXPECT_EQ(r.err, "error: " + name + ": " + message + "\n");
+    }
+  }
+  EXPECT_TRUE(outputs({}).empty());
+}
+
+// An option the renderer does not read (the render option table's readers) is a warning of that
+// renderer's, where its other warnings go: stderr once, render --stats, metrics.json under the
+// renderer and the report. An option it reads is not.
+TEST_F(Cli, OptionsTheRendererDoesNotReadAreWarnings) {
+  const fs::path stats = dir_ / "stats.json";
+  RunResult render = run("render builtin:cornell -r raytrace " + std::string(kSmall) +
+                         " --shadow-map-size 512 --accel bvh2 -o " + (dir_ / "r.png").string() +
+                         " --stats " + stats.string());
+  ASSERT_EQ(render.status, 0) << render.err;
+  const std::string unread = "option --shadow-map-size is not read by raytrace";
+  EXPECT_EQ(render.err.find("warning: raytrace: " + unread + "\n"),
+            render.err.rfind("warning: raytrace: " + unread + "\n"));
+  EXPECT_NE(render.err.find("warning: raytrace: " + unread + "\n"), std::string::npos)
+      << render.err;
+  EXPECT_EQ(render.err.find("--accel"), std::string::npos) << render.err;
+  EXPECT_EQ(nlohmann::json::parse(slurp(stats))["warnings"], nlohmann::json::array({unread}));
+
+  const fs::path out = dir_ / "cmp";
+  RunResult cmp = run("compare builtin:cornell -r softraster,raytrace " + std::string(kSmall) +
+                      " --accel none --hiz off -q -o " + out.string());
+  ASSERT_EQ(cmp.status, 0) << cmp.err;
+  const nlohmann::json m = nlohmann::json::parse(slurp(out / "metrics.json"));
+  EXPECT_EQ(m["renderers"]["softraster"]["warnings"],
+            nlohmann::json::array({"option --accel is not read by softraster"}));
+  EXPECT_EQ(m["renderers"]["raytrace"]["warnings"],
+            nlohmann::json::array({"option --hiz is not read by raytrace"}));
+  EXPECT_NE(cmp.err.find("warning: softraster: option --accel is not read by softraster\n"),
+            std::string::npos)
+      << cmp.err;
+  const std::string html = slurp(out / "report.html");
+  EXPECT_NE(html.find("<li><b>raytrace</b>: option --hiz is not read by raytrace</li>"),
+            std::string::npos);
 }
 
 // An unknown command or option names the nearest known one, in one error line, exit 2.

@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli_exit.h"
@@ -14,6 +15,7 @@
 #include "rvr/compare/compare.h"
 #include "rvr/compare/mismatch_classes.h"
 #include "rvr/core/expected.h"
+#include "rvr/core/render_option_table.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
 #include "rvr/image_codec/image_io.h"
@@ -99,6 +101,10 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
   };
   // Everything is computed before the first file is written.
   CompareResult result = take(compare_renderers(scene, a.renderers, options, compare));
+  const std::vector<std::string> given = given_render_options(a.common);
+  for (size_t i = 0; i < result.renderers.size(); ++i)
+    for (std::string& w : unread_option_warnings(given, a.renderers[i], true))
+      result.renderers[i].output.warnings.push_back(std::move(w));
 
   ReportContext context;
   context.mode = to_string(options.mode);

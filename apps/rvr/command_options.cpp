@@ -1,15 +1,21 @@
 // The options render and compare share (see commands.h).
+#include <fmt/format.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <glm/glm.hpp>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <tuple>
 #include <utility>
+#include <vector>
 
 #include "cli_exit.h"
 #include "commands.h"
@@ -17,22 +23,73 @@
 #include "rvr/core/expected.h"
 #include "rvr/core/gl_backend.h"
 #include "rvr/core/limits.h"
+#include "rvr/core/render_option_table.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
-#include "rvr/core/texture.h"
 #include "rvr/scene_io/scene_for_render.h"
 #include "rvr/scene_io/scene_loader.h"
+#include "suggest.h"
 
 namespace rvr::cli {
 
+namespace {
+
+// The type CLI11's help shows for an option of the table.
+const char* type_name(OptionType type) {
+  switch (type) {
+    case OptionType::Integer:
+      return "INT";
+    case OptionType::Unsigned:
+      return "UINT";
+    case OptionType::Real:
+      return "FLOAT";
+    case OptionType::Flag:
+    case OptionType::Choice:
+      break;
+  }
+  return "TEXT";
+}
+
+// The table's check of a value as a CLI11 validator; a choice's error asks "did you mean".
+CLI::Validator table_check(const RenderOptionSpec& spec) {
+  std::vector<std::string> choices(spec.choices.begin(), spec.choices.end());
+  std::string description;
+  if (spec.type == OptionType::Choice) description = fmt::format("{}", fmt::join(choices, "|"));
+  if (spec.type == OptionType::Integer || spec.type == OptionType::Real)
+    description = fmt::format("{} in [{} - {}]", type_name(spec.type), spec.min, spec.max);
+  return CLI::Validator(
+      [&spec, choices](std::string& value) -> std::string {
+        RenderOptions scratch;
+        const Status status = set_render_option(scratch, spec, value);
+        if (status) return "";
+        if (spec.type == OptionType::Choice) return not_one_of(value, choices);
+        return status.error().message;
+      },
+      description);
+}
+
+// One option of the render option table, as --kebab-name.
+void add_render_option(CLI::App& cmd, CommonOptions& o, const RenderOptionSpec& spec) {
+  std::optional<std::string>& text = o.render_option_text[std::string(spec.name)];
+  const std::string name = cli_option_name(spec);
+  const std::string help(spec.help);
+  if (spec.type == OptionType::Flag) {
+    cmd.add_flag_callback(
+        name, [&text] { text = "on"; }, help);
+    return;
+  }
+  cmd.add_option(name, text, help)->type_name(type_name(spec.type))->check(table_check(spec));
+}
+
+}  // namespace
+
 void add_common_options(CLI::App& cmd, CommonOptions& o) {
   cmd.add_option("scene", o.scene, "scene file or builtin:NAME (default builtin:cornell)");
-  cmd.add_option("--mode", o.mode, "visibility | local | full")
-      ->check(one_of({"visibility", "local", "full"}));
+  add_render_option(cmd, o, *find_render_option("mode"));
   cmd.add_option("--width", o.width, "image width (overrides the scene)")
-      ->check(CLI::Range(1, 16384));
+      ->check(CLI::Range(1, kMaxImageSize));
   cmd.add_option("--height", o.height, "image height (overrides the scene)")
-      ->check(CLI::Range(1, 16384));
+      ->check(CLI::Range(1, kMaxImageSize));
   cmd.add_option("--image", o.image, "image size WxH, e.g. 800x600 (overrides the scene)")
       ->excludes(cmd.get_option("--width"))
       ->excludes(cmd.get_option("--height"));
@@ -57,43 +114,11 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
       ->check(one_of({"file", "auto"}));
   cmd.add_option("--spp", o.spp, "samples per pixel (overrides the scene)")
       ->check(CLI::Range(1, 65536));
-  cmd.add_option("--threads", o.threads, "worker threads, 0 = every core")
-      ->check(CLI::Range(0, 1024));
-  cmd.add_option("--accel", o.accel,
-                 "tracer acceleration: bvh (wide SIMD BVH, default) | bvh2 (binary, one box at a "
-                 "time) | none (every object for every ray)")
-      ->check(one_of({"bvh", "bvh2", "none"}));
-  cmd.add_option("--spheres", o.spheres,
-                 "tracer spheres: analytic | mesh (the raster's tessellation)")
-      ->check(one_of({"analytic", "mesh"}));
-  cmd.add_option("--sphere-segments", o.sphere_segments, "sphere tessellation: longitudes")
-      ->check(CLI::Range(3, 4096));
-  cmd.add_option("--triangle-test", o.triangle_test,
-                 "tracer ray-triangle test: mt (Moller-Trumbore) | chapter (plane, then edges)")
-      ->check(one_of({"mt", "chapter"}));
-  cmd.add_option("--texture-lod", o.texture_lod,
-                 "tracers' texture level of detail: cones (ray cones, default) | differentials "
-                 "(ray differentials) | none (level 0, bilinear)")
-      ->check(one_of({"cones", "differentials", "none"}));
-  cmd.add_option("--max-depth", o.max_depth, "recursion limit for bounce rays")
-      ->check(CLI::Range(0, 64));
-  cmd.add_option("--seed", o.seed, "seed of the per-pixel random streams");
+  for (const RenderOptionSpec& spec : render_option_table())
+    if (spec.name != "mode") add_render_option(cmd, o, spec);
   cmd.add_option("--gl", o.gl,
                  "raster GL back end: osmesa | egl (default osmesa, egl when OSMesa is missing)")
       ->check(one_of({"osmesa", "egl"}));
-  cmd.add_option("--shadow-map-size", o.shadow_map_size, "raster shadow maps: texels per side")
-      ->check(CLI::Range(16, 8192));
-  cmd.add_option("--shadow-bias", o.shadow_bias, "raster shadow maps: depth bias (scene units)")
-      ->check(CLI::Range(0.0f, 10.0f));
-  cmd.add_flag("--shadow-pcf", o.shadow_pcf, "raster shadow maps: 3x3 percentage-closer filtering");
-  cmd.add_option("--hiz", o.hiz,
-                 "softraster: hierarchical z, each 8x8 block's farthest depth rejecting what lies "
-                 "behind it: on | off (the textbook z-buffer)")
-      ->check(one_of({"on", "off"}));
-  cmd.add_option("--depth-format", o.depth_format,
-                 "rasterizers' z-buffer: d24 | d32f | d32f_reversed (default: the most precise "
-                 "the renderer has)")
-      ->check(one_of({"d24", "d32f", "d32f_reversed"}));
   cmd.add_flag("--quiet,-q", o.quiet, "no progress output");
   cmd.add_option("--max-samples", o.limits.max_samples,
                  "refuse more than N pixels x samples (default 2^30)")
@@ -120,26 +145,22 @@ RenderMode parse_mode(const std::string& s) {
 
 RenderOptions render_options(const CommonOptions& o, const std::string& default_mode) {
   RenderOptions r;
-  r.mode = parse_mode(o.mode.empty() ? default_mode : o.mode);
-  r.spheres = o.spheres == "mesh" ? SphereMode::Mesh : SphereMode::Analytic;
-  r.sphere_segments = o.sphere_segments;
-  r.threads = o.threads;
-  r.max_depth = o.max_depth;
-  r.seed = o.seed;
-  r.accel = o.accel == "none"   ? AccelKind::None
-            : o.accel == "bvh2" ? AccelKind::Bvh2
-                                : AccelKind::Bvh;
-  r.triangle_test =
-      o.triangle_test == "chapter" ? TriangleTest::Chapter : TriangleTest::MollerTrumbore;
-  r.texture_lod = o.texture_lod == "differentials" ? TextureLod::Differentials
-                  : o.texture_lod == "none"        ? TextureLod::None
-                                                   : TextureLod::Cones;
-  r.shadow_map_size = o.shadow_map_size;
-  r.shadow_bias = o.shadow_bias;
-  r.shadow_pcf = o.shadow_pcf;
-  r.hiz = o.hiz == "on";
-  if (!o.depth_format.empty()) r.depth_format = parse_depth_format(o.depth_format);
+  check(set_render_option(r, *find_render_option("mode"), default_mode));
+  for (const RenderOptionSpec& spec : render_option_table()) {
+    const auto it = o.render_option_text.find(std::string(spec.name));
+    if (it != o.render_option_text.end() && it->second)
+      check(set_render_option(r, spec, *it->second));  // checked by CLI11 already
+  }
   return r;
+}
+
+std::vector<std::string> given_render_options(const CommonOptions& o) {
+  std::vector<std::string> given;
+  for (const RenderOptionSpec& spec : render_option_table()) {
+    const auto it = o.render_option_text.find(std::string(spec.name));
+    if (it != o.render_option_text.end() && it->second) given.emplace_back(spec.name);
+  }
+  return given;
 }
 
 namespace {
@@ -156,13 +177,14 @@ glm::vec3 parse_direction(const std::string& text) {
   return d;
 }
 
-// "WxH", each in [1, 16384].
+// "WxH", each in [1, kMaxImageSize].
 std::pair<int, int> parse_image_size(const std::string& text) {
   int w = 0, h = 0;
   char end = 0;
-  if (std::sscanf(text.c_str(), " %d x %d %c", &w, &h, &end) != 2 || w < 1 || h < 1 || w > 16384 ||
-      h > 16384) {
-    fail(bad_input("--image: expected WIDTHxHEIGHT, each 1 to 16384, got '" + text + "'"));
+  if (std::sscanf(text.c_str(), " %d x %d %c", &w, &h, &end) != 2 || w < 1 || h < 1 ||
+      w > kMaxImageSize || h > kMaxImageSize) {
+    fail(bad_input(fmt::format("--image: expected WIDTHxHEIGHT, each 1 to {}, got '{}'",
+                               kMaxImageSize, text)));
   }
   return {w, h};
 }

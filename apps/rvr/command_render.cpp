@@ -10,6 +10,7 @@
 #include "cli_exit.h"
 #include "commands.h"
 #include "render_stats.h"
+#include "rvr/core/render_option_table.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
 #include "rvr/core/timer.h"
@@ -41,6 +42,8 @@ int run_render(const RenderArgs& a) {
   progress.begin(a.renderer, "render");
   auto start = Clock::now();
   RenderOutput out = take(renderer->render(scene, options));
+  for (std::string& w : unread_option_warnings(given_render_options(a.common), a.renderer, true))
+    out.warnings.push_back(std::move(w));
   double render_seconds = seconds_since(start);
 
   progress.begin(a.renderer, "write");

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,7 +25,6 @@ constexpr const char* kVersion = "0.1.0";
 // Options shared by render and compare.
 struct CommonOptions {
   std::string scene = "builtin:cornell";
-  std::string mode;
   std::optional<int> width, height, spp;
   std::string image;              // --image WxH
   std::string camera_from;        // --camera-from X,Y,Z
@@ -32,20 +32,10 @@ struct CommonOptions {
   std::string up = "auto";        // --up auto | y | z (model files)
   std::string camera = "file";    // --camera file | auto | file-always (model files)
   std::string lights = "file";    // --lights file | auto (model files)
-  int threads = 0;
-  std::string accel = "bvh";
-  std::string spheres = "analytic";
-  int sphere_segments = 64;
-  std::string triangle_test = "mt";
-  std::string texture_lod = "cones";  // --texture-lod cones | differentials | none (tracers)
-  int max_depth = 5;
-  uint64_t seed = 0;
-  std::string gl;  // empty: osmesa, falling back to egl when OSMesa is missing
-  int shadow_map_size = 1024;
-  float shadow_bias = 0.01f;
-  bool shadow_pcf = false;
-  std::string hiz = "on";
-  std::string depth_format;  // --depth-format: d24 | d32f | d32f_reversed (empty: the best)
+  std::string gl;                 // empty: osmesa, falling back to egl when OSMesa is missing
+  // The options of the render option table (rvr/core/render_option_table.h) by snake_case
+  // name: the text typed, unset when not given (RenderOptions' default then holds).
+  std::map<std::string, std::optional<std::string>> render_option_text;
   bool quiet = false;
   Limits limits;
   uint64_t max_memory_mb = 0;
@@ -55,6 +45,8 @@ void add_common_options(CLI::App& cmd, CommonOptions& o);
 GlBackend gl_backend(const CommonOptions& o);
 RenderMode parse_mode(const std::string& s);
 RenderOptions render_options(const CommonOptions& o, const std::string& default_mode);
+// The render options the user gave (snake_case names, in the table's order).
+std::vector<std::string> given_render_options(const CommonOptions& o);
 Scene load(const CommonOptions& o, const RenderOptions& options, double& load_seconds);
 
 // Refuses, before any work, an output file that names a folder (an existing one, or a name

@@ -29,10 +29,10 @@ Expected<ShadowMapPlan> plan_shadow_maps(const RenderOptions& options,
                                          bool any_geometry, std::vector<std::string>& warnings) {
   RVR_DCHECK(!samples.empty() && max_side > 0 && max_batch > 0,
              "a plan is made for at least one light sample, on a device that holds a cube");
-  if (options.shadow_map_size < 1)
-    return bad_input(fmt::format("shadow map size {} must be positive", options.shadow_map_size));
-  if (!(options.shadow_bias >= 0.0f) || !std::isfinite(options.shadow_bias))
-    return bad_input(fmt::format("shadow bias {} must be >= 0", options.shadow_bias));
+  // The render option table's ranges (rvr/core/render_option_table.h) hold these.
+  RVR_DCHECK(options.shadow_map_size >= 1 && options.shadow_bias >= 0.0f &&
+                 std::isfinite(options.shadow_bias),
+             "shadow map options outside the render option table's ranges");
   ShadowMapPlan plan;
   plan.size = std::min(options.shadow_map_size, max_side);
   const double texels = 6.0 * double(samples.size()) * double(plan.size) * double(plan.size);

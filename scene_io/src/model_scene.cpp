@@ -201,7 +201,7 @@ Scene scene_of_model(ImportedModel model, const std::string& path,
   if (own_camera && model.camera_aspect > 0.0f) {  // the image takes the camera's shape
     scene.image.width = overrides.width.value_or(scene.image.width);
     scene.image.height =
-        std::clamp(int(std::lround(scene.image.width / model.camera_aspect)), 1, 16384);
+        std::clamp(int(std::lround(scene.image.width / model.camera_aspect)), 1, kMaxImageSize);
   }
   if (overrides.width) scene.image.width = *overrides.width;
   if (overrides.height) scene.image.height = *overrides.height;

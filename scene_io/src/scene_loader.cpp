@@ -56,7 +56,6 @@ namespace scene_load {
 namespace {
 
 constexpr int kMaxCsgDepth = 64;
-constexpr int kMaxImageSize = 16384;
 constexpr int kMaxSamplesPerPixel = 4096;
 constexpr int kMaxLightSamples = 64;
 constexpr const char* kFormat = "rvr-scene/1";

@@ -79,8 +79,16 @@ def test_bad_options_name_what_is_wrong():
         rvr.render(scene, "raytrace", mode="fast")
     with pytest.raises(rvr.BadInput, match="^unknown option 'acel'"):
         rvr.render(scene, "raytrace", acel="bvh")
-    with pytest.raises(rvr.BadInput, match="^accel: expected one of bvh, bvh2, none"):
+    with pytest.raises(rvr.BadInput, match="^accel: 'kd' is not one of bvh, bvh2, none$"):
         rvr.render(scene, "raytrace", accel="kd")
+    with pytest.raises(rvr.BadInput,
+                       match="^texture_lod: 'cone' is not one of cones, differentials, none: "
+                             "did you mean 'cones'\\?$"):
+        rvr.render(scene, "raytrace", texture_lod="cone")
+    with pytest.raises(rvr.BadInput, match="^shadow_map_size: must be 16 to 8192, got 8$"):
+        rvr.render(scene, "raster", shadow_map_size=8)
+    with pytest.raises(rvr.BadInput, match="^shadow_bias: must be 0 to 10, got 10.5$"):
+        rvr.render(scene, "raster", shadow_bias=10.5)
     with pytest.raises(rvr.BadInput, match="^width: must be 1 to 16384, got 0"):
         scene.width = 0
     with pytest.raises(rvr.BadInput, match="^camera: unknown key 'foo'"):
@@ -204,3 +212,25 @@ def test_model_files_that_overstate_their_size_are_refused_as_by_the_command_lin
     with pytest.raises(rvr.BadInput) as caught:
         rvr.Scene(path)
     assert str(caught.value) == expected
+
+
+def test_the_stub_lists_every_render_keyword():
+    # rvr.render's docstring names the keywords the module takes (the render option table's
+    # and gl), in the table's order: those an unknown keyword's error lists.
+    with pytest.raises(rvr.BadInput) as caught:
+        rvr.render(rvr.Scene("builtin:cornell", width=8, height=8), "raytrace", zzz=1)
+    known = str(caught.value).split("(known: ")[1].rstrip(")")
+    doc = " ".join(rvr.render.__doc__.split())
+    listed = doc.split("of the same names: ")[1].split(". ")[0]
+    assert listed == known
+
+
+def test_options_the_renderer_does_not_read_are_warnings():
+    scene = rvr.Scene("builtin:cornell", width=16, height=12)
+    r = rvr.render(scene, "raytrace", shadow_map_size=512, accel="bvh2")
+    assert r.warnings == ["option shadow_map_size is not read by raytrace"]
+    assert r.stats["warnings"] == r.warnings
+    r = rvr.render(scene, "softraster", accel="none", hiz=False, threads=1)
+    assert r.warnings == ["option accel is not read by softraster"]
+    assert rvr.render(scene, "raster", threads=2).warnings == [
+        "option threads is not read by raster"]

@@ -1,6 +1,7 @@
 # Every renderer of the table renders through the module; rvr.compare gives metrics.json's
 # keys and figures as `rvr compare` writes them for the same scene.
 import json
+import re
 
 import numpy as np
 
@@ -52,8 +53,13 @@ def test_compare_is_metrics_json(run_cli, tmp_path):
         assert got[key] == expected[key], key
     assert len(got["pairs"]) == 1 and got["pairs"][0]["visibility"] == expected["pairs"][0]["visibility"]
     for name in ["raster", "raytrace"]:
-        for key in ["warnings", "info", "depth_format", "image"]:
+        for key in ["info", "depth_format", "image"]:
             assert got["renderers"][name][key] == expected["renderers"][name][key]
+        # The same warnings, an option named as each front end spells it (--threads, threads).
+        assert got["renderers"][name]["warnings"] == [
+            re.sub(r"--([a-z-]+)", lambda m: m.group(1).replace("-", "_"), w)
+            for w in expected["renderers"][name]["warnings"]]
+    assert got["renderers"]["raster"]["warnings"] == ["option threads is not read by raster"]
 
 
 def test_compare_classes_depth_outliers_as_the_command_line(run_cli, tmp_path):

@@ -23,6 +23,8 @@ Expected<Scene> parse_scene(const std::string& json_text, const std::string& sou
 // What the command line may change in a scene as it is loaded.
 // The largest exposure, in stops either way (image.exposure, --exposure).
 constexpr float kMaxExposure = 64.0f;
+// The largest image width and height (image.width/height, --width, --height, --image).
+constexpr int kMaxImageSize = 16384;
 
 // Model files: which axis of the file's coordinates (as Assimp reads them) is up. Auto: FBX
 // from its UpAxis/UpAxisSign; every other format +y (Assimp has already turned Collada's
