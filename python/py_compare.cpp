@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "arguments.h"
@@ -23,6 +24,7 @@
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes.h"
 #include "rvr/core/texture.h"
 #include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/compare_renderers.h"
@@ -69,20 +71,14 @@ bool same_light(const Light& a, const Light& b) {
 
 bool same_object(const Object& a, const Object& b) {
   if (a.type != b.type || a.material != b.material) return false;
-  switch (a.type) {
-    case ObjectType::Sphere:
-      return a.sphere.center == b.sphere.center && a.sphere.radius == b.sphere.radius;
-    case ObjectType::Plane:
-      return a.plane.point == b.plane.point && a.plane.normal == b.plane.normal &&
-             a.plane.half_size == b.plane.half_size;
-    case ObjectType::Triangles:
-      return a.mesh.positions == b.mesh.positions && a.mesh.triangles == b.mesh.triangles &&
-             a.mesh.normals == b.mesh.normals && a.mesh.uvs == b.mesh.uvs &&
-             a.mesh.colours == b.mesh.colours;
-    case ObjectType::Csg:
-      return a.csg == b.csg;  // CSG trees are not edited after loading: shared when the same
-  }
-  return false;
+  // Shape by shape (a CSG solid by its tree, which is not edited after loading: shared when the
+  // same).
+  return visit_shape(a, [&](const auto& shape_a) {
+    return visit_shape(b, [&](const auto& shape_b) {
+      if constexpr (std::is_same_v<decltype(shape_a), decltype(shape_b)>) return shape_a == shape_b;
+      return false;
+    });
+  });
 }
 
 template <class T, class Same>

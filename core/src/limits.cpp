@@ -6,7 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "rvr/core/tessellate.h"
+#include "rvr/core/shapes.h"
+#include "rvr/core/shapes/shape_geometry.h"
 
 namespace rvr {
 namespace {
@@ -26,21 +27,11 @@ ResourceEstimate estimate_resources(const Scene& scene, const RenderOptions& opt
   uint64_t pixels =
       uint64_t(std::max(0, scene.image.width)) * uint64_t(std::max(0, scene.image.height));
   e.samples = pixels * uint64_t(std::max(1, scene.image.samples_per_pixel));
-  for (const Object& o : scene.objects) {
-    switch (o.type) {
-      case ObjectType::Triangles:
-        e.triangles += o.mesh.triangle_count();
-        break;
-      case ObjectType::Sphere:  // the z-buffer draws the tessellation whatever the tracer does
-        e.triangles += sphere_triangle_count(options.sphere_segments);
-        break;
-      case ObjectType::Plane:
-        e.triangles += kPlaneTriangleCount;
-        break;
-      case ObjectType::Csg:
-        break;
-    }
-  }
+  // The z-buffers draw the triangle form whatever the tracers do.
+  const TessellationOptions tessellation{options.sphere_segments, false};
+  for (const Object& o : scene.objects)
+    e.triangles +=
+        visit_shape(o, [&](const auto& shape) { return shape.triangle_count(tessellation); });
   e.memory_bytes = pixels * kBytesPerPixel + e.triangles * kBytesPerTriangle;
   return e;
 }

@@ -6,9 +6,10 @@
 
 #include <algorithm>
 #include <glm/glm.hpp>
+#include <utility>
 
 #include "rvr/core/check.h"
-#include "rvr/core/tessellate.h"
+#include "rvr/core/shapes.h"
 
 namespace rvr {
 
@@ -22,12 +23,6 @@ Expected<const Material*> object_material(const Scene& scene, const Object& o,
     return bad_input(
         fmt::format("object '{}': material index {} out of range", o.name, o.material));
   return &fallback;  // a hand-made scene with no material list: the built-in grey
-}
-
-// The triangles drawn for an analytic sphere or square.
-TriangleMesh tessellate_shape(const Object& o, int sphere_segments) {
-  return o.type == ObjectType::Sphere ? tessellate_sphere(o.sphere, sphere_segments)
-                                      : tessellate_plane(o.plane);
 }
 
 // How the skipped-CSG warning names an object.
@@ -61,28 +56,22 @@ Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
   PreparedScene prepared;
   prepared.fallback = std::make_unique<const Material>(default_material());
   prepared.objects.resize(scene.objects.size());
+  const TessellationOptions tessellation{sphere_segments, spheres == SphereMode::Mesh};
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
     PreparedObject& p = prepared.objects[i];
     RVR_TRY_ASSIGN(material, object_material(scene, o, *prepared.fallback));
     p.material = *material;
-    switch (o.type) {
-      case ObjectType::Triangles:
-        p.mesh = &o.mesh;
-        p.own_mesh = true;
-        p.names_triangles = true;
-        break;
-      case ObjectType::Sphere:
-      case ObjectType::Plane:
-        prepared.tessellations.push_back(
-            std::make_unique<const TriangleMesh>(tessellate_shape(o, sphere_segments)));
-        p.mesh = prepared.tessellations.back().get();
-        p.names_triangles = o.type == ObjectType::Sphere && spheres == SphereMode::Mesh;
-        break;
-      case ObjectType::Csg:
-        prepared.skipped_csg.push_back(object_label(o, i));
-        continue;
+    TriangleForm form =
+        visit_shape(o, [&](const auto& shape) { return shape.triangle_form(tessellation); });
+    if (!form.mesh) {
+      prepared.skipped_csg.push_back(object_label(o, i));
+      continue;
     }
+    p.mesh = form.mesh;
+    p.own_mesh = form.is_object_mesh;
+    p.names_triangles = form.names_triangles;
+    if (form.made) prepared.tessellations.push_back(std::move(form.made));
     RVR_TRY(check_mesh(*p.mesh, o.name));
     p.smooth = p.mesh->smooth();
   }

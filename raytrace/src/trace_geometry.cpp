@@ -1,80 +1,15 @@
 #include "rvr/raytrace/trace_geometry.h"
 
 #include <cmath>
-#include <initializer_list>
 #include <type_traits>
+#include <utility>
+#include <variant>
 
 #include "embree_backend.h"
 #include "rvr/core/check.h"
-#include "rvr/core/tessellate.h"
 #include "rvr/raytrace/traversal_kernels.h"
 
 namespace rvr {
-namespace {
-
-// CSG along one ray: every leaf sphere gives an interval of the whole line; a sweep over
-// the sorted boundaries tracks inside(A) and inside(B) per node and keeps the boundaries
-// where the node's inside changes. A subtracted solid's boundary is reversed: its outward
-// normal points into the result.
-struct CsgBoundary {
-  float t;
-  bool entering;  // the result is entered here
-  uint32_t leaf;  // depth-first leaf number
-  bool flip;      // normal = -(sphere's outward normal)
-};
-
-void collect_leaves(const CsgNode* node, std::vector<Sphere>& leaves) {
-  if (node->is_leaf) {
-    leaves.push_back(node->sphere);
-    return;
-  }
-  collect_leaves(node->a.get(), leaves);
-  collect_leaves(node->b.get(), leaves);
-}
-
-void csg_boundaries(const CsgNode* node, const Ray& ray, uint32_t& next_leaf,
-                    std::vector<CsgBoundary>& out) {
-  if (node->is_leaf) {
-    uint32_t leaf = next_leaf++;
-    float t0, t1;
-    if (sphere_interval(ray, node->sphere, t0, t1) && t0 < t1) {
-      out.push_back({t0, true, leaf, false});
-      out.push_back({t1, false, leaf, false});
-    }
-    return;
-  }
-  std::vector<CsgBoundary> a, b;
-  csg_boundaries(node->a.get(), ray, next_leaf, a);
-  csg_boundaries(node->b.get(), ray, next_leaf, b);
-  // Both lists are sorted and alternate enter/exit; merge them in t order.
-  bool in_a = false, in_b = false;
-  auto inside = [&](bool ia, bool ib) {
-    switch (node->op) {
-      case CsgOp::Union:
-        return ia || ib;
-      case CsgOp::Intersection:
-        return ia && ib;
-      case CsgOp::Difference:
-        return ia && !ib;
-    }
-    return false;
-  };
-  size_t i = 0, j = 0;
-  while (i < a.size() || j < b.size()) {
-    bool from_a = j >= b.size() || (i < a.size() && a[i].t <= b[j].t);
-    CsgBoundary e = from_a ? a[i++] : b[j++];
-    bool before = inside(in_a, in_b);
-    (from_a ? in_a : in_b) = e.entering;
-    bool after = inside(in_a, in_b);
-    if (before == after) continue;
-    if (!from_a && node->op == CsgOp::Difference) e.flip = !e.flip;
-    e.entering = after;
-    out.push_back(e);
-  }
-}
-
-}  // namespace
-
 TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_segments,
                              AccelKind accel, TriangleTest triangle_test, std::optional<Isa> isa,
                              EmbreeQuality embree_quality)
@@ -108,41 +43,27 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
     }
   };
 
+  const TessellationOptions tessellation{sphere_segments, spheres == SphereMode::Mesh};
   for (uint32_t id = 0; id < n_objects; ++id) {
     const Object& o = scene.objects[id];
     object_material_[id] = o.material;
-    switch (o.type) {
-      case ObjectType::Triangles:
-        add_mesh(id, o.mesh);
-        break;
-      case ObjectType::Sphere:
-        if (spheres == SphereMode::Mesh) {
-          owned_meshes_.push_back(
-              std::make_unique<TriangleMesh>(tessellate_sphere(o.sphere, sphere_segments)));
-          add_mesh(id, *owned_meshes_.back());
-        } else {
+    visit_shape(o, [&](const auto& shape) {
+      if constexpr (requires { shape.traced(); }) {
+        if (shape.traced_analytically(tessellation)) {
           object_analytic_[id] = uint32_t(analytic_.size());
-          analytic_.push_back({Kind::Sphere, id, o.sphere, {}, {}, {}, nullptr, {}});
+          analytic_.push_back({id, TracedShape(shape.traced())});
+          return;
         }
-        break;
-      case ObjectType::Plane: {
-        auto [u, v] = plane_axes(o.plane.normal);
-        object_analytic_[id] = uint32_t(analytic_.size());
-        analytic_.push_back({Kind::Square, id, {}, o.plane, u, v, nullptr, {}});
-        break;
       }
-      case ObjectType::Csg: {
-        std::vector<Sphere> leaves;
-        collect_leaves(o.csg.get(), leaves);
-        object_analytic_[id] = uint32_t(analytic_.size());
-        analytic_.push_back({Kind::Csg, id, {}, {}, {}, {}, o.csg.get(), std::move(leaves)});
-        break;
-      }
-    }
+      TriangleForm form = shape.triangle_form(tessellation);
+      if (form.made) owned_meshes_.push_back(std::move(form.made));
+      add_mesh(id, *form.mesh);
+    });
   }
 
   for (size_t k = 0; k < analytic_.size(); ++k)
-    if (analytic_[k].kind == Kind::Csg) csg_primitives_.push_back(uint32_t(triangles_.size() + k));
+    if (std::holds_alternative<CsgSolid::Traced>(analytic_[k].shape))
+      csg_primitives_.push_back(uint32_t(triangles_.size() + k));
 
   if (accel_ == AccelKind::Embree) {
     embree_.reset(make_embree_backend(*this, error_.message));
@@ -198,33 +119,24 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
 TraceGeometry::~TraceGeometry() = default;
 
 Aabb TraceGeometry::analytic_bounds(const Analytic& a) {
+  std::vector<BoundingBall> balls;
+  std::visit([&](const auto& shape) { shape.bounding_balls(balls); }, a.shape);
   Aabb b;
-  switch (a.kind) {
-    case Kind::Sphere:
-      b.grow(a.sphere.center - glm::vec3(a.sphere.radius));
-      b.grow(a.sphere.center + glm::vec3(a.sphere.radius));
-      break;
-    case Kind::Square: {
-      float h = a.plane.half_size;
-      for (float su : {-h, h})
-        for (float sv : {-h, h}) b.grow(a.plane.point + su * a.axis_u + sv * a.axis_v);
-      break;
-    }
-    case Kind::Csg:
-      // Any CSG result lies inside the union of its leaves.
-      for (const Sphere& s : a.csg_leaves) {
-        b.grow(s.center - glm::vec3(s.radius));
-        b.grow(s.center + glm::vec3(s.radius));
-      }
-      break;
+  for (const BoundingBall& ball : balls) {
+    b.grow(ball.centre - glm::vec3(ball.radius));
+    b.grow(ball.centre + glm::vec3(ball.radius));
   }
   return b;
 }
 
 std::vector<Aabb> TraceGeometry::approximated_bounds() const {
   std::vector<Aabb> bounds;
-  for (const Analytic& a : analytic_)
-    if (a.kind != Kind::Square) bounds.push_back(analytic_bounds(a));
+  for (const Analytic& a : analytic_) {
+    const bool exact = std::visit(
+        [](const auto& shape) { return std::decay_t<decltype(shape)>::kTriangleFormExact; },
+        a.shape);
+    if (!exact) bounds.push_back(analytic_bounds(a));
+  }
   return bounds;
 }
 
@@ -242,32 +154,12 @@ bool TraceGeometry::hit_analytic(const Analytic& a, const Ray& ray, float t_max,
                                  HitRecord& hit) const {
   Ray r = ray;
   r.tmax = t_max;
-  float t;
-  switch (a.kind) {
-    case Kind::Sphere:
-      if (!intersect_sphere(r, a.sphere, t)) return false;
-      hit.t = t;
-      return true;
-    case Kind::Square:
-      if (!intersect_square(r, a.plane, a.axis_u, a.axis_v, t)) return false;
-      hit.t = t;
-      return true;
-    case Kind::Csg: {
-      std::vector<CsgBoundary> boundaries;
-      uint32_t next_leaf = 0;
-      csg_boundaries(a.csg, r, next_leaf, boundaries);
-      for (const CsgBoundary& e : boundaries) {
-        if (e.t <= r.tmin) continue;
-        if (e.t >= r.tmax) return false;
-        hit.t = e.t;
-        hit.csg_leaf = e.leaf;
-        hit.csg_flip = e.flip;
-        return true;
-      }
-      return false;
-    }
-  }
-  return false;
+  ShapeHit h;
+  if (!std::visit([&](const auto& shape) { return shape.intersect(r, h); }, a.shape)) return false;
+  hit.t = h.t;
+  hit.csg_leaf = h.part;
+  hit.csg_flip = h.flip;
+  return true;
 }
 
 struct MollerTrumboreTest {
@@ -524,20 +416,9 @@ SurfaceHit TraceGeometry::surface(const Ray& ray, const HitRecord& hit) const {
     const Analytic& a = analytic_[hit.primitive - n_triangles];
     s.object = a.object;
     s.primitive = 0;
-    switch (a.kind) {
-      case Kind::Sphere:
-        s.geometric_normal = (s.position - a.sphere.center) / a.sphere.radius;
-        break;
-      case Kind::Square:
-        s.geometric_normal = a.plane.normal;
-        break;
-      case Kind::Csg: {
-        const Sphere& leaf = a.csg_leaves[hit.csg_leaf];
-        s.geometric_normal = (s.position - leaf.center) / leaf.radius;
-        if (hit.csg_flip) s.geometric_normal = -s.geometric_normal;
-        break;
-      }
-    }
+    const ShapeHit shape_hit{hit.t, hit.csg_leaf, hit.csg_flip};
+    s.geometric_normal = std::visit(
+        [&](const auto& shape) { return shape.normal_at(s.position, shape_hit); }, a.shape);
     s.geometric_normal = glm::normalize(s.geometric_normal);
     s.shading_normal = s.geometric_normal;
   }

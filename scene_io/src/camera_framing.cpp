@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "rvr/core/tessellate.h"
+#include "rvr/core/shapes.h"
 
 namespace rvr {
 namespace {
@@ -18,52 +18,29 @@ void grow(glm::vec3& lo, glm::vec3& hi, const glm::vec3& p) {
   hi = glm::max(hi, p);
 }
 
-void csg_points(const CsgNode* node, std::vector<std::pair<glm::vec3, float>>& balls) {
-  if (!node) return;
-  if (node->is_leaf) {
-    balls.emplace_back(node->sphere.center, node->sphere.radius);
-    return;
-  }
-  csg_points(node->a.get(), balls);
-  csg_points(node->b.get(), balls);
-}
-
-// Every object as points with a radius (0 for vertices).
-std::vector<std::pair<glm::vec3, float>> scene_points(const Scene& scene) {
-  std::vector<std::pair<glm::vec3, float>> points;
-  for (const Object& o : scene.objects) {
-    switch (o.type) {
-      case ObjectType::Triangles:
-        for (const glm::vec3& p : o.mesh.positions) points.emplace_back(p, 0.0f);
-        break;
-      case ObjectType::Sphere:
-        points.emplace_back(o.sphere.center, o.sphere.radius);
-        break;
-      case ObjectType::Plane:
-        for (const glm::vec3& p : plane_corners(o.plane)) points.emplace_back(p, 0.0f);
-        break;
-      case ObjectType::Csg:
-        csg_points(o.csg.get(), points);
-        break;
-    }
-  }
+// Every object as balls that bound it.
+std::vector<BoundingBall> scene_points(const Scene& scene) {
+  std::vector<BoundingBall> points;
+  for (const Object& o : scene.objects)
+    visit_shape(o, [&](const auto& shape) { shape.bounding_balls(points); });
   return points;
 }
 
 }  // namespace
 
 BoundingSphere scene_bounds(const Scene& scene) {
-  std::vector<std::pair<glm::vec3, float>> points = scene_points(scene);
+  std::vector<BoundingBall> points = scene_points(scene);
   BoundingSphere b;
   if (points.empty()) return b;
   glm::vec3 lo(INFINITY), hi(-INFINITY);
-  for (const auto& [p, r] : points) {
-    grow(lo, hi, p - glm::vec3(r));
-    grow(lo, hi, p + glm::vec3(r));
+  for (const BoundingBall& ball : points) {
+    grow(lo, hi, ball.centre - glm::vec3(ball.radius));
+    grow(lo, hi, ball.centre + glm::vec3(ball.radius));
   }
   b.centre = 0.5f * (lo + hi);
   float radius = 0.0f;
-  for (const auto& [p, r] : points) radius = std::max(radius, glm::length(p - b.centre) + r);
+  for (const BoundingBall& ball : points)
+    radius = std::max(radius, glm::length(ball.centre - b.centre) + ball.radius);
   b.radius = radius > 0.0f ? radius : 1.0f;  // a single point: a unit sphere round it
   b.empty = false;
   return b;

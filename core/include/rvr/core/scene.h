@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+#include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/square.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/texture.h"
 
 namespace rvr {
@@ -78,46 +82,7 @@ struct ImageSettings {
   float exposure = 0.0f;
 };
 
-struct Sphere {
-  glm::vec3 center{0.0f};
-  float radius = 1.0f;
-};
-
-// A square of side 2*half_size centred at point, facing normal (unit length): the scene
-// format's "plane" (ObjectType::Plane).
-struct Square {
-  glm::vec3 point{0.0f};
-  glm::vec3 normal{0.0f, 1.0f, 0.0f};
-  float half_size = 10.0f;
-};
-
-// Triangles in world space. normals is empty (flat shading: geometric normal) or holds one
-// unit normal per position (smooth shading: interpolated). uvs and colours are empty or hold
-// one value per position, interpolated like the normals: texture coordinates (OpenGL's
-// convention: v = 0 is the image's bottom row) and linear RGB vertex colours.
-struct TriangleMesh {
-  std::vector<glm::vec3> positions;
-  std::vector<glm::vec3> normals;
-  std::vector<glm::uvec3> triangles;
-  std::vector<glm::vec2> uvs;
-  std::vector<glm::vec3> colours;
-
-  size_t triangle_count() const { return triangles.size(); }
-  bool smooth() const { return !normals.empty(); }
-  bool textured() const { return !uvs.empty(); }
-  bool coloured() const { return !colours.empty(); }
-};
-
-enum class CsgOp { Union, Intersection, Difference };
-
-// A CSG tree: leaves are spheres, inner nodes combine two solids.
-struct CsgNode {
-  bool is_leaf = true;
-  Sphere sphere;  // leaf
-  CsgOp op = CsgOp::Union;
-  std::shared_ptr<const CsgNode> a, b;  // inner node
-};
-
+// The kind of an object: which of its shape fields holds it. rvr/core/shapes.h lists the shapes.
 enum class ObjectType { Sphere, Plane, Triangles, Csg };
 
 struct Object {

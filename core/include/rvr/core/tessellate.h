@@ -10,7 +10,9 @@
 #include <cstdint>
 #include <glm/glm.hpp>
 
-#include "rvr/core/scene.h"
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/square.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr {
 

@@ -1,5 +1,5 @@
-// Ray-primitive intersection: the tests of chapter 20 (ray-sphere, ray-plane, ray-triangle)
-// plus Moller-Trumbore. Each returns the hit parameter t in (ray.tmin, ray.tmax) and the
+// Ray-triangle intersection: the test of chapter 20 plus Moller-Trumbore (the analytic shapes
+// own theirs: rvr/core/shapes/). Each returns the hit parameter t in (ray.tmin, ray.tmax) and the
 // cheap data the closest-hit search needs; surface data is computed once, later.
 #pragma once
 
@@ -8,16 +8,9 @@
 #include <glm/glm.hpp>
 #include <utility>
 
-#include "rvr/core/scene.h"
+#include "rvr/core/ray.h"
 
 namespace rvr {
-
-struct Ray {
-  glm::vec3 origin;
-  glm::vec3 dir;  // need not be unit length; t is measured in units of |dir|
-  float tmin = 0.0f;
-  float tmax = INFINITY;
-};
 
 // A triangle precomputed as v0, e1 = v1 - v0, e2 = v2 - v0 (as Embree stores them).
 struct TrianglePrecomputed {
@@ -116,59 +109,6 @@ inline bool intersect_triangle_chapter(const Ray& ray, const TrianglePrecomputed
   float w_w = glm::dot(glm::cross(tri.e2 - tri.e1, p - tri.e1), n);
   if (w_w < slack) return false;
   hit = {t, w_u / n2, w_v / n2};
-  return true;
-}
-
-// Both roots t0 <= t1 of the ray-sphere quadratic |o + t d - c|^2 = r^2, in the form of
-// Ray Tracing Gems ch. 7, which keeps precision when the sphere is small or far away.
-// False when the line misses. CSG uses the interval [t0, t1] directly.
-inline bool sphere_interval(const Ray& ray, const Sphere& s, float& t0, float& t1) {
-  glm::vec3 f = ray.origin - s.center;
-  float a = glm::dot(ray.dir, ray.dir);
-  float b = -glm::dot(f, ray.dir);      // -b/2 of the textbook quadratic
-  glm::vec3 l = f + (b / a) * ray.dir;  // closest approach of the line to the centre
-  float disc = a * (s.radius * s.radius - glm::dot(l, l));
-  if (disc < 0.0f) return false;
-  float c = glm::dot(f, f) - s.radius * s.radius;
-  float q = b + std::copysign(std::sqrt(disc), b);
-  if (q == 0.0f) {  // origin on the sphere and ray tangent
-    t0 = t1 = 0.0f;
-    return true;
-  }
-  t0 = c / q;
-  t1 = q / a;
-  if (t0 > t1) std::swap(t0, t1);
-  return true;
-}
-
-// Ray-sphere: the nearest root in (tmin, tmax): the near one from outside, the far one from
-// inside.
-inline bool intersect_sphere(const Ray& ray, const Sphere& s, float& t_hit) {
-  float t0, t1;
-  if (!sphere_interval(ray, s, t0, t1)) return false;
-  if (t0 > ray.tmin && t0 < ray.tmax) {
-    t_hit = t0;
-    return true;
-  }
-  if (t1 > ray.tmin && t1 < ray.tmax) {
-    t_hit = t1;
-    return true;
-  }
-  return false;
-}
-
-// Ray-plane: the plane equation N.(P - point) = 0, then the square's bounds along the
-// plane's axes (u, v from plane_axes).
-inline bool intersect_square(const Ray& ray, const Square& plane, const glm::vec3& u,
-                             const glm::vec3& v, float& t_hit) {
-  float denom = glm::dot(plane.normal, ray.dir);
-  if (denom == 0.0f) return false;  // parallel
-  float t = glm::dot(plane.normal, plane.point - ray.origin) / denom;
-  if (!(t > ray.tmin && t < ray.tmax)) return false;
-  glm::vec3 local = ray.origin + t * ray.dir - plane.point;
-  if (std::abs(glm::dot(local, u)) > plane.half_size) return false;
-  if (std::abs(glm::dot(local, v)) > plane.half_size) return false;
-  t_hit = t;
   return true;
 }
 

@@ -25,6 +25,7 @@
 #include "rvr/core/isa.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/wide_bvh.h"
@@ -47,8 +48,8 @@ struct HitRecord {
   float t = INFINITY;
   uint32_t primitive = kNoPrimitive;  // unified primitive index
   float u = 0.0f, v = 0.0f;           // triangle barycentrics
-  uint32_t csg_leaf = 0;              // CSG: which leaf sphere's surface was hit
-  bool csg_flip = false;              // CSG: surface of a subtracted solid (normal reversed)
+  uint32_t csg_leaf = 0;              // ShapeHit::part: which surface of the shape (CSG leaf)
+  bool csg_flip = false;              // ShapeHit::flip: its normal reversed
 };
 
 // Everything shading needs, computed once for the closest hit.
@@ -150,15 +151,10 @@ class TraceGeometry {
   size_t acceleration_bytes() const;
 
  private:
-  enum class Kind : uint8_t { Sphere, Square, Csg };
+  // An object the tracer traces analytically (rvr/core/shapes.h).
   struct Analytic {
-    Kind kind;
     uint32_t object;
-    Sphere sphere;
-    Square plane;
-    glm::vec3 axis_u{0.0f}, axis_v{0.0f};
-    const CsgNode* csg = nullptr;
-    std::vector<Sphere> csg_leaves;  // depth-first, as HitRecord::csg_leaf numbers them
+    TracedShape shape;
   };
 
   template <class TriangleTestFn, bool kAnyHit>
@@ -185,8 +181,8 @@ class TraceGeometry {
   std::vector<uint32_t> triangle_id_;       // primitive id reported: the index in its mesh
   std::vector<uint32_t> triangle_in_mesh_;  // index into the mesh's triangles (normals)
   std::vector<Analytic> analytic_;
-  std::vector<const TriangleMesh*> object_mesh_;             // per object, or null
-  std::vector<std::unique_ptr<TriangleMesh>> owned_meshes_;  // tessellated spheres
+  std::vector<const TriangleMesh*> object_mesh_;                   // per object, or null
+  std::vector<std::unique_ptr<const TriangleMesh>> owned_meshes_;  // tessellated spheres
   std::vector<uint32_t> object_material_;
   std::vector<uint32_t> object_first_triangle_;  // unified index of each object's triangle 0
   std::vector<uint32_t> object_analytic_;        // index into analytic_, or kNoPrimitive
