@@ -52,6 +52,7 @@
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/isa.h"
+#include "rvr/core/ray.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
 #include "rvr/core/texture.h"

@@ -26,6 +26,7 @@
 #include "rvr/core/image_sample.h"
 #include "rvr/core/isa.h"
 #include "rvr/core/renderer.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/image_codec/image_io.h"
 #include "rvr/scene_io/scene_for_render.h"
 #include "rvr/scene_io/scene_loader.h"

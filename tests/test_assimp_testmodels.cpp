@@ -25,6 +25,7 @@
 
 #include "rvr/core/expected.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/texture.h"
 #include "rvr/scene_io/scene_loader.h"
 

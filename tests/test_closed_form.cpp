@@ -29,6 +29,9 @@
 #include "rvr/core/gl_backend.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/square.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/tessellate.h"
 #include "rvr/renderers/registry.h"
 

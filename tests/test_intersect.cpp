@@ -8,9 +8,10 @@
 #include <random>
 #include <string>
 
-#include "rvr/core/scene.h"
+#include "rvr/core/ray.h"
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/square.h"
 #include "rvr/core/tessellate.h"
-#include "rvr/core/texture.h"
 #include "rvr/raytrace/intersect.h"
 
 using namespace rvr;

@@ -21,6 +21,8 @@
 #include "rvr/core/check.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/tessellate.h"
 
 using namespace rvr;

@@ -31,6 +31,7 @@
 #include "rvr/core/isa.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/camera_framing.h"
 #include "rvr/scene_io/scene_loader.h"

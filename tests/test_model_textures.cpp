@@ -21,6 +21,7 @@
 #include "model_corpus.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/surface_colour.h"
 #include "rvr/core/texture.h"
 #include "rvr/image_codec/image_io.h"

@@ -18,6 +18,7 @@
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/scene_loader.h"
 #include "scene_builders.h"

@@ -10,7 +10,7 @@
 #include <memory>
 
 #include "ray_footprint.h"
-#include "rvr/core/texture.h"
+#include "rvr/core/ray.h"
 
 using namespace rvr;
 

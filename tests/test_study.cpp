@@ -28,6 +28,7 @@
 #include "rvr/core/camera.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/scene_io/scene_loader.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"

@@ -16,9 +16,10 @@
 #include "rvr/core/camera.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
+#include "rvr/core/ray.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
-#include "rvr/core/texture.h"
+#include "rvr/core/shapes/sphere.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "scene_builders.h"
 

@@ -8,6 +8,8 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "rvr/core/shapes/triangle_mesh.h"
+
 namespace rvr {
 namespace {
 

@@ -20,6 +20,8 @@
 #include "rvr/core/camera.h"
 #include "rvr/core/check.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/srgb.h"
 #include "rvr/core/tessellate.h"
 

@@ -12,6 +12,7 @@
 
 #include "rvr/core/camera.h"
 #include "rvr/core/check.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/srgb.h"
 #include "rvr/core/tessellate.h"
 

@@ -12,9 +12,9 @@
 
 #include "hybrid_counters.h"
 #include "primary_visibility.h"
+#include "rvr/core/ray.h"
 #include "rvr/core/scene.h"
 #include "rvr/raytrace/bvh.h"
-#include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/primary_hit_source.h"
 #include "rvr/raytrace/trace_geometry.h"
 

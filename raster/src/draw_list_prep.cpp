@@ -10,6 +10,7 @@
 
 #include "rvr/core/check.h"
 #include "rvr/core/shapes.h"
+#include "rvr/core/shapes/shape_geometry.h"
 
 namespace rvr {
 

@@ -12,6 +12,7 @@
 #include "rvr/core/expected.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr {
 

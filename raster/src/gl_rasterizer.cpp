@@ -34,6 +34,7 @@
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/image_sample.h"
 #include "rvr/core/progress.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/surface_colour.h"
 #include "rvr/core/texture.h"
 #include "rvr/core/timer.h"

@@ -27,6 +27,7 @@
 #include "rvr/core/progress.h"
 #include "rvr/core/shade_kernel.h"
 #include "rvr/core/shading.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/surface_colour.h"
 #include "rvr/core/timer.h"
 #include "shadow_plan.h"

@@ -10,7 +10,7 @@
 #include "embree_abi.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/plugin.h"
-#include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/ray_tracer.h"
 

@@ -4,7 +4,7 @@
 
 #include <string>
 
-#include "rvr/raytrace/intersect.h"
+#include "rvr/core/ray.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
 

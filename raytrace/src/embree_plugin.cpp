@@ -5,6 +5,7 @@
 #include <embree3/rtcore.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -16,8 +17,8 @@
 
 #include "embree_abi.h"
 #include "rvr/core/check.h"
+#include "rvr/core/ray.h"
 #include "rvr/raytrace/bvh.h"
-#include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
 

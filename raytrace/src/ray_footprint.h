@@ -17,6 +17,7 @@
 
 #include "rvr/core/camera.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/texture.h"
 
 namespace rvr {

@@ -7,6 +7,8 @@
 
 #include "embree_backend.h"
 #include "rvr/core/check.h"
+#include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/shape_geometry.h"
 #include "rvr/raytrace/traversal_kernels.h"
 
 namespace rvr {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "rvr/core/check.h"
+#include "rvr/core/ray.h"
 
 namespace rvr {
 namespace {

@@ -16,6 +16,10 @@
 
 #include "rvr/core/expected.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/square.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/tessellate.h"
 #include "rvr/core/texture.h"
 #include "rvr/scene_io/scene_loader.h"

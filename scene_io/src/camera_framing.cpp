@@ -2,13 +2,12 @@
 #include "rvr/scene_io/camera_framing.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <memory>
-#include <utility>
 #include <vector>
 
 #include "rvr/core/shapes.h"
+#include "rvr/core/shapes/shape_geometry.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr {
 namespace {

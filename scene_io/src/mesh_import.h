@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/texture.h"
 
 namespace rvr::scene_load {

@@ -6,7 +6,7 @@
 #include <glm/glm.hpp>
 #include <string>
 
-#include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "scene_transforms.h"
 
 namespace rvr::scene_load {

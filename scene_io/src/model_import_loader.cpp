@@ -14,7 +14,7 @@
 #include "model_import_abi.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/plugin.h"
-#include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "scene_json_errors.h"
 
 namespace rvr::scene_load {

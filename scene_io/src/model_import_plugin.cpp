@@ -10,7 +10,7 @@
 
 #include "mesh_import.h"
 #include "model_import_abi.h"
-#include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "scene_json_errors.h"
 
 namespace rvr::scene_load {

@@ -23,6 +23,7 @@
 #include "mesh_repair.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/scene_io/camera_framing.h"
 #include "rvr/scene_io/scene_loader.h"
 #include "scene_json_errors.h"

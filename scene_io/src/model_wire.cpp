@@ -10,6 +10,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "rvr/core/scene.h"
 #include "rvr/core/texture.h"
 
 namespace rvr::scene_load {

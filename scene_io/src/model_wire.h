@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "mesh_import.h"
-#include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr::scene_load {
 

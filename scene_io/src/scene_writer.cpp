@@ -21,6 +21,10 @@
 #include <system_error>
 #include <utility>
 
+#include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/square.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/texture.h"
 
 namespace rvr {

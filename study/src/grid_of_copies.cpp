@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/scene_io/camera_framing.h"
 
 namespace rvr::study {

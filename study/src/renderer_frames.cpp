@@ -9,6 +9,7 @@
 #include <variant>
 
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/renderers/prepared_renderer.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/scene_loader.h"

@@ -13,6 +13,7 @@
 
 #include "rvr/core/check.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/scene_io/scene_loader.h"
 
 namespace rvr::study {

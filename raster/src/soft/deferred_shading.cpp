@@ -12,6 +12,7 @@
 
 #include "rvr/core/check.h"
 #include "rvr/core/shade_batch.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/surface_colour.h"
 
 namespace rvr::soft {

@@ -11,6 +11,7 @@
 
 #include "rvr/core/progress.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "soft/tile_raster.h"
 
 namespace rvr::soft {

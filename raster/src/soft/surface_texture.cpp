@@ -6,6 +6,7 @@
 #include <limits>
 #include <memory>
 
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/surface_colour.h"
 #include "rvr/core/texture.h"
 

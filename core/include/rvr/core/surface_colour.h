@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr {
 

@@ -13,7 +13,7 @@
 #include <new>
 #include <vector>
 
-#include "rvr/raytrace/intersect.h"
+#include "rvr/core/ray.h"
 
 namespace rvr {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "rvr/core/camera.h"
-#include "rvr/raytrace/intersect.h"
+#include "rvr/core/ray.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
 
 namespace rvr {

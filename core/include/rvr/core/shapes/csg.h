@@ -9,7 +9,8 @@
 #include "rvr/core/ray.h"
 #include "rvr/core/shapes/shape_geometry.h"
 #include "rvr/core/shapes/sphere.h"
-#include "rvr/core/shapes/triangle_mesh.h"  // IWYU pragma: keep (destroys TriangleForm)
+// TriangleForm destroys the mesh it owns: the type must be complete here.
+#include "rvr/core/shapes/triangle_mesh.h"  // IWYU pragma: keep
 
 namespace rvr {
 
