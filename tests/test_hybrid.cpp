@@ -27,6 +27,7 @@
 #include "rvr/core/texture.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/scene_loader.h"
+#include "same_bytes.h"
 
 using namespace rvr;
 
@@ -70,9 +71,7 @@ RenderOutput render_full(const std::string& renderer, const Scene& scene, int th
   return std::move(out).value();
 }
 
-bool same_bytes(const PixelVector<glm::vec3>& a, const PixelVector<glm::vec3>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
-}
+using rvr::test::same_bytes;
 
 // Whether pixel i shows a textured surface in fb (its lod AOV holds a level there).
 bool textured_pixel(const FrameBuffers& fb, size_t i) {

@@ -34,15 +34,13 @@
 #include "soft/setup_kernel.h"
 #include "soft/setup_triangle.h"
 #include "soft/triangle_setup.h"
+#include "same_bytes.h"
 
 using namespace rvr;
 
 namespace {
 
-template <class T>
-bool same_bytes(const PixelVector<T>& a, const PixelVector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+using rvr::test::same_bytes;
 
 // The first differing buffer, or "" when all are the same bytes.
 std::string first_difference(const FrameBuffers& a, const FrameBuffers& b) {

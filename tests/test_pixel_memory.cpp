@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <cstring>
 #include <initializer_list>
 #include <memory>
 #include <string>
@@ -20,6 +19,7 @@
 #include "rvr/core/scene.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/scene_loader.h"
+#include "same_bytes.h"
 
 using namespace rvr;
 
@@ -84,10 +84,7 @@ void poison_frame_memory(size_t pixels, unsigned char byte) {
   for (auto [p, bytes] : blocks) release_pixel_memory(p, bytes);
 }
 
-template <class T>
-bool same_bytes(const PixelVector<T>& a, const PixelVector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+using rvr::test::same_bytes;
 
 }  // namespace
 

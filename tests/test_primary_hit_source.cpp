@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 #include <stdint.h>
 
-#include <cstring>
 #include <glm/glm.hpp>
 #include <initializer_list>
 #include <map>
@@ -24,6 +23,7 @@
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
 #include "rvr/scene_io/scene_loader.h"
+#include "same_bytes.h"
 
 using namespace rvr;
 
@@ -58,10 +58,7 @@ class NothingButBackground : public ClosestHits {
   bool only_background(int, int, int, int) const override { return true; }
 };
 
-template <class T>
-bool same_bytes(const PixelVector<T>& a, const PixelVector<T>& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
-}
+using rvr::test::same_bytes;
 
 Scene small_scene(const std::string& name, int samples_per_pixel) {
   Scene scene = make_builtin_scene(name).value();

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstring>
 #include <fstream>
 #include <initializer_list>
 #include <memory>
@@ -22,6 +21,7 @@
 #include "rvr/core/scene.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/scene_loader.h"
+#include "same_bytes.h"
 
 namespace rvr {
 namespace {
@@ -134,11 +134,7 @@ std::string other_value(const RenderOptionSpec& spec) {
   return standard;
 }
 
-template <class V>
-bool same_bytes(const V& a, const V& b) {
-  return a.size() == b.size() &&
-         std::memcmp(a.data(), b.data(), a.size() * sizeof(typename V::value_type)) == 0;
-}
+using rvr::test::same_bytes;
 
 bool same_image(const FrameBuffers& a, const FrameBuffers& b) {
   return same_bytes(a.colour, b.colour) && same_bytes(a.depth, b.depth) &&

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <glm/glm.hpp>
 #include <initializer_list>
 #include <map>
@@ -30,6 +29,7 @@
 #include "rvr/scene_io/scene_loader.h"
 #include "scene_builders.h"
 #include "visibility_frame.h"
+#include "same_bytes.h"
 
 namespace rvr {
 namespace {
@@ -146,9 +146,7 @@ TEST(SoftRasterizer, SameBytesWithOneAndTwoThreads) {
   RenderOutput a = render_soft(*scene, RenderMode::Local, 1);
   RenderOutput b = render_soft(*scene, RenderMode::Local, 2);
   const FrameBuffers &fa = a.buffers, &fb = b.buffers;
-  auto same = [](const auto& x, const auto& y) {
-    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
-  };
+  auto same = [](const auto& x, const auto& y) { return rvr::test::same_bytes(x, y); };
   EXPECT_TRUE(same(fa.colour, fb.colour));
   EXPECT_TRUE(same(fa.depth, fb.depth));
   EXPECT_TRUE(same(fa.object_id, fb.object_id));
@@ -205,9 +203,7 @@ TEST(SoftRasterizer, CostIsDepthComplexity) {
 // nothing is rejected. The cost AOV adds each rejection as 1/64 to the pixels of its block, so
 // over the frame it sums to fragments + blocks rejected.
 TEST(SoftRasterizer, HierarchicalZChangesNothingSeen) {
-  auto same = [](const auto& x, const auto& y) {
-    return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
-  };
+  auto same = [](const auto& x, const auto& y) { return rvr::test::same_bytes(x, y); };
   for (const char* name : {"occluders:16", "occluders_back:16", "tessphere:20000", "soup:2000",
                            "cornell", "spheres"}) {
     Expected<Scene> scene = make_builtin_scene(name);
@@ -313,9 +309,7 @@ TEST(SoftRasterizer, ManyChunksSameBytesBoundedMemory) {
 // triangles where the next has few).
 TEST(SoftRasterizer, ReusedRendererDrawsWhatAFreshOneDraws) {
   auto same = [](const RenderOutput& a, const RenderOutput& b) {
-    auto eq = [](const auto& x, const auto& y) {
-      return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(x[0])) == 0;
-    };
+    auto eq = [](const auto& x, const auto& y) { return rvr::test::same_bytes(x, y); };
     return eq(a.buffers.colour, b.buffers.colour) && eq(a.buffers.depth, b.buffers.depth) &&
            eq(a.buffers.object_id, b.buffers.object_id) &&
            eq(a.buffers.primitive_id, b.buffers.primitive_id) &&

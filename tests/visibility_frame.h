@@ -10,13 +10,9 @@
 #include <string>
 
 #include "rvr/core/renderer.h"
+#include "same_bytes.h"
 
 namespace rvr::test {
-
-template <class V>
-bool same_bytes(const V& a, const V& b) {
-  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(a[0])) == 0;
-}
 
 // `visibility` and `no_cost` are visibility-mode frames of `scene` (with and without the cost
 // AOV), `local` a local-mode one, all from the same renderer. Depth, object and primitive ids and
