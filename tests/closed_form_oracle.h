@@ -62,6 +62,18 @@ inline std::optional<double> hit_square(const Ray& r, const Square& p, double t_
   return t;
 }
 
+// The disc: the plane point within radius of its centre, in double precision.
+inline std::optional<double> hit_disc(const Ray& r, const Disc& d, double t_min = 1e-9) {
+  dvec3 n(d.normal);
+  double denom = glm::dot(n, r.direction);
+  if (std::abs(denom) < 1e-12) return std::nullopt;
+  double t = glm::dot(dvec3(d.center) - r.origin, n) / denom;
+  if (!(t > t_min)) return std::nullopt;
+  dvec3 q = r.origin + t * r.direction - dvec3(d.center);
+  if (glm::length(q) > double(d.radius)) return std::nullopt;
+  return t;
+}
+
 struct PointLight {
   dvec3 position;
   dvec3 intensity;

@@ -84,7 +84,7 @@ std::vector<RendererCase> renderer_cases() {
 // test_raster) and there is nothing to agree on.
 const char* kScenes[] = {"cornell",   "spheres",         "occluders:16", "occluders_back:16",
                          "soup:2000", "tessphere:20000", "effects:5000", "dof",
-                         "glass",     "textured"};
+                         "discs",     "glass",           "textured"};
 
 TEST(ConformanceScenes, CoverEveryBuiltinSceneButCsg) {
   std::set<std::string> listed;
@@ -174,7 +174,7 @@ std::string worst_depth(const FrameBuffers& a, const FrameBuffers& b) {
 // scene alone: a mesh's own triangles; a UV sphere of `segments` longitudes and segments / 2
 // rings has two pole fans of `segments` triangles and segments / 2 - 2 bands of 2 * segments,
 // segments * (segments - 2) in all; a square is two triangles for a z-buffer and one analytic
-// primitive for a tracer (`square_primitives`).
+// primitive for a tracer (`square_primitives`); a disc is a fan of `segments` triangles.
 size_t scene_primitives(const Scene& scene, int segments, size_t square_primitives) {
   size_t n = 0;
   for (const Object& o : scene.objects) {
@@ -187,6 +187,9 @@ size_t scene_primitives(const Scene& scene, int segments, size_t square_primitiv
         break;
       case ObjectType::Plane:
         n += square_primitives;
+        break;
+      case ObjectType::Disc:
+        n += size_t(segments);
         break;
       case ObjectType::Csg:  // no z-buffer form (kScenes has none)
         break;

@@ -295,6 +295,25 @@ TEST_F(SceneLoader, TransformOnAnalyticShapes) {
   EXPECT_TRUE(near3(s.objects[2].csg->b->sphere.center, {11, 0, 0}));
 }
 
+TEST_F(SceneLoader, DiscIsReadTransformedAndNormalised) {
+  Scene s = parse_ok(scene(R"("objects": [
+    {"type": "disc", "center": [0, 0, 0], "normal": [0, 0, 3], "radius": 0.5},
+    {"type": "disc", "name": "lid", "center": [1, 0, 0], "normal": [0, 1, 0], "radius": 0.25,
+     "transform": {"scale": [-2, 2, 2], "rotate_deg": [90, 0, 0], "translate": [0, 0, 5]}}
+  ])"));
+  ASSERT_EQ(s.objects.size(), 2u);
+  EXPECT_EQ(s.objects[0].type, rvr::ObjectType::Disc);
+  EXPECT_EQ(s.objects[0].name, "disc#0");
+  EXPECT_TRUE(near3(s.objects[0].disc.normal, {0, 0, 1}));  // normalised
+  EXPECT_FLOAT_EQ(s.objects[0].disc.radius, 0.5f);
+  // (1,0,0) scaled by (-2,2,2) is (-2,0,0), which a rotation about x keeps, then + (0,0,5); the
+  // normal (0,1,0) rotated 90 degrees about x is (0,0,1); the radius doubles.
+  EXPECT_EQ(s.objects[1].name, "lid");
+  EXPECT_TRUE(near3(s.objects[1].disc.center, {-2, 0, 5}));
+  EXPECT_TRUE(near3(s.objects[1].disc.normal, {0, 0, 1}));
+  EXPECT_FLOAT_EQ(s.objects[1].disc.radius, 0.5f);
+}
+
 TEST_F(SceneLoader, TransformOnTriangleAndNonUniformNormals) {
   // A smooth mesh with the normal (1,1,0)/sqrt2 on every vertex, scaled by (2,1,1): normals
   // go through the inverse transpose, (0.5, 1, 0), renormalised.
@@ -524,6 +543,25 @@ std::vector<BadCase> bad_cases() {
        "t.json: objects[0].radius: is required"},
       {"zero plane normal", one_object(R"({"type": "plane", "point": [0,0,0], "normal": [0,0,0]})"),
        "t.json: objects[0].normal: must be non-zero"},
+      {"disc without radius",
+       one_object(R"({"type": "disc", "center": [0,0,0], "normal": [0,1,0]})"),
+       "t.json: objects[0].radius: is required"},
+      {"zero disc radius",
+       one_object(R"({"type": "disc", "center": [0,0,0], "normal": [0,1,0], "radius": 0})"),
+       "t.json: objects[0].radius: must be > 0, got 0"},
+      {"zero disc normal",
+       one_object(R"({"type": "disc", "center": [0,0,0], "normal": [0,0,0], "radius": 1})"),
+       "t.json: objects[0].normal: must be non-zero"},
+      {"a plane's key on a disc",
+       one_object(R"({"type": "disc", "center": [0,0,0], "normal": [0,1,0], "radius": 1,
+                      "half_size": 2})"),
+       "t.json: objects[0]: unknown key 'half_size' for a disc; allowed: center, material, name, "
+       "normal, radius, transform, type"},
+      {"non-uniform scale on a disc",
+       one_object(R"({"type": "disc", "center": [0,0,0], "normal": [0,1,0], "radius": 1,
+                      "transform": {"scale": [1, 2, 1]}})"),
+       "t.json: objects[0].transform.scale: a disc needs a uniform scale (one number, or three of "
+       "equal magnitude), got [1, 2, 1]"},
       {"zero half size",
        one_object(R"({"type": "plane", "point": [0,0,0], "normal": [0,1,0], "half_size": 0})"),
        "t.json: objects[0].half_size: must be > 0, got 0"},

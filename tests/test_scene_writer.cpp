@@ -195,6 +195,11 @@ void expect_same_scene(const Scene& a, const Scene& b) {
         EXPECT_SAME3(oa.plane.normal, ob.plane.normal);
         EXPECT_SAME(oa.plane.half_size, ob.plane.half_size);
         break;
+      case ObjectType::Disc:
+        EXPECT_SAME3(oa.disc.center, ob.disc.center);
+        EXPECT_SAME3(oa.disc.normal, ob.disc.normal);
+        EXPECT_SAME(oa.disc.radius, ob.disc.radius);
+        break;
       case ObjectType::Triangles:
         expect_same_mesh(oa.mesh, ob.mesh);
         break;

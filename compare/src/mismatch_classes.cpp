@@ -12,9 +12,10 @@
 
 #include "rvr/core/camera.h"
 #include "rvr/core/check.h"
+#include "rvr/core/shapes.h"
+#include "rvr/core/shapes/shape_geometry.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/srgb.h"
-#include "rvr/core/tessellate.h"
 
 namespace rvr {
 
@@ -249,26 +250,32 @@ bool on_own_outline(const FrameBuffers& fb, int x, int y) {
   return false;
 }
 
-// The triangles an object's primitive ids index: a mesh's own, a sphere's facets when the
-// renderers drew and traced its tessellation (tessellated once, on first use); null for an
-// object drawn as one primitive.
+// The triangles an object's primitive ids index: a mesh's own, a round shape's facets (sphere,
+// disc) when the renderers drew and traced its triangle form (made once, on first use); null for
+// an object drawn as one primitive.
 class NamedTriangles {
  public:
   NamedTriangles(const Scene& scene, int sphere_segments)
-      : scene_(scene), sphere_segments_(sphere_segments), spheres_(scene.objects.size()) {}
+      : scene_(scene), sphere_segments_(sphere_segments), made_(scene.objects.size()) {}
 
   const TriangleMesh* of(uint32_t object) {
     const Object& o = scene_.objects[object];
     if (o.type == ObjectType::Triangles) return &o.mesh;
-    if (o.type != ObjectType::Sphere || sphere_segments_ <= 0) return nullptr;
-    if (!spheres_[object]) spheres_[object] = tessellate_sphere(o.sphere, sphere_segments_);
-    return &*spheres_[object];
+    if (sphere_segments_ <= 0) return nullptr;
+    if (!made_[object]) {
+      const TessellationOptions traced_as_mesh{sphere_segments_, true};
+      TriangleForm form =
+          visit_shape(o, [&](const auto& shape) { return shape.triangle_form(traced_as_mesh); });
+      made_[object] = form.names_triangles && form.made ? std::move(form.made) : nullptr;
+      if (!made_[object]) made_[object] = std::make_unique<const TriangleMesh>();
+    }
+    return made_[object]->triangles.empty() ? nullptr : made_[object].get();
   }
 
  private:
   const Scene& scene_;
   int sphere_segments_;
-  std::vector<std::optional<TriangleMesh>> spheres_;
+  std::vector<std::unique_ptr<const TriangleMesh>> made_;  // empty: drawn as one primitive
 };
 
 // Whether the hit `fb` shows at (x, y) is within the tolerance of an edge of its primitive: a

@@ -83,8 +83,8 @@ std::vector<RenderOptionSpec> tracer_options() {
       {.name = "spheres",
        .type = OptionType::Choice,
        .choices = kSpheres,
-       .help = "spheres: analytic | mesh (the z-buffers' tessellation, traced as triangles, its "
-               "facets named alike in the primitive ids)",
+       .help = "spheres and discs: analytic | mesh (the z-buffers' tessellation, traced as "
+               "triangles, its facets named alike in the primitive ids)",
        .readers = kEveryRenderer,
        .store = [](O& o, U i, double) { o.spheres = SphereMode(i); },
        .show = [](const O& o) { return choice_text(kSpheres, size_t(o.spheres)); }},

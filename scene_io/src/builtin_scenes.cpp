@@ -188,6 +188,36 @@ Scene spheres() {
   return s;
 }
 
+void add_disc(Scene& s, const std::string& name, uint32_t material, glm::vec3 c, glm::vec3 n,
+              float r) {
+  Object& o = add_object(s, name, ObjectType::Disc, material);
+  o.disc = {c, glm::normalize(n), r};
+}
+
+// Discs in every orientation on a floor: a table top with a plate above it, a wheel facing the
+// camera, one tilted towards the light, and a round mirror behind them (full mode reflects the
+// others in it).
+Scene discs() {
+  Scene s = base_scene("discs");
+  add_floor(s, {0.6f, 0.6f, 0.55f}, {0, 0, 0}, 6.0f);
+  uint32_t wood = add_material(s, "wood", {0.55f, 0.35f, 0.2f}, glm::vec3(0.2f), 12.0f);
+  uint32_t china = add_material(s, "china", {0.85f, 0.85f, 0.8f}, glm::vec3(0.6f), 64.0f);
+  uint32_t red = add_material(s, "red", {0.7f, 0.1f, 0.1f}, glm::vec3(0.3f), 24.0f);
+  uint32_t blue = add_material(s, "blue", {0.15f, 0.25f, 0.75f}, glm::vec3(0.3f), 24.0f);
+  uint32_t mirror = add_material(s, "mirror", {0.1f, 0.1f, 0.1f}, {0.9f, 0.9f, 0.9f}, 200.0f);
+  s.materials[mirror].mirror = 0.85f;
+  add_disc(s, "table", wood, {0.0f, 0.8f, 0.0f}, {0, 1, 0}, 1.2f);
+  add_disc(s, "plate", china, {0.3f, 0.95f, 0.2f}, {0, 1, 0}, 0.35f);
+  add_disc(s, "wheel", red, {-2.0f, 1.0f, -0.5f}, {0, 0, 1}, 0.9f);
+  add_disc(s, "tilted", blue, {2.0f, 0.9f, -0.3f}, {-1, 1, 1}, 0.8f);
+  add_disc(s, "round mirror", mirror, {0.0f, 1.7f, -2.8f}, {0, 0, 1}, 1.4f);
+  look_at(s, {0.0f, 3.2f, 6.5f}, {0.0f, 0.8f, 0.0f}, 45.0f, 0.1f, 100.0f);
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  add_point_light(s, {-3.0f, 6.0f, 4.0f}, {40.0f, 40.0f, 40.0f});
+  add_point_light(s, {4.0f, 3.0f, 2.0f}, {10.0f, 9.0f, 8.0f});
+  return s;
+}
+
 // N parallel quads facing the camera, one behind another; the rear ones are hidden by the
 // front one wherever it covers them, so the z-buffer shades N fragments there and the tracer 1.
 // back_to_front submits the rearmost first: the order hi-z cannot exploit.
@@ -439,6 +469,7 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
        "tessphere's sphere of about N triangles on a floor in front of a mirror: a shadow and a "
        "reflection of N triangles (default 10000)"},
       {"csg", "union, intersection, difference of spheres and a nested tree, on a floor"},
+      {"discs", "discs in every orientation on a floor, one of them a round mirror"},
       {"dof", "spheres at several depths, thin lens focused on the middle one, 16 samples"},
       {"glass", "a glass slab and a glass sphere in front of coloured quads"},
       {"textured",
@@ -473,6 +504,7 @@ Expected<Scene> make_builtin_scene(const std::string& spec) {
   if (name == "tessphere") return tessphere(has_count ? count : 10000);
   if (name == "effects") return effects(has_count ? count : 10000);
   if (name == "csg") return has_count ? no_count() : Expected<Scene>(csg());
+  if (name == "discs") return has_count ? no_count() : Expected<Scene>(discs());
   if (name == "dof") return has_count ? no_count() : Expected<Scene>(dof());
   if (name == "glass") return has_count ? no_count() : Expected<Scene>(glass());
   if (name == "textured") return has_count ? no_count() : Expected<Scene>(textured());

@@ -7,11 +7,11 @@
 //
 // Decisions the format's key table leaves open (all documented in docs/scene-format.md):
 // - `transform` is accepted on every object type. On `mesh` and `triangle` it is a full affine
-//   map (normals by the inverse transpose). On the analytic shapes (`sphere`, `plane`, `csg`)
-//   it moves centres/points and turns normals; the scale must then be uniform in magnitude
+//   map (normals by the inverse transpose). On the analytic shapes (`sphere`, `plane`, `disc`,
+//   `csg`) it moves centres/points and turns normals; the scale must then be uniform in magnitude
 //   (|sx| = |sy| = |sz|), since a sphere would otherwise become an ellipsoid and a square a
-//   rectangle, which the model cannot express. A plane's square keeps the in-plane
-//   orientation given by plane_axes(normal) (a rotation about the normal has no effect).
+//   rectangle and a disc an ellipse, which the model cannot express. A plane's square keeps the
+//   in-plane orientation given by plane_axes(normal) (a rotation about the normal has no effect).
 // - A `triangle` object whose triangle is degenerate (zero area) is an error; in a `mesh`,
 //   degenerate triangles are dropped with a warning, and a mesh left with none is an error.
 // - Duplicate keys in a JSON object are an error (the last one would silently win).
@@ -457,7 +457,8 @@ class Reader {
   // Appends the object to the scene: one, or for a mesh with "material": "from_file" one per
   // material of the file.
   void read_object(const json& v, size_t index) {
-    static const std::vector<std::string> kTypes = {"sphere", "plane", "triangle", "mesh", "csg"};
+    static const std::vector<std::string> kTypes = {"sphere",   "plane", "disc",
+                                                    "triangle", "mesh",  "csg"};
     std::string path = index_path("objects", index);
     check_object(v, path);
     std::string tp = key_path(path, "type");
@@ -467,6 +468,8 @@ class Reader {
       keys.insert(keys.end(), {"center", "radius"});
     } else if (type == "plane") {
       keys.insert(keys.end(), {"point", "normal", "half_size"});
+    } else if (type == "disc") {
+      keys.insert(keys.end(), {"center", "normal", "radius"});
     } else if (type == "triangle") {
       keys.insert(keys.end(), {"vertices", "uvs", "colors"});
     } else if (type == "mesh") {
@@ -497,6 +500,9 @@ class Reader {
     } else if (type == "plane") {
       o.type = ObjectType::Plane;
       o.plane = read_plane(v, path, t);
+    } else if (type == "disc") {
+      o.type = ObjectType::Disc;
+      o.disc = read_disc(v, path, t);
     } else if (type == "triangle") {
       read_triangle_object(v, path, t, o);
     } else if (type == "mesh") {
@@ -622,6 +628,28 @@ class Reader {
     p.normal = glm::vec3(glm::normalize(n));
     if (!finite(p.normal) || glm::length(p.normal) == 0.0f) fail(np, "cannot be normalised");
     return p;
+  }
+
+  static Disc read_disc(const json& v, const std::string& path, const Transform& t) {
+    Disc d;
+    d.center = vec3(require(v, path, "center"), key_path(path, "center"));
+    std::string np = key_path(path, "normal");
+    glm::dvec3 n(vec3(require(v, path, "normal"), np));
+    if (glm::length(n) == 0.0) fail(np, "must be non-zero");
+    d.radius = real_at_least(require(v, path, "radius"), key_path(path, "radius"), 0, Bound::Open);
+    if (!t.identity) {
+      require_uniform(t, path, "a disc");
+      d.center = to_float(t.point(glm::dvec3(d.center)), path, "the centre");
+      n = t.normal(n);
+      double r = double(d.radius) * std::abs(t.scale.x);
+      if (!(float(r) > 0.0f) || !std::isfinite(float(r))) {
+        fail(path + ".transform.scale", "makes the radius leave the 32-bit float range");
+      }
+      d.radius = float(r);
+    }
+    d.normal = glm::vec3(glm::normalize(n));
+    if (!finite(d.normal) || glm::length(d.normal) == 0.0f) fail(np, "cannot be normalised");
+    return d;
   }
 
   // The csg object itself (depth 1) or a nested child; leaves are spheres.

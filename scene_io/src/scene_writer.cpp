@@ -392,6 +392,12 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix,
         j["normal"] = vec(o.plane.normal, path + ".normal");
         j["half_size"] = num(o.plane.half_size, path + ".half_size");
         break;
+      case ObjectType::Disc:
+        j["type"] = "disc";
+        j["center"] = vec(o.disc.center, path + ".center");
+        j["normal"] = vec(o.disc.normal, path + ".normal");
+        j["radius"] = num(o.disc.radius, path + ".radius");
+        break;
       case ObjectType::Triangles: {
         const TriangleMesh& mesh = o.mesh;
         if (mesh.triangles.empty()) fail(path + ": a mesh with no triangles");

@@ -71,8 +71,8 @@ struct MismatchContext {
   DepthStore store_a = DepthStore::ViewFloat;
   DepthStore store_b = DepthStore::ViewFloat;
   double edge_tolerance_pixels = kEdgeTolerancePixels;
-  // > 0 when both renderers drew and traced spheres as tessellate_sphere(sphere,
-  // sphere_segments) (SphereMode::Mesh): a sphere's primitive ids then index those facets.
+  // > 0 when both renderers drew and traced the round shapes (spheres, discs) as their triangle
+  // forms of sphere_segments (SphereMode::Mesh): their primitive ids then index those facets.
   int sphere_segments = 0;
   // > 0 when spheres are analytic (SphereMode::Analytic): a tracer hits the sphere itself
   // while a z-buffer, which cannot draw one, draws tessellate_sphere(sphere,
@@ -84,8 +84,8 @@ struct MismatchContext {
 // One class per pixel (None where the (object, primitive) ids agree, background counting as
 // one id). Both buffers have the same size; otherwise every pixel is Coverage.
 //
-// Edge: an object whose primitive ids index triangles (a mesh, or a sphere's facets when
-// context.sphere_segments > 0) gives the hit triangle; the pixel centre's distance to its
+// Edge: an object whose primitive ids index triangles (a mesh, or a sphere's or disc's facets
+// when context.sphere_segments > 0) gives the hit triangle; the pixel centre's distance to its
 // nearest projected edge, in pixels, is tested against the tolerance, for the hit of either
 // image. Objects drawn as one primitive (analytic spheres, planes, CSG) have no edges inside
 // them; their outline stands in: a 3x3 neighbourhood holding another object or the background

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/disc.h"
 #include "rvr/core/shapes/sphere.h"
 #include "rvr/core/shapes/square.h"
 #include "rvr/core/shapes/triangle_mesh.h"
@@ -83,7 +84,7 @@ struct ImageSettings {
 };
 
 // The kind of an object: which of its shape fields holds it. rvr/core/shapes.h lists the shapes.
-enum class ObjectType { Sphere, Plane, Triangles, Csg };
+enum class ObjectType { Sphere, Plane, Triangles, Csg, Disc };
 
 struct Object {
   std::string name;
@@ -93,6 +94,7 @@ struct Object {
   Square plane;                        // ObjectType::Plane
   TriangleMesh mesh;                   // ObjectType::Triangles ("triangle" and "mesh" in the file)
   std::shared_ptr<const CsgNode> csg;  // ObjectType::Csg
+  Disc disc;                           // ObjectType::Disc
 };
 
 struct Scene {

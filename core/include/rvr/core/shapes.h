@@ -8,6 +8,7 @@
 
 #include "rvr/core/scene.h"
 #include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/disc.h"
 #include "rvr/core/shapes/sphere.h"
 #include "rvr/core/shapes/square.h"
 #include "rvr/core/shapes/triangle_mesh.h"
@@ -19,9 +20,9 @@ namespace rvr {
 //   void bounding_balls(std::vector<BoundingBall>& out) const;
 //   bool intersect(const Ray& ray, ShapeHit& hit) const;  // nearest hit in (tmin, tmax)
 //   glm::vec3 normal_at(const glm::vec3& position, const ShapeHit& hit) const;  // outward
-using TracedShape = std::variant<Sphere, Square::Traced, CsgSolid::Traced>;
+using TracedShape = std::variant<Sphere, Square::Traced, CsgSolid::Traced, Disc>;
 
-// f(shape) for the object's shape: a TriangleMesh, Sphere, Square or CsgSolid.
+// f(shape) for the object's shape: a TriangleMesh, Sphere, Square, CsgSolid or Disc.
 template <class F>
 decltype(auto) visit_shape(const Object& o, F&& f) {
   switch (o.type) {
@@ -31,6 +32,8 @@ decltype(auto) visit_shape(const Object& o, F&& f) {
       return f(o.plane);
     case ObjectType::Csg:
       return f(CsgSolid{o.csg.get()});
+    case ObjectType::Disc:
+      return f(o.disc);
     case ObjectType::Triangles:
       break;
   }
