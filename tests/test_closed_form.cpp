@@ -377,9 +377,9 @@ TEST_P(ClosedForm, PointLightsMatchTheShadingEquation) {
 }
 
 // Local mode, two discs over the plane: one facing the camera, one tilted away from it and seen
-// from its back. The z-buffers draw each as a fan of 64 triangles whose rim points lie on the
-// circle, so the fan lies in the disc's plane and inside it (by at most the sagitta
-// r (1 - cos(pi / 64)), 0.001 here, far inside the 1.5 px margin): away from the rim every
+// from its back. The z-buffers draw each as a fan of 64 triangles whose outer edges touch the
+// circle, so the fan lies in the disc's plane and around it (beyond it by at most
+// r (1 / cos(pi / 64) - 1), 0.001 here, far inside the 1.5 px margin): away from the rim every
 // renderer shades the exact disc point with the exact normal, to kTolerance.
 TEST_P(ClosedForm, DiscsMatchTheShadingEquation) {
   const RendererChoice choice = this->choice();
@@ -611,10 +611,12 @@ TEST(ClosedFormTessellation, SphereMeshIsClosed) {
 }
 
 // The disc's fan: S triangles, every one facing the disc's normal (counter-clockwise seen from
-// its side), the rim vertices on the circle, and the fan's area the regular S-gon's,
-// (S / 2) r^2 sin(2 pi / S): no triangle dropped, doubled or folded over another.
-TEST(ClosedFormTessellation, DiscFanIsTheInscribedRegularPolygon) {
+// its side), the corners at r / cos(pi / S) from the centre so that every outer edge touches the
+// circle at its midpoint, and the fan's area the circumscribed regular S-gon's,
+// S r^2 tan(pi / S): no triangle dropped, doubled or folded over another.
+TEST(ClosedFormTessellation, DiscFanIsTheCircumscribedRegularPolygon) {
   const Disc disc{{0.5f, -1.0f, 2.0f}, glm::normalize(glm::vec3(1.0f, 2.0f, -0.5f)), 1.5f};
+  const dvec3 centre(disc.center);
   for (int S : {3, 8, 64}) {
     SCOPED_TRACE(std::to_string(S) + " segments");
     TriangleMesh m = tessellate_disc(disc, S);
@@ -626,10 +628,11 @@ TEST(ClosedFormTessellation, DiscFanIsTheInscribedRegularPolygon) {
       dvec3 n = glm::cross(b - a, c - a);
       EXPECT_GT(glm::dot(n, dvec3(disc.normal)), 0.0);
       area += 0.5 * glm::length(n);
+      EXPECT_NEAR(glm::length(0.5 * (b + c) - centre), 1.5, 1e-5);  // the outer edge's midpoint
     }
     for (size_t v = 1; v < m.positions.size(); ++v)
-      EXPECT_NEAR(glm::length(dvec3(m.positions[v]) - dvec3(disc.center)), 1.5, 1e-6);
-    EXPECT_NEAR(area, 0.5 * S * 1.5 * 1.5 * std::sin(2 * kPi / S), 1e-5);
+      EXPECT_NEAR(glm::length(dvec3(m.positions[v]) - centre), 1.5 / std::cos(kPi / S), 1e-5);
+    EXPECT_NEAR(area, S * 1.5 * 1.5 * std::tan(kPi / S), 1e-4);
   }
 }
 

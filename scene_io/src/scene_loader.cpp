@@ -35,7 +35,10 @@
 #include <memory>
 #include <new>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
 #include <system_error>
+#include <type_traits>
 #include <utility>
 #include <variant>
 
@@ -43,8 +46,8 @@
 #include "mesh_import.h"
 #include "mesh_repair.h"
 #include "rvr/core/shapes/csg.h"
-#include "rvr/core/shapes/sphere.h"
-#include "rvr/core/shapes/square.h"
+#include "rvr/core/shapes/scene_field.h"
+#include "rvr/core/shapes/shape_list.h"
 #include "rvr/core/texture.h"
 #include "rvr/scene_io/camera_framing.h"
 #include "scene_json_errors.h"
@@ -457,19 +460,14 @@ class Reader {
   // Appends the object to the scene: one, or for a mesh with "material": "from_file" one per
   // material of the file.
   void read_object(const json& v, size_t index) {
-    static const std::vector<std::string> kTypes = {"sphere",   "plane", "disc",
-                                                    "triangle", "mesh",  "csg"};
+    static const std::vector<std::string> kTypes = object_types();
     std::string path = index_path("objects", index);
     check_object(v, path);
     std::string tp = key_path(path, "type");
     const std::string& type = string(require(v, path, "type", "one of " + join(kTypes)), tp);
     std::vector<std::string> keys = {"name", "type", "material", "transform"};
-    if (type == "sphere") {
-      keys.insert(keys.end(), {"center", "radius"});
-    } else if (type == "plane") {
-      keys.insert(keys.end(), {"point", "normal", "half_size"});
-    } else if (type == "disc") {
-      keys.insert(keys.end(), {"center", "normal", "radius"});
+    if (std::optional<std::vector<std::string>> shape_keys = analytic_shape_keys(type)) {
+      keys.insert(keys.end(), shape_keys->begin(), shape_keys->end());
     } else if (type == "triangle") {
       keys.insert(keys.end(), {"vertices", "uvs", "colors"});
     } else if (type == "mesh") {
@@ -493,23 +491,15 @@ class Reader {
       t = parse_transform(*tr, key_path(path, "transform"));
     std::string label = path + " (" + o.name + ")";
 
-    if (type == "sphere") {
-      o.type = ObjectType::Sphere;
-      o.sphere = read_sphere(v, path);
-      o.sphere = transform_sphere(o.sphere, t, path);
-    } else if (type == "plane") {
-      o.type = ObjectType::Plane;
-      o.plane = read_plane(v, path, t);
-    } else if (type == "disc") {
-      o.type = ObjectType::Disc;
-      o.disc = read_disc(v, path, t);
-    } else if (type == "triangle") {
+    if (type == "triangle") {
       read_triangle_object(v, path, t, o);
     } else if (type == "mesh") {
       if (!read_mesh_object(v, path, t, from_file, label, o)) return;
-    } else {  // csg
+    } else if (type == "csg") {
       o.type = ObjectType::Csg;
       o.csg = read_csg_inner(v, path, 1, t);
+    } else {  // one of shape_list.h's analytic shapes: the type is checked above
+      read_analytic_shape(v, path, type, t, o);
     }
     scene_.objects.push_back(std::move(o));
   }
@@ -578,11 +568,58 @@ class Reader {
     }
   }
 
-  static Sphere read_sphere(const json& v, const std::string& path) {
-    Sphere s;
-    s.center = vec3(require(v, path, "center"), key_path(path, "center"));
-    s.radius = real_at_least(require(v, path, "radius"), key_path(path, "radius"), 0, Bound::Open);
-    return s;
+  // The scene format's object types: the analytic shapes of shape_list.h, then the others.
+  static std::vector<std::string> object_types() {
+#define RVR_SHAPE_TYPE(Type, Enumerator, member) Type::kSceneType,
+    return {RVR_ANALYTIC_SHAPES(RVR_SHAPE_TYPE) "triangle", "mesh", "csg"};
+#undef RVR_SHAPE_TYPE
+  }
+
+  // The keys of the analytic shape called `type` in the file; nullopt when no shape is.
+  static std::optional<std::vector<std::string>> analytic_shape_keys(const std::string& type) {
+    std::optional<std::vector<std::string>> keys;
+    auto keys_of = [&](auto shape) {
+      keys.emplace();
+      decltype(shape)::scene_fields(shape,
+                                    [&](const SceneField& f, auto&) { keys->push_back(f.key); });
+    };
+#define RVR_SHAPE_KEYS(Type, Enumerator, member) \
+  if (type == Type::kSceneType) keys_of(Type{});
+    RVR_ANALYTIC_SHAPES(RVR_SHAPE_KEYS)
+#undef RVR_SHAPE_KEYS
+    return keys;
+  }
+
+  // Reads the object as the analytic shape called `type`, transformed.
+  static void read_analytic_shape(const json& v, const std::string& path, const std::string& type,
+                                  const Transform& t, Object& o) {
+#define RVR_READ_SHAPE(Type, Enumerator, member)                    \
+  if (type == Type::kSceneType) {                                   \
+    o.type = ObjectType::Enumerator;                                \
+    o.member = transform_shape(read_shape<Type>(v, path), t, path); \
+  }
+    RVR_ANALYTIC_SHAPES(RVR_READ_SHAPE)
+#undef RVR_READ_SHAPE
+  }
+
+  // A shape's keys as its scene_fields state them, checked but not transformed (directions
+  // are normalised by transform_shape).
+  template <class Shape>
+  static Shape read_shape(const json& v, const std::string& path) {
+    Shape shape;
+    Shape::scene_fields(shape, [&](const SceneField& f, auto& member) {
+      const std::string kp = key_path(path, f.key);
+      const json* value = f.required ? &require(v, path, f.key) : find(v, f.key);
+      if (!value) return;
+      if constexpr (std::is_same_v<std::decay_t<decltype(member)>, float>) {
+        member = real_at_least(*value, kp, 0, Bound::Open);  // SceneFieldKind::Length
+      } else {
+        member = vec3(*value, kp);
+        if (f.kind == SceneFieldKind::Direction && glm::length(glm::dvec3(member)) == 0.0)
+          fail(kp, "must be non-zero");
+      }
+    });
+    return shape;
   }
 
   static void require_uniform(const Transform& t, const std::string& path, const char* what) {
@@ -594,62 +631,36 @@ class Reader {
     }
   }
 
-  static Sphere transform_sphere(Sphere s, const Transform& t, const std::string& path) {
-    if (t.identity) return s;
-    require_uniform(t, path, "a sphere");
-    s.center = to_float(t.point(glm::dvec3(s.center)), path, "the centre");
-    double r = double(s.radius) * std::abs(t.scale.x);
-    if (!(float(r) > 0.0f) || !std::isfinite(float(r))) {
-      fail(path + ".transform.scale", "makes the radius leave the 32-bit float range");
-    }
-    s.radius = float(r);
-    return s;
-  }
-
-  static Square read_plane(const json& v, const std::string& path, const Transform& t) {
-    Square p;
-    p.point = vec3(require(v, path, "point"), key_path(path, "point"));
-    std::string np = key_path(path, "normal");
-    glm::dvec3 n(vec3(require(v, path, "normal"), np));
-    if (glm::length(n) == 0.0) fail(np, "must be non-zero");
-    if (const json* h = find(v, "half_size")) {
-      p.half_size = real_at_least(*h, key_path(path, "half_size"), 0, Bound::Open);
-    }
+  // The shape moved, turned and scaled by `t` (whose scale must then be uniform: an analytic
+  // shape cannot be stretched), its directions normalised (in double precision).
+  template <class Shape>
+  static Shape transform_shape(Shape shape, const Transform& t, const std::string& path) {
     if (!t.identity) {
-      require_uniform(t, path, "a plane");
-      p.point = to_float(t.point(glm::dvec3(p.point)), path, "the point");
-      n = t.normal(n);
-      double h = double(p.half_size) * std::abs(t.scale.x);
-      if (!(float(h) > 0.0f) || !std::isfinite(float(h))) {
-        fail(path + ".transform.scale", "makes half_size leave the 32-bit float range");
-      }
-      p.half_size = float(h);
+      require_uniform(t, path, (std::string("a ") + Shape::kSceneType).c_str());
+      Shape::scene_fields(shape, [&](const SceneField& f, auto& member) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(member)>, float>) {
+          const double scaled = double(member) * std::abs(t.scale.x);
+          if (!(float(scaled) > 0.0f) || !std::isfinite(float(scaled))) {
+            fail(path + ".transform.scale",
+                 fmt::format("makes {} leave the 32-bit float range", f.what));
+          }
+          member = float(scaled);
+        } else if (f.kind == SceneFieldKind::Point) {
+          member = to_float(t.point(glm::dvec3(member)), path, f.what);
+        }
+      });
     }
-    p.normal = glm::vec3(glm::normalize(n));
-    if (!finite(p.normal) || glm::length(p.normal) == 0.0f) fail(np, "cannot be normalised");
-    return p;
-  }
-
-  static Disc read_disc(const json& v, const std::string& path, const Transform& t) {
-    Disc d;
-    d.center = vec3(require(v, path, "center"), key_path(path, "center"));
-    std::string np = key_path(path, "normal");
-    glm::dvec3 n(vec3(require(v, path, "normal"), np));
-    if (glm::length(n) == 0.0) fail(np, "must be non-zero");
-    d.radius = real_at_least(require(v, path, "radius"), key_path(path, "radius"), 0, Bound::Open);
-    if (!t.identity) {
-      require_uniform(t, path, "a disc");
-      d.center = to_float(t.point(glm::dvec3(d.center)), path, "the centre");
-      n = t.normal(n);
-      double r = double(d.radius) * std::abs(t.scale.x);
-      if (!(float(r) > 0.0f) || !std::isfinite(float(r))) {
-        fail(path + ".transform.scale", "makes the radius leave the 32-bit float range");
+    Shape::scene_fields(shape, [&](const SceneField& f, auto& member) {
+      if constexpr (!std::is_same_v<std::decay_t<decltype(member)>, float>) {
+        if (f.kind != SceneFieldKind::Direction) return;
+        glm::dvec3 d(member);
+        if (!t.identity) d = t.normal(d);
+        member = glm::vec3(glm::normalize(d));
+        if (!finite(member) || glm::length(member) == 0.0f)
+          fail(key_path(path, f.key), "cannot be normalised");
       }
-      d.radius = float(r);
-    }
-    d.normal = glm::vec3(glm::normalize(n));
-    if (!finite(d.normal) || glm::length(d.normal) == 0.0f) fail(np, "cannot be normalised");
-    return d;
+    });
+    return shape;
   }
 
   // The csg object itself (depth 1) or a nested child; leaves are spheres.
@@ -706,7 +717,7 @@ class Reader {
       check_keys(v, path, {"type", "center", "radius"}, "a csg sphere");
       auto leaf = std::make_shared<CsgNode>();
       leaf->is_leaf = true;
-      leaf->sphere = transform_sphere(read_sphere(v, path), t, path);
+      leaf->sphere = transform_shape(read_shape<Sphere>(v, path), t, path);
       return leaf;
     }
     check_keys(v, path, {"type", "op", "a", "b"}, "a csg node");

@@ -18,12 +18,14 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
+#include <string>
 #include <system_error>
+#include <type_traits>
 #include <utility>
 
 #include "rvr/core/shapes/csg.h"
-#include "rvr/core/shapes/sphere.h"
-#include "rvr/core/shapes/square.h"
+#include "rvr/core/shapes/scene_field.h"
+#include "rvr/core/shapes/shape_list.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/texture.h"
 
@@ -160,16 +162,25 @@ bool same_material(const Material& a, const Material& b) {
          b.uv_transform.identity();
 }
 
-json sphere_members(json o, const Sphere& s, const std::string& path) {
-  o["center"] = vec(s.center, path + ".center");
-  o["radius"] = num(s.radius, path + ".radius");
+// An analytic shape's type and keys, as its scene_fields state them (scene_field.h).
+template <class Shape>
+json shape_members(json o, const Shape& shape, const std::string& path) {
+  o["type"] = Shape::kSceneType;
+  Shape::scene_fields(shape, [&](const SceneField& f, const auto& member) {
+    const std::string key_path = path + "." + f.key;
+    if constexpr (std::is_same_v<std::decay_t<decltype(member)>, float>) {
+      o[f.key] = num(member, key_path);
+    } else {
+      o[f.key] = vec(member, key_path);
+    }
+  });
   return o;
 }
 
 // A csg node below the object: a leaf is a sphere, an inner node a nested csg.
 json csg_node(const CsgNode& n, const std::string& path, int depth) {
   if (depth > 64) fail(path + ": csg tree nested deeper than 64 levels");
-  if (n.is_leaf) return sphere_members(json{{"type", "sphere"}}, n.sphere, path);
+  if (n.is_leaf) return shape_members(json::object(), n.sphere, path);
   if (!n.a || !n.b) fail(path + ": csg node without two children");
   static const char* kOps[] = {"union", "intersection", "difference"};
   json o = json::object();
@@ -381,44 +392,28 @@ SceneDocument write(const Scene& scene, const std::string& mesh_prefix,
     json j = json::object();
     j["type"] = "";  // first in the object; set below
     j["name"] = o.name;
-    switch (o.type) {
-      case ObjectType::Sphere:
-        j["type"] = "sphere";
-        j = sphere_members(std::move(j), o.sphere, path);
-        break;
-      case ObjectType::Plane:
-        j["type"] = "plane";
-        j["point"] = vec(o.plane.point, path + ".point");
-        j["normal"] = vec(o.plane.normal, path + ".normal");
-        j["half_size"] = num(o.plane.half_size, path + ".half_size");
-        break;
-      case ObjectType::Disc:
-        j["type"] = "disc";
-        j["center"] = vec(o.disc.center, path + ".center");
-        j["normal"] = vec(o.disc.normal, path + ".normal");
-        j["radius"] = num(o.disc.radius, path + ".radius");
-        break;
-      case ObjectType::Triangles: {
-        const TriangleMesh& mesh = o.mesh;
-        if (mesh.triangles.empty()) fail(path + ": a mesh with no triangles");
-        if (mesh.triangles.size() == 1 && !mesh.smooth()) {
-          j = triangle_members(std::move(j), mesh, path);
-        } else {
-          std::string file = fmt::format("{}.mesh{}.ply", mesh_prefix, i);
-          j["type"] = "mesh";
-          j["file"] = file;
-          j["smooth"] = mesh.smooth();
-          doc.mesh_files.push_back({file, ply(mesh, path)});
-        }
-        break;
+    if (o.type == ObjectType::Triangles) {
+      const TriangleMesh& mesh = o.mesh;
+      if (mesh.triangles.empty()) fail(path + ": a mesh with no triangles");
+      if (mesh.triangles.size() == 1 && !mesh.smooth()) {
+        j = triangle_members(std::move(j), mesh, path);
+      } else {
+        std::string file = fmt::format("{}.mesh{}.ply", mesh_prefix, i);
+        j["type"] = "mesh";
+        j["file"] = file;
+        j["smooth"] = mesh.smooth();
+        doc.mesh_files.push_back({file, ply(mesh, path)});
       }
-      case ObjectType::Csg: {
-        if (!o.csg || o.csg->is_leaf) fail(path + ": a csg object needs an operation at its root");
-        json tree = csg_node(*o.csg, path, 1);
-        j["type"] = "csg";
-        for (auto& [k, v] : tree.items()) j[k] = v;
-        break;
-      }
+    } else if (o.type == ObjectType::Csg) {
+      if (!o.csg || o.csg->is_leaf) fail(path + ": a csg object needs an operation at its root");
+      json tree = csg_node(*o.csg, path, 1);
+      j["type"] = "csg";
+      for (auto& [k, v] : tree.items()) j[k] = v;
+    } else {  // one of shape_list.h's analytic shapes
+#define RVR_WRITE_SHAPE(Type, Enumerator, member) \
+  if (o.type == ObjectType::Enumerator) j = shape_members(std::move(j), o.member, path);
+      RVR_ANALYTIC_SHAPES(RVR_WRITE_SHAPE)
+#undef RVR_WRITE_SHAPE
     }
     if (o.material != 0) j["material"] = scene.materials[o.material].name;
     objects.push_back(std::move(j));

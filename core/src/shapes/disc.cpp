@@ -22,13 +22,14 @@ int fan_segments(int segments) {
 TriangleMesh tessellate_disc(const Disc& disc, int segments) {
   segments = fan_segments(segments);
   const auto [u, v] = plane_axes(disc.normal);
-  const double two_pi = 6.283185307179586;
+  const double pi = 3.141592653589793;
+  const float corner = float(double(disc.radius) / std::cos(pi / double(segments)));
   TriangleMesh mesh;
   mesh.positions.push_back(disc.center);
   for (int k = 0; k < segments; ++k) {
-    const double phi = two_pi * double(k) / double(segments);
+    const double phi = 2.0 * pi * double(k) / double(segments);
     const float c = float(std::cos(phi)), s = float(std::sin(phi));
-    mesh.positions.push_back(disc.center + disc.radius * (c * u + s * v));
+    mesh.positions.push_back(disc.center + corner * (c * u + s * v));
   }
   // u x v = n: the angle grows counter-clockwise seen from the normal's side.
   for (int k = 0; k < segments; ++k) {

@@ -11,9 +11,7 @@
 #include <vector>
 
 #include "rvr/core/shapes/csg.h"
-#include "rvr/core/shapes/disc.h"
-#include "rvr/core/shapes/sphere.h"
-#include "rvr/core/shapes/square.h"
+#include "rvr/core/shapes/shape_list.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/texture.h"
 
@@ -83,18 +81,22 @@ struct ImageSettings {
   float exposure = 0.0f;
 };
 
-// The kind of an object: which of its shape fields holds it. rvr/core/shapes.h lists the shapes.
-enum class ObjectType { Sphere, Plane, Triangles, Csg, Disc };
+// The kind of an object: which of its shape fields holds it. Triangle meshes and CSG trees, then
+// one kind per analytic shape of shapes/shape_list.h; rvr/core/shapes.h visits them all.
+#define RVR_OBJECT_TYPE(Type, Enumerator, member) , Enumerator
+enum class ObjectType { Triangles, Csg RVR_ANALYTIC_SHAPES(RVR_OBJECT_TYPE) };
+#undef RVR_OBJECT_TYPE
 
 struct Object {
   std::string name;
   ObjectType type = ObjectType::Triangles;
   uint32_t material = 0;               // index into Scene::materials
-  Sphere sphere;                       // ObjectType::Sphere
-  Square plane;                        // ObjectType::Plane
   TriangleMesh mesh;                   // ObjectType::Triangles ("triangle" and "mesh" in the file)
   std::shared_ptr<const CsgNode> csg;  // ObjectType::Csg
-  Disc disc;                           // ObjectType::Disc
+  // One field per analytic shape, named as in shape_list.h: sphere, plane, disc...
+#define RVR_OBJECT_SHAPE(Type, Enumerator, member) Type member;
+  RVR_ANALYTIC_SHAPES(RVR_OBJECT_SHAPE)
+#undef RVR_OBJECT_SHAPE
 };
 
 struct Scene {

@@ -4,13 +4,13 @@
 // than switching on ObjectType themselves.
 #pragma once
 
+#include <type_traits>
+#include <utility>
 #include <variant>
 
 #include "rvr/core/scene.h"
 #include "rvr/core/shapes/csg.h"
-#include "rvr/core/shapes/disc.h"
-#include "rvr/core/shapes/sphere.h"
-#include "rvr/core/shapes/square.h"
+#include "rvr/core/shapes/shape_list.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr {
@@ -20,23 +20,21 @@ namespace rvr {
 //   void bounding_balls(std::vector<BoundingBall>& out) const;
 //   bool intersect(const Ray& ray, ShapeHit& hit) const;  // nearest hit in (tmin, tmax)
 //   glm::vec3 normal_at(const glm::vec3& position, const ShapeHit& hit) const;  // outward
-using TracedShape = std::variant<Sphere, Square::Traced, CsgSolid::Traced, Disc>;
+template <class Shape>
+using TracedFormOf = std::decay_t<decltype(std::declval<const Shape&>().traced())>;
+#define RVR_TRACED_FORM(Type, Enumerator, member) TracedFormOf<Type>,
+using TracedShape = std::variant<RVR_ANALYTIC_SHAPES(RVR_TRACED_FORM) CsgSolid::Traced>;
+#undef RVR_TRACED_FORM
 
-// f(shape) for the object's shape: a TriangleMesh, Sphere, Square, CsgSolid or Disc.
+// f(shape) for the object's shape: a TriangleMesh, a CsgSolid or an analytic shape of
+// shape_list.h.
 template <class F>
 decltype(auto) visit_shape(const Object& o, F&& f) {
-  switch (o.type) {
-    case ObjectType::Sphere:
-      return f(o.sphere);
-    case ObjectType::Plane:
-      return f(o.plane);
-    case ObjectType::Csg:
-      return f(CsgSolid{o.csg.get()});
-    case ObjectType::Disc:
-      return f(o.disc);
-    case ObjectType::Triangles:
-      break;
-  }
+#define RVR_VISIT_SHAPE(Type, Enumerator, member) \
+  if (o.type == ObjectType::Enumerator) return f(o.member);
+  RVR_ANALYTIC_SHAPES(RVR_VISIT_SHAPE)
+#undef RVR_VISIT_SHAPE
+  if (o.type == ObjectType::Csg) return f(CsgSolid{o.csg.get()});
   return f(o.mesh);
 }
 

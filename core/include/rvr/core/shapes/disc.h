@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rvr/core/ray.h"
+#include "rvr/core/shapes/scene_field.h"
 #include "rvr/core/shapes/shape_geometry.h"
 // TriangleForm destroys the mesh it owns: the type must be complete here.
 #include "rvr/core/shapes/triangle_mesh.h"  // IWYU pragma: keep
@@ -22,9 +23,18 @@ struct Disc {
 
   bool operator==(const Disc&) const = default;
 
+  // Its keys in the scene format (scene_field.h).
+  static constexpr const char* kSceneType = "disc";
+  template <class Self, class F>
+  static void scene_fields(Self& self, F&& field) {
+    field(SceneField{"center", SceneFieldKind::Point, "the centre"}, self.center);
+    field(SceneField{"normal", SceneFieldKind::Direction, "the normal"}, self.normal);
+    field(SceneField{"radius", SceneFieldKind::Length, "the radius"}, self.radius);
+  }
+
   // As a shape (shape_geometry.h): the ball of its radius around the center bounds it; its
-  // triangle form is a fan of `sphere_segments` triangles around the center, whose rim points
-  // lie on the circle (tessellate_disc), traced instead of the exact disc under --spheres mesh.
+  // triangle form is a fan of `sphere_segments` triangles around the center whose outer edges
+  // touch the circle (tessellate_disc), traced instead of the exact disc under --spheres mesh.
   void bounding_balls(std::vector<BoundingBall>& out) const { out.push_back({center, radius}); }
   uint64_t triangle_count(const TessellationOptions& options) const;
   TriangleForm triangle_form(const TessellationOptions& options) const;
@@ -33,7 +43,8 @@ struct Disc {
   }
 
   // What the tracers trace (the members every traced shape has, rvr/core/shapes.h): the disc
-  // itself, whose triangle form lies inside it.
+  // itself, which its triangle form covers: a z-buffer never leaves a pixel of the disc empty,
+  // and where its polygon covers a pixel centre the disc does not, the hybrids' tracer decides.
   static constexpr bool kTriangleFormExact = false;
   const Disc& traced() const { return *this; }
   bool intersect(const Ray& ray, ShapeHit& hit) const;
@@ -57,9 +68,11 @@ inline bool Disc::intersect(const Ray& ray, ShapeHit& hit) const {
   return intersect_disc(ray, *this, hit.t);
 }
 
-// The disc as `segments` (>= 3) triangles around its center: vertex 0 the center, vertex 1 + k
-// the rim point at angle 2 pi k / segments from the first plane axis (plane_axes), counter-
-// clockwise seen from the side the normal points to, flat (no vertex normals).
+// The disc as `segments` (>= 3) triangles around its centre: the regular polygon circumscribed
+// about its circle (each outer edge touches it at its midpoint), so that the polygon covers the
+// disc. Vertex 0 is the centre, vertex 1 + k the corner at angle 2 pi k / segments from the
+// first plane axis (plane_axes) and distance radius / cos(pi / segments); counter-clockwise
+// seen from the side the normal points to, flat (no vertex normals).
 TriangleMesh tessellate_disc(const Disc& disc, int segments);
 
 }  // namespace rvr

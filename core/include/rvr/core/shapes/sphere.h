@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rvr/core/ray.h"
+#include "rvr/core/shapes/scene_field.h"
 #include "rvr/core/shapes/shape_geometry.h"
 // TriangleForm destroys the mesh it owns: the type must be complete here.
 #include "rvr/core/shapes/triangle_mesh.h"  // IWYU pragma: keep
@@ -19,6 +20,14 @@ struct Sphere {
   float radius = 1.0f;
 
   bool operator==(const Sphere&) const = default;
+
+  // Its keys in the scene format (scene_field.h).
+  static constexpr const char* kSceneType = "sphere";
+  template <class Self, class F>
+  static void scene_fields(Self& self, F&& field) {
+    field(SceneField{"center", SceneFieldKind::Point, "the centre"}, self.center);
+    field(SceneField{"radius", SceneFieldKind::Length, "the radius"}, self.radius);
+  }
 
   // As a shape (shape_geometry.h): its triangle form is a UV sphere (tessellate_sphere), traced
   // instead of the exact sphere under --spheres mesh.

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rvr/core/ray.h"
+#include "rvr/core/shapes/scene_field.h"
 #include "rvr/core/shapes/shape_geometry.h"
 // TriangleForm destroys the mesh it owns: the type must be complete here.
 #include "rvr/core/shapes/triangle_mesh.h"  // IWYU pragma: keep
@@ -20,6 +21,15 @@ struct Square {
   float half_size = 10.0f;
 
   bool operator==(const Square&) const = default;
+
+  // Its keys in the scene format (scene_field.h): the file calls it a "plane".
+  static constexpr const char* kSceneType = "plane";
+  template <class Self, class F>
+  static void scene_fields(Self& self, F&& field) {
+    field(SceneField{"point", SceneFieldKind::Point, "the point"}, self.point);
+    field(SceneField{"normal", SceneFieldKind::Direction, "the normal"}, self.normal);
+    field(SceneField{"half_size", SceneFieldKind::Length, "half_size", false}, self.half_size);
+  }
 
   // As a shape (shape_geometry.h): its corners bound it; its triangle form is two triangles
   // (tessellate_plane); the tracers always trace it exactly.
