@@ -1,5 +1,6 @@
 #include "render_kwargs.h"
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -66,9 +67,9 @@ RenderSettings render_settings(const std::string& mode, int threads, const py::k
     const std::string name = py::cast<std::string>(key);
     if (name == "gl") {
       const std::string gl = py::cast<std::string>(value);
-      if (gl != "osmesa" && gl != "egl")
-        throw BadInputError("gl: " + cli::not_one_of(gl, {"osmesa", "egl"}));
-      s.config.gl = gl == "egl" ? GlBackend::Egl : GlBackend::OsMesa;
+      const std::optional<GlBackend> backend = parse_gl_backend(gl);
+      if (!backend) throw BadInputError("gl: " + cli::not_one_of(gl, gl_backend_names()));
+      s.config.gl = *backend;
       continue;
     }
     const RenderOptionSpec* spec = find_render_option(name);

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <glm/glm.hpp>
 #include <initializer_list>
 #include <map>
 #include <memory>

@@ -4,6 +4,7 @@
 // colours (cornell: its area light jitters by each sample's own random stream). A source
 // calling every block background gives the background and casts no ray.
 #include <gtest/gtest.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include <glm/glm.hpp>

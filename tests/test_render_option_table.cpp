@@ -3,6 +3,7 @@
 // does not name renders the same image whatever the option's value), and docs/cli.md's rows say
 // what the table says.
 #include <gtest/gtest.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <fstream>

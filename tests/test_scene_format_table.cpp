@@ -5,13 +5,16 @@
 // the same order, which are required, and what each holds (a vector, a non-zero vector, a number
 // > 0). A shape added without its documentation, or a key renamed in one place, fails here.
 #include <gtest/gtest.h>
+#include <stddef.h>
 
 #include <algorithm>
 #include <fstream>
+#include <initializer_list>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <set>
-#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "rvr/core/shapes/scene_field.h"

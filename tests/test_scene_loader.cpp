@@ -26,6 +26,7 @@
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
 #include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/disc.h"
 #include "rvr/core/shapes/sphere.h"
 #include "rvr/core/shapes/square.h"
 #include "rvr/core/shapes/triangle_mesh.h"

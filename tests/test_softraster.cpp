@@ -1,6 +1,7 @@
 // SoftRasterizer: the top-left fill rule, near-plane clipping, orientation, determinism across
 // thread counts, agreement with the GL rasterizer and the ray tracer, and the cost AOV.
 #include <gtest/gtest.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include <algorithm>
@@ -27,9 +28,9 @@
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/scene_loader.h"
+#include "same_bytes.h"
 #include "scene_builders.h"
 #include "visibility_frame.h"
-#include "same_bytes.h"
 
 namespace rvr {
 namespace {

@@ -118,7 +118,7 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
     if (spec.name != "mode") add_render_option(cmd, o, spec);
   cmd.add_option("--gl", o.gl,
                  "raster GL back end: osmesa | egl (default osmesa, egl when OSMesa is missing)")
-      ->check(one_of({"osmesa", "egl"}));
+      ->check(one_of(gl_backend_names()));
   cmd.add_flag("--quiet,-q", o.quiet, "no progress output");
   cmd.add_option("--max-samples", o.limits.max_samples,
                  "refuse more than N pixels x samples (default 2^30)")
@@ -132,9 +132,7 @@ void add_common_options(CLI::App& cmd, CommonOptions& o) {
 }
 
 GlBackend gl_backend(const CommonOptions& o) {
-  if (o.gl == "osmesa") return GlBackend::OsMesa;
-  if (o.gl == "egl") return GlBackend::Egl;
-  return GlBackend::Default;
+  return parse_gl_backend(o.gl).value_or(GlBackend::Default);
 }
 
 RenderMode parse_mode(const std::string& s) {

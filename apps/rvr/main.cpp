@@ -19,6 +19,7 @@
 #include "one_of.h"
 #include "rvr/compare/compare.h"
 #include "rvr/core/expected.h"
+#include "rvr/core/gl_backend.h"
 #include "rvr/image_codec/image_io.h"
 #include "rvr/renderers/registry.h"
 #include "study_processes.h"
@@ -170,7 +171,7 @@ int run(int argc, char** argv) {
   CLI::App* info_cmd = app.add_subcommand("info", "versions and machine facts for bug reports");
   std::string info_gl;
   info_cmd->add_option("--gl", info_gl, "GL back end to describe: osmesa | egl (default as render)")
-      ->check(one_of({"osmesa", "egl"}));
+      ->check(one_of(gl_backend_names()));
 
   StudyArgs study;
   CLI::App* study_cmd = nullptr;

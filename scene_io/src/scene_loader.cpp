@@ -578,13 +578,14 @@ class Reader {
   // The keys of the analytic shape called `type` in the file; nullopt when no shape is.
   static std::optional<std::vector<std::string>> analytic_shape_keys(const std::string& type) {
     std::optional<std::vector<std::string>> keys;
-    auto keys_of = [&](auto shape) {
+    auto keys_of = [&](auto shape_type) {
+      using Shape = typename decltype(shape_type)::type;
+      Shape shape;
       keys.emplace();
-      decltype(shape)::scene_fields(shape,
-                                    [&](const SceneField& f, auto&) { keys->push_back(f.key); });
+      Shape::scene_fields(shape, [&](const SceneField& f, auto&) { keys->push_back(f.key); });
     };
 #define RVR_SHAPE_KEYS(Type, Enumerator, member) \
-  if (type == Type::kSceneType) keys_of(Type{});
+  if (type == Type::kSceneType) keys_of(std::type_identity<Type>{});
     RVR_ANALYTIC_SHAPES(RVR_SHAPE_KEYS)
 #undef RVR_SHAPE_KEYS
     return keys;

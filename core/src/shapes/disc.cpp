@@ -1,9 +1,11 @@
 #include "rvr/core/shapes/disc.h"
 
+#include <stddef.h>
+
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <memory>
+#include <utility>
 
 #include "rvr/core/check.h"
 #include "rvr/core/shapes/triangle_mesh.h"

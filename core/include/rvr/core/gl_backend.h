@@ -2,7 +2,9 @@
 // here so that the renderer table and the command line name them without including raster/.
 #pragma once
 
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace rvr {
@@ -10,6 +12,20 @@ namespace rvr {
 // Both run Mesa's llvmpipe; they differ only in how the context is made. Default: OSMesa, or
 // EGL surfaceless when OSMesa cannot be loaded (the rasterizer then says so in its warnings).
 enum class GlBackend { Default, OsMesa, Egl };
+
+// The names a user chooses a back end by (the command line's --gl, Python's gl=), stated once.
+inline const std::vector<std::string>& gl_backend_names() {
+  static const std::vector<std::string> names = {"osmesa", "egl"};
+  return names;
+}
+
+// The back end gl_backend_names() calls `name`; nullopt for any other name (an empty one
+// included: the caller's default).
+inline std::optional<GlBackend> parse_gl_backend(std::string_view name) {
+  if (name == "osmesa") return GlBackend::OsMesa;
+  if (name == "egl") return GlBackend::Egl;
+  return std::nullopt;
+}
 
 // What the GL context reports, for `rvr info` and bug reports.
 struct GlInfo {
