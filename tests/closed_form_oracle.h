@@ -45,18 +45,27 @@ inline std::optional<double> hit_sphere(const Ray& r, const Sphere& s, double t_
   return std::nullopt;
 }
 
+// Where the ray meets the plane through `point` with normal `normal`, beyond t_min; nullopt
+// when it runs parallel to it or meets it behind.
+inline std::optional<double> hit_plane(const Ray& r, const dvec3& point, const dvec3& normal,
+                                       double t_min) {
+  double denom = glm::dot(normal, r.direction);
+  if (std::abs(denom) < 1e-12) return std::nullopt;
+  double t = glm::dot(point - r.origin, normal) / denom;
+  if (!(t > t_min)) return std::nullopt;
+  return t;
+}
+
 // The square of side 2 * half_size centred at point, facing normal, with its edges along the
 // axes tessellate.h documents for it (world y, or x when the normal is near y, crossed with the
 // normal). The tests keep pixels near its edges out, so only its interior matters.
 inline std::optional<double> hit_square(const Ray& r, const Square& p, double t_min = 1e-9) {
   dvec3 n(p.normal);
-  double denom = glm::dot(n, r.direction);
-  if (std::abs(denom) < 1e-12) return std::nullopt;
-  double t = glm::dot(dvec3(p.point) - r.origin, n) / denom;
-  if (!(t > t_min)) return std::nullopt;
+  std::optional<double> t = hit_plane(r, dvec3(p.point), n, t_min);
+  if (!t) return std::nullopt;
   dvec3 a = std::abs(n.y) < 0.9 ? dvec3(0, 1, 0) : dvec3(1, 0, 0);
   dvec3 u = glm::normalize(glm::cross(a, n)), v = glm::cross(n, u);
-  dvec3 q = r.origin + t * r.direction - dvec3(p.point);
+  dvec3 q = r.origin + *t * r.direction - dvec3(p.point);
   if (std::abs(glm::dot(q, u)) > p.half_size || std::abs(glm::dot(q, v)) > p.half_size)
     return std::nullopt;
   return t;
@@ -64,13 +73,9 @@ inline std::optional<double> hit_square(const Ray& r, const Square& p, double t_
 
 // The disc: the plane point within radius of its centre, in double precision.
 inline std::optional<double> hit_disc(const Ray& r, const Disc& d, double t_min = 1e-9) {
-  dvec3 n(d.normal);
-  double denom = glm::dot(n, r.direction);
-  if (std::abs(denom) < 1e-12) return std::nullopt;
-  double t = glm::dot(dvec3(d.center) - r.origin, n) / denom;
-  if (!(t > t_min)) return std::nullopt;
-  dvec3 q = r.origin + t * r.direction - dvec3(d.center);
-  if (glm::length(q) > double(d.radius)) return std::nullopt;
+  std::optional<double> t = hit_plane(r, dvec3(d.center), dvec3(d.normal), t_min);
+  if (!t || glm::length(r.origin + *t * r.direction - dvec3(d.center)) > double(d.radius))
+    return std::nullopt;
   return t;
 }
 
