@@ -53,7 +53,7 @@ Status check_limits(const Scene& scene, const RenderOptions& options, const Limi
                      std::to_string(limits.max_samples) + " (raise it with --max-samples)");
   if (e.triangles > limits.max_triangles)
     return bad_input(file + ": objects: " + std::to_string(e.triangles) +
-                     " triangles (spheres and planes tessellated), over the limit of " +
+                     " triangles (spheres, planes and discs tessellated), over the limit of " +
                      std::to_string(limits.max_triangles) + " (raise it with --max-triangles)");
   uint64_t max_memory = limits.max_memory_bytes ? limits.max_memory_bytes : default_memory_limit();
   if (e.memory_bytes > max_memory)

@@ -11,6 +11,7 @@
 #include <set>
 #include <type_traits>
 #include <utility>
+#include <variant>
 
 #include "rvr/core/check.h"
 #include "rvr/renderers/registry.h"
@@ -129,8 +130,18 @@ class Sweep {
   // Takes `seconds` (the fits between the sweep and the checks) out of the budget's clock.
   void exclude(double seconds) { excluded_ += seconds; }
   bool cancelled() const { return hooks_.cancelled && hooks_.cancelled(); }
-  // The budget is a limit: past it no frame is started (the run in progress is dropped).
-  bool out_of_time() const { return elapsed() > request_.budget_seconds; }
+  // The budget is a limit: no frame, preparation or session is started that would end past it,
+  // were it as long as the longest such step so far (the run in progress is dropped).
+  bool out_of_time() const { return elapsed() + longest_step_ > request_.budget_seconds; }
+  // f(), a frame, a preparation or a session's opening, its duration kept as the longest step
+  // when it is.
+  template <class F>
+  auto timed_step(F&& f) {
+    const double before = elapsed();
+    auto result = f();
+    longest_step_ = std::max(longest_step_, elapsed() - before);
+    return result;
+  }
   bool stopped() const { return cancelled() || out_of_time(); }
   SystemSnapshot probe() const {
     SystemSnapshot s = hooks_.probe(kProbeWindow);
@@ -144,7 +155,10 @@ class Sweep {
   Status measure_checks(const std::vector<Family>& families);
 
  private:
-  Expected<OpenSession> open_session(const Family& family);
+  Expected<OpenSession> open_session(const Family& family) {
+    return timed_step([&] { return open_new_session(family); });
+  }
+  Expected<OpenSession> open_new_session(const Family& family);
   Expected<double> time_reference(FrameSource& reference);
   Status measure_run(const Family& family, size_t n, int width, OpenSession& session,
                      PointSet& into);
@@ -169,6 +183,7 @@ class Sweep {
   StudyResult& result_;
   Rng rng_;
   double start_ = 0, excluded_ = 0;
+  double longest_step_ = 0;  // seconds of the longest step so far (timed_step)
   std::map<std::string, FamilyState> families_;
   FamilyState* f_ = nullptr;  // the family being measured
   size_t plan_size_ = 0;      // of the families swept so far
@@ -178,7 +193,7 @@ class Sweep {
 // full width, the first renderer) prepared in it and timed five times. In the family's first
 // session the reference's frames in a row are chosen to take kReferenceSeconds (a frame of a
 // few microseconds alone would measure the timer and the scheduler).
-Expected<OpenSession> Sweep::open_session(const Family& family) {
+Expected<OpenSession> Sweep::open_new_session(const Family& family) {
   OpenSession open;
   SessionInfo info;
   info.system = probe();
@@ -249,7 +264,7 @@ void Sweep::time_rounds(const std::string& what, FrameSource& frames, FrameSourc
       progress(fmt::format("{} round {}/{} {}", what, round + 1, request_.repetitions,
                            request_.renderers[order[k]]));
       if (stopped()) return;
-      Expected<FrameTime> t = frames.time_frame(order[k]);
+      Expected<FrameTime> t = timed_step([&] { return frames.time_frame(order[k]); });
       if (!t) {
         status = t.error();
         return;
@@ -272,7 +287,7 @@ Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession
                                        width, width * 3 / 4, session.index + 1);
   if (stopped()) return ok_status();
   progress(what + ": preparing");
-  RVR_TRY_ASSIGN(frames, session.session->prepare(family, n, width));
+  RVR_TRY_ASSIGN(frames, timed_step([&] { return session.session->prepare(family, n, width); }));
   std::vector<Run> runs(request_.renderers.size());
   for (size_t i = 0; i < runs.size(); ++i) {
     runs[i].session = session.index;

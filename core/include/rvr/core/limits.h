@@ -14,7 +14,7 @@ namespace rvr {
 struct Limits {
   // Pixels x samples per pixel (--max-samples): 2^30, a 4K image at 128 samples.
   uint64_t max_samples = uint64_t(1) << 30;
-  // Triangles drawn or traced, spheres and planes tessellated included (--max-triangles).
+  // Triangles drawn or traced, spheres, planes and discs tessellated included (--max-triangles).
   uint64_t max_triangles = 50'000'000;
   // Estimated peak memory in bytes (--max-memory-mb); 0 = three quarters of physical memory.
   uint64_t max_memory_bytes = 0;
