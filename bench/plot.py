@@ -106,7 +106,8 @@ def depth_complexity(rows, context, out):
 
 
 def effect_rows(rows):
-    """BM_Effects medians in ms: {renderer: {effect: ms}}, renderer raytrace, hybrid, hybrid_soft."""
+    """BM_Effects medians in ms: {renderer: {effect: ms}}, renderer raytrace, hybrid, hybrid_soft,
+    and the z-buffers' techniques as "raster (accumulation)" (BM_Effects/<zbuffer>/<effect>/<technique>)."""
     table = defaultdict(dict)
     for b in rows:
         p = parts(b)
@@ -116,6 +117,8 @@ def effect_rows(rows):
             table["raytrace"][p[1]] = ms(b)
         elif len(p) == 3:
             table[p[1]][p[2]] = ms(b)
+        elif len(p) == 4:
+            table[f"{p[1]} ({p[3]})"][p[2]] = ms(b)
     # Registration order (the JSON's is the random interleaving's): cheapest effect first.
     order = ["primary", "hard_shadows", "area_light_4x4"] + [f"mirror_depth_{d}" for d in range(1, 6)]
     order += ["glass", "dof_16"]
@@ -138,12 +141,18 @@ def effects(rows, context, out):
         return
     names = list(tracer)
     series = [("raytrace", "tab:orange", "raytrace")] + [h for h in HYBRIDS if table.get(h[0])]
+    # The z-buffers' answers to the effects they render, technique by technique.
+    hybrid_names = {"raytrace"} | {h[0] for h in HYBRIDS}
+    zbuffer_colours = ["tab:purple", "tab:brown", "tab:pink", "tab:gray", "tab:olive", "tab:cyan"]
+    series += [(key, zbuffer_colours[i % len(zbuffer_colours)], key)
+               for i, key in enumerate(sorted(k for k in table if k not in hybrid_names))]
     width = 0.8 / len(series)
     fig, ax = plt.subplots(figsize=(10, 4.5))
     for i, (key, colour, label) in enumerate(series):
         offset = (i - (len(series) - 1) / 2) * width
         ax.bar([x + offset for x in range(len(names))],
-               [table[key].get(n, 0) / tracer["primary"] for n in names], width, color=colour,
+               [table[key].get(n, float("nan")) / tracer["primary"] for n in names], width,
+               color=colour,
                label=label)
     ax.legend()
     ax.set_xticks(list(range(len(names))))

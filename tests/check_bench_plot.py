@@ -61,6 +61,8 @@ def synthetic_run(new):
         rows.append(row(f"BM_Effects/{effect}", 30.0, not new))
         rows.append(row(f"BM_Effects/hybrid_soft/{effect}", 40.0, not new, zbuffer_ms=10.0,
                         trace_ms=28.0))
+    # A z-buffer's technique for an effect it renders (four parts: renderer, effect, technique).
+    rows.append(row("BM_Effects/softraster/hard_shadows/shadow_maps", 25.0, not new))
     rows.append(row("BM_Threads/softraster/1", 50.0, not new))
     rows.append(row("BM_Threads/softraster/2", 27.0, not new))
     context = {"date": "2026-12-01T00:00:00+00:00", "num_cpus": 2, "mhz_per_cpu": 2445}

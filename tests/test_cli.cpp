@@ -1275,34 +1275,31 @@ TEST_F(Cli, StudyShardAndMergeRefuseBadInput) {
 // A renderer's warning is printed "warning: RENDERER: what", the renderer named once, and
 // reaches metrics.json and report.html with the same text.
 TEST_F(Cli, WarningsNameTheirRendererOnce) {
-  const std::string spp_note =
-      "2 samples per pixel requested; multisampling is not implemented, rendered 1";
+  const std::string note = "transparency not rendered";
   RunResult r = run("render builtin:glass -r softraster --mode full --spp 2 " +
                     std::string(kSmall) + " -o " + (dir_ / "g.png").string() + " --quiet");
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find("warning: softraster: " + spp_note + "\n"), std::string::npos) << r.err;
-  EXPECT_NE(r.err.find("warning: softraster: transparency not rendered\n"), std::string::npos)
-      << r.err;
+  EXPECT_NE(r.err.find("warning: softraster: " + note + "\n"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("softraster: softraster"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("by softraster"), std::string::npos) << r.err;
 
-  // The hybrid's tracer takes every sample: softraster's single-sample note is not its own.
-  RunResult hybrid = run("render builtin:spheres -r hybrid_soft --mode local --spp 2 " +
+  // The hybrid's tracer refracts: its z-buffer's full-mode note is not its own.
+  RunResult hybrid = run("render builtin:glass -r hybrid_soft --mode full --spp 2 " +
                          std::string(kSmall) + " -o " + (dir_ / "h.png").string() + " --quiet");
   ASSERT_EQ(hybrid.status, 0) << hybrid.err;
-  EXPECT_EQ(hybrid.err.find("multisampling"), std::string::npos) << hybrid.err;
+  EXPECT_EQ(hybrid.err.find(note), std::string::npos) << hybrid.err;
 
   fs::path out = dir_ / "cmp";
-  RunResult c = run("compare builtin:spheres -r softraster,raytrace --mode local --spp 2 " +
+  RunResult c = run("compare builtin:glass -r softraster,raytrace --mode full " +
                     std::string(kSmall) + " -o " + out.string() + " --quiet");
   ASSERT_EQ(c.status, 0) << c.err;
-  EXPECT_NE(c.err.find("warning: softraster: " + spp_note + "\n"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("warning: softraster: " + note + "\n"), std::string::npos) << c.err;
   EXPECT_EQ(c.err.find("softraster: softraster"), std::string::npos) << c.err;
   nlohmann::json metrics = nlohmann::json::parse(slurp(out / "metrics.json"));
   const auto soft_warnings =
       metrics["renderers"]["softraster"]["warnings"].get<std::vector<std::string>>();
-  EXPECT_EQ(soft_warnings, std::vector<std::string>{spp_note});
-  EXPECT_NE(slurp(out / "report.html").find("<b>softraster</b>: " + spp_note), std::string::npos);
+  EXPECT_EQ(soft_warnings, std::vector<std::string>{note});
+  EXPECT_NE(slurp(out / "report.html").find("<b>softraster</b>: " + note), std::string::npos);
 }
 
 // Outputs are written to a temporary beside them and renamed into place; an error names the

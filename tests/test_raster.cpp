@@ -94,11 +94,13 @@ Object quad(float half, float z, const std::string& name = "quad") {
 }
 
 RenderOutput render_ok(const Scene& s, RenderMode mode = RenderMode::Local,
-                       GlRasterizer* rasterizer = nullptr) {
+                       GlRasterizer* rasterizer = nullptr,
+                       Supersampling supersampling = Supersampling::Accumulation) {
   GlRasterizer local;
   GlRasterizer& r = rasterizer ? *rasterizer : local;
   RenderOptions options;
   options.mode = mode;
+  options.supersampling = supersampling;
   auto out = r.render(s, options);
   EXPECT_TRUE(out.ok()) << (out.ok() ? "" : out.error().message);
   if (!out.ok()) return RenderOutput{};
@@ -742,7 +744,7 @@ TEST(GlRaster, MultisamplingBlendsEdgesAndKeepsPerPixelIds) {
   RenderOutput one = render_ok(s, RenderMode::Local);
   s.image.samples_per_pixel = 4;
   GlRasterizer r;
-  RenderOutput four = render_ok(s, RenderMode::Local, &r);
+  RenderOutput four = render_ok(s, RenderMode::Local, &r, Supersampling::Msaa);
   EXPECT_TRUE(four.warnings.empty());
   EXPECT_EQ(four.buffers.object_id, one.buffers.object_id);
   EXPECT_EQ(four.buffers.primitive_id, one.buffers.primitive_id);
@@ -782,7 +784,7 @@ TEST(GlRaster, MultisamplingBlendsEdgesAndKeepsPerPixelIds) {
   EXPECT_GT(blended, 20u);  // edge pixels with intermediate colours
 
   s.image.samples_per_pixel = 1 << 16;  // more than any GL allows
-  RenderOutput clamped = render_ok(s, RenderMode::Local, &r);
+  RenderOutput clamped = render_ok(s, RenderMode::Local, &r, Supersampling::Msaa);
   ASSERT_EQ(clamped.warnings.size(), 1u);
   EXPECT_NE(clamped.warnings[0].find("samples per pixel requested"), std::string::npos);
   EXPECT_EQ(clamped.buffers.object_id, one.buffers.object_id);
@@ -794,7 +796,7 @@ TEST(GlRaster, MultisampledFullModeMatchesSingleSampleInside) {
   Scene s = shadow_scene(80, 60);
   RenderOutput one = render_ok(s, RenderMode::Full);
   s.image.samples_per_pixel = 4;
-  RenderOutput four = render_ok(s, RenderMode::Full);
+  RenderOutput four = render_ok(s, RenderMode::Full, nullptr, Supersampling::Msaa);
   EXPECT_EQ(four.buffers.object_id, one.buffers.object_id);
   glm::ivec2 far_out = pixel_of(s, {2.0f, 0.0f, 2.0f});
   size_t i = one.buffers.index(far_out.x, far_out.y);
@@ -829,8 +831,7 @@ TEST(GlRaster, FullModeWarnsOnlyAboutWhatTheSceneUses) {
             std::string::npos)
       << full.warnings[1];
   EXPECT_EQ(full.warnings[1].find("unused"), std::string::npos);
-  EXPECT_NE(full.warnings[2].find("depth of field (aperture_radius > 0) not rendered: pinhole"),
-            std::string::npos)
+  EXPECT_NE(full.warnings[2].find(kDepthOfFieldNeedsSamples), std::string::npos)
       << full.warnings[2];
   // Local mode has no mirror, glass or lens by definition: nothing to warn about.
   EXPECT_TRUE(render_ok(s, RenderMode::Local).warnings.empty());

@@ -47,6 +47,12 @@ ImageSample image_sample(const Camera& camera, uint64_t seed, int k, int spp, bo
   return s;
 }
 
+glm::vec3 sample_eye(const Camera& camera, const ImageSample& sample) {
+  // The axes the tracer's frame has (make_camera_frame), so a lens point is the same point.
+  const CameraFrame frame = make_camera_frame(camera, 1, 1);
+  return frame.eye + sample.lens_x * frame.right + sample.lens_y * frame.up;
+}
+
 glm::mat4 sample_view_matrix(const Camera& camera, const ImageSample& sample) {
   // Eye space moved by the lens offset; its axes stay those of the pinhole camera.
   return glm::translate(glm::mat4(1.0f), glm::vec3(-sample.lens_x, -sample.lens_y, 0.0f)) *

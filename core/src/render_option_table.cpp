@@ -40,6 +40,7 @@ const std::vector<std::string_view> kSpheres = {"analytic", "mesh"};
 const std::vector<std::string_view> kTriangleTests = {"mt", "chapter"};
 const std::vector<std::string_view> kTextureLods = {"cones", "differentials", "none"};
 const std::vector<std::string_view> kDepthFormats = {"d24", "d32f", "d32f_reversed"};
+const std::vector<std::string_view> kSupersamplings = {"accumulation", "msaa"};
 const std::vector<std::string_view> kOnOff = {"on", "off"};
 
 // Each entry's store and show convert between the table's values and RenderOptions' members;
@@ -173,6 +174,14 @@ std::vector<RenderOptionSpec> zbuffer_options() {
              return o.depth_format ? choice_text(kDepthFormats, size_t(*o.depth_format))
                                    : std::string();
            }},
+      {.name = "supersampling",
+       .type = OptionType::Choice,
+       .choices = kSupersamplings,
+       .help = "raster with samples_per_pixel > 1: accumulation (a pass per sample of the "
+               "tracer's set, lens included: default) | msaa (one multisampled pass, pinhole)",
+       .readers = {"raster"},
+       .store = [](O& o, U i, double) { o.supersampling = Supersampling(i); },
+       .show = [](const O& o) { return choice_text(kSupersamplings, size_t(o.supersampling)); }},
   };
 }
 

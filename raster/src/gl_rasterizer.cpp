@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "accumulation_buffer.h"
 #include "draw_list_prep.h"
 #include "gl_check.h"
 #include "gl_context.h"
@@ -195,6 +196,7 @@ struct ScenePass {
   const ShadowPlan& shadows;
   glm::mat4 view, projection;
   DepthFormat depth_format;
+  glm::vec3 eye;  // where the pass looks from: the camera's eye or a sample's lens point
 };
 
 // Renderbuffer format of a z-buffer format.
@@ -230,8 +232,13 @@ void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& opt
       material_names(upload.draws, [](const Material& m) { return m.transparency > 0.0f; });
   if (!clear.empty())
     warnings.push_back(fmt::format("refraction/transparency (materials: {}) not rendered", clear));
-  if (scene.camera.aperture_radius > 0.0f)
-    warnings.push_back("depth of field (aperture_radius > 0) not rendered: pinhole");
+  if (scene.camera.aperture_radius > 0.0f) {
+    if (scene.image.samples_per_pixel == 1)
+      warnings.push_back(kDepthOfFieldNeedsSamples);
+    else if (options.supersampling == Supersampling::Msaa)
+      warnings.push_back(
+          "depth of field (aperture_radius > 0) not rendered by --supersampling msaa: pinhole");
+  }
 }
 
 }  // namespace
@@ -331,6 +338,7 @@ struct GlRasterizer::Impl {
 
   // One frame, in the order render() runs them.
   Expected<RenderOutput> render(const Scene& scene, const RenderOptions& options);
+  Expected<RenderOutput> render_pass(const Scene& scene, const RenderOptions& options);
   Expected<SceneUpload> upload(const Scene& scene, const RenderOptions& options);
   Expected<ShadowPlan> plan_shadows(const RenderOptions& options,
                                     const std::vector<LightSample>& samples, RenderOutput& out);
@@ -780,7 +788,7 @@ void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size
   gl().UseProgram(scene_program);
   gl().UniformMatrix4fv(su.view, 1, GL_FALSE, glm::value_ptr(pass.view));
   gl().UniformMatrix4fv(su.projection, 1, GL_FALSE, glm::value_ptr(pass.projection));
-  gl().Uniform3fv(su.eye, 1, glm::value_ptr(scene.camera.eye));
+  gl().Uniform3fv(su.eye, 1, glm::value_ptr(pass.eye));
   gl().Uniform3fv(su.ambient, 1, glm::value_ptr(scene.ambient));
   gl().Uniform3fv(su.background, 1, glm::value_ptr(scene.image.background));
   gl().Uniform1i(su.shade, shade_pass ? 1 : 0);
@@ -1039,6 +1047,15 @@ Status GlRasterizer::Impl::readback(int w, int h, const ScenePass& pass, FrameBu
 
 Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
                                                   const RenderOptions& options) {
+  // Several samples per pixel: the accumulation buffer, a pass per sample (unless msaa).
+  if (accumulates(scene, options) && options.supersampling == Supersampling::Accumulation)
+    return render_accumulated(scene, options,
+                              [&](const RenderOptions& pass) { return render_pass(scene, pass); });
+  return render_pass(scene, options);
+}
+
+Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
+                                                       const RenderOptions& options) {
   const int w = scene.image.width, h = scene.image.height;
   if (w < 1 || h < 1) return bad_input(fmt::format("image size {}x{} is empty", w, h));
   RenderOutput out;
@@ -1073,7 +1090,8 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
 
   // --- multisampling: colour into a multisampled FBO, resolved into the colour target
   int msaa = 1;
-  if (options.mode != RenderMode::Visibility && scene.image.samples_per_pixel > 1) {
+  if (options.mode != RenderMode::Visibility && scene.image.samples_per_pixel > 1 &&
+      options.supersampling == Supersampling::Msaa && !options.image_sample) {
     msaa = std::min(scene.image.samples_per_pixel, int(max_samples));
     if (msaa < scene.image.samples_per_pixel)
       out.warnings.push_back(
@@ -1096,7 +1114,8 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
       depth_format == DepthFormat::D32FReversed
           ? reversed_z_projection(camera_projection, scene.camera.near, scene.camera.far)
           : camera_projection,
-      depth_format};
+      depth_format,
+      options.image_sample ? sample_eye(scene.camera, *options.image_sample) : scene.camera.eye};
   RVR_TRY(scene_passes(pass, msaa, out));
   if (is_cancelled(progress)) return cancelled_error();
 

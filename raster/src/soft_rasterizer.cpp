@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "accumulation_buffer.h"
 #include "draw_list_prep.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/framebuffers.h"
@@ -133,6 +134,7 @@ struct VisibleFrame {
   const DepthTarget& target;
   const soft::SurfaceColours* surfaces;
   const FrameBuffers& fb;
+  glm::vec3 eye;  // where the pass looks from: the camera's eye or a sample's lens point
 };
 
 Surface surface_at(const VisibleFrame& frame, size_t o) {
@@ -152,7 +154,7 @@ Surface surface_at(const VisibleFrame& frame, size_t o) {
       s.object->smooth ? glm::normalize(b.x * mesh.normals[tri.x] + b.y * mesh.normals[tri.y] +
                                         b.z * mesh.normals[tri.z])
                        : s.geometric;
-  s.V = glm::normalize(frame.scene.camera.eye - s.P);
+  s.V = glm::normalize(frame.eye - s.P);
   s.N = face_viewer(shading, s.geometric, s.V);
   if (frame.surfaces && frame.surfaces->varies(id)) {
     // The level of detail the deferred pass sampled at (kept in fb.lod when textured).
@@ -280,13 +282,14 @@ void note_what_is_left_out(const Scene& scene, const RenderOptions& options,
   if (options.mode == RenderMode::Full) {
     if (draws.mirror) warnings.push_back("mirror reflection not rendered");
     if (draws.transparency) warnings.push_back("transparency not rendered");
-    if (scene.camera.aperture_radius > 0.0f)
-      warnings.push_back("depth of field (aperture) not rendered: pinhole");
+    if (scene.camera.aperture_radius > 0.0f && scene.image.samples_per_pixel == 1)
+      warnings.push_back(kDepthOfFieldNeedsSamples);
   }
-  if (scene.image.samples_per_pixel > 1)
-    warnings.push_back(
-        fmt::format("{} samples per pixel requested; multisampling is not implemented, rendered 1",
-                    scene.image.samples_per_pixel));
+}
+
+// One pass's eye: the camera's, or the lens point of the accumulation-buffer sample it draws.
+glm::vec3 pass_eye(const Scene& scene, const RenderOptions& options) {
+  return options.image_sample ? sample_eye(scene.camera, *options.image_sample) : scene.camera.eye;
 }
 
 // Setup (objects to triangles, then transform, clip, bin in submission order in the draw), the
@@ -354,7 +357,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   if (shade) {
     if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
     soft::DeferredShading shading;
-    shading.eye = scene.camera.eye;
+    shading.eye = pass_eye(scene, options);
     shading.ambient = scene.ambient;
     shading.background = scene.image.background;
     shading.colour = shadows ? soft::ShadedColour::Base : soft::ShadedColour::Local;
@@ -368,7 +371,8 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
 
   // Shadows (full mode): the lights, seen through this z-buffer's shadow cubes.
   if (shadows) {
-    const VisibleFrame frame{scene, list, target, surfaces ? &*surfaces : nullptr, fb};
+    const VisibleFrame frame{
+        scene, list, target, surfaces ? &*surfaces : nullptr, fb, pass_eye(scene, options)};
     RVR_TRY(add_shadowed_light(frame, samples, options, kernels, arena, fb, out));
   }
 
@@ -389,6 +393,11 @@ SoftRasterizer::~SoftRasterizer() = default;
 
 Expected<RenderOutput> SoftRasterizer::render(const Scene& scene, const RenderOptions& options) {
   try {
+    // Several samples per pixel: the accumulation buffer, a pass per sample.
+    if (accumulates(scene, options))
+      return render_accumulated(scene, options, [&](const RenderOptions& pass) {
+        return render_impl(scene, pass, frame_->target);
+      });
     return render_impl(scene, options, frame_->target);
   } catch (const std::bad_alloc&) {
     frame_->target.reset();  // possibly half resized

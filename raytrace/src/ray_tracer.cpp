@@ -697,7 +697,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   }
   if (options.mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f &&
       scene.image.samples_per_pixel == 1) {
-    out.warnings.push_back("depth of field needs samples_per_pixel > 1: one sample is a pinhole");
+    out.warnings.push_back(kDepthOfFieldNeedsSamples);
   }
   return out;
 }

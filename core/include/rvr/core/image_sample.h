@@ -20,11 +20,20 @@ struct ImageSample {
   float lens_x = 0.0f, lens_y = 0.0f;
 };
 
+// What every renderer says of a lens with one sample per pixel: a single lens point is a
+// pinhole, so depth of field needs several samples (the tracer's and the accumulation buffer's).
+inline constexpr const char* kDepthOfFieldNeedsSamples =
+    "depth of field needs samples_per_pixel > 1: one sample is a pinhole";
+
 // Sample k of spp for every pixel of a frame rendered with `seed`: the pixel split into an
 // m x m grid (m = floor(sqrt(spp))), samples k < m*m jittered inside cell k, the rest uniform.
 // With a lens (`thin_lens`: full mode and aperture_radius > 0), a point on the aperture disk:
 // angle stratified by k, radius by the square root of a uniform number (uniform over the disk).
 ImageSample image_sample(const Camera& camera, uint64_t seed, int k, int spp, bool thin_lens);
+
+// Where `sample`'s rays start: the eye moved to its lens point (the eye itself for a pinhole), as
+// the tracer's sample rays do; the point a z-buffer pass shades the direction to the eye from.
+glm::vec3 sample_eye(const Camera& camera, const ImageSample& sample);
 
 // The OpenGL matrices (view_matrix, projection_matrix of camera.h) that draw what `sample` sees:
 // the eye moved to the lens point and the image sheared so that the focus plane stays put, then

@@ -29,6 +29,10 @@ enum class TriangleTest { MollerTrumbore, Chapter };
 // D32F: the same z as a 32-bit float; D32FReversed: z reversed (1 at near, 0 at far, float's
 // dense exponents near 0 where the hyperbola is flattest), tested with "greater".
 enum class DepthFormat { D24, D32F, D32FReversed };
+// How a GL z-buffer takes several samples per pixel (docs/cli.md, --supersampling).
+// Accumulation: one pass per sample of the tracer's own set (its positions in the pixel, its
+// lens points), averaged; Msaa: one multisampled pass at the GL's own sample positions, no lens.
+enum class Supersampling { Accumulation, Msaa };
 
 const char* to_string(RenderMode mode);
 const char* to_string(AccelKind accel);     // bvh, bvh2, none, embree
@@ -57,6 +61,9 @@ struct RenderOptions {
   // d32f_reversed when the GL offers ARB_clip_control, else d32f; softraster: view depth in
   // double precision, finer than any of the formats). The tracers ignore it.
   std::optional<DepthFormat> depth_format;
+  // raster: how several samples per pixel are taken (softraster and the hybrids always take the
+  // tracer's samples, one pass each).
+  Supersampling supersampling = Supersampling::Accumulation;
   // Tracers: how a ray chooses a texture's level of detail (the z-buffers take theirs from
   // screen-space derivatives; the hybrids' primary hits from their z-buffer's).
   TextureLod texture_lod = TextureLod::Cones;
@@ -87,7 +94,6 @@ struct RenderOutput {
   // Facts that are words, not numbers, e.g. "kernel": "avx2".
   std::map<std::string, std::string> info;
 };
-
 
 class Renderer {
  public:
