@@ -3,13 +3,17 @@
 // average the same rays.
 #include <gtest/gtest.h>
 
-#include <cstddef>
 #include <glm/glm.hpp>
 #include <initializer_list>
+#include <map>
+#include <memory>
 #include <string>
+#include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "rvr/compare/compare.h"
+#include "rvr/compare/mismatch_classes.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"

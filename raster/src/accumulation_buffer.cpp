@@ -4,7 +4,10 @@
 #include <chrono>
 #include <cstddef>
 #include <glm/glm.hpp>
+#include <map>
+#include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "rvr/core/check.h"
