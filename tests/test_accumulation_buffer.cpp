@@ -123,6 +123,32 @@ TEST(AccumulationBuffer, MsaaIsOnePassThroughThePinholeAndSaysSo) {
   EXPECT_TRUE(said);
 }
 
+// The passes of one render share their shadow maps, and only they: a renderer that rendered
+// another scene's passes before draws this scene's maps afresh (the same bytes as a new
+// renderer's), and sharing changes no byte of the image.
+TEST(AccumulationBuffer, PassesShareOnlyTheirOwnRendersShadowMaps) {
+  Scene first = small_scene("dof");
+  Scene second = first;
+  ASSERT_FALSE(second.lights.empty());
+  for (Light& light : second.lights) light.position += glm::vec3(1.5f, 0.5f, 0.0f);
+  RenderOptions options;
+  options.mode = RenderMode::Full;
+  for (const char* zbuffer : {"raster", "softraster"}) {
+    auto used = make_renderer(zbuffer, GlBackend::OsMesa);
+    auto fresh = make_renderer(zbuffer, GlBackend::OsMesa);
+    ASSERT_TRUE(used.ok() && fresh.ok()) << zbuffer;
+    ASSERT_TRUE(used.value()->render(first, options).ok()) << zbuffer;
+    Expected<RenderOutput> again = used.value()->render(second, options);
+    Expected<RenderOutput> anew = fresh.value()->render(second, options);
+    ASSERT_TRUE(again.ok() && anew.ok()) << zbuffer;
+    EXPECT_TRUE(test::same_bytes(again->buffers.colour, anew->buffers.colour)) << zbuffer;
+    // The moved light changes the image: had the first scene's maps been kept, it would show.
+    Expected<RenderOutput> before = fresh.value()->render(first, options);
+    ASSERT_TRUE(before.ok()) << zbuffer;
+    EXPECT_FALSE(test::same_bytes(before->buffers.colour, anew->buffers.colour)) << zbuffer;
+  }
+}
+
 // The passes are the tracer's samples whatever the thread count: the same bytes.
 TEST(AccumulationBuffer, SameBytesWithOneAndTwoThreads) {
   const Scene scene = small_scene("dof");

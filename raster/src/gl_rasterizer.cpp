@@ -307,6 +307,10 @@ struct GlRasterizer::Impl {
   GlFramebuffer shadow_fbo;
   GlTexture shadow_texture;
   int shadow_size = 0, shadow_layers = 0;
+  // The passes of one accumulation buffer share their shadow maps (they do not depend on the
+  // view): set for the passes of one render, and once the first pass has drawn every sample's
+  // maps in one batch. Reset by every render and whenever the maps are reallocated.
+  bool keep_shadow_maps = false, shadow_maps_kept = false;
 
   // Kept to reuse their capacity across renders.
   std::vector<Vertex> vertices;
@@ -540,6 +544,7 @@ void GlRasterizer::Impl::release_msaa() {
 Status GlRasterizer::Impl::ensure_shadow_maps(int size, int layers) {
   if (shadow_texture != 0 && shadow_size == size && shadow_layers == layers) return ok_status();
   release_shadow_maps();
+  shadow_maps_kept = false;
   shadow_texture = GlTexture::generate();
   gl().ActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
   gl().BindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
@@ -884,13 +889,15 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
   for (size_t b = 0; b < batches; ++b) {
     if (is_cancelled(progress)) return cancelled_error();
     const size_t first = b * shadows.batch, end = std::min(samples.size(), first + shadows.batch);
-    if (shadows.enabled) {
+    const bool reuse = shadows.enabled && batches == 1 && keep_shadow_maps && shadow_maps_kept;
+    if (shadows.enabled && !reuse) {
       auto ts = Clock::now();
       use_depth_convention(false);
       RVR_TRY(render_shadow_maps(samples, first, end, shadows.light_projection,
                                  GLsizei(vertices.size())));
       gl().Finish();
       shadow_time += seconds_since(ts);
+      shadow_maps_kept = batches == 1 && keep_shadow_maps;
     }
     use_depth_convention(reversed);
     gl().Viewport(0, 0, w, h);
@@ -1048,9 +1055,15 @@ Status GlRasterizer::Impl::readback(int w, int h, const ScenePass& pass, FrameBu
 Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
                                                   const RenderOptions& options) {
   // Several samples per pixel: the accumulation buffer, a pass per sample (unless msaa).
-  if (accumulates(scene, options) && options.supersampling == Supersampling::Accumulation)
-    return render_accumulated(scene, options,
-                              [&](const RenderOptions& pass) { return render_pass(scene, pass); });
+  // Its passes share their shadow maps.
+  keep_shadow_maps = shadow_maps_kept = false;
+  if (accumulates(scene, options) && options.supersampling == Supersampling::Accumulation) {
+    keep_shadow_maps = true;
+    Expected<RenderOutput> out = render_accumulated(
+        scene, options, [&](const RenderOptions& pass) { return render_pass(scene, pass); });
+    keep_shadow_maps = shadow_maps_kept = false;
+    return out;
+  }
   return render_pass(scene, options);
 }
 

@@ -193,12 +193,21 @@ Expected<soft::ShadowSettings> shadow_settings(const RenderOptions& options, con
   return settings;
 }
 
+// The shadow cubes the passes of one accumulation buffer share: they do not depend on the view,
+// so when every sample's cube fits in one batch the first pass draws them and the others sample
+// the same cubes (one render's passes only: the same scene and options).
+struct KeptShadowCubes {
+  std::vector<soft::ShadowCube> cubes;
+  bool drawn = false;
+};
+
 // Full mode's shadows: a cube of distance maps per light sample, drawn by this z-buffer, in
 // batches that fit kShadowBatchBytes; each batch then adds its samples' light to the covered
-// pixels.
+// pixels. With `kept` and one batch, the cubes are drawn once into it and reused.
 Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSample>& samples,
                           const RenderOptions& options, const soft::FillKernels& kernels,
-                          tbb::task_arena& arena, FrameBuffers& fb, RenderOutput& out) {
+                          tbb::task_arena& arena, KeptShadowCubes* kept, FrameBuffers& fb,
+                          RenderOutput& out) {
   ShadowMapPlan plan;
   RVR_TRY_ASSIGN(planned, shadow_settings(options, frame.list, samples, plan, out.warnings));
   const auto t = Clock::now();
@@ -206,13 +215,17 @@ Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSamp
   const float near_plane = plan.near_plane, far_plane = plan.far_plane;
   const size_t per_sample = 6 * size_t(settings.size) * size_t(settings.size) * sizeof(float);
   const size_t batch = plan.batch;
+  const bool keep = kept && batch >= samples.size();
+  const bool reuse = keep && kept->drawn;
   std::optional<DepthTarget> scratch_built;
-  arena.execute([&] {
-    scratch_built.emplace(settings.size, settings.size, near_plane, far_plane, options.hiz, kernels,
-                          /*depth_only=*/true);
-  });
-  DepthTarget& scratch = *scratch_built;
-  std::vector<soft::ShadowCube> cubes(batch);
+  if (!reuse)
+    arena.execute([&] {
+      scratch_built.emplace(settings.size, settings.size, near_plane, far_plane, options.hiz,
+                            kernels, /*depth_only=*/true);
+    });
+  std::vector<soft::ShadowCube> own_cubes;
+  std::vector<soft::ShadowCube>& cubes = keep ? kept->cubes : own_cubes;
+  if (!reuse) cubes.assign(batch, soft::ShadowCube{});
   DrawResult shadow_work;
   double draw_seconds = 0;
   ProgressSink* const progress = options.progress;
@@ -221,9 +234,10 @@ Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSamp
     if (is_cancelled(progress)) return cancelled_error();
     const size_t end = std::min(samples.size(), first + batch);
     auto t_draw = Clock::now();
-    for (size_t i = first; i < end; ++i)
-      cubes[i - first].build(frame.list, samples[i].position, settings, scratch, arena,
-                             shadow_work);
+    if (!reuse)
+      for (size_t i = first; i < end; ++i)
+        cubes[i - first].build(frame.list, samples[i].position, settings, *scratch_built, arena,
+                               shadow_work);
     draw_seconds += seconds_since(t_draw);
     arena.execute([&] {
       tbb::parallel_for(tbb::blocked_range<size_t>(0, fb.pixel_count()),
@@ -249,8 +263,10 @@ Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSamp
   out.stats["shadows.triangles_setup"] = double(shadow_work.set_up);
   out.stats["shadows.fragments"] = double(shadow_work.counters.generated);
   out.stats["shadows.hiz_blocks_rejected"] = double(shadow_work.counters.blocks_rejected);
+  if (keep) kept->drawn = true;
   out.stats["memory.shadow_bytes"] =
-      double(batch * per_sample + scratch.bytes() + shadow_work.peak_chunk_bytes);
+      double(batch * per_sample + (scratch_built ? scratch_built->bytes() : 0) +
+             shadow_work.peak_chunk_bytes);
   return ok_status();
 }
 
@@ -296,7 +312,8 @@ glm::vec3 pass_eye(const Scene& scene, const RenderOptions& options) {
 // draw into the camera's target, then per mode: visibility's read-back, or deferred shading of
 // each visible pixel once and, in full mode, the shadowed lights.
 Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options,
-                                   std::optional<DepthTarget>& kept) {
+                                   std::optional<DepthTarget>& kept,
+                                   KeptShadowCubes* kept_shadows = nullptr) {
   const int w = scene.image.width, h = scene.image.height;
   RVR_TRY(check_image_size(w, h));
   RenderOutput out;
@@ -373,7 +390,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   if (shadows) {
     const VisibleFrame frame{
         scene, list, target, surfaces ? &*surfaces : nullptr, fb, pass_eye(scene, options)};
-    RVR_TRY(add_shadowed_light(frame, samples, options, kernels, arena, fb, out));
+    RVR_TRY(add_shadowed_light(frame, samples, options, kernels, arena, kept_shadows, fb, out));
   }
 
   record_draw_stats(drawn, target, submitted, shade, fb, out);
@@ -394,10 +411,13 @@ SoftRasterizer::~SoftRasterizer() = default;
 Expected<RenderOutput> SoftRasterizer::render(const Scene& scene, const RenderOptions& options) {
   try {
     // Several samples per pixel: the accumulation buffer, a pass per sample.
-    if (accumulates(scene, options))
+    // The passes share their shadow cubes.
+    if (accumulates(scene, options)) {
+      KeptShadowCubes shadows;
       return render_accumulated(scene, options, [&](const RenderOptions& pass) {
-        return render_impl(scene, pass, frame_->target);
+        return render_impl(scene, pass, frame_->target, &shadows);
       });
+    }
     return render_impl(scene, options, frame_->target);
   } catch (const std::bad_alloc&) {
     frame_->target.reset();  // possibly half resized
