@@ -356,11 +356,12 @@ void BM_WriteAovs(benchmark::State& state, const std::vector<std::string>& aovs)
 // primary hits, the tracer does the effect), built afresh each frame as the tracer's are. The
 // split of its time: zbuffer_ms (visibility passes) and trace_ms (hits rebuilt, shading, rays).
 void BM_EffectsWith(benchmark::State& state, const std::string& renderer_name,
-                    const std::string& effect, Supersampling supersampling) {
+                    const std::string& effect, Supersampling supersampling, ZBufferDof dof) {
   Scene scene;
   RenderOptions options;
   effect_scene(effect, scene, options);
   options.supersampling = supersampling;
+  options.zbuffer_dof = dof;
   std::unique_ptr<Renderer> renderer = make_renderer(renderer_name).value();
   RenderOutput out = renderer->render(scene, options).value();
   PhaseTimes phases;
@@ -700,7 +701,7 @@ void register_all() {
     // Beside the tracer's: the hybrids (GL's z-buffer, softraster's) on the same frames.
     for (std::string h : {"hybrid", "hybrid_soft"})
       benchmark::RegisterBenchmark(bench_name({"BM_Effects", h, e}).c_str(), BM_EffectsWith, h, e,
-                                   Supersampling::Accumulation)
+                                   Supersampling::Accumulation, ZBufferDof::Accumulation)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
   }
@@ -709,17 +710,19 @@ void register_all() {
   struct ZBufferEffect {
     std::string renderer, effect, technique;
     Supersampling supersampling = Supersampling::Accumulation;
+    ZBufferDof dof = ZBufferDof::Accumulation;
   };
   for (const std::string z : {"raster", "softraster"}) {
     std::vector<ZBufferEffect> cases = {{z, "primary", "zbuffer"},
                                         {z, "hard_shadows", "shadow_maps"},
                                         {z, "area_light_4x4", "shadow_maps"},
                                         {z, "dof_16", "accumulation"}};
+    cases.push_back({z, "dof_16", "blur", Supersampling::Accumulation, ZBufferDof::Blur});
     if (z == "raster") cases.push_back({z, "dof_16", "msaa", Supersampling::Msaa});
     for (const ZBufferEffect& c : cases)
       benchmark::RegisterBenchmark(
           bench_name({"BM_Effects", c.renderer, c.effect, c.technique}).c_str(), BM_EffectsWith,
-          c.renderer, c.effect, c.supersampling)
+          c.renderer, c.effect, c.supersampling, c.dof)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
   }

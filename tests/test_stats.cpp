@@ -79,6 +79,23 @@ TEST(StatsTable, EveryStatReportedIsDeclaredAndEveryDeclaredOneReported) {
         }
       }
   }
+  // The z-buffers' depth of field by blur (an option's technique, not a variant).
+  Scene dof = make_builtin_scene("dof").value();
+  dof.image.width = 32;
+  dof.image.height = 24;
+  for (const char* zbuffer : {"raster", "softraster"}) {
+    RenderOptions options;
+    options.mode = RenderMode::Full;
+    options.zbuffer_dof = ZBufferDof::Blur;
+    Expected<std::unique_ptr<Renderer>> renderer = make_renderer(zbuffer, RendererConfig{});
+    ASSERT_TRUE(renderer.ok()) << zbuffer;
+    Expected<RenderOutput> out = (*renderer)->render(dof, options);
+    ASSERT_TRUE(out.ok()) << zbuffer << ": " << out.error().message;
+    for (const auto& [name, value] : out->stats) {
+      EXPECT_NE(find_stat(name), nullptr) << zbuffer << " with a blur reports '" << name << "'";
+      if (const StatDeclaration* s = find_stat(name)) reported.insert(std::string(s->name));
+    }
+  }
   for (const StatDeclaration& s : stat_declarations())
     EXPECT_TRUE(reported.count(std::string(s.name)))
         << "'" << s.name << "' is declared, but no renderer reported it";

@@ -41,6 +41,7 @@ const std::vector<std::string_view> kTriangleTests = {"mt", "chapter"};
 const std::vector<std::string_view> kTextureLods = {"cones", "differentials", "none"};
 const std::vector<std::string_view> kDepthFormats = {"d24", "d32f", "d32f_reversed"};
 const std::vector<std::string_view> kSupersamplings = {"accumulation", "msaa"};
+const std::vector<std::string_view> kZBufferDofs = {"accumulation", "blur"};
 const std::vector<std::string_view> kOnOff = {"on", "off"};
 
 // Each entry's store and show convert between the table's values and RenderOptions' members;
@@ -182,6 +183,14 @@ std::vector<RenderOptionSpec> zbuffer_options() {
        .readers = {"raster"},
        .store = [](O& o, U i, double) { o.supersampling = Supersampling(i); },
        .show = [](const O& o) { return choice_text(kSupersamplings, size_t(o.supersampling)); }},
+      {.name = "zbuffer_dof",
+       .type = OptionType::Choice,
+       .choices = kZBufferDofs,
+       .help = "z-buffers' depth of field: accumulation (a pass per lens sample: default) | blur "
+               "(pinhole passes blurred by each pixel's circle of confusion)",
+       .readers = kZBuffers,
+       .store = [](O& o, U i, double) { o.zbuffer_dof = ZBufferDof(i); },
+       .show = [](const O& o) { return choice_text(kZBufferDofs, size_t(o.zbuffer_dof)); }},
   };
 }
 

@@ -44,6 +44,9 @@ constexpr std::array kStats = {
                     "the depth target and the largest chunk of set-up triangles held at once"},
     StatDeclaration{"zbuffer.depth_bits", kCount, "bits", "raster",
                     "the depth buffer's bits per pixel (24 or 32)"},
+    StatDeclaration{"dof.blur_radius", kRatio, "pixels", "z-buffers",
+                    "the widest circle of confusion of a depth-of-field blur, before clamping "
+                    "to 32 pixels (--zbuffer-dof blur)"},
     StatDeclaration{"zbuffer.accumulation_passes", kCount, "passes", "z-buffers",
                     "sample passes of an accumulation buffer (samples_per_pixel > 1), each "
                     "drawn and shaded whole, after the centre pass that gives the AOVs"},
@@ -142,6 +145,8 @@ constexpr std::array kStats = {
                     "the lights' shadow maps drawn (full mode)"},
     StatDeclaration{"time.shadows", kSeconds, "s", "softraster",
                     "shadows in all: cubes drawn and sampled (full mode)"},
+    StatDeclaration{"time.dof_blur", kSeconds, "s", "z-buffers",
+                    "depth of field as a post-process blur (--zbuffer-dof blur)"},
     StatDeclaration{"time.accumulation", kSeconds, "s", "z-buffers",
                     "the accumulation buffer's sample passes, each drawn and shaded whole"},
     StatDeclaration{"time.zbuffer", kSeconds, "s", "hybrids", "the z-buffer passes"},

@@ -19,8 +19,10 @@
 namespace rvr {
 
 bool accumulates(const Scene& scene, const RenderOptions& options) {
+  const bool blurred = options.mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f &&
+                       options.zbuffer_dof == ZBufferDof::Blur;
   return scene.image.samples_per_pixel > 1 && options.mode != RenderMode::Visibility &&
-         !options.image_sample;
+         !options.image_sample && !blurred;
 }
 
 Expected<RenderOutput> render_accumulated(const Scene& scene, const RenderOptions& options,

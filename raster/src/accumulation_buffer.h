@@ -15,8 +15,9 @@
 namespace rvr {
 
 // Whether a render takes its colour from an accumulation buffer: several samples per pixel in a
-// shaded mode (local or full; full mode adds the lens when the camera has an aperture), and not
-// already one pass of one (options.image_sample set).
+// shaded mode (local or full; full mode adds the lens when the camera has an aperture), not
+// already one pass of one (options.image_sample set), and not a lens whose depth of field is a
+// blur (--zbuffer-dof blur: one pinhole pass, blurred).
 bool accumulates(const Scene& scene, const RenderOptions& options);
 
 // Renders one pass with the options given (image_sample set for a sample's pass, unset for the

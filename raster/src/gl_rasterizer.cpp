@@ -22,9 +22,11 @@
 #include <string_view>
 #include <type_traits>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "accumulation_buffer.h"
+#include "depth_of_field_blur.h"
 #include "draw_list_prep.h"
 #include "gl_check.h"
 #include "gl_context.h"
@@ -235,7 +237,8 @@ void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& opt
   if (scene.camera.aperture_radius > 0.0f) {
     if (scene.image.samples_per_pixel == 1)
       warnings.push_back(kDepthOfFieldNeedsSamples);
-    else if (options.supersampling == Supersampling::Msaa)
+    else if (options.supersampling == Supersampling::Msaa &&
+             options.zbuffer_dof == ZBufferDof::Accumulation)
       warnings.push_back(
           "depth of field (aperture_radius > 0) not rendered by --supersampling msaa: pinhole");
   }
@@ -1056,15 +1059,18 @@ Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
                                                   const RenderOptions& options) {
   // Several samples per pixel: the accumulation buffer, a pass per sample (unless msaa).
   // Its passes share their shadow maps.
+  const bool accumulate =
+      accumulates(scene, options) && options.supersampling == Supersampling::Accumulation;
+  keep_shadow_maps = accumulate;
+  shadow_maps_kept = false;
+  Expected<RenderOutput> out =
+      accumulate
+          ? render_accumulated(scene, options,
+                               [&](const RenderOptions& pass) { return render_pass(scene, pass); })
+          : render_pass(scene, options);
   keep_shadow_maps = shadow_maps_kept = false;
-  if (accumulates(scene, options) && options.supersampling == Supersampling::Accumulation) {
-    keep_shadow_maps = true;
-    Expected<RenderOutput> out = render_accumulated(
-        scene, options, [&](const RenderOptions& pass) { return render_pass(scene, pass); });
-    keep_shadow_maps = shadow_maps_kept = false;
-    return out;
-  }
-  return render_pass(scene, options);
+  if (out) add_depth_of_field_blur(scene, options, *out);
+  return out;
 }
 
 Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,

@@ -17,9 +17,11 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "accumulation_buffer.h"
+#include "depth_of_field_blur.h"
 #include "draw_list_prep.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/framebuffers.h"
@@ -412,13 +414,16 @@ Expected<RenderOutput> SoftRasterizer::render(const Scene& scene, const RenderOp
   try {
     // Several samples per pixel: the accumulation buffer, a pass per sample.
     // The passes share their shadow cubes.
-    if (accumulates(scene, options)) {
-      KeptShadowCubes shadows;
-      return render_accumulated(scene, options, [&](const RenderOptions& pass) {
-        return render_impl(scene, pass, frame_->target, &shadows);
-      });
-    }
-    return render_impl(scene, options, frame_->target);
+    KeptShadowCubes shadows;
+    Expected<RenderOutput> out =
+        accumulates(scene, options)
+            ? render_accumulated(scene, options,
+                                 [&](const RenderOptions& pass) {
+                                   return render_impl(scene, pass, frame_->target, &shadows);
+                                 })
+            : render_impl(scene, options, frame_->target);
+    if (out) add_depth_of_field_blur(scene, options, *out);
+    return out;
   } catch (const std::bad_alloc&) {
     frame_->target.reset();  // possibly half resized
     return internal_error(fmt::format("out of memory rendering {}x{} with {} objects",

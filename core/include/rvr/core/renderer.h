@@ -33,6 +33,10 @@ enum class DepthFormat { D24, D32F, D32FReversed };
 // Accumulation: one pass per sample of the tracer's own set (its positions in the pixel, its
 // lens points), averaged; Msaa: one multisampled pass at the GL's own sample positions, no lens.
 enum class Supersampling { Accumulation, Msaa };
+// How a z-buffer renders depth of field (docs/cli.md, --zbuffer-dof). Accumulation: each sample
+// pass through its lens point; Blur: pinhole passes, then the image blurred by each pixel's
+// circle of confusion (a post-process).
+enum class ZBufferDof { Accumulation, Blur };
 
 const char* to_string(RenderMode mode);
 const char* to_string(AccelKind accel);     // bvh, bvh2, none, embree
@@ -64,6 +68,8 @@ struct RenderOptions {
   // raster: how several samples per pixel are taken (softraster and the hybrids always take the
   // tracer's samples, one pass each).
   Supersampling supersampling = Supersampling::Accumulation;
+  // Z-buffers in full mode with an aperture: how depth of field is rendered.
+  ZBufferDof zbuffer_dof = ZBufferDof::Accumulation;
   // Tracers: how a ray chooses a texture's level of detail (the z-buffers take theirs from
   // screen-space derivatives; the hybrids' primary hits from their z-buffer's).
   TextureLod texture_lod = TextureLod::Cones;
