@@ -8,8 +8,6 @@
 #include <map>
 #include <memory>
 #include <string>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 #include "rvr/compare/compare.h"
@@ -22,8 +20,8 @@
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
 #include "rvr/renderers/registry.h"
-#include "rvr/scene_io/scene_loader.h"
 #include "same_bytes.h"
+#include "table_render.h"
 
 namespace rvr {
 namespace {
@@ -37,12 +35,7 @@ namespace {
 constexpr double kMinAgreement = 0.999;
 constexpr double kMinPsnr = 50.0;
 
-Scene small_scene(const std::string& name) {
-  Scene scene = make_builtin_scene(name).value();
-  scene.image.width = 128;
-  scene.image.height = 96;
-  return scene;
-}
+using test::small_builtin_scene;
 
 RenderOutput render(const std::string& renderer, const Scene& scene, RenderMode mode,
                     int threads = 0, Supersampling supersampling = Supersampling::Accumulation) {
@@ -50,11 +43,7 @@ RenderOutput render(const std::string& renderer, const Scene& scene, RenderMode 
   options.mode = mode;
   options.threads = threads;
   options.supersampling = supersampling;
-  auto r = make_renderer(renderer, GlBackend::OsMesa);
-  EXPECT_TRUE(r.ok()) << renderer;
-  Expected<RenderOutput> out = r.value()->render(scene, options);
-  EXPECT_TRUE(out.ok()) << renderer << ": " << (out.ok() ? "" : out.error().message);
-  return out.ok() ? std::move(out).value() : RenderOutput{};
+  return test::table_render(renderer, scene, options);
 }
 
 }  // namespace
@@ -63,7 +52,7 @@ RenderOutput render(const std::string& renderer, const Scene& scene, RenderMode 
 // eye the z-buffer shades from is the one it draws from, and the tracer's lens point (the eye
 // moved along the camera's right and up axes).
 TEST(AccumulationBuffer, ASamplesEyeIsWhereItsViewLooksFrom) {
-  const Scene scene = small_scene("dof");
+  const Scene scene = small_builtin_scene("dof");
   const CameraFrame frame = make_camera_frame(scene.camera, 128, 96);
   for (int k = 0; k < scene.image.samples_per_pixel; ++k) {
     const ImageSample s =
@@ -80,7 +69,7 @@ TEST(AccumulationBuffer, ASamplesEyeIsWhereItsViewLooksFrom) {
 // Depth of field: every z-buffer draws the tracer's lens samples, one pass each, so its image is
 // the tracer's up to rasterization (and, in full mode, shadow maps against shadow rays).
 TEST(AccumulationBuffer, DepthOfFieldAgreesWithTheTracer) {
-  const Scene scene = small_scene("dof");
+  const Scene scene = small_builtin_scene("dof");
   const int spp = scene.image.samples_per_pixel;
   ASSERT_GT(spp, 1);
   ASSERT_GT(scene.camera.aperture_radius, 0.0f);
@@ -113,7 +102,7 @@ TEST(AccumulationBuffer, DepthOfFieldAgreesWithTheTracer) {
 // GL's multisampling stays on offer: one pass at the GL's own sample positions, a pinhole,
 // which it says.
 TEST(AccumulationBuffer, MsaaIsOnePassThroughThePinholeAndSaysSo) {
-  const Scene scene = small_scene("dof");
+  const Scene scene = small_builtin_scene("dof");
   const RenderOutput msaa = render("raster", scene, RenderMode::Full, 0, Supersampling::Msaa);
   EXPECT_EQ(msaa.stats.count("zbuffer.accumulation_passes"), 0u);
   bool said = false;
@@ -127,7 +116,7 @@ TEST(AccumulationBuffer, MsaaIsOnePassThroughThePinholeAndSaysSo) {
 // another scene's passes before draws this scene's maps afresh (the same bytes as a new
 // renderer's), and sharing changes no byte of the image.
 TEST(AccumulationBuffer, PassesShareOnlyTheirOwnRendersShadowMaps) {
-  Scene first = small_scene("dof");
+  Scene first = small_builtin_scene("dof");
   Scene second = first;
   ASSERT_FALSE(second.lights.empty());
   for (Light& light : second.lights) light.position += glm::vec3(1.5f, 0.5f, 0.0f);
@@ -151,7 +140,7 @@ TEST(AccumulationBuffer, PassesShareOnlyTheirOwnRendersShadowMaps) {
 
 // The passes are the tracer's samples whatever the thread count: the same bytes.
 TEST(AccumulationBuffer, SameBytesWithOneAndTwoThreads) {
-  const Scene scene = small_scene("dof");
+  const Scene scene = small_builtin_scene("dof");
   const RenderOutput one = render("softraster", scene, RenderMode::Full, 1);
   const RenderOutput two = render("softraster", scene, RenderMode::Full, 2);
   EXPECT_TRUE(test::same_bytes(one.buffers.colour, two.buffers.colour));

@@ -10,20 +10,15 @@
 #include <map>
 #include <memory>
 #include <string>
-#include <type_traits>
-#include <utility>
 #include <vector>
 
 #include "depth_of_field_blur.h"
 #include "rvr/compare/compare.h"
-#include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
-#include "rvr/core/gl_backend.h"
 #include "rvr/core/image_sample.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
-#include "rvr/renderers/registry.h"
-#include "rvr/scene_io/scene_loader.h"
+#include "table_render.h"
 
 namespace rvr {
 namespace {
@@ -62,22 +57,11 @@ double disk_share_beyond(double s, double r) {
   return (r * r * std::acos(s / r) - s * std::sqrt(r * r - s * s)) / (kPi * r * r);
 }
 
-Scene small_scene(const std::string& name) {
-  Scene scene = make_builtin_scene(name).value();
-  scene.image.width = 128;
-  scene.image.height = 96;
-  return scene;
-}
-
 RenderOutput render_full(const std::string& renderer, const Scene& scene, ZBufferDof dof) {
   RenderOptions options;
   options.mode = RenderMode::Full;
   options.zbuffer_dof = dof;
-  auto r = make_renderer(renderer, GlBackend::OsMesa);
-  EXPECT_TRUE(r.ok()) << renderer;
-  Expected<RenderOutput> out = r.value()->render(scene, options);
-  EXPECT_TRUE(out.ok()) << renderer << ": " << (out.ok() ? "" : out.error().message);
-  return out.ok() ? std::move(out).value() : RenderOutput{};
+  return test::table_render(renderer, scene, options);
 }
 
 }  // namespace
@@ -167,7 +151,7 @@ TEST(DepthOfFieldBlur, ABlurredBackgroundDoesNotSpreadOverASharpSurfaceInFront) 
 // blurs (no depth of field) and the accumulation buffer's (the tracer's own lens samples), and
 // the renderer says so.
 TEST(DepthOfFieldBlur, ItsErrorLiesBetweenThePinholesAndTheAccumulationBuffers) {
-  const Scene scene = small_scene("dof");
+  const Scene scene = test::small_builtin_scene("dof");
   Scene pinhole = scene;
   pinhole.camera.aperture_radius = 0.0f;
   pinhole.image.samples_per_pixel = 1;
