@@ -187,7 +187,7 @@ std::vector<RenderOptionSpec> zbuffer_options() {
        .type = OptionType::Choice,
        .choices = kZBufferDofs,
        .help = "z-buffers' depth of field: accumulation (a pass per lens sample: default) | blur "
-               "(pinhole passes blurred by each pixel's circle of confusion)",
+               "(one pinhole pass blurred by each pixel's circle of confusion)",
        .readers = kZBuffers,
        .store = [](O& o, U i, double) { o.zbuffer_dof = ZBufferDof(i); },
        .show = [](const O& o) { return choice_text(kZBufferDofs, size_t(o.zbuffer_dof)); }},
