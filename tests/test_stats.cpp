@@ -52,12 +52,13 @@ TEST(StatsTable, AZbufferCopyIsWhatItsNameIs) {
   EXPECT_EQ(find_stat(""), nullptr);
 }
 
-// Every renderer and variant in every mode, on a scene with lights, mirrors and glass, and on
-// one with several samples per pixel (the hybrids' accumulation passes): each stat reported is
+// Every renderer and variant in every mode, on a scene with lights, mirrors and glass, on one
+// with several samples per pixel (the hybrids' accumulation passes) and on one with a flat
+// mirror (the z-buffers' reflected views): each stat reported is
 // declared, and each declared stat is reported by some renderer.
 TEST(StatsTable, EveryStatReportedIsDeclaredAndEveryDeclaredOneReported) {
   std::set<std::string> reported;
-  for (const char* scene_name : {"cornell", "dof"}) {
+  for (const char* scene_name : {"cornell", "dof", "discs"}) {
     Scene scene = make_builtin_scene(scene_name).value();
     scene.image.width = 32;
     scene.image.height = 24;

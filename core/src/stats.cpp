@@ -50,6 +50,17 @@ constexpr std::array kStats = {
     StatDeclaration{"zbuffer.accumulation_passes", kCount, "passes", "z-buffers",
                     "sample passes of an accumulation buffer (samples_per_pixel > 1), each "
                     "drawn and shaded whole, after the centre pass that gives the AOVs"},
+    // Planar mirrors drawn by the z-buffers (full mode): a reflected view per mirror seen.
+    StatDeclaration{"mirror.views", kCount, "views", "z-buffers",
+                    "reflected views drawn for planar mirrors: one per mirror seen, per level of "
+                    "reflection (full mode)"},
+    StatDeclaration{"mirror.depth", kCount, "reflections", "z-buffers",
+                    "the most reflections one drawn view holds (at most --max-depth)"},
+    StatDeclaration{"mirror.pixels", kCount, "pixels", "z-buffers",
+                    "mirror pixels given their reflection, summed over the views"},
+    StatDeclaration{"mirror.pixels_at_limit", kCount, "pixels", "z-buffers",
+                    "mirror pixels seen at --max-depth reflections: their mirrored share "
+                    "dropped, as the tracer drops it"},
     // Shadows drawn by the z-buffers (full mode).
     StatDeclaration{"shadow_map.maps", kCount, "maps", "raster",
                     "shadow cube maps drawn, one per light sample"},
@@ -149,6 +160,8 @@ constexpr std::array kStats = {
                     "depth of field as a post-process blur (--zbuffer-dof blur)"},
     StatDeclaration{"time.accumulation", kSeconds, "s", "z-buffers",
                     "the accumulation buffer's sample passes, each drawn and shaded whole"},
+    StatDeclaration{"time.mirrors", kSeconds, "s", "z-buffers",
+                    "planar mirrors' reflected views, drawn, shaded and composited"},
     StatDeclaration{"time.zbuffer", kSeconds, "s", "hybrids", "the z-buffer passes"},
     StatDeclaration{"time.trace", kSeconds, "s", "hybrids",
                     "the tracer's part: hits rebuilt, rays traced, shading"},

@@ -23,6 +23,7 @@
 #include "accumulation_buffer.h"
 #include "depth_of_field_blur.h"
 #include "draw_list_prep.h"
+#include "planar_mirrors.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/image_sample.h"
@@ -295,10 +296,11 @@ void record_draw_stats(const DrawResult& drawn, const DepthTarget& target, size_
 // prints them says whose they are.
 void note_what_is_left_out(const Scene& scene, const RenderOptions& options,
                            const PreparedScene& prepared, const SceneDraws& draws,
+                           const std::vector<std::string>& curved_mirrors,
                            std::vector<std::string>& warnings) {
   if (!prepared.skipped_csg.empty()) warnings.push_back(skipped_csg_warning(prepared.skipped_csg));
   if (options.mode == RenderMode::Full) {
-    if (draws.mirror) warnings.push_back("mirror reflection not rendered");
+    if (!curved_mirrors.empty()) warnings.push_back(curved_mirrors_warning(curved_mirrors));
     if (draws.transparency) warnings.push_back("transparency not rendered");
     if (scene.camera.aperture_radius > 0.0f && scene.image.samples_per_pixel == 1)
       warnings.push_back(kDepthOfFieldNeedsSamples);
@@ -310,46 +312,55 @@ glm::vec3 pass_eye(const Scene& scene, const RenderOptions& options) {
   return options.image_sample ? sample_eye(scene.camera, *options.image_sample) : scene.camera.eye;
 }
 
-// Setup (objects to triangles, then transform, clip, bin in submission order in the draw), the
-// draw into the camera's target, then per mode: visibility's read-back, or deferred shading of
-// each visible pixel once and, in full mode, the shadowed lights.
-Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options,
-                                   std::optional<DepthTarget>& kept,
-                                   KeptShadowCubes* kept_shadows = nullptr) {
-  const int w = scene.image.width, h = scene.image.height;
-  RVR_TRY(check_image_size(w, h));
-  RenderOutput out;
-  ProgressSink* const progress = options.progress;
-  // The per-pixel kernels: RenderOptions::isa, else RVR_ISA, else the best this CPU runs.
-  RVR_TRY_ASSIGN(resolved_isa, resolve_isa(options.isa));
-  const Isa isa = *resolved_isa;
-  const soft::FillKernels& kernels = soft::fill_kernels(isa);
-  out.info["kernel"] = kernels.isa;
-  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+// What a render sets up once for every view it draws (the camera's and its mirrors').
+struct RenderSetup {
+  const Scene& scene;
+  const RenderOptions& options;
+  Isa isa;
+  const soft::FillKernels& kernels;
+  tbb::task_arena& arena;
+  const DrawList& list;
+  const std::vector<LightSample>& samples;  // empty: no shading
+  std::optional<DepthTarget>& kept;
+  KeptShadowCubes& kept_shadows;
+};
 
-  // Setup: the objects' meshes and materials (the tessellations live until shading ends).
+// `list` without object `hidden` (a mirror's view does not draw the mirror); ids stay the same.
+DrawList without_object(const DrawList& list, uint32_t hidden) {
+  std::vector<DrawObject> objects = list.objects;
+  objects[hidden].mesh = nullptr;
+  return soft::make_draw_list(std::move(objects));
+}
+
+// One view (the camera's, or one seen through mirrors: `view`), drawn into the kept target and,
+// per mode, read back (visibility) or shaded once per visible pixel with, in full mode, the
+// shadowed lights. `drawn` receives the draw's counts.
+Status draw_view(const RenderSetup& setup, const MirrorView& view, RenderOutput& out,
+                 DrawResult& drawn) {
+  const Scene& scene = setup.scene;
+  const RenderOptions& options = setup.options;
+  tbb::task_arena& arena = setup.arena;
+  const int w = scene.image.width, h = scene.image.height;
+  ProgressSink* const progress = options.progress;
   auto t = Clock::now();
   const auto t_visibility = t;
-  RVR_TRY_ASSIGN(prepared, prepare_objects(scene, options.spheres, options.sphere_segments));
-  const SceneDraws draws = scene_draws(*prepared);
-  const DrawList& list = draws.list;
-  const glm::dmat4 view_projection = camera_view_projection(scene, options, w, h);
+  std::optional<DrawList> own_list;
+  if (view.hidden != kNoId) own_list = without_object(setup.list, view.hidden);
+  const DrawList& list = own_list ? *own_list : setup.list;
+  const glm::dmat4 view_projection = camera_view_projection(scene, options, w, h) * view.reflection;
   // Textured and vertex-coloured objects (none: no per-pixel work at all).
   std::optional<soft::SurfaceColours> surfaces;
   if (options.mode != RenderMode::Visibility || options.visibility_lod) {
     surfaces.emplace(scene, view_projection, w, h);
     if (!surfaces->any()) surfaces.reset();
   }
-  const size_t submitted = list.triangles();
   out.stats["time.setup"] = seconds_since(t);
 
   // Draw: every triangle into the camera's target.
-  DepthTarget& target = camera_target(scene, options, kernels, arena, kept);
-  out.info["depth_format"] =
-      options.depth_format ? to_string(*options.depth_format) : "exact (view depth, double)";
+  DepthTarget& target = camera_target(scene, options, setup.kernels, arena, setup.kept);
   // The fraction in triangles, the speed in fragments.
-  if (progress) progress->begin("draw", submitted, "triangles", "fragments");
-  const DrawResult drawn = soft::draw_triangles(list, view_projection, target, arena, progress);
+  if (progress) progress->begin("draw", list.triangles(), "triangles", "fragments");
+  drawn = soft::draw_triangles(list, view_projection, target, arena, progress, view.keep);
   if (is_cancelled(progress)) return cancelled_error();
   out.stats["time.setup"] += drawn.setup_seconds;
   out.stats["time.bin"] = drawn.bin_seconds;
@@ -365,39 +376,101 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     soft::write_visibility(list, target, scene.image.background, options.cost_aov,
                            surfaces ? &*surfaces : nullptr, arena, progress, fb);
     out.stats["time.readback"] = seconds_since(t);
+    return ok_status();
   }
 
   // Shade (local and full mode): deferred, each visible pixel once.
   t = Clock::now();
-  const bool shade = options.mode != RenderMode::Visibility;
-  const std::vector<LightSample> samples =
-      shade ? light_samples(scene.lights) : std::vector<LightSample>{};
-  const bool shadows = options.mode == RenderMode::Full && !samples.empty();
-  if (shade) {
-    if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
-    soft::DeferredShading shading;
-    shading.eye = pass_eye(scene, options);
-    shading.ambient = scene.ambient;
-    shading.background = scene.image.background;
-    shading.colour = shadows ? soft::ShadedColour::Base : soft::ShadedColour::Local;
-    shading.samples = &samples;
-    shading.cost = options.cost_aov;
-    shading.surfaces = surfaces ? &*surfaces : nullptr;
-    soft::shade_pixels(list, target, shading, shade_kernels(isa), arena, progress, fb);
-    if (is_cancelled(progress)) return cancelled_error();
-    out.stats["time.shade"] = seconds_since(t);
-  }
+  const bool shadows = options.mode == RenderMode::Full && !setup.samples.empty();
+  if (progress) progress->begin("shade", uint64_t(w) * uint64_t(h), "pixels");
+  soft::DeferredShading shading;
+  shading.eye = view.eye;
+  shading.ambient = scene.ambient;
+  shading.background = scene.image.background;
+  shading.colour = shadows ? soft::ShadedColour::Base : soft::ShadedColour::Local;
+  shading.samples = &setup.samples;
+  shading.cost = options.cost_aov;
+  shading.surfaces = surfaces ? &*surfaces : nullptr;
+  soft::shade_pixels(list, target, shading, shade_kernels(setup.isa), arena, progress, fb);
+  if (is_cancelled(progress)) return cancelled_error();
+  out.stats["time.shade"] = seconds_since(t);
 
   // Shadows (full mode): the lights, seen through this z-buffer's shadow cubes.
   if (shadows) {
-    const VisibleFrame frame{
-        scene, list, target, surfaces ? &*surfaces : nullptr, fb, pass_eye(scene, options)};
-    RVR_TRY(add_shadowed_light(frame, samples, options, kernels, arena, kept_shadows, fb, out));
+    const VisibleFrame frame{scene, list, target, surfaces ? &*surfaces : nullptr, fb, view.eye};
+    RVR_TRY(add_shadowed_light(frame, setup.samples, options, setup.kernels, arena,
+                               &setup.kept_shadows, fb, out));
   }
+  return ok_status();
+}
 
-  record_draw_stats(drawn, target, submitted, shade, fb, out);
+// Full mode's planar mirrors: a view per mirror seen, drawn and shaded as the camera's is,
+// composited into `out` (planar_mirrors.h). The reflected views' own counts are not the
+// camera pass's: they go to the mirror stats only.
+Status add_mirrors(const RenderSetup& setup, const std::vector<PlanarMirror>& mirrors,
+                   const MirrorView& camera, RenderOutput& out) {
+  const auto t = Clock::now();
+  MirrorStats stats;
+  const MirrorViewPass pass = [&](const MirrorView& view) -> Expected<FrameBuffers> {
+    RenderOutput reflected;
+    DrawResult drawn;
+    RVR_TRY(draw_view(setup, view, reflected, drawn));
+    for (const std::string& w : reflected.warnings)
+      if (std::find(out.warnings.begin(), out.warnings.end(), w) == out.warnings.end())
+        out.warnings.push_back(w);
+    return std::move(reflected.buffers);
+  };
+  RVR_TRY(
+      add_planar_reflections(mirrors, setup.options.max_depth, camera, pass, out.buffers, stats));
+  record_mirror_stats(stats, seconds_since(t), out);
+  return ok_status();
+}
+
+// Setup (objects to triangles, then transform, clip, bin in submission order in the draw), the
+// camera's view drawn and shaded, then in full mode the views its planar mirrors show.
+Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& options,
+                                   std::optional<DepthTarget>& kept,
+                                   KeptShadowCubes* kept_shadows = nullptr) {
+  const int w = scene.image.width, h = scene.image.height;
+  RVR_TRY(check_image_size(w, h));
+  RenderOutput out;
+  // The per-pixel kernels: RenderOptions::isa, else RVR_ISA, else the best this CPU runs.
+  RVR_TRY_ASSIGN(resolved_isa, resolve_isa(options.isa));
+  const Isa isa = *resolved_isa;
+  const soft::FillKernels& kernels = soft::fill_kernels(isa);
+  out.info["kernel"] = kernels.isa;
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+
+  // Setup: the objects' meshes and materials (the tessellations live until shading ends).
+  const auto t = Clock::now();
+  RVR_TRY_ASSIGN(prepared, prepare_objects(scene, options.spheres, options.sphere_segments));
+  const SceneDraws draws = scene_draws(*prepared);
+  const bool shade = options.mode != RenderMode::Visibility;
+  const std::vector<LightSample> samples =
+      shade ? light_samples(scene.lights) : std::vector<LightSample>{};
+  const double prepare_seconds = seconds_since(t);
+  KeptShadowCubes own_shadows;  // shared by the camera's view and its mirrors' views
+  const RenderSetup setup{scene,   options, isa,
+                          kernels, arena,   draws.list,
+                          samples, kept,    kept_shadows ? *kept_shadows : own_shadows};
+  out.info["depth_format"] =
+      options.depth_format ? to_string(*options.depth_format) : "exact (view depth, double)";
+
+  MirrorView camera;
+  camera.eye = pass_eye(scene, options);
+  DrawResult drawn;
+  RVR_TRY(draw_view(setup, camera, out, drawn));
+  out.stats["time.setup"] += prepare_seconds;
+  out.stats["time.visibility"] += prepare_seconds;
+  record_draw_stats(drawn, *kept, draws.list.triangles(), shade, out.buffers, out);
+
+  std::vector<std::string> curved;
+  if (options.mode == RenderMode::Full && draws.mirror) {
+    const std::vector<PlanarMirror> mirrors = planar_mirrors(scene, *prepared, curved);
+    if (!mirrors.empty()) RVR_TRY(add_mirrors(setup, mirrors, camera, out));
+  }
   out.info["hiz"] = options.hiz ? "on" : "off";
-  note_what_is_left_out(scene, options, *prepared, draws, out.warnings);
+  note_what_is_left_out(scene, options, *prepared, draws, curved, out.warnings);
   return out;
 }
 

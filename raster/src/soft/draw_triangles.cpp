@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <memory>
+#include <optional>
 #include <utility>
 
 #include "rvr/core/check.h"
@@ -131,6 +132,7 @@ struct SetupContext {
   const FillKernels& kernels;
   ProjectionParams params;
   int width, height;
+  std::optional<glm::dvec4> keep;  // a user clip plane in the world (TriangleSetup's)
 };
 
 // The triangle (a, b, c of the batch's vertices) clipped or batched: trivially outside the view
@@ -164,6 +166,12 @@ void set_up_range(const SetupContext& ctx, SetupWorker& worker, const TriangleMe
                   uint32_t object, const glm::uvec3* tris, size_t n, uint32_t primitive0,
                   uint32_t lo, uint32_t span, SetupTriangles& local, size_t& local_clipped) {
   worker.project_range(ctx.kernels, ctx.params, m.positions.data() + lo, span);
+  if (ctx.keep)  // the kernels know the frustum only: the user plane's flags as project() sets them
+    for (uint32_t v = 0; v < span; ++v)
+      if (discarded_by(*ctx.keep, m.positions[lo + v])) {
+        worker.range_reject[v] |= uint8_t(kUserPlaneReject);
+        worker.range_clip[v] |= uint8_t(kUserPlaneClip);
+      }
   SetupBatch& batch = worker.batch;
   batch.vertices = worker.range.arrays();
   const uint8_t* reject = worker.range_reject.data();
@@ -254,16 +262,16 @@ size_t set_up_sub_chunk(const SetupContext& ctx, SetupWorker& worker, const Draw
 // counters.
 class ChunkedDraw {
  public:
-  ChunkedDraw(const DrawList& list, const glm::dmat4& view_projection, DepthTarget& target,
-              tbb::task_arena& arena)
+  ChunkedDraw(const DrawList& list, const glm::dmat4& view_projection,
+              const std::optional<glm::dvec4>& keep, DepthTarget& target, tbb::task_arena& arena)
       : list_(list),
         target_(target),
         arena_(arena),
         ctx_{target.kernels(), projection_params(target.width(), target.height(), view_projection),
-             target.width(), target.height()},
+             target.width(), target.height(), keep},
         tiles_x_(target.tiles_x()),
         tile_count_(size_t(target.tiles_x()) * size_t(target.tiles_y())),
-        workers_(TriangleSetup(target.width(), target.height(), view_projection)),
+        workers_(TriangleSetup(target.width(), target.height(), view_projection, keep)),
         sub_out_((kChunk + kSubChunk - 1) / kSubChunk),
         sub_clipped_(sub_out_.size()),
         sub_spans_(sub_out_.size()),
@@ -408,9 +416,10 @@ DrawList make_draw_list(std::vector<DrawObject> objects) {
 }
 
 DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projection,
-                          DepthTarget& target, tbb::task_arena& arena, ProgressSink* progress) {
+                          DepthTarget& target, tbb::task_arena& arena, ProgressSink* progress,
+                          const std::optional<glm::dvec4>& keep) {
   DrawResult result;
-  ChunkedDraw draw(list, view_projection, target, arena);
+  ChunkedDraw draw(list, view_projection, keep, target, arena);
   const size_t submitted = list.triangles();
   for (size_t chunk = 0; chunk < submitted; chunk += kChunk) {
     if (is_cancelled(progress)) break;  // the caller returns cancelled_error()

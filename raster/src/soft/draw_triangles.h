@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <glm/glm.hpp>
+#include <optional>
 #include <vector>
 
 #include "rvr/core/progress.h"
@@ -41,7 +42,9 @@ struct DrawResult {
 
 // Draws every triangle of `list` into `target` (sized to the viewport) through
 // `view_projection`. `progress` (may be null) advances by triangles, with fragments as the rate.
+// `keep`, a world plane: only what lies on its positive side is drawn (a planar mirror's view).
 DrawResult draw_triangles(const DrawList& list, const glm::dmat4& view_projection,
-                          DepthTarget& target, tbb::task_arena& arena, ProgressSink* progress);
+                          DepthTarget& target, tbb::task_arena& arena, ProgressSink* progress,
+                          const std::optional<glm::dvec4>& keep = std::nullopt);
 
 }  // namespace rvr::soft

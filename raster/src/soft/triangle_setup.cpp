@@ -37,8 +37,9 @@ bool placeable(const ProjectedVertex& v) {
 
 }  // namespace
 
-TriangleSetup::TriangleSetup(int width, int height, const glm::dmat4& view_projection)
-    : width_(width), height_(height), view_projection_(view_projection) {
+TriangleSetup::TriangleSetup(int width, int height, const glm::dmat4& view_projection,
+                             const std::optional<glm::dvec4>& keep)
+    : width_(width), height_(height), view_projection_(view_projection), keep_(keep) {
   RVR_CHECK(width > 0 && height > 0 && width <= kMaxImageSide && height <= kMaxImageSide,
             "the renderer refuses frames outside 1..kMaxImageSide: ", width, "x", height);
   const double gx = kGuardPixels / width, gy = kGuardPixels / height;
@@ -49,6 +50,9 @@ TriangleSetup::TriangleSetup(int width, int height, const glm::dmat4& view_proje
       {0, 0, 1, 1}, {1, 0, 0, gx}, {-1, 0, 0, gx}, {0, 1, 0, gy}, {0, -1, 0, gy}};
   std::copy(frustum, frustum + 6, frustum_);
   std::copy(clip, clip + 5, clip_planes_);
+  // A plane's coefficients map to clip space by the inverse transpose: keep · P =
+  // keep · (VP^-1 c) = (VP^-T keep) · c.
+  if (keep) keep_clip_ = glm::transpose(glm::inverse(view_projection)) * *keep;
   poly_.reserve(16);
   scratch_.reserve(16);
 }
@@ -66,6 +70,10 @@ ProjectedVertex TriangleSetup::project(const glm::vec3& p) const {
   v.clip_planes = uint32_t(c.z + c.w < 0) | uint32_t(c.x + gx * c.w < 0) << 1 |
                   uint32_t(-c.x + gx * c.w < 0) << 2 | uint32_t(c.y + gy * c.w < 0) << 3 |
                   uint32_t(-c.y + gy * c.w < 0) << 4;
+  if (keep_ && discarded_by(*keep_, p)) {
+    v.reject |= kUserPlaneReject;
+    v.clip_planes |= kUserPlaneClip;
+  }
   if (v.clip_planes == 0) {  // in front of the near plane and inside the guard band
     const glm::dvec4& k = v.clip;
     // Viewport with y flipped: row 0 is the top.
@@ -139,15 +147,19 @@ void TriangleSetup::clip_and_emit(const ProjectedVertex* pv[3], uint32_t object,
     v[i].b = glm::dvec3(0.0);
     v[i].b[i] = 1.0;
   }
-  for (const glm::dvec4& plane : clip_planes_) {
+  auto clip_by = [&](const glm::dvec4& plane) {
     bool outside = false;
     for (const ClipVertex& c : v) outside |= glm::dot(plane, c.c) < 0;
-    if (!outside) continue;
+    if (!outside) return;
     clip_polygon(v, plane, scratch_);
     std::swap(v, scratch_);
+  };
+  for (const glm::dvec4& plane : clip_planes_) {
+    clip_by(plane);
     if (v.size() < 3) break;
   }
-  RVR_DCHECK(v.size() <= 3 + std::size(clip_planes_),
+  if (keep_clip_ && v.size() >= 3) clip_by(*keep_clip_);
+  RVR_DCHECK(v.size() <= 4 + std::size(clip_planes_),
              "each clip plane adds at most one vertex to a convex polygon: ", v.size());
   // A convex polygon as a fan: the inner diagonals are shared edges, drawn once by the rule.
   for (size_t i = 1; i + 1 < v.size(); ++i) {

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <optional>
 #include <vector>
 
 #include "soft/setup_triangle.h"
@@ -30,9 +31,23 @@ struct ProjectedVertex {
   uint32_t clip_planes = 0;  // bit p: outside near or guard plane p (any: the triangle is clipped)
 };
 
+// The flags of a vertex on the discarded side of a user clip plane (a planar mirror's view keeps
+// only what lies beyond the mirror): beside the frustum's reject bits 0-5 and the near and guard
+// planes' clip bits 0-4 (kScalarOnly is bit 5).
+constexpr uint32_t kUserPlaneReject = 1u << 6;
+constexpr uint32_t kUserPlaneClip = 1u << 6;
+
+// Whether a world point lies on the discarded side of the world plane `keep` (keep · (p, 1) < 0).
+inline bool discarded_by(const glm::dvec4& keep, const glm::vec3& p) {
+  return glm::dot(keep, glm::dvec4(glm::dvec3(p), 1.0)) < 0.0;
+}
+
 class TriangleSetup {
  public:
-  TriangleSetup(int width, int height, const glm::dmat4& view_projection);
+  // `keep`, when set, is a world plane: only the part of each triangle on its positive side is
+  // drawn (clipped as the near plane is).
+  TriangleSetup(int width, int height, const glm::dmat4& view_projection,
+                const std::optional<glm::dvec4>& keep = std::nullopt);
 
   ProjectedVertex project(const glm::vec3& p) const;
 
@@ -59,6 +74,8 @@ class TriangleSetup {
   glm::dmat4 view_projection_;
   glm::dvec4 frustum_[6];
   glm::dvec4 clip_planes_[5];
+  std::optional<glm::dvec4> keep_;       // the user plane in the world
+  std::optional<glm::dvec4> keep_clip_;  // the same plane in clip space
   Polygon poly_, scratch_;
 };
 

@@ -1,0 +1,147 @@
+#include "planar_mirrors.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+#include "rvr/core/check.h"
+#include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
+
+namespace rvr {
+
+namespace {
+
+// The plane of a flat mesh, or nothing: every vertex within a millionth of the mesh's extent of
+// the plane through its largest triangle, and every vertex normal (a smooth mesh's) that plane's
+// normal to 1e-5, so that the tracer's reflection, about the shading normal, is the plane's.
+std::optional<glm::dvec4> flat_plane(const TriangleMesh& mesh) {
+  if (mesh.triangles.empty()) return std::nullopt;
+  glm::dvec3 n(0.0);
+  double largest = 0.0;
+  glm::dvec3 lo(mesh.positions.front()), hi(mesh.positions.front());
+  for (const glm::vec3& p : mesh.positions) {
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
+  }
+  for (const glm::uvec3& t : mesh.triangles) {
+    const glm::dvec3 a(mesh.positions[t.x]), b(mesh.positions[t.y]), c(mesh.positions[t.z]);
+    const glm::dvec3 cross = glm::cross(b - a, c - a);
+    const double area = glm::length(cross);
+    if (area > largest) {
+      largest = area;
+      n = cross / area;
+    }
+  }
+  if (!(largest > 0.0)) return std::nullopt;
+  const glm::dvec3 on(mesh.positions[mesh.triangles.front().x]);
+  // The point of the largest triangle would do as well; any vertex is on a flat mesh's plane.
+  const double d = -glm::dot(n, on);
+  const double tolerance = 1e-6 * std::max(1.0, glm::length(hi - lo));
+  for (const glm::vec3& p : mesh.positions)
+    if (std::abs(glm::dot(n, glm::dvec3(p)) + d) > tolerance) return std::nullopt;
+  for (const glm::vec3& v : mesh.normals)
+    if (std::abs(std::abs(glm::dot(n, glm::normalize(glm::dvec3(v)))) - 1.0) > 1e-5)
+      return std::nullopt;
+  return glm::dvec4(n, d);
+}
+
+std::string mirror_label(const Object& o, size_t index) {
+  return o.name.empty() ? fmt::format("object#{}", index) : o.name;
+}
+
+}  // namespace
+
+std::vector<PlanarMirror> planar_mirrors(const Scene& scene, const PreparedScene& prepared,
+                                         std::vector<std::string>& curved) {
+  std::vector<PlanarMirror> mirrors;
+  for (size_t i = 0; i < prepared.objects.size(); ++i) {
+    const PreparedObject& p = prepared.objects[i];
+    if (!p.mesh || !(p.material->mirror > 0.0f)) continue;
+    if (const std::optional<glm::dvec4> plane = flat_plane(*p.mesh))
+      mirrors.push_back({uint32_t(i), *plane, p.material->mirror});
+    else
+      curved.push_back(mirror_label(scene.objects[i], i));
+  }
+  return mirrors;
+}
+
+glm::dmat4 reflection_matrix(const glm::dvec4& plane) {
+  const glm::dvec3 n(plane);
+  glm::dmat4 r(1.0);
+  for (int c = 0; c < 3; ++c)
+    for (int row = 0; row < 3; ++row) r[c][row] -= 2.0 * n[row] * n[c];
+  for (int row = 0; row < 3; ++row) r[3][row] = -2.0 * plane.w * n[row];
+  return r;
+}
+
+namespace {
+
+// The view `parent` sees reflected in mirror m: its reflections then m's (a point P beyond the
+// mirror is drawn where the parent would draw its mirror image), the parent's eye reflected,
+// and only what lies on the parent eye's side of the mirror drawn (what a ray leaving the mirror
+// towards that side can meet).
+MirrorView reflected_view(const MirrorView& parent, const PlanarMirror& m) {
+  MirrorView child;
+  const glm::dmat4 r = reflection_matrix(m.plane);
+  child.reflection = parent.reflection * r;
+  child.eye = glm::vec3(r * glm::dvec4(glm::dvec3(parent.eye), 1.0));
+  const double side = glm::dot(m.plane, glm::dvec4(glm::dvec3(parent.eye), 1.0));
+  child.keep = side >= 0.0 ? m.plane : -m.plane;
+  child.hidden = m.object;
+  child.depth = parent.depth + 1;
+  return child;
+}
+
+}  // namespace
+
+Status add_planar_reflections(const std::vector<PlanarMirror>& mirrors, int max_depth,
+                              const MirrorView& view, const MirrorViewPass& pass, FrameBuffers& fb,
+                              MirrorStats& stats) {
+  for (const PlanarMirror& m : mirrors) {
+    std::vector<size_t> seen;  // the pixels where this view sees mirror m
+    for (size_t o = 0; o < fb.pixel_count(); ++o)
+      if (fb.object_id[o] == m.object) seen.push_back(o);
+    if (seen.empty()) continue;
+    if (view.depth >= max_depth) {  // the tracer's recursion limit: the mirrored share dropped
+      for (size_t o : seen) fb.colour[o] = (1.0f - m.mirror) * fb.colour[o];
+      stats.dropped += seen.size();
+      continue;
+    }
+    const MirrorView child = reflected_view(view, m);
+    Expected<FrameBuffers> reflected = pass(child);
+    if (!reflected) return reflected.error();
+    ++stats.passes;
+    stats.deepest = std::max(stats.deepest, child.depth);
+    RVR_TRY(add_planar_reflections(mirrors, max_depth, child, pass, *reflected, stats));
+    RVR_CHECK(reflected->colour.size() == fb.colour.size(),
+              "a reflected view has the frame's size");
+    // The tracer's sum: (1 - mirror - transparency) · local, plus mirror · reflected. The
+    // z-buffers leave transparency out (its share stays local), so the first term is (1 - mirror).
+    for (size_t o : seen)
+      fb.colour[o] = (1.0f - m.mirror) * fb.colour[o] + m.mirror * reflected->colour[o];
+    stats.pixels += seen.size();
+  }
+  return ok_status();
+}
+
+void record_mirror_stats(const MirrorStats& stats, double seconds, RenderOutput& out) {
+  out.stats["mirror.views"] = double(stats.passes);
+  out.stats["mirror.depth"] = double(stats.deepest);
+  out.stats["mirror.pixels"] = double(stats.pixels);
+  out.stats["mirror.pixels_at_limit"] = double(stats.dropped);
+  out.stats["time.mirrors"] = seconds;
+}
+
+std::string curved_mirrors_warning(const std::vector<std::string>& curved) {
+  std::string names;
+  for (const std::string& s : curved) names += (names.empty() ? "" : ", ") + s;
+  return fmt::format(
+      "mirror reflection not rendered on {} curved mirror{} ({}): a z-buffer reflects planar "
+      "mirrors only",
+      curved.size(), curved.size() == 1 ? "" : "s", names);
+}
+
+}  // namespace rvr

@@ -1,0 +1,197 @@
+// The z-buffers' planar mirrors (raster/src/planar_mirrors.h): a reflected view per mirror seen,
+// clipped at the mirror, composited by the shading equation, recursing to --max-depth. Held to
+// the tracer's reflection rays with primary visibility's tolerance.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <glm/glm.hpp>
+#include <string>
+
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+#include "rvr/scene_io/scene_loader.h"
+#include "table_render.h"
+
+namespace rvr {
+namespace {
+
+// Two mirrors turned towards each other (each sees the other, so reflections recurse), two balls
+// and a floor. Every surface only glows (no lights, no ambient): a pixel's colour is its own
+// emission, or (1 - m) of a mirror's plus m of what the mirror shows, so the colour names the
+// chain of surfaces a pixel sees and both loop orders compute it with the same float operations.
+// Balls as the z-buffers' tessellation in both (SphereMode::Mesh): the same triangles.
+constexpr const char* kTwoMirrors = R"({
+  "format": "rvr-scene/1",
+  "image": { "width": 160, "height": 120, "background": [0.05, 0.05, 0.05] },
+  "camera": { "eye": [0.3, 1.4, 5], "target": [0, 0.9, 0], "up": [0, 1, 0], "fov_y_deg": 50 },
+  "ambient": [0, 0, 0],
+  "materials": {
+    "floor":   { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.2, 0.25, 0.6] },
+    "red":     { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.9, 0.1, 0.1] },
+    "green":   { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.1, 0.8, 0.2] },
+    "mirror":  { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.3, 0.3, 0.1],
+                 "mirror": 0.75 },
+    "mirror2": { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.1, 0.3, 0.3],
+                 "mirror": 0.6 }
+  },
+  "objects": [
+    { "name": "floor", "type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0],
+      "half_size": 4, "material": "floor" },
+    { "name": "left mirror", "type": "plane", "point": [-1.3, 1.2, -0.6],
+      "normal": [0.8, 0, 0.6], "half_size": 1.1, "material": "mirror" },
+    { "name": "right mirror", "type": "plane", "point": [1.5, 1.1, -0.4],
+      "normal": [-0.8, 0, 0.6], "half_size": 1.0, "material": "mirror2" },
+    { "name": "red ball", "type": "sphere", "center": [0.1, 0.5, 0.4], "radius": 0.5,
+      "material": "red" },
+    { "name": "green ball", "type": "sphere", "center": [-0.9, 0.4, 3.0], "radius": 0.35,
+      "material": "green" }
+  ]
+})";
+constexpr uint32_t kLeftMirror = 1, kRightMirror = 2;
+
+// Primary visibility's tolerance (test_conformance): the two agree at every pixel but on edge
+// ties, a float rounding on either side of an edge, at most 1 pixel in 1000. Agreeing pixels
+// see the same surfaces and compute the same floats: 1e-6 is rounding, a wrong surface in the
+// chain differs by at least 0.01 here.
+constexpr double kMinAgreement = 0.999;
+constexpr float kSameColour = 1e-6f;
+
+Scene two_mirrors() {
+  Expected<Scene> scene = load_scene_text(kTwoMirrors, "two_mirrors", ".");
+  EXPECT_TRUE(scene.ok()) << (scene.ok() ? "" : scene.error().message);
+  return scene.ok() ? std::move(scene).value() : Scene{};
+}
+
+RenderOutput render(const std::string& renderer, const Scene& scene, int max_depth) {
+  RenderOptions options;
+  options.mode = RenderMode::Full;
+  options.spheres = SphereMode::Mesh;
+  options.max_depth = max_depth;
+  return test::table_render(renderer, scene, options);
+}
+
+float colour_difference(const FrameBuffers& a, const FrameBuffers& b, size_t i) {
+  const glm::vec3 d = glm::abs(a.colour[i] - b.colour[i]);
+  return std::max({d.x, d.y, d.z});
+}
+
+// Whether pixel (x, y) of `fb` lies beside an edge of its image: a neighbour of another colour.
+bool beside_an_edge(const FrameBuffers& fb, int x, int y) {
+  const size_t i = size_t(y) * size_t(fb.width) + size_t(x);
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int nx = x + dx, ny = y + dy;
+      if (nx < 0 || ny < 0 || nx >= fb.width || ny >= fb.height) continue;
+      const size_t j = size_t(ny) * size_t(fb.width) + size_t(nx);
+      const glm::vec3 d = glm::abs(fb.colour[i] - fb.colour[j]);
+      if (std::max({d.x, d.y, d.z}) > kSameColour) return true;
+    }
+  return false;
+}
+
+// The same mirrors with the balls lit by a point light above them (diffuse and a Blinn-Phong
+// highlight, which moves with the eye), everything else glowing as before: nothing the light
+// reaches is shadowed but the balls' own far sides, so shadow maps and shadow rays agree.
+Scene two_mirrors_lit() {
+  Scene scene = two_mirrors();
+  for (uint32_t ball : {3u, 4u}) {
+    Material& m = scene.materials[scene.objects[ball].material];
+    m.diffuse = m.emission * 0.6f;
+    m.specular = glm::vec3(0.5f);
+    m.shininess = 40.0f;
+    m.emission = glm::vec3(0.0f);
+  }
+  scene.ambient = glm::vec3(0.05f);
+  Light light;
+  light.type = LightType::Point;
+  light.position = {0.2f, 4.0f, 2.0f};
+  light.intensity = glm::vec3(12.0f);
+  scene.lights.push_back(light);
+  return scene;
+}
+
+class PlanarMirrors : public ::testing::TestWithParam<const char*> {};
+
+// Every pixel, mirror pixels included, at every recursion limit: the z-buffer's colour is the
+// tracer's but on edge ties of the image it shows (primary edges or reflected ones).
+TEST_P(PlanarMirrors, AgreeWithTheTracersReflectionRaysAtEveryDepth) {
+  const Scene scene = two_mirrors();
+  for (int max_depth : {0, 1, 2, 5}) {
+    // The longest chain of mirrors this geometry has: a ray reflected thrice between the two
+    // leaves them (the tracer's image agrees, so the z-buffer's views stop there too).
+    constexpr int kLongestChain = 3;
+    const RenderOutput z = render(GetParam(), scene, max_depth);
+    const RenderOutput t = render("raytrace", scene, max_depth);
+    const FrameBuffers &a = z.buffers, &b = t.buffers;
+    ASSERT_EQ(a.pixel_count(), b.pixel_count());
+    size_t mirror_pixels = 0, differing = 0, away_from_edges = 0;
+    for (int y = 0; y < a.height; ++y)
+      for (int x = 0; x < a.width; ++x) {
+        const size_t i = size_t(y) * size_t(a.width) + size_t(x);
+        mirror_pixels += b.object_id[i] == kLeftMirror || b.object_id[i] == kRightMirror;
+        if (colour_difference(a, b, i) <= kSameColour) continue;
+        ++differing;
+        if (!beside_an_edge(b, x, y)) ++away_from_edges;
+      }
+    const std::string where = std::string(GetParam()) + " max_depth " + std::to_string(max_depth);
+    // Something to agree on: both mirrors fill a fifth of the frame.
+    EXPECT_GT(mirror_pixels, a.pixel_count() / 5) << where;
+    EXPECT_LE(double(differing), (1.0 - kMinAgreement) * double(a.pixel_count())) << where;
+    EXPECT_EQ(away_from_edges, 0u) << where;
+    // The views drawn: none at depth 0, and the two mirrors see each other to the limit.
+    EXPECT_EQ(z.stats.at("mirror.depth"), double(std::min(max_depth, kLongestChain))) << where;
+    EXPECT_EQ(z.stats.at("mirror.views") > 0, max_depth > 0) << where;
+    EXPECT_EQ(z.stats.at("mirror.pixels_at_limit") > 0, max_depth < kLongestChain) << where;
+  }
+}
+
+// Without the reflected views (every mirror at the limit from the start) the mirrors lose what
+// they show: the agreement above is the reflections', not the scene's.
+TEST_P(PlanarMirrors, TheReflectionsAreWhatTheMirrorsShow) {
+  const Scene scene = two_mirrors();
+  const RenderOutput none = render(GetParam(), scene, 0);
+  const RenderOutput t = render("raytrace", scene, 5);
+  size_t differing = 0;
+  for (size_t i = 0; i < t.buffers.pixel_count(); ++i)
+    differing += colour_difference(none.buffers, t.buffers, i) > 0.01f;
+  EXPECT_GT(differing, t.buffers.pixel_count() / 5);
+}
+
+// A reflected view shades towards the eye reflected in its mirrors (the direction the tracer's
+// reflection ray arrives from): the balls' highlights, seen in the mirrors, sit where the
+// tracer's do. Primary visibility's colour bound (test_conformance: 1e-3 per pixel, the same
+// equation on float inputs) everywhere but on 1 pixel in 1000 (the edge ties).
+TEST_P(PlanarMirrors, ReflectionsAreShadedFromTheReflectedEye) {
+  const Scene scene = two_mirrors_lit();
+  const RenderOutput z = render(GetParam(), scene, 5);
+  const RenderOutput t = render("raytrace", scene, 5);
+  size_t differing = 0;
+  for (size_t i = 0; i < t.buffers.pixel_count(); ++i)
+    differing += colour_difference(z.buffers, t.buffers, i) > 1e-3f;
+  EXPECT_LE(double(differing), (1.0 - kMinAgreement) * double(t.buffers.pixel_count()));
+}
+
+// The mirrors' planes are found from their meshes; a curved mirror is said, by name, and drawn
+// with its local share only.
+TEST_P(PlanarMirrors, ACurvedMirrorIsNamedInAWarning) {
+  Scene scene = make_builtin_scene("cornell").value();
+  scene.image.width = 64;
+  scene.image.height = 48;
+  RenderOptions options;
+  options.mode = RenderMode::Full;
+  const RenderOutput out = test::table_render(GetParam(), scene, options);
+  bool named = false;
+  for (const std::string& w : out.warnings)
+    named |=
+        w.find("curved mirror") != std::string::npos && w.find("mirror ball") != std::string::npos;
+  EXPECT_TRUE(named);
+  EXPECT_EQ(out.stats.count("mirror.views"), 0u);
+}
+
+INSTANTIATE_TEST_SUITE_P(ZBuffers, PlanarMirrors, ::testing::Values("softraster"));
+
+}  // namespace
+}  // namespace rvr
