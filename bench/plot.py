@@ -121,7 +121,7 @@ def effect_rows(rows):
             table[f"{p[1]} ({p[3]})"][p[2]] = ms(b)
     # Registration order (the JSON's is the random interleaving's): cheapest effect first.
     order = ["primary", "hard_shadows", "area_light_4x4"] + [f"mirror_depth_{d}" for d in range(1, 6)]
-    order += ["glass", "dof_16"]
+    order += ["planar_mirror", "glass", "dof_16"]
     rank = {n: i for i, n in enumerate(order)}
     return {r: dict(sorted(e.items(), key=lambda kv: rank.get(kv[0], len(order))))
             for r, e in table.items()}

@@ -281,6 +281,15 @@ void effect_scene(const std::string& effect, Scene& scene, RenderOptions& option
     // A second mirror facing the first one: depth matters only between mirrors.
     for (Object& o : scene.objects)
       if (o.name == "back wall") o.material = scene.objects[6].material;
+  } else if (effect == "planar_mirror") {
+    // The back wall a mirror (flat: every renderer reflects it, the z-buffers by a reflected
+    // view), the ball matt.
+    for (Material& m : scene.materials)
+      if (m.name == "mirror") m.mirror = 0.85f;
+    for (Object& o : scene.objects) {
+      if (o.name == "back wall") o.material = scene.objects[6].material;
+      if (o.name == "mirror ball") o.material = scene.objects[0].material;
+    }
   } else if (effect == "glass") {
     for (Material& m : scene.materials)
       if (m.name == "glass") m.transparency = 0.9f;
@@ -694,7 +703,7 @@ void register_all() {
             ->UseRealTime();
   for (std::string e :
        {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1", "mirror_depth_2",
-        "mirror_depth_3", "mirror_depth_4", "mirror_depth_5", "glass", "dof_16"}) {
+        "mirror_depth_3", "mirror_depth_4", "mirror_depth_5", "planar_mirror", "glass", "dof_16"}) {
     benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
@@ -706,7 +715,8 @@ void register_all() {
           ->UseRealTime();
   }
   // The z-buffers' own answers to the effects they render, by technique: primary visibility,
-  // shadow maps, and depth of field by the accumulation buffer (raster also by MSAA: a pinhole).
+  // shadow maps, a flat mirror by reflected views, and depth of field by the accumulation buffer
+  // (raster also by MSAA: a pinhole) or a blur.
   struct ZBufferEffect {
     std::string renderer, effect, technique;
     Supersampling supersampling = Supersampling::Accumulation;
@@ -716,6 +726,7 @@ void register_all() {
     std::vector<ZBufferEffect> cases = {{z, "primary", "zbuffer"},
                                         {z, "hard_shadows", "shadow_maps"},
                                         {z, "area_light_4x4", "shadow_maps"},
+                                        {z, "planar_mirror", "reflected_views"},
                                         {z, "dof_16", "accumulation"}};
     cases.push_back({z, "dof_16", "blur", Supersampling::Accumulation, ZBufferDof::Blur});
     if (z == "raster") cases.push_back({z, "dof_16", "msaa", Supersampling::Msaa});

@@ -33,6 +33,7 @@
 #include "gl_objects.h"
 #include "gl_program.h"
 #include "gl_shaders.h"
+#include "planar_mirrors.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/image_sample.h"
@@ -83,7 +84,7 @@ struct SceneUniforms {
         smooth = -1, use_primitive_id = -1, object_id = -1, diffuse = -1, specular = -1,
         emission = -1, shininess = -1, lights = -1, light_first = -1, light_end = -1, base = -1,
         shadows = -1, shadow_maps = -1, face_rotation = -1, shadow_bias = -1, shadow_texel = -1,
-        shadow_pcf = -1, textured = -1, coloured = -1, texture = -1;
+        shadow_pcf = -1, textured = -1, coloured = -1, texture = -1, keep = -1;
 };
 
 // Texture units of the scene pass.
@@ -199,6 +200,11 @@ struct ScenePass {
   glm::mat4 view, projection;
   DepthFormat depth_format;
   glm::vec3 eye;  // where the pass looks from: the camera's eye or a sample's lens point
+  // A planar mirror's view (planar_mirrors.h): only what lies on the positive side of the world
+  // plane `keep` is drawn (when `clipped`), and not the mirror `hidden`.
+  bool clipped = false;
+  glm::vec4 keep{0.0f, 0.0f, 0.0f, 1.0f};
+  uint32_t hidden = kNoId;
 };
 
 // Renderbuffer format of a z-buffer format.
@@ -221,15 +227,13 @@ glm::mat4 reversed_z_projection(glm::mat4 projection, float near_plane, float fa
 
 // What a z-buffer cannot do, named for this scene only (shadows it does, with shadow maps).
 void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& options,
-                                    const SceneUpload& upload, std::vector<std::string>& warnings) {
+                                    const SceneUpload& upload,
+                                    const std::vector<std::string>& curved_mirrors,
+                                    std::vector<std::string>& warnings) {
   if (!upload.prepared.skipped_csg.empty())
     warnings.push_back(skipped_csg_warning(upload.prepared.skipped_csg));
   if (options.mode != RenderMode::Full) return;
-  std::string mirrors =
-      material_names(upload.draws, [](const Material& m) { return m.mirror > 0.0f; });
-  if (!mirrors.empty())
-    warnings.push_back(
-        fmt::format("reflection (mirror materials: {}) not rendered by a z-buffer", mirrors));
+  if (!curved_mirrors.empty()) warnings.push_back(curved_mirrors_warning(curved_mirrors));
   std::string clear =
       material_names(upload.draws, [](const Material& m) { return m.transparency > 0.0f; });
   if (!clear.empty())
@@ -355,6 +359,8 @@ struct GlRasterizer::Impl {
   void draw_to_every_target();
   Status cost_pass(const ScenePass& pass);
   Status readback(int w, int h, const ScenePass& pass, FrameBuffers& fb, uint64_t& samples_passed);
+  Status add_mirrors(const ScenePass& camera, const std::vector<PlanarMirror>& mirrors,
+                     RenderOutput& out);
 };
 
 Status GlRasterizer::Impl::init() {
@@ -387,6 +393,7 @@ Status GlRasterizer::Impl::create_resources() {
   su.view = loc("u_view");
   su.projection = loc("u_projection");
   su.eye = loc("u_eye");
+  su.keep = loc("u_keep");
   su.ambient = loc("u_ambient");
   su.background = loc("u_background");
   su.shade = loc("u_shade");
@@ -797,6 +804,7 @@ void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size
   gl().UniformMatrix4fv(su.view, 1, GL_FALSE, glm::value_ptr(pass.view));
   gl().UniformMatrix4fv(su.projection, 1, GL_FALSE, glm::value_ptr(pass.projection));
   gl().Uniform3fv(su.eye, 1, glm::value_ptr(pass.eye));
+  gl().Uniform4fv(su.keep, 1, glm::value_ptr(pass.keep));
   gl().Uniform3fv(su.ambient, 1, glm::value_ptr(scene.ambient));
   gl().Uniform3fv(su.background, 1, glm::value_ptr(scene.image.background));
   gl().Uniform1i(su.shade, shade_pass ? 1 : 0);
@@ -816,6 +824,7 @@ void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size
   gl().Uniform1i(su.texture, kTextureUnit);
   gl().ActiveTexture(GLenum(GL_TEXTURE0 + kTextureUnit));
   for (const DrawItem& d : pass.upload.draws) {
+    if (d.object == pass.hidden) continue;
     gl().Uniform1i(su.textured, d.texture != 0 ? 1 : 0);
     gl().Uniform1i(su.coloured, d.coloured ? 1 : 0);
     gl().BindTexture(GL_TEXTURE_2D, d.texture);
@@ -876,6 +885,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
 
   gl().Disable(GL_CULL_FACE);  // two-sided, like the tracer
   gl().Disable(GL_BLEND);
+  if (pass.clipped) gl().Enable(GL_CLIP_DISTANCE0);
   gl().ActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
   gl().BindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
   gl().ActiveTexture(GL_TEXTURE0);
@@ -953,6 +963,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
   gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
   draw_to_every_target();
   gl().Finish();
+  gl().Disable(GL_CLIP_DISTANCE0);
   use_depth_convention(false);
   RVR_GL_CHECK("scene pass");
   out.stats["time.render"] = seconds_since(t) - shadow_time;
@@ -1058,10 +1069,10 @@ Status GlRasterizer::Impl::readback(int w, int h, const ScenePass& pass, FrameBu
 Expected<RenderOutput> GlRasterizer::Impl::render(const Scene& scene,
                                                   const RenderOptions& options) {
   // Several samples per pixel: the accumulation buffer, a pass per sample (unless msaa).
-  // Its passes share their shadow maps.
+  // The passes of one render (its samples' and its mirrors') share their shadow maps.
   const bool accumulate =
       accumulates(scene, options) && options.supersampling == Supersampling::Accumulation;
-  keep_shadow_maps = accumulate;
+  keep_shadow_maps = true;
   shadow_maps_kept = false;
   Expected<RenderOutput> out =
       accumulate
@@ -1166,8 +1177,43 @@ Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
   }
   out.stats["fragments.passed"] = double(passed);
   out.stats["pixels.covered"] = double(covered);
-  note_what_a_zbuffer_leaves_out(scene, options, *uploaded, out.warnings);
+
+  std::vector<std::string> curved;
+  if (options.mode == RenderMode::Full) {
+    const std::vector<PlanarMirror> mirrors = planar_mirrors(scene, uploaded->prepared, curved);
+    if (!mirrors.empty()) RVR_TRY(add_mirrors(pass, mirrors, out));
+  }
+  note_what_a_zbuffer_leaves_out(scene, options, *uploaded, curved, out.warnings);
   return out;
+}
+
+// Full mode's planar mirrors: a view per mirror seen, drawn and shaded single-sampled as the
+// camera's pass is, read back and composited into `out` (planar_mirrors.h).
+Status GlRasterizer::Impl::add_mirrors(const ScenePass& camera,
+                                       const std::vector<PlanarMirror>& mirrors,
+                                       RenderOutput& out) {
+  const auto t = Clock::now();
+  const int w = camera.scene.image.width, h = camera.scene.image.height;
+  MirrorStats stats;
+  const MirrorViewPass draw_view = [&](const MirrorView& view) -> Expected<FrameBuffers> {
+    ScenePass pass = camera;
+    pass.view = glm::mat4(glm::dmat4(camera.view) * view.reflection);
+    pass.eye = view.eye;
+    pass.clipped = view.keep.has_value();
+    if (view.keep) pass.keep = glm::vec4(*view.keep);
+    pass.hidden = view.hidden;
+    RenderOutput reflected;
+    RVR_TRY(scene_passes(pass, 1, reflected));
+    uint64_t passed = 0;
+    RVR_TRY(readback(w, h, pass, reflected.buffers, passed));
+    return std::move(reflected.buffers);
+  };
+  MirrorView view;
+  view.eye = camera.eye;
+  RVR_TRY(add_planar_reflections(mirrors, camera.options.max_depth, view, draw_view, out.buffers,
+                                 stats));
+  record_mirror_stats(stats, seconds_since(t), out);
+  return ok_status();
 }
 
 GlRasterizer::GlRasterizer(GlBackend backend) : impl_(std::make_unique<Impl>()) {

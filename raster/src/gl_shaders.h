@@ -30,6 +30,9 @@ layout(location = 4) in vec3 a_colour;
 
 uniform mat4 u_view;
 uniform mat4 u_projection;
+// A planar mirror's view draws only what lies beyond the mirror: the world plane u_keep, as
+// gl_ClipDistance[0] (enabled for those views only; (0, 0, 0, 1) keeps everything).
+uniform vec4 u_keep;
 
 out vec3 v_world;
 out float v_view_depth;
@@ -47,6 +50,7 @@ void main() {
   v_geometric_normal = a_geometric_normal;
   v_uv = a_uv;
   v_colour = a_colour;
+  gl_ClipDistance[0] = dot(u_keep, vec4(a_position, 1.0));
   gl_Position = u_projection * eye;
 }
 )glsl";
