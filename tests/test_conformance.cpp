@@ -84,7 +84,7 @@ std::vector<RendererCase> renderer_cases() {
 // test_raster) and there is nothing to agree on.
 const char* kScenes[] = {"cornell",   "spheres",         "occluders:16", "occluders_back:16",
                          "soup:2000", "tessphere:20000", "effects:5000", "dof",
-                         "discs",     "glass",           "textured"};
+                         "discs",     "mirrors:16",      "glass",        "textured"};
 
 TEST(ConformanceScenes, CoverEveryBuiltinSceneButCsg) {
   std::set<std::string> listed;

@@ -120,7 +120,10 @@ TEST_P(HybridFullMode, IsTheTracersImageButOnEdges) {
     untextured_same =
         untextured_same && std::memcmp(&a.colour[i], &b.colour[i], sizeof(a.colour[i])) == 0;
   }
-  if (m.visibility.mismatched_pixels == 0) {
+  // The ids are the centre samples': with several samples per pixel another sample may still
+  // fall either way on an edge (dof: 67 dB with every centre id agreeing), so byte identity
+  // follows from agreeing ids only with one sample.
+  if (m.visibility.mismatched_pixels == 0 && scene.image.samples_per_pixel == 1) {
     EXPECT_TRUE(untextured_same) << "ids agree everywhere";
   }
   if (scene_name == "textured") {

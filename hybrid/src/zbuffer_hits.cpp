@@ -56,7 +56,7 @@ bool ZBufferHits::only_background(int x0, int y0, int x1, int y1) const {
 // draws approximately or not at all may appear.
 bool ZBufferHits::may_hide_a_surface(int x, int y) const {
   const size_t width = size_t(visible_.width);
-  if (!approximated_.empty() && approximated_[size_t(y) * width + size_t(x)]) return true;
+  if (approximated_at(size_t(y) * width + size_t(x))) return true;
   for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, visible_.height - 1); ++ny)
     for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, visible_.width - 1); ++nx)
       if (visible_.object_id[size_t(ny) * width + size_t(nx)] != kNoId) return true;
@@ -83,7 +83,7 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
   uint64_t background = 0;
   // The ids the z-buffer drew, and which pixels need a ray at all.
   uint32_t object[kPacketRays], primitive[kPacketRays];
-  bool drawn[kPacketRays], rebuilt[kPacketRays];
+  bool drawn[kPacketRays], rebuilt[kPacketRays], approximate[kPacketRays];
   for (int y = block.y0, k = 0; y < block.y1; ++y)
     for (int x = block.x0; x < block.x1; ++x, ++k) {  // ray k is pixel (x, y)
       const size_t i = size_t(y) * size_t(visible_.width) + size_t(x);
@@ -92,6 +92,7 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
       object[k] = visible_.object_id[i];
       primitive[k] = visible_.primitive_id[i];
       drawn[k] = object[k] != kNoId;
+      approximate[k] = approximated_at(i);
       hits[k] = HitRecord{};
       work[k] = TraversalCounters{};
       traced[k] = !drawn[k] && may_hide_a_surface(x, y);
@@ -105,12 +106,14 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
       n_traced += traced[k];
       continue;
     }
-    if (!rebuilt[k]) {
+    if (!rebuilt[k] || approximate[k]) {
       // The z-buffer's polygon covers the centre where the exact surface does not
-      // (silhouettes, shared edges): the tracer decides, below.
+      // (silhouettes, shared edges), or the centre lies where a shape it draws approximately
+      // may cover what it drew (a sphere's inscribed polygon misses the rim in front of the
+      // surface it shows there): the tracer decides, below.
       traced[k] = true;
       n_traced++;
-      counters.fallback_missed++;
+      counters.fallback_missed += !rebuilt[k];
       continue;
     }
     counters.rebuilt++;
@@ -161,7 +164,7 @@ void ZBufferHits::sample_hits(SampleBlock& block) const {
       const Ray& ray = block.rays[j];
       HitRecord& hit = block.hits[j];
       hit = HitRecord{};
-      const bool rebuilt = visible_.object_id[i] != kNoId &&
+      const bool rebuilt = visible_.object_id[i] != kNoId && !approximated_at(i) &&
                            geometry_.intersect_named(ray, visible_.object_id[i],
                                                      visible_.primitive_id[i], hit, block.work);
       // A hit rebuilt from the z-buffer samples its texture at the z-buffer's level.
@@ -175,7 +178,7 @@ void ZBufferHits::sample_hits(SampleBlock& block) const {
         }
       } else {
         counters.fallback_traced++;
-        counters.fallback_missed += visible_.object_id[i] != kNoId;
+        counters.fallback_missed += visible_.object_id[i] != kNoId && !approximated_at(i);
         if (!geometry_.closest(ray, hit, block.work)) hit = HitRecord{};
       }
     }

@@ -22,8 +22,9 @@ namespace rvr {
 
 class ZBufferHits : public PrimaryHitSource {
  public:
-  // `approximated`: 1 at the pixels a z-buffer may leave empty where the scene is not
-  // (approximated_pixels), row-major; empty: none.
+  // `approximated`: 1 at the pixels where a shape the z-buffer draws approximately may appear
+  // (approximated_pixels), row-major; empty: none. There the z-buffer may show nothing, or a
+  // surface behind the shape, where the tracer sees the shape: those pixels are traced.
   ZBufferHits(const Scene& scene, const TraceGeometry& geometry, const PrimaryVisibility& visible,
               std::span<const uint8_t> approximated = {});
 
@@ -36,6 +37,8 @@ class ZBufferHits : public PrimaryHitSource {
 
  private:
   bool may_hide_a_surface(int x, int y) const;
+  // Pixel i lies where a shape the z-buffer draws approximately may appear.
+  bool approximated_at(size_t i) const { return !approximated_.empty() && approximated_[i]; }
   // Whether the hit a CSG object gives `ray` is nearer than `hit` (ties by primitive index, as
   // closest() breaks them); if so `hit` becomes it.
   bool csg_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const;

@@ -97,33 +97,88 @@ MirrorView reflected_view(const MirrorView& parent, const PlanarMirror& m) {
 
 }  // namespace
 
-Status add_planar_reflections(const std::vector<PlanarMirror>& mirrors, int max_depth,
-                              const MirrorView& view, const MirrorViewPass& pass, FrameBuffers& fb,
-                              MirrorStats& stats) {
-  for (const PlanarMirror& m : mirrors) {
-    std::vector<size_t> seen;  // the pixels where this view sees mirror m
-    for (size_t o = 0; o < fb.pixel_count(); ++o)
-      if (fb.object_id[o] == m.object) seen.push_back(o);
+namespace {
+
+// The pixels of a view that matter (all of the camera's; of a reflected view, those where the
+// view above it sees its mirror), with the view's colour and object id at each.
+struct ViewPixels {
+  std::vector<size_t> pixel;
+  std::vector<glm::vec3> colour;
+  std::vector<uint32_t> id;
+};
+
+// For each mirror, the indices into `px` of the pixels that see it.
+std::vector<std::vector<size_t>> pixels_per_mirror(const std::vector<PlanarMirror>& mirrors,
+                                                   const ViewPixels& px) {
+  uint32_t last_object = 0;
+  for (const PlanarMirror& m : mirrors) last_object = std::max(last_object, m.object);
+  std::vector<int> mirror_of(size_t(last_object) + 1, -1);
+  for (size_t i = 0; i < mirrors.size(); ++i) mirror_of[mirrors[i].object] = int(i);
+  std::vector<std::vector<size_t>> seen_by(mirrors.size());
+  for (size_t k = 0; k < px.id.size(); ++k) {
+    const uint32_t id = px.id[k];
+    if (id <= last_object && mirror_of[id] >= 0) seen_by[size_t(mirror_of[id])].push_back(k);
+  }
+  return seen_by;
+}
+
+// The recursion of add_planar_reflections over the pixels `px` of `view`. A reflected view's
+// frame is kept only at the pixels that see its mirror (what the view above needs), so a chain
+// of reflections holds one frame at a time however deep it goes.
+Status reflect(const std::vector<PlanarMirror>& mirrors, int max_depth, const MirrorView& view,
+               const MirrorViewPass& pass, ViewPixels& px, MirrorStats& stats) {
+  const std::vector<std::vector<size_t>> seen_by = pixels_per_mirror(mirrors, px);
+  for (size_t i = 0; i < mirrors.size(); ++i) {
+    const PlanarMirror& m = mirrors[i];
+    const std::vector<size_t>& seen = seen_by[i];
     if (seen.empty()) continue;
     if (view.depth >= max_depth) {  // the tracer's recursion limit: the mirrored share dropped
-      for (size_t o : seen) fb.colour[o] = (1.0f - m.mirror) * fb.colour[o];
+      for (size_t k : seen) px.colour[k] = (1.0f - m.mirror) * px.colour[k];
       stats.dropped += seen.size();
       continue;
     }
     const MirrorView child = reflected_view(view, m);
-    Expected<FrameBuffers> reflected = pass(child);
-    if (!reflected) return reflected.error();
+    ViewPixels reflected;
+    {
+      Expected<FrameBuffers> frame = pass(child);
+      if (!frame) return frame.error();
+      RVR_CHECK(frame->colour.size() == frame->pixel_count() &&
+                    frame->object_id.size() == frame->pixel_count(),
+                "a reflected view has colour and ids at every pixel");
+      for (size_t k : seen) {
+        const size_t p = px.pixel[k];
+        RVR_CHECK(p < frame->pixel_count(), "a reflected view has the frame's size");
+        reflected.pixel.push_back(p);
+        reflected.colour.push_back(frame->colour[p]);
+        reflected.id.push_back(frame->object_id[p]);
+      }
+    }
     ++stats.passes;
     stats.deepest = std::max(stats.deepest, child.depth);
-    RVR_TRY(add_planar_reflections(mirrors, max_depth, child, pass, *reflected, stats));
-    RVR_CHECK(reflected->colour.size() == fb.colour.size(),
-              "a reflected view has the frame's size");
+    RVR_TRY(reflect(mirrors, max_depth, child, pass, reflected, stats));
     // The tracer's sum: (1 - mirror - transparency) · local, plus mirror · reflected. The
     // z-buffers leave transparency out (its share stays local), so the first term is (1 - mirror).
-    for (size_t o : seen)
-      fb.colour[o] = (1.0f - m.mirror) * fb.colour[o] + m.mirror * reflected->colour[o];
+    for (size_t j = 0; j < seen.size(); ++j) {
+      glm::vec3& c = px.colour[seen[j]];
+      c = (1.0f - m.mirror) * c + m.mirror * reflected.colour[j];
+    }
     stats.pixels += seen.size();
   }
+  return ok_status();
+}
+
+}  // namespace
+
+Status add_planar_reflections(const std::vector<PlanarMirror>& mirrors, int max_depth,
+                              const MirrorView& view, const MirrorViewPass& pass, FrameBuffers& fb,
+                              MirrorStats& stats) {
+  ViewPixels px;
+  px.pixel.resize(fb.pixel_count());
+  for (size_t p = 0; p < px.pixel.size(); ++p) px.pixel[p] = p;
+  px.colour.assign(fb.colour.begin(), fb.colour.end());
+  px.id.assign(fb.object_id.begin(), fb.object_id.end());
+  RVR_TRY(reflect(mirrors, max_depth, view, pass, px, stats));
+  std::copy(px.colour.begin(), px.colour.end(), fb.colour.begin());
   return ok_status();
 }
 

@@ -60,8 +60,10 @@ struct MirrorStats {
 
 // The reflections of every planar mirror seen in `fb` (drawn through `view`), composited as the
 // tracer's shading equation: on the pixels whose object is mirror m, colour = (1 - m) · colour +
-// m · (the view reflected in m there). A view holding max_depth reflections gets no more: its
-// mirror pixels keep (1 - m) · colour, the mirrored share dropped, as the tracer drops it.
+// m · (the view reflected in m there). A reflected view's own mirrors count only where its
+// mirror is seen: a mirror it shows elsewhere gets no view. A view holding max_depth reflections
+// gets no more: its mirror pixels keep (1 - m) · colour, the mirrored share dropped, as the tracer
+// drops it.
 Status add_planar_reflections(const std::vector<PlanarMirror>& mirrors, int max_depth,
                               const MirrorView& view, const MirrorViewPass& pass, FrameBuffers& fb,
                               MirrorStats& stats);

@@ -219,6 +219,49 @@ Scene discs() {
   return s;
 }
 
+// A wall of N flat square mirrors (k x k cells, k = ceil(sqrt(N)), filled row by row from the
+// top), each turned a few degrees its own way, facing three balls on a floor: the tracer pays a
+// reflection ray per mirror pixel whatever N is, a z-buffer a whole view per mirror seen. N = 1
+// is one large mirror filling the wall.
+Scene mirrors(size_t n) {
+  Scene s = base_scene("mirrors:" + std::to_string(n));
+  add_floor(s, {0.6f, 0.6f, 0.55f}, {0, 0, 0}, 6.0f);
+  uint32_t mirror = add_material(s, "mirror", {0.1f, 0.1f, 0.1f}, {0.9f, 0.9f, 0.9f}, 200.0f);
+  s.materials[mirror].mirror = 0.85f;
+  const uint32_t red = add_material(s, "red", {0.7f, 0.1f, 0.1f}, glm::vec3(0.3f), 24.0f);
+  const uint32_t blue = add_material(s, "blue", {0.15f, 0.25f, 0.75f}, glm::vec3(0.3f), 24.0f);
+  const uint32_t gold = add_material(s, "gold", {0.75f, 0.6f, 0.2f}, glm::vec3(0.5f), 48.0f);
+  const uint32_t teal = add_material(s, "teal", {0.2f, 0.5f, 0.5f});
+  // Behind the camera, for the mirrors to show.
+  add_quad(s, "backdrop", teal, {6.0f, 0.0f, 8.0f}, {-6.0f, 0.0f, 8.0f}, {-6.0f, 6.0f, 8.0f},
+           {6.0f, 6.0f, 8.0f});
+  const size_t k = size_t(std::ceil(std::sqrt(double(n))));
+  // The wall: x in [-2.4, 2.4], y in [0.2, 3.8], at z = -2.
+  const float cell_w = 4.8f / float(k), cell_h = 3.6f / float(k);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t row = i / k, column = i % k;
+    const glm::vec3 centre(-2.4f + (float(column) + 0.5f) * cell_w,
+                           3.8f - (float(row) + 0.5f) * cell_h, -2.0f);
+    // Each tile turned its own way (none when it is the only one), so each has its own plane.
+    const float yaw = n == 1 ? 0.0f : glm::radians(8.0f) * std::sin(1.7f * float(i) + 0.3f);
+    const float pitch = n == 1 ? 0.0f : glm::radians(6.0f) * std::cos(2.3f * float(i) + 1.1f);
+    const glm::vec3 normal = glm::normalize(glm::vec3(
+        std::sin(yaw) * std::cos(pitch), std::sin(pitch), std::cos(yaw) * std::cos(pitch)));
+    const glm::vec3 u = glm::normalize(glm::cross(glm::vec3(0, 1, 0), normal));
+    const glm::vec3 v = glm::cross(normal, u);
+    const float hu = 0.46f * cell_w, hv = 0.46f * cell_h;
+    add_quad(s, "mirror " + std::to_string(i), mirror, centre - hu * u - hv * v,
+             centre + hu * u - hv * v, centre + hu * u + hv * v, centre - hu * u + hv * v);
+  }
+  add_sphere(s, "red ball", red, {-1.0f, 0.6f, 0.2f}, 0.6f);
+  add_sphere(s, "blue ball", blue, {0.9f, 0.5f, 0.8f}, 0.5f);
+  add_sphere(s, "gold ball", gold, {0.1f, 0.4f, 2.2f}, 0.4f);
+  look_at(s, {0.8f, 2.0f, 6.0f}, {0.0f, 1.4f, -1.0f}, 50.0f, 0.1f, 100.0f);
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  add_point_light(s, {2.0f, 5.0f, 4.0f}, {40.0f, 40.0f, 40.0f});
+  return s;
+}
+
 // N parallel quads facing the camera, one behind another; the rear ones are hidden by the
 // front one wherever it covers them, so the z-buffer shades N fragments there and the tracer 1.
 // back_to_front submits the rearmost first: the order hi-z cannot exploit.
@@ -471,6 +514,9 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
        "reflection of N triangles (default 10000)"},
       {"csg", "union, intersection, difference of spheres and a nested tree, on a floor"},
       {"discs", "discs in every orientation on a floor, one of them a round mirror"},
+      {"mirrors:N",
+       "a wall of N flat square mirrors, each turned its own way, facing three balls (default "
+       "16; 1: one large mirror)"},
       {"dof", "spheres at several depths, thin lens focused on the middle one, 16 samples"},
       {"glass", "a glass slab and a glass sphere in front of coloured quads"},
       {"textured",
@@ -506,6 +552,14 @@ Expected<Scene> make_builtin_scene(const std::string& spec) {
   if (name == "effects") return effects(has_count ? count : 10000);
   if (name == "csg") return has_count ? no_count() : Expected<Scene>(csg());
   if (name == "discs") return has_count ? no_count() : Expected<Scene>(discs());
+  if (name == "mirrors") {
+    // Each mirror seen costs a z-buffer a whole view: past a few thousand, a frame takes hours.
+    constexpr size_t kMaxMirrors = 4096;
+    if (count > kMaxMirrors)
+      return bad_input("builtin:" + spec + ": at most " + std::to_string(kMaxMirrors) +
+                       " mirrors, got " + std::to_string(count));
+    return mirrors(has_count ? count : 16);
+  }
   if (name == "dof") return has_count ? no_count() : Expected<Scene>(dof());
   if (name == "glass") return has_count ? no_count() : Expected<Scene>(glass());
   if (name == "textured") return has_count ? no_count() : Expected<Scene>(textured());
