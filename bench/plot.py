@@ -105,6 +105,32 @@ def depth_complexity(rows, context, out):
     fig.savefig(out / "depth_complexity.png", dpi=100)
 
 
+def mirrors(rows, context, out):
+    """Frame time against the number of flat mirrors (BM_Mirrors): the tracer pays per mirror
+    pixel, a z-buffer a whole view per mirror; where the lines cross is the crossover."""
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    series = defaultdict(list)
+    for b in rows:
+        p = parts(b)
+        if p[0] == "BM_Mirrors" and len(p) >= 3:
+            series[p[1]].append((int(p[2]), ms(b)))
+    for name, pts in sorted(series.items()):
+        pts.sort()
+        ax.plot([x for x, _ in pts], [y for _, y in pts], marker="o", label=name)
+    ax.set_xscale("log", base=2)
+    ax.set_yscale("log")
+    ax.set_xlabel("flat mirrors N (mirrors:N, 640x480, full mode)")
+    ax.set_ylabel("frame time (ms)")
+    ax.grid(True, alpha=0.3)
+    if series:
+        ax.legend()
+    else:
+        ax.text(0.5, 0.5, "no BM_Mirrors rows", ha="center", va="center", transform=ax.transAxes)
+    fig.suptitle("Flat mirrors: a ray per mirror pixel vs a view per mirror\n(" + subtitle(context) + ")")
+    fig.tight_layout()
+    fig.savefig(out / "mirrors.png", dpi=100)
+
+
 def effect_rows(rows):
     """BM_Effects medians in ms: {renderer: {effect: ms}}, renderer raytrace, hybrid, hybrid_soft,
     and the z-buffers' techniques as "raster (accumulation)" (BM_Effects/<zbuffer>/<effect>/<technique>)."""
@@ -419,8 +445,8 @@ def main():
     context, rows = load(sys.argv[1])
     out = Path(sys.argv[2])
     out.mkdir(parents=True, exist_ok=True)
-    for chart in (frame_vs_triangles, depth_complexity, effects, hybrid_wins, ours_vs_embree, threads,
-                  targets):
+    for chart in (frame_vs_triangles, depth_complexity, effects, mirrors, hybrid_wins, ours_vs_embree,
+                  threads, targets):
         chart(rows, context, out)
     print(f"wrote charts to {out}/")
 

@@ -5,6 +5,7 @@
 //   BM_DepthComplexityBackToFront/<renderer>/<N>  the same quads rearmost first
 //   BM_Effects/<effect>                        the tracer on cornell, one effect at a time
 //   BM_Effects/hybrid[_soft]/<effect>          the same frames with the hybrids
+//   BM_Mirrors/<renderer>/<N>                  builtin:mirrors:N, full mode: rays vs views
 //   BM_Trace/<accel>/<rays>/<scene>/<n>        one thread, rays only, no shading
 //   BM_Build/<accel>/<n>                       acceleration structure build
 //   BM_Texture/<renderer>/<lod>                builtin:textured at 640x480, local mode; lod is
@@ -298,6 +299,23 @@ void effect_scene(const std::string& effect, Scene& scene, RenderOptions& option
     scene.camera.focus_distance = 9.5f;
     scene.image.samples_per_pixel = 16;
   }  // "hard_shadows": the point light in full mode
+}
+
+// builtin:mirrors:N at 640x480 in full mode: the tracer's reflection rays (one per mirror pixel,
+// whatever N) against a z-buffer's reflected views (one whole view per mirror seen). The
+// counter mirror_views is the z-buffer's view count.
+void BM_Mirrors(benchmark::State& state, const std::string& renderer_name) {
+  Scene scene = builtin("mirrors:" + std::to_string(state.range(0)));
+  scene.image.width = 640;
+  scene.image.height = 480;
+  RenderOptions options;
+  options.mode = RenderMode::Full;
+  FrameRenderer renderer(renderer_name, scene, options);
+  PhaseTimes phases;
+  RenderOutput out = time_frames(state, renderer, phases);
+  add_counters(state, out, double(scene.image.width) * scene.image.height);
+  if (auto it = out.stats.find("mirror.views"); it != out.stats.end())
+    state.counters["mirror_views"] = it->second;
 }
 
 // The tracer on cornell with exactly one effect switched on.
@@ -714,6 +732,13 @@ void register_all() {
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
   }
+  // The crossover in the number of mirrors.
+  for (std::string r : {"raytrace", "softraster", "raster", "hybrid_soft"})
+    benchmark::RegisterBenchmark(("BM_Mirrors/" + r).c_str(), BM_Mirrors, r)
+        ->RangeMultiplier(4)
+        ->Range(1, 256)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   // The z-buffers' own answers to the effects they render, by technique: primary visibility,
   // shadow maps, a flat mirror by reflected views, and depth of field by the accumulation buffer
   // (raster also by MSAA: a pinhole) or a blur.

@@ -21,7 +21,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-CHARTS = ["frame_vs_triangles.png", "depth_complexity.png", "effects.png", "hybrid_wins.png",
+CHARTS = ["frame_vs_triangles.png", "depth_complexity.png", "effects.png", "mirrors.png",
+          "hybrid_wins.png",
           "ours_vs_embree.png", "threads.png", "targets.md"]
 FAILURES = []
 
@@ -63,6 +64,9 @@ def synthetic_run(new):
                         trace_ms=28.0))
     # A z-buffer's technique for an effect it renders (four parts: renderer, effect, technique).
     rows.append(row("BM_Effects/softraster/hard_shadows/shadow_maps", 25.0, not new))
+    for n in [1, 16, 256]:
+        rows.append(row(f"BM_Mirrors/raytrace/{n}", 30.0, not new))
+        rows.append(row(f"BM_Mirrors/softraster/{n}", 5.0 * n, not new, mirror_views=float(n)))
     rows.append(row("BM_Threads/softraster/1", 50.0, not new))
     rows.append(row("BM_Threads/softraster/2", 27.0, not new))
     context = {"date": "2026-12-01T00:00:00+00:00", "num_cpus": 2, "mhz_per_cpu": 2445}
