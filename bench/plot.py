@@ -81,19 +81,26 @@ def frame_vs_triangles(rows, context, out):
     fig.savefig(out / "frame_vs_triangles.png", dpi=100)
 
 
+def plot_renderers_against_n(ax, rows, family):
+    """One line per renderer of `family`'s rows named <family>/<renderer>/<N>: frame time
+    against N. Returns how many lines were drawn."""
+    series = defaultdict(list)
+    for b in rows:
+        p = parts(b)
+        if p[0] == family and len(p) >= 3:
+            series[p[1]].append((int(p[2]), ms(b)))
+    for name, pts in sorted(series.items()):
+        pts.sort()
+        ax.plot([x for x, _ in pts], [y for _, y in pts], marker="o", label=name)
+    return len(series)
+
+
 def depth_complexity(rows, context, out):
     """Front to back (hi-z can skip what is hidden) and back to front (it cannot), side by side."""
     fig, axes = plt.subplots(1, 2, figsize=(12, 4.5), sharey=True)
     for ax, family, title in [(axes[0], "BM_DepthComplexity", "drawn front to back"),
                               (axes[1], "BM_DepthComplexityBackToFront", "drawn back to front")]:
-        series = defaultdict(list)
-        for b in rows:
-            p = parts(b)
-            if p[0] == family:
-                series[p[1]].append((int(p[2]), ms(b)))
-        for name, pts in sorted(series.items()):
-            pts.sort()
-            ax.plot([x for x, _ in pts], [y for _, y in pts], marker="o", label=name)
+        plot_renderers_against_n(ax, rows, family)
         ax.set_xscale("log", base=2)
         ax.set_xlabel("depth complexity N (occluders:N, 512x384)")
         ax.set_title(title)
@@ -109,20 +116,13 @@ def mirrors(rows, context, out):
     """Frame time against the number of flat mirrors (BM_Mirrors): the tracer pays per mirror
     pixel, a z-buffer a whole view per mirror; where the lines cross is the crossover."""
     fig, ax = plt.subplots(figsize=(10, 4.5))
-    series = defaultdict(list)
-    for b in rows:
-        p = parts(b)
-        if p[0] == "BM_Mirrors" and len(p) >= 3:
-            series[p[1]].append((int(p[2]), ms(b)))
-    for name, pts in sorted(series.items()):
-        pts.sort()
-        ax.plot([x for x, _ in pts], [y for _, y in pts], marker="o", label=name)
+    drawn = plot_renderers_against_n(ax, rows, "BM_Mirrors")
     ax.set_xscale("log", base=2)
     ax.set_yscale("log")
     ax.set_xlabel("flat mirrors N (mirrors:N, 640x480, full mode)")
     ax.set_ylabel("frame time (ms)")
     ax.grid(True, alpha=0.3)
-    if series:
+    if drawn:
         ax.legend()
     else:
         ax.text(0.5, 0.5, "no BM_Mirrors rows", ha="center", va="center", transform=ax.transAxes)

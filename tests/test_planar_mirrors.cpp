@@ -2,16 +2,25 @@
 // clipped at the mirror, composited by the shading equation, recursing to --max-depth. Held to
 // the tracer's reflection rays with primary visibility's tolerance.
 #include <gtest/gtest.h>
+#include <stdint.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstddef>
 #include <glm/glm.hpp>
+#include <initializer_list>
+#include <map>
+#include <memory>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
+#include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/square.h"
+#include "rvr/core/texture.h"
 #include "rvr/scene_io/scene_loader.h"
 #include "table_render.h"
 
@@ -111,6 +120,30 @@ Scene two_mirrors_lit() {
   return scene;
 }
 
+// How many pixels' colours differ by more than `by`.
+size_t pixels_differing(const FrameBuffers& a, const FrameBuffers& b, float by) {
+  size_t n = 0;
+  for (size_t i = 0; i < b.pixel_count(); ++i) n += colour_difference(a, b, i) > by;
+  return n;
+}
+
+// The pixels of `a` whose colour is not the tracer's (`b`), and of those the ones away from
+// every edge of the tracer's image (where no tie can explain them).
+struct Disagreement {
+  size_t differing = 0, away_from_edges = 0;
+};
+Disagreement disagreement(const FrameBuffers& a, const FrameBuffers& b) {
+  Disagreement d;
+  for (int y = 0; y < b.height; ++y)
+    for (int x = 0; x < b.width; ++x) {
+      const size_t i = size_t(y) * size_t(b.width) + size_t(x);
+      if (colour_difference(a, b, i) <= kSameColour) continue;
+      ++d.differing;
+      if (!beside_an_edge(b, x, y)) ++d.away_from_edges;
+    }
+  return d;
+}
+
 class PlanarMirrors : public ::testing::TestWithParam<const char*> {};
 
 // Every pixel, mirror pixels included, at every recursion limit: the z-buffer's colour is the
@@ -125,20 +158,15 @@ TEST_P(PlanarMirrors, AgreeWithTheTracersReflectionRaysAtEveryDepth) {
     const RenderOutput t = render("raytrace", scene, max_depth);
     const FrameBuffers &a = z.buffers, &b = t.buffers;
     ASSERT_EQ(a.pixel_count(), b.pixel_count());
-    size_t mirror_pixels = 0, differing = 0, away_from_edges = 0;
-    for (int y = 0; y < a.height; ++y)
-      for (int x = 0; x < a.width; ++x) {
-        const size_t i = size_t(y) * size_t(a.width) + size_t(x);
-        mirror_pixels += b.object_id[i] == kLeftMirror || b.object_id[i] == kRightMirror;
-        if (colour_difference(a, b, i) <= kSameColour) continue;
-        ++differing;
-        if (!beside_an_edge(b, x, y)) ++away_from_edges;
-      }
+    size_t mirror_pixels = 0;
+    for (size_t i = 0; i < b.pixel_count(); ++i)
+      mirror_pixels += b.object_id[i] == kLeftMirror || b.object_id[i] == kRightMirror;
+    const Disagreement d = disagreement(a, b);
     const std::string where = std::string(GetParam()) + " max_depth " + std::to_string(max_depth);
     // Something to agree on: both mirrors fill a fifth of the frame.
     EXPECT_GT(mirror_pixels, a.pixel_count() / 5) << where;
-    EXPECT_LE(double(differing), (1.0 - kMinAgreement) * double(a.pixel_count())) << where;
-    EXPECT_EQ(away_from_edges, 0u) << where;
+    EXPECT_LE(double(d.differing), (1.0 - kMinAgreement) * double(a.pixel_count())) << where;
+    EXPECT_EQ(d.away_from_edges, 0u) << where;
     // The views drawn: none at depth 0, and the two mirrors see each other to the limit.
     EXPECT_EQ(z.stats.at("mirror.depth"), double(std::min(max_depth, kLongestChain))) << where;
     EXPECT_EQ(z.stats.at("mirror.views") > 0, max_depth > 0) << where;
@@ -158,17 +186,11 @@ TEST_P(PlanarMirrors, FacingMirrorsRecurseToTheLimit) {
   for (int max_depth : {3, 6}) {
     const RenderOutput z = render(GetParam(), scene, max_depth);
     const RenderOutput t = render("raytrace", scene, max_depth);
-    size_t differing = 0, away_from_edges = 0;
-    for (int y = 0; y < t.buffers.height; ++y)
-      for (int x = 0; x < t.buffers.width; ++x) {
-        const size_t i = size_t(y) * size_t(t.buffers.width) + size_t(x);
-        if (colour_difference(z.buffers, t.buffers, i) <= kSameColour) continue;
-        ++differing;
-        if (!beside_an_edge(t.buffers, x, y)) ++away_from_edges;
-      }
+    const Disagreement d = disagreement(z.buffers, t.buffers);
     const std::string where = std::string(GetParam()) + " max_depth " + std::to_string(max_depth);
-    EXPECT_LE(double(differing), (1.0 - kMinAgreement) * double(t.buffers.pixel_count())) << where;
-    EXPECT_EQ(away_from_edges, 0u) << where;
+    EXPECT_LE(double(d.differing), (1.0 - kMinAgreement) * double(t.buffers.pixel_count()))
+        << where;
+    EXPECT_EQ(d.away_from_edges, 0u) << where;
     EXPECT_EQ(z.stats.at("mirror.depth"), double(max_depth)) << where;
     EXPECT_GT(z.stats.at("mirror.pixels_at_limit"), 0.0) << where;
   }
@@ -180,10 +202,7 @@ TEST_P(PlanarMirrors, TheReflectionsAreWhatTheMirrorsShow) {
   const Scene scene = two_mirrors();
   const RenderOutput none = render(GetParam(), scene, 0);
   const RenderOutput t = render("raytrace", scene, 5);
-  size_t differing = 0;
-  for (size_t i = 0; i < t.buffers.pixel_count(); ++i)
-    differing += colour_difference(none.buffers, t.buffers, i) > 0.01f;
-  EXPECT_GT(differing, t.buffers.pixel_count() / 5);
+  EXPECT_GT(pixels_differing(none.buffers, t.buffers, 0.01f), t.buffers.pixel_count() / 5);
 }
 
 // A reflected view shades towards the eye reflected in its mirrors (the direction the tracer's
@@ -194,10 +213,8 @@ TEST_P(PlanarMirrors, ReflectionsAreShadedFromTheReflectedEye) {
   const Scene scene = two_mirrors_lit();
   const RenderOutput z = render(GetParam(), scene, 5);
   const RenderOutput t = render("raytrace", scene, 5);
-  size_t differing = 0;
-  for (size_t i = 0; i < t.buffers.pixel_count(); ++i)
-    differing += colour_difference(z.buffers, t.buffers, i) > 1e-3f;
-  EXPECT_LE(double(differing), (1.0 - kMinAgreement) * double(t.buffers.pixel_count()));
+  EXPECT_LE(double(pixels_differing(z.buffers, t.buffers, 1e-3f)),
+            (1.0 - kMinAgreement) * double(t.buffers.pixel_count()));
 }
 
 // The mirrors' planes are found from their meshes; a curved mirror is said, by name, and drawn

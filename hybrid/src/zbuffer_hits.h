@@ -5,6 +5,7 @@
 // intersected besides for every rebuilt pixel, the nearer hit kept.
 #pragma once
 
+#include <stddef.h>
 #include <tbb/combinable.h>
 
 #include <cstdint>

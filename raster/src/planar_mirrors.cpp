@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <map>
+#include <memory>
 
 #include "rvr/core/check.h"
 #include "rvr/core/scene.h"

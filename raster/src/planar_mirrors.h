@@ -18,6 +18,7 @@
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
 
 namespace rvr {
 
