@@ -15,7 +15,11 @@
    dropped mismatched_off_edge count back in `visibility`, a mismatch class missing, no pairs,
    an unknown depth format, a negative count, a lod block without its p99, a count stat that is
    not a whole number.
-6. Every count stat of the real documents is written as a JSON integer (159305728, not
+6. A full-mode compare (builtin:cornell, raster,raytrace) writes the `effects` block (the
+   colour error over the pixels each effect touches, masks from the tracer's frame) that the
+   schema accepts, with reflection and refraction; local mode writes none; an unknown effect
+   is refused.
+7. Every count stat of the real documents is written as a JSON integer (159305728, not
    159305728.0; JSON Schema cannot tell the two apart): a stat is a count unless the schema's
    patternProperties for stats name it (seconds, declared ratios).
 
@@ -44,9 +48,9 @@ def failure(message):
     print("FAIL: " + message)
 
 
-def compare(rvr, scene, renderers, out):
+def compare(rvr, scene, renderers, out, extra=()):
     r = subprocess.run([rvr, "compare", scene, "-r", ",".join(renderers), "--width", "64",
-                        "--height", "48", "-o", str(out)],
+                        "--height", "48", "-o", str(out), *extra],
                        capture_output=True, text=True, timeout=100)
     if r.returncode != 0:
         failure(f"rvr compare {scene}: exit {r.returncode}: {r.stderr.strip()}")
@@ -103,6 +107,31 @@ def check_textured(rvr, validator, work, untextured):
     if not (0 <= lod["mean_abs"] < 1.0 and lod["mean_abs"] <= lod["p99_abs"] + 1e-12):
         failure(f"builtin:textured: implausible lod difference {lod}")
     print(f"textured: lod {lod}")
+    return doc
+
+
+def check_effects(rvr, validator, work, local):
+    """Full mode writes the per-effect block, masks from the tracer; local mode has none."""
+    if local is not None and "effects" in local:
+        failure("builtin:cornell in local mode: metrics.json has an effects block")
+    doc = compare(rvr, "builtin:cornell", ["raster", "raytrace"], work / "effects",
+                  ["--mode", "full"])
+    if doc is None:
+        return None
+    accepted(validator, doc, "effects")
+    effects = doc.get("effects")
+    names = [e["effect"] for e in (effects or {}).get("by_effect", [])]
+    if effects is None or effects.get("mask_from") != "raytrace" or names != ["reflection",
+                                                                             "refraction"]:
+        failure(f"builtin:cornell full: want reflection and refraction masked from raytrace, "
+                f"got {effects}")
+        return None
+    if effects != doc["pairs"][0].get("effects"):
+        failure("builtin:cornell full: pairs[0] does not repeat the effects block")
+    picture = doc.get("files", {}).get("effects")
+    if picture is None or not (work / "effects" / picture).is_file():
+        failure(f"builtin:cornell full: the effect masks' picture {picture!r} was not written")
+    print(f"effects: {effects}")
     return doc
 
 
@@ -191,7 +220,13 @@ def main():
         written = work / folder / "metrics.json"
         if written.is_file():
             count_stats_written_as_integers(schema, written.read_text(), label)
+    effects = check_effects(args.rvr, validator, work, doc)
     check_nothing_visible(args.rvr, validator, work)
+    if effects is not None:
+        bad = copy.deepcopy(effects)
+        bad["effects"]["by_effect"][0]["effect"] = "caustics"
+        if not schema_errors(validator, bad):
+            failure("the schema accepts an effect it does not know")
     if doc is not None:
         check_refused(validator, doc)
     if textured is not None:

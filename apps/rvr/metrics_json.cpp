@@ -92,14 +92,26 @@ ordered_json pair_metrics(const ComparisonMetrics& m) {
     doc["lod"] = {{"pixels", m.lod.pixels},
                   {"mean_abs", number(m.lod.mean_abs)},
                   {"p99_abs", number(m.lod.p99_abs)}};
+  if (!m.effects.empty()) {
+    ordered_json by_effect = ordered_json::array();
+    for (const EffectError& e : m.effects)
+      by_effect.push_back({{"effect", e.effect},
+                           {"pixels", e.pixels},
+                           {"rmse", number(e.rmse)},
+                           {"psnr_db", psnr_number(e.psnr_db)},
+                           {"max_abs", number(e.max_abs)}});
+    doc["effects"] = {{"mask_from", m.effects_mask_from}, {"by_effect", by_effect}};
+  }
   return doc;
 }
 
 ordered_json pair_files(const ReportPair& p) {
-  return {{"diff", p.file("diff")},
-          {"depth_diff", p.file("depth_diff")},
-          {"id_mismatch", p.file("id_mismatch")},
-          {"mismatch_classes", p.file("mismatch_classes")}};
+  ordered_json files = {{"diff", p.file("diff")},
+                        {"depth_diff", p.file("depth_diff")},
+                        {"id_mismatch", p.file("id_mismatch")},
+                        {"mismatch_classes", p.file("mismatch_classes")}};
+  if (!p.metrics.effects.empty()) files["effects"] = p.file("effects");
+  return files;
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "report_script.h"
 #include "report_text.h"
 #include "rvr/compare/compare.h"
+#include "rvr/compare/effect_errors.h"
 #include "rvr/compare/mismatch_classes.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/stats.h"
@@ -207,6 +208,7 @@ std::vector<std::string> renderer_names(const ReportInput& input,
 struct ReportImages {
   std::vector<std::string> renders, costs;    // per renderer; a cost URI is empty without a file
   std::string diff, id_mismatch, depth_diff;  // of the first pair
+  std::string effects;                        // of the first pair; empty when no effect acts
   std::vector<std::string> classes;           // per pair
 };
 
@@ -232,6 +234,10 @@ Expected<ReportImages> embed_images(const ReportInput& input,
         std::pair{"depth_diff", &images.depth_diff}}) {
     RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, first.file(file)));
     *to = std::move(uri.value());
+  }
+  if (!first.metrics.effects.empty()) {
+    RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, first.file("effects")));
+    images.effects = std::move(uri.value());
   }
   for (const ReportPair& p : pairs) {
     RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, p.file("mismatch_classes")));
@@ -369,6 +375,30 @@ std::string differences(const ReportInput& input, const ReportPair& first,
   return h.str();
 }
 
+// The first pair's effect masks (effects.png) with their legend and each effect's error; nothing
+// when no effect acts.
+std::string effect_masks(const ReportPair& first, const ReportImages& images) {
+  if (images.effects.empty()) return "";
+  std::ostringstream h;
+  h << "<h2>Where the effects act</h2>\n<div class=\"grid\">\n<figure><img src=\"" << images.effects
+    << "\" alt=\"effect masks\"><figcaption><b>" << escape_html(first.file("effects"))
+    << "</b>: the pixels whose primary surface in " << escape_html(first.metrics.effects_mask_from)
+    << "'s frame shows an effect, over a dimmed grey version of that frame (the lens, which "
+       "acts on every pixel, where no other does):";
+  for (const EffectKey& key : kEffectKeys) {
+    const EffectError* error = nullptr;
+    for (const EffectError& e : first.metrics.effects)
+      if (e.effect == key.name) error = &e;
+    if (!error) continue;
+    h << "<span class=\"key\">" << swatch(key.rgb) << key.name << ": " << error->pixels
+      << " pixels, PSNR "
+      << (std::isinf(error->psnr_db) ? std::string("&infin;") : fmt("%.2f dB", error->psnr_db))
+      << "</span>";
+  }
+  h << "</figcaption></figure>\n</div>\n";
+  return h.str();
+}
+
 // Work per pixel: what each loop order pays where.
 std::string work_per_pixel(const ReportInput& input, const ReportImages& images) {
   std::ostringstream h;
@@ -465,6 +495,15 @@ std::vector<MetricRow> metric_rows(const ComparisonMetrics& m) {
     rows.push_back(
         {"lod", "p99_abs", fmt("%.3g", lod.p99_abs), "99th percentile of the same difference."});
   }
+  for (const EffectError& e : m.effects)
+    rows.push_back(
+        {"effects", e.effect + " psnr_db",
+         std::isinf(e.psnr_db) ? std::string("&infin; (999 in metrics.json)")
+                               : fmt("%.2f", e.psnr_db),
+         "The colour's PSNR over the " + std::to_string(e.pixels) + " pixels whose primary " +
+             "surface in " + m.effects_mask_from + "'s frame shows " + e.effect + " (rmse " +
+             fmt("%.4g", e.rmse) + ", max " + fmt("%.4g", e.max_abs) +
+             "): the error where the effect acts, which the whole image's PSNR dilutes."});
   return rows;
 }
 
@@ -562,8 +601,8 @@ Expected<std::string> report_html(const ReportInput& input) {
     std::ostringstream h;
     h << present::page_start(title, present::PageWidth::Wide) << summary(input, title, first)
       << warnings(input) << renders(input, *images, name_a, name_b)
-      << differences(input, first, *images, name_a, name_b) << work_per_pixel(input, *images)
-      << metrics_table(metric_rows(first.metrics))
+      << differences(input, first, *images, name_a, name_b) << effect_masks(first, *images)
+      << work_per_pixel(input, *images) << metrics_table(metric_rows(first.metrics))
       << outlier_table(first.metrics.depth, name_a, name_b)
       << other_pairs(pairs, names, images->classes) << timings(input) << all_statistics(input)
       << page_end(input);

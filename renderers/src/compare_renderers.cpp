@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/compare/effect_errors.h"
 #include "rvr/compare/mismatch_classes.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/timer.h"
@@ -45,6 +46,22 @@ std::string background_warning(const ComparedRenderer& r) {
          "background";
 }
 
+// How near a renderer's loop order is to the tracer's ray tree, which the effect masks are read
+// from: the tracers, then the hybrids (the tracer's rays after a z-buffer), then the z-buffers.
+int mask_rank(const std::string& name) {
+  const Expected<RendererChoice> choice = find_renderer_choice(name);
+  if (!choice.ok()) return 3;
+  switch (choice->info->order) {
+    case LoopOrder::PixelMajor:
+      return 0;
+    case LoopOrder::Hybrid:
+      return 1;
+    case LoopOrder::TriangleMajor:
+      return 2;
+  }
+  return 3;
+}
+
 ComparedPair compare_pair(const Scene& scene, const CompareResult& result, size_t ia, size_t ib,
                           const CompareOptions& compare) {
   const ComparedRenderer& ra = result.renderers[ia];
@@ -61,6 +78,10 @@ ComparedPair compare_pair(const Scene& scene, const CompareResult& result, size_
   p.a = ia;
   p.b = ib;
   p.metrics = compare_buffers(a, b, context);
+  p.metrics.effects_mask_from = mask_rank(rb.name) < mask_rank(ra.name) ? rb.name : ra.name;
+  const FrameBuffers& masks = p.metrics.effects_mask_from == ra.name ? a : b;
+  p.metrics.effects = effect_errors(scene, compare.mode, masks, a, b);
+  if (!p.metrics.effects.empty()) p.effects = effect_mask_image(scene, compare.mode, masks);
   p.diff = diff_heat_map(ra.image, rb.image, compare.heat_map_scale);
   p.id_mismatch = id_mismatch_image(a, b);
   p.depth_diff = depth_diff_image(a, b, compare.depth_diff_scale);
@@ -99,6 +120,7 @@ Expected<CompareResult> compare_renderers(const Scene& scene, const std::vector<
 
   phase("", "compare");
   CompareOptions comparing = compare;
+  comparing.mode = options.mode;
   if (options.spheres == SphereMode::Mesh)
     comparing.sphere_segments = options.sphere_segments;
   else

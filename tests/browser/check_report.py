@@ -83,7 +83,8 @@ def layout_problems(probe):
 
 
 def run_compare(rvr, out_dir, renderers):
-    cmd = [rvr, "compare", "builtin:cornell", "--width", "160", "--height", "120",
+    # Full mode: the mirror and the glass give the report its effect masks too.
+    cmd = [rvr, "compare", "builtin:cornell", "--width", "160", "--height", "120", "--mode", "full",
            "--renderers", renderers, "-o", str(out_dir)]
     print("running:", " ".join(cmd))
     r = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,

@@ -4,8 +4,10 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <string>
 #include <vector>
 
+#include "rvr/compare/effect_errors.h"
 #include "rvr/compare/mismatch_classes.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
@@ -91,6 +93,10 @@ struct ComparisonMetrics {
   DepthMetrics depth;
   ColourMetrics colour;
   LodMetrics lod;
+  // The colour error where each effect acts (effect_errors.h), masks read from the frame of
+  // `effects_mask_from` (one of the two renderers' names); set by compare_renderers.
+  std::vector<EffectError> effects;
+  std::string effects_mask_from;
 };
 
 LodMetrics lod_metrics(const FrameBuffers& a, const FrameBuffers& b);

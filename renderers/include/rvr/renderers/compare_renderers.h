@@ -43,6 +43,9 @@ struct CompareOptions {
   // > 0: spheres were analytic, the z-buffers drew tessellate_sphere(sphere,
   // polygon_sphere_segments) (MismatchContext); compare_renderers sets it.
   int polygon_sphere_segments = 0;
+  // The mode the renders were made in: which effects act (effect_errors.h); compare_renderers
+  // sets it.
+  RenderMode mode = RenderMode::Local;
 };
 
 // Two of the renderers compared, a before b in the order asked for; a is the reference of the
@@ -54,6 +57,7 @@ struct ComparedPair {
   Image id_mismatch;       // id mismatches over grey
   Image depth_diff;        // relative depth difference
   Image mismatch_classes;  // mismatched pixels coloured by class over grey
+  Image effects;           // the effect masks (effect_mask_image); empty when none acts
 };
 
 // A renderer whose image shows a surface in fewer than this fraction of its pixels is warned

@@ -1,0 +1,107 @@
+#include "rvr/compare/effect_errors.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <iterator>
+#include <limits>
+
+#include "rvr/core/srgb.h"
+
+namespace rvr {
+
+namespace {
+
+// Bit k: the effect kEffectKeys[k].
+enum EffectBit : uint8_t { kReflection = 1, kRefraction = 2, kLens = 4, kCsg = 8 };
+
+// The effects acting at a pixel whose primary surface is object `id` (kNoId: background).
+uint8_t effects_at(const Scene& scene, RenderMode mode, bool lens, uint32_t id) {
+  uint8_t bits = lens ? kLens : 0;
+  if (id == kNoId || id >= scene.objects.size()) return bits;
+  const Object& o = scene.objects[id];
+  if (o.type == ObjectType::Csg) bits |= kCsg;
+  if (mode == RenderMode::Full && o.material < scene.materials.size()) {
+    const Material& m = scene.materials[o.material];
+    if (m.mirror > 0.0f) bits |= kReflection;
+    if (m.transparency > 0.0f) bits |= kRefraction;
+  }
+  return bits;
+}
+
+// Every pixel's effects (EffectBit), by its primary surface in `mask_from`.
+std::vector<uint8_t> effect_bits(const Scene& scene, RenderMode mode,
+                                 const FrameBuffers& mask_from) {
+  const bool lens = mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f &&
+                    scene.image.samples_per_pixel > 1;
+  std::vector<uint8_t> bits(mask_from.object_id.size());
+  for (size_t i = 0; i < bits.size(); ++i)
+    bits[i] = effects_at(scene, mode, lens, mask_from.object_id[i]);
+  return bits;
+}
+
+}  // namespace
+
+std::vector<EffectError> effect_errors(const Scene& scene, RenderMode mode,
+                                       const FrameBuffers& mask_from, const FrameBuffers& a,
+                                       const FrameBuffers& b) {
+  const size_t n = mask_from.pixel_count();
+  if (mask_from.object_id.size() != n || a.colour.size() != n || b.colour.size() != n) return {};
+  const std::vector<uint8_t> bits = effect_bits(scene, mode, mask_from);
+  std::vector<EffectError> errors;
+  for (size_t k = 0; k < std::size(kEffectKeys); ++k) {
+    EffectError e;
+    e.effect = kEffectKeys[k].name;
+    double sq = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+      if (!(bits[i] & (1u << k))) continue;
+      ++e.pixels;
+      for (int c = 0; c < 3; ++c) {
+        double d = std::fabs(double(a.colour[i][c]) - double(b.colour[i][c]));
+        if (std::isnan(d)) d = 1.0;  // as the whole image's colour error counts a NaN
+        sq += d * d;
+        e.max_abs = std::max(e.max_abs, d);
+      }
+    }
+    if (e.pixels == 0) continue;
+    e.rmse = std::sqrt(sq / (3.0 * double(e.pixels)));
+    e.psnr_db =
+        e.rmse > 0.0 ? 20.0 * std::log10(1.0 / e.rmse) : std::numeric_limits<double>::infinity();
+    errors.push_back(e);
+  }
+  return errors;
+}
+
+Image effect_mask_image(const Scene& scene, RenderMode mode, const FrameBuffers& mask_from) {
+  Image img;
+  img.width = mask_from.width;
+  img.height = mask_from.height;
+  img.channels = 3;
+  img.channel_names = {"R", "G", "B"};
+  const size_t n = mask_from.pixel_count();
+  img.pixels.assign(n * 3, 0.0f);
+  const std::vector<uint8_t> bits = effect_bits(scene, mode, mask_from);
+  for (size_t i = 0; i < n && i < bits.size(); ++i) {
+    float* p = &img.pixels[3 * i];
+    // The lens last: it touches every pixel, and the others would not show through it.
+    int shown = -1;
+    for (int k : {0, 1, 3, 2})
+      if (shown < 0 && (bits[i] & (1u << k))) shown = k;
+    if (shown >= 0) {
+      std::copy(kEffectKeys[shown].rgb, kEffectKeys[shown].rgb + 3, p);
+      continue;
+    }
+    // Display-referred grey, dimmed so the masks stand out: the sRGB encoding of half of the
+    // frame's linear luminance.
+    float lum = 0.0f;
+    if (i < mask_from.colour.size()) {
+      const glm::vec3 c = glm::clamp(mask_from.colour[i], glm::vec3(0.0f), glm::vec3(1.0f));
+      lum = 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
+    }
+    p[0] = p[1] = p[2] = srgb_encode(0.5f * lum);
+  }
+  return img;
+}
+
+}  // namespace rvr
