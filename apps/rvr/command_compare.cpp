@@ -13,6 +13,7 @@
 #include "report.h"
 #include "report_input.h"
 #include "rvr/compare/compare.h"
+#include "rvr/compare/effect_errors.h"
 #include "rvr/compare/mismatch_classes.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/render_option_table.h"

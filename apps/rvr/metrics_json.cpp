@@ -18,6 +18,7 @@
 #include "report.h"
 #include "report_text.h"
 #include "rvr/compare/compare.h"
+#include "rvr/compare/effect_errors.h"
 #include "rvr/compare/mismatch_classes.h"
 
 namespace rvr {

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <iterator>
 #include <limits>
 
