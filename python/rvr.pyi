@@ -188,8 +188,8 @@ def render(
     """Renders SCENE (an rvr.Scene) with RENDERER (a name from rvr.renderers()) in MODE
     (visibility, local, full) on THREADS worker threads (0: every core). Other keyword options
     are the command line's of the same names: accel, spheres, sphere_segments, triangle_test,
-    texture_lod, max_depth, seed, shadow_map_size, shadow_bias, shadow_pcf, hiz,
-    depth_format, supersampling, zbuffer_dof, gl. One the renderer does not read is named in
+    texture_lod, max_depth, seed, shadow_map_size, cube_map_size, shadow_bias, shadow_pcf,
+    hiz, depth_format, supersampling, zbuffer_dof, gl. One the renderer does not read is named in
     Render.warnings. The GIL is released while rendering; Ctrl-C cancels the render (it stops
     at its next tile or chunk) and raises KeyboardInterrupt."""
 

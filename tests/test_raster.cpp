@@ -826,7 +826,7 @@ TEST(GlRaster, FullModeWarnsOnlyAboutWhatTheSceneUses) {
   RenderOutput full = render_ok(s, RenderMode::Full);
   // The mirror is flat: reflected (planar_mirrors.h), nothing to say of it.
   ASSERT_EQ(full.warnings.size(), 2u);
-  EXPECT_NE(full.warnings[0].find("refraction/transparency (materials: crystal)"),
+  EXPECT_NE(full.warnings[0].find("refraction on 1 transparent object (g) from cube maps"),
             std::string::npos)
       << full.warnings[0];
   EXPECT_EQ(full.warnings[0].find("unused"), std::string::npos);

@@ -50,6 +50,18 @@ constexpr std::array kStats = {
     StatDeclaration{"zbuffer.accumulation_passes", kCount, "passes", "z-buffers",
                     "sample passes of an accumulation buffer (samples_per_pixel > 1), each "
                     "drawn and shaded whole, after the centre pass that gives the AOVs"},
+    // Curved mirrors and glass drawn by the z-buffers (full mode): a cube map per object seen.
+    StatDeclaration{"cube_map.faces", kCount, "faces", "z-buffers",
+                    "cube-map faces drawn for curved mirrors and transparent objects: six per "
+                    "object seen (full mode)"},
+    StatDeclaration{"cube_map.reflected_pixels", kCount, "pixels", "z-buffers",
+                    "pixels given a reflection looked up in a cube map"},
+    StatDeclaration{"cube_map.refracted_pixels", kCount, "pixels", "z-buffers",
+                    "pixels given a transmitted colour looked up in a cube map (at the first "
+                    "interface)"},
+    StatDeclaration{"cube_map.total_internal", kCount, "pixels", "z-buffers",
+                    "of the refracted pixels, those whose ray is totally internally reflected "
+                    "(looked up in the reflected direction)"},
     // Planar mirrors drawn by the z-buffers (full mode): a reflected view per mirror seen.
     StatDeclaration{"mirror.views", kCount, "views", "z-buffers",
                     "reflected views drawn for planar mirrors: one per mirror seen, per level of "
@@ -162,6 +174,9 @@ constexpr std::array kStats = {
                     "the accumulation buffer's sample passes, each drawn and shaded whole"},
     StatDeclaration{"time.mirrors", kSeconds, "s", "z-buffers",
                     "planar mirrors' reflected views, drawn, shaded and composited"},
+    StatDeclaration{"time.cube_maps", kSeconds, "s", "z-buffers",
+                    "cube maps of curved mirrors and transparent objects, drawn, shaded and "
+                    "looked up"},
     StatDeclaration{"time.zbuffer", kSeconds, "s", "hybrids", "the z-buffer passes"},
     StatDeclaration{"time.trace", kSeconds, "s", "hybrids",
                     "the tracer's part: hits rebuilt, rays traced, shading"},

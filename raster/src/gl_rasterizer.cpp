@@ -33,6 +33,7 @@
 #include "gl_objects.h"
 #include "gl_program.h"
 #include "gl_shaders.h"
+#include "environment_maps.h"
 #include "planar_mirrors.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/framebuffers.h"
@@ -113,20 +114,6 @@ constexpr GLint kTextureUnit = 2;
 // the last two, grazing surfaces (the Cornell ceiling, just above the lamp's samples) show
 // acne rings; with them the classification agrees with shadow rays on >99% of pixels.
 
-// "name1, name2" of the materials drawn by `draws` for which `uses` holds, each once.
-template <class Draws, class Pred>
-std::string material_names(const Draws& draws, Pred uses) {
-  std::vector<const Material*> seen;
-  std::string names;
-  for (const auto& d : draws) {
-    if (!uses(*d.material) || std::find(seen.begin(), seen.end(), d.material) != seen.end())
-      continue;
-    seen.push_back(d.material);
-    names += (names.empty() ? "" : ", ") + (d.material->name.empty() ? "?" : d.material->name);
-  }
-  return names;
-}
-
 // Colour attachments of the scene FBO, in fragment-output order (gl_shaders.h).
 enum Target : int {
   kColour,
@@ -200,6 +187,7 @@ struct ScenePass {
   glm::mat4 view, projection;
   DepthFormat depth_format;
   glm::vec3 eye;  // where the pass looks from: the camera's eye or a sample's lens point
+  int width, height;  // the frame's size: the image's, or a cube map face's
   // A planar mirror's view (planar_mirrors.h): only what lies on the positive side of the world
   // plane `keep` is drawn (when `clipped`), and not the mirror `hidden`.
   bool clipped = false;
@@ -228,16 +216,13 @@ glm::mat4 reversed_z_projection(glm::mat4 projection, float near_plane, float fa
 // What a z-buffer cannot do, named for this scene only (shadows it does, with shadow maps).
 void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& options,
                                     const SceneUpload& upload,
-                                    const std::vector<std::string>& curved_mirrors,
+                                    const std::vector<EnvironmentMapped>& mapped,
+                                    const std::vector<std::string>& left_out,
                                     std::vector<std::string>& warnings) {
   if (!upload.prepared.skipped_csg.empty())
     warnings.push_back(skipped_csg_warning(upload.prepared.skipped_csg));
   if (options.mode != RenderMode::Full) return;
-  if (!curved_mirrors.empty()) warnings.push_back(curved_mirrors_warning(curved_mirrors));
-  std::string clear =
-      material_names(upload.draws, [](const Material& m) { return m.transparency > 0.0f; });
-  if (!clear.empty())
-    warnings.push_back(fmt::format("refraction/transparency (materials: {}) not rendered", clear));
+  note_environment_maps(scene, mapped, left_out, options.cube_map_size > 0, warnings);
   if (scene.camera.aperture_radius > 0.0f) {
     if (scene.image.samples_per_pixel == 1)
       warnings.push_back(kDepthOfFieldNeedsSamples);
@@ -359,6 +344,8 @@ struct GlRasterizer::Impl {
   void draw_to_every_target();
   Status cost_pass(const ScenePass& pass);
   Status readback(int w, int h, const ScenePass& pass, FrameBuffers& fb, uint64_t& samples_passed);
+  Status add_cube_maps(const ScenePass& camera, const std::vector<EnvironmentMapped>& mapped,
+                       RenderOutput& out);
   Status add_mirrors(const ScenePass& camera, const std::vector<PlanarMirror>& mirrors,
                      RenderOutput& out);
 };
@@ -869,7 +856,7 @@ void GlRasterizer::Impl::draw_to_every_target() {
 
 // --- scene passes: z-buffer visibility, ids, depth, normal, shading; shadow maps per batch
 Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderOutput& out) {
-  const int w = pass.scene.image.width, h = pass.scene.image.height;
+  const int w = pass.width, h = pass.height;
   const std::vector<LightSample>& samples = pass.upload.samples;
   const ShadowPlan& shadows = pass.shadows;
   const bool shade = pass.options.mode != RenderMode::Visibility;
@@ -1145,7 +1132,9 @@ Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
           ? reversed_z_projection(camera_projection, scene.camera.near, scene.camera.far)
           : camera_projection,
       depth_format,
-      options.image_sample ? sample_eye(scene.camera, *options.image_sample) : scene.camera.eye};
+      options.image_sample ? sample_eye(scene.camera, *options.image_sample) : scene.camera.eye,
+      w,
+      h};
   RVR_TRY(scene_passes(pass, msaa, out));
   if (is_cancelled(progress)) return cancelled_error();
 
@@ -1178,12 +1167,16 @@ Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
   out.stats["fragments.passed"] = double(passed);
   out.stats["pixels.covered"] = double(covered);
 
-  std::vector<std::string> curved;
+  std::vector<EnvironmentMapped> mapped;
+  std::vector<std::string> left_out;  // transparent planar mirrors
   if (options.mode == RenderMode::Full) {
-    const std::vector<PlanarMirror> mirrors = planar_mirrors(scene, uploaded->prepared, curved);
+    const std::vector<PlanarMirror> mirrors = planar_mirrors(uploaded->prepared);
     if (!mirrors.empty()) RVR_TRY(add_mirrors(pass, mirrors, out));
+    mapped = environment_mapped(scene, uploaded->prepared, mirrors, left_out);
+    // Last: its faces resize the targets.
+    if (!mapped.empty() && options.cube_map_size > 0) RVR_TRY(add_cube_maps(pass, mapped, out));
   }
-  note_what_a_zbuffer_leaves_out(scene, options, *uploaded, curved, out.warnings);
+  note_what_a_zbuffer_leaves_out(scene, options, *uploaded, mapped, left_out, out.warnings);
   return out;
 }
 
@@ -1213,6 +1206,35 @@ Status GlRasterizer::Impl::add_mirrors(const ScenePass& camera,
   RVR_TRY(add_planar_reflections(mirrors, camera.options.max_depth, view, draw_view, out.buffers,
                                  stats));
   record_mirror_stats(stats, seconds_since(t), out);
+  return ok_status();
+}
+
+// Full mode's curved mirrors and transparent objects: six single-sampled faces per object seen,
+// drawn and shaded as the camera's pass is into targets resized to the face, read back and
+// looked up at the object's pixels (environment_maps.h).
+Status GlRasterizer::Impl::add_cube_maps(const ScenePass& camera,
+                                         const std::vector<EnvironmentMapped>& mapped,
+                                         RenderOutput& out) {
+  const auto t = Clock::now();
+  EnvironmentStats stats;
+  const CubeFacePass draw_face = [&](const CubeFace& face) -> Expected<FrameBuffers> {
+    RVR_TRY(resize(face.size, face.size, depth_internal_format(camera.depth_format)));
+    ScenePass pass = camera;
+    pass.view = glm::mat4(face.view);
+    pass.projection = camera.depth_format == DepthFormat::D32FReversed
+                          ? reversed_z_projection(glm::mat4(face.projection), face.near, face.far)
+                          : glm::mat4(face.projection);
+    pass.eye = face.eye;
+    pass.width = pass.height = face.size;
+    pass.hidden = face.hidden;
+    RenderOutput drawn;
+    RVR_TRY(scene_passes(pass, 1, drawn));
+    uint64_t passed = 0;
+    RVR_TRY(readback(face.size, face.size, pass, drawn.buffers, passed));
+    return std::move(drawn.buffers);
+  };
+  RVR_TRY(add_environment_maps(camera.scene, camera.options, mapped, draw_face, out.buffers, stats));
+  record_environment_stats(stats, seconds_since(t), out);
   return ok_status();
 }
 

@@ -50,22 +50,15 @@ std::optional<glm::dvec4> flat_plane(const TriangleMesh& mesh) {
   return glm::dvec4(n, d);
 }
 
-std::string mirror_label(const Object& o, size_t index) {
-  return o.name.empty() ? fmt::format("object#{}", index) : o.name;
-}
-
 }  // namespace
 
-std::vector<PlanarMirror> planar_mirrors(const Scene& scene, const PreparedScene& prepared,
-                                         std::vector<std::string>& curved) {
+std::vector<PlanarMirror> planar_mirrors(const PreparedScene& prepared) {
   std::vector<PlanarMirror> mirrors;
   for (size_t i = 0; i < prepared.objects.size(); ++i) {
     const PreparedObject& p = prepared.objects[i];
     if (!p.mesh || !(p.material->mirror > 0.0f)) continue;
     if (const std::optional<glm::dvec4> plane = flat_plane(*p.mesh))
       mirrors.push_back({uint32_t(i), *plane, p.material->mirror});
-    else
-      curved.push_back(mirror_label(scene.objects[i], i));
   }
   return mirrors;
 }
@@ -190,15 +183,6 @@ void record_mirror_stats(const MirrorStats& stats, double seconds, RenderOutput&
   out.stats["mirror.pixels"] = double(stats.pixels);
   out.stats["mirror.pixels_at_limit"] = double(stats.dropped);
   out.stats["time.mirrors"] = seconds;
-}
-
-std::string curved_mirrors_warning(const std::vector<std::string>& curved) {
-  std::string names;
-  for (const std::string& s : curved) names += (names.empty() ? "" : ", ") + s;
-  return fmt::format(
-      "mirror reflection not rendered on {} curved mirror{} ({}): a z-buffer reflects planar "
-      "mirrors only",
-      curved.size(), curved.size() == 1 ? "" : "s", names);
 }
 
 }  // namespace rvr

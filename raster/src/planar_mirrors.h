@@ -30,9 +30,8 @@ struct PlanarMirror {
 };
 
 // The mirrors of `prepared` (material mirror > 0, something drawn) that are planar, with their
-// planes, in object order. The names of the mirrors that are not flat go to `curved`.
-std::vector<PlanarMirror> planar_mirrors(const Scene& scene, const PreparedScene& prepared,
-                                         std::vector<std::string>& curved);
+// planes, in object order (the others are curved: environment_maps.h).
+std::vector<PlanarMirror> planar_mirrors(const PreparedScene& prepared);
 
 // The reflection about `plane` ((n, d), |n| = 1): P - 2 (n · P + d) n, as a matrix.
 glm::dmat4 reflection_matrix(const glm::dvec4& plane);
@@ -72,8 +71,5 @@ Status add_planar_reflections(const std::vector<PlanarMirror>& mirrors, int max_
 // The mirror stats of a render (mirror.views, mirror.depth, mirror.pixels,
 // mirror.pixels_at_limit, time.mirrors) into `out`.
 void record_mirror_stats(const MirrorStats& stats, double seconds, RenderOutput& out);
-
-// What a z-buffer says of the mirrors it cannot reflect: those that are not flat.
-std::string curved_mirrors_warning(const std::vector<std::string>& curved);
 
 }  // namespace rvr

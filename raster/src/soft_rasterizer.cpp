@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "accumulation_buffer.h"
+#include "environment_maps.h"
 #include "depth_of_field_blur.h"
 #include "draw_list_prep.h"
 #include "planar_mirrors.h"
@@ -102,15 +103,14 @@ glm::dmat4 camera_view_projection(const Scene& scene, const RenderOptions& optio
 // parallel clear uses the threads the options allow. The camera pass's depth test as the format
 // would store depth (unset: the view depth in double precision); shadow maps keep exact
 // distances.
-DepthTarget& camera_target(const Scene& scene, const RenderOptions& options,
+DepthTarget& camera_target(const RenderOptions& options, int w, int h, float near, float far,
                            const soft::FillKernels& kernels, tbb::task_arena& arena,
                            std::optional<DepthTarget>& kept) {
-  const int w = scene.image.width, h = scene.image.height;
   arena.execute([&] {
-    if (kept && kept->same_setup(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels))
+    if (kept && kept->same_setup(w, h, near, far, options.hiz, kernels))
       kept->clear();
     else
-      kept.emplace(w, h, scene.camera.near, scene.camera.far, options.hiz, kernels);
+      kept.emplace(w, h, near, far, options.hiz, kernels);
   });
   kept->set_depth_format(!options.depth_format                        ? soft::kDepthExact
                          : *options.depth_format == DepthFormat::D24  ? soft::kDepthD24
@@ -295,13 +295,13 @@ void record_draw_stats(const DrawResult& drawn, const DepthTarget& target, size_
 // What this z-buffer leaves out of the scene. The warnings do not name the renderer: whoever
 // prints them says whose they are.
 void note_what_is_left_out(const Scene& scene, const RenderOptions& options,
-                           const PreparedScene& prepared, const SceneDraws& draws,
-                           const std::vector<std::string>& curved_mirrors,
+                           const PreparedScene& prepared,
+                           const std::vector<EnvironmentMapped>& mapped,
+                           const std::vector<std::string>& left_out,
                            std::vector<std::string>& warnings) {
   if (!prepared.skipped_csg.empty()) warnings.push_back(skipped_csg_warning(prepared.skipped_csg));
   if (options.mode == RenderMode::Full) {
-    if (!curved_mirrors.empty()) warnings.push_back(curved_mirrors_warning(curved_mirrors));
-    if (draws.transparency) warnings.push_back("transparency not rendered");
+    note_environment_maps(scene, mapped, left_out, options.cube_map_size > 0, warnings);
     if (scene.camera.aperture_radius > 0.0f && scene.image.samples_per_pixel == 1)
       warnings.push_back(kDepthOfFieldNeedsSamples);
   }
@@ -325,6 +325,27 @@ struct RenderSetup {
   KeptShadowCubes& kept_shadows;
 };
 
+// Where a view is drawn: its view-projection, its frame's size, near and far planes and the
+// target kept for it.
+struct ViewFrame {
+  glm::dmat4 view_projection;
+  int width, height;
+  float near, far;
+  std::optional<DepthTarget>& kept;
+};
+
+// The camera's frame for a view seen through mirrors (`reflection`, identity for the camera's).
+ViewFrame camera_frame(const RenderSetup& setup, const glm::dmat4& reflection) {
+  const Scene& scene = setup.scene;
+  const int w = scene.image.width, h = scene.image.height;
+  return {camera_view_projection(scene, setup.options, w, h) * reflection,
+          w,
+          h,
+          scene.camera.near,
+          scene.camera.far,
+          setup.kept};
+}
+
 // `list` without object `hidden` (a mirror's view does not draw the mirror); ids stay the same.
 DrawList without_object(const DrawList& list, uint32_t hidden) {
   std::vector<DrawObject> objects = list.objects;
@@ -332,22 +353,23 @@ DrawList without_object(const DrawList& list, uint32_t hidden) {
   return soft::make_draw_list(std::move(objects));
 }
 
-// One view (the camera's, or one seen through mirrors: `view`), drawn into the kept target and,
-// per mode, read back (visibility) or shaded once per visible pixel with, in full mode, the
-// shadowed lights. `drawn` receives the draw's counts.
-Status draw_view(const RenderSetup& setup, const MirrorView& view, RenderOutput& out,
-                 DrawResult& drawn) {
+// One view (the camera's, one seen through mirrors, or a cube map's face: `view` through
+// `frame`), drawn into the frame's kept target and, per mode, read back (visibility) or shaded
+// once per visible pixel with, in full mode, the shadowed lights. `drawn` receives the draw's
+// counts.
+Status draw_view(const RenderSetup& setup, const MirrorView& view, const ViewFrame& frame,
+                 RenderOutput& out, DrawResult& drawn) {
   const Scene& scene = setup.scene;
   const RenderOptions& options = setup.options;
   tbb::task_arena& arena = setup.arena;
-  const int w = scene.image.width, h = scene.image.height;
+  const int w = frame.width, h = frame.height;
   ProgressSink* const progress = options.progress;
   auto t = Clock::now();
   const auto t_visibility = t;
   std::optional<DrawList> own_list;
   if (view.hidden != kNoId) own_list = without_object(setup.list, view.hidden);
   const DrawList& list = own_list ? *own_list : setup.list;
-  const glm::dmat4 view_projection = camera_view_projection(scene, options, w, h) * view.reflection;
+  const glm::dmat4& view_projection = frame.view_projection;
   // Textured and vertex-coloured objects (none: no per-pixel work at all).
   std::optional<soft::SurfaceColours> surfaces;
   if (options.mode != RenderMode::Visibility || options.visibility_lod) {
@@ -357,7 +379,7 @@ Status draw_view(const RenderSetup& setup, const MirrorView& view, RenderOutput&
   out.stats["time.setup"] = seconds_since(t);
 
   // Draw: every triangle into the camera's target.
-  DepthTarget& target = camera_target(scene, options, setup.kernels, arena, setup.kept);
+  DepthTarget& target = camera_target(options, w, h, frame.near, frame.far, setup.kernels, arena, frame.kept);
   // The fraction in triangles, the speed in fragments.
   if (progress) progress->begin("draw", list.triangles(), "triangles", "fragments");
   drawn = soft::draw_triangles(list, view_projection, target, arena, progress, view.keep);
@@ -397,8 +419,10 @@ Status draw_view(const RenderSetup& setup, const MirrorView& view, RenderOutput&
 
   // Shadows (full mode): the lights, seen through this z-buffer's shadow cubes.
   if (shadows) {
-    const VisibleFrame frame{scene, list, target, surfaces ? &*surfaces : nullptr, fb, view.eye};
-    RVR_TRY(add_shadowed_light(frame, setup.samples, options, setup.kernels, arena,
+    // The lights' shadow cubes hold every object, the one this view hides included.
+    const VisibleFrame visible{
+        scene, setup.list, target, surfaces ? &*surfaces : nullptr, fb, view.eye};
+    RVR_TRY(add_shadowed_light(visible, setup.samples, options, setup.kernels, arena,
                                &setup.kept_shadows, fb, out));
   }
   return ok_status();
@@ -414,7 +438,7 @@ Status add_mirrors(const RenderSetup& setup, const std::vector<PlanarMirror>& mi
   const MirrorViewPass pass = [&](const MirrorView& view) -> Expected<FrameBuffers> {
     RenderOutput reflected;
     DrawResult drawn;
-    RVR_TRY(draw_view(setup, view, reflected, drawn));
+    RVR_TRY(draw_view(setup, view, camera_frame(setup, view.reflection), reflected, drawn));
     for (const std::string& w : reflected.warnings)
       if (std::find(out.warnings.begin(), out.warnings.end(), w) == out.warnings.end())
         out.warnings.push_back(w);
@@ -423,6 +447,33 @@ Status add_mirrors(const RenderSetup& setup, const std::vector<PlanarMirror>& mi
   RVR_TRY(
       add_planar_reflections(mirrors, setup.options.max_depth, camera, pass, out.buffers, stats));
   record_mirror_stats(stats, seconds_since(t), out);
+  return ok_status();
+}
+
+// Full mode's curved mirrors and transparent objects: six faces per object seen, each drawn and
+// shaded as the camera's view is into a square target of its own, then looked up at the
+// object's pixels (environment_maps.h). The faces' counts go to the cube-map stats only.
+Status add_cube_maps(const RenderSetup& setup, const std::vector<EnvironmentMapped>& mapped,
+                     RenderOutput& out) {
+  const auto t = Clock::now();
+  EnvironmentStats stats;
+  std::optional<DepthTarget> face_target;
+  const CubeFacePass pass = [&](const CubeFace& face) -> Expected<FrameBuffers> {
+    MirrorView view;
+    view.eye = face.eye;
+    view.hidden = face.hidden;
+    const ViewFrame frame{face.projection * face.view, face.size, face.size, face.near, face.far,
+                          face_target};
+    RenderOutput drawn_face;
+    DrawResult drawn;
+    RVR_TRY(draw_view(setup, view, frame, drawn_face, drawn));
+    for (const std::string& w : drawn_face.warnings)
+      if (std::find(out.warnings.begin(), out.warnings.end(), w) == out.warnings.end())
+        out.warnings.push_back(w);
+    return std::move(drawn_face.buffers);
+  };
+  RVR_TRY(add_environment_maps(setup.scene, setup.options, mapped, pass, out.buffers, stats));
+  record_environment_stats(stats, seconds_since(t), out);
   return ok_status();
 }
 
@@ -459,18 +510,22 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   MirrorView camera;
   camera.eye = pass_eye(scene, options);
   DrawResult drawn;
-  RVR_TRY(draw_view(setup, camera, out, drawn));
+  RVR_TRY(draw_view(setup, camera, camera_frame(setup, camera.reflection), out, drawn));
   out.stats["time.setup"] += prepare_seconds;
   out.stats["time.visibility"] += prepare_seconds;
   record_draw_stats(drawn, *kept, draws.list.triangles(), shade, out.buffers, out);
 
-  std::vector<std::string> curved;
-  if (options.mode == RenderMode::Full && draws.mirror) {
-    const std::vector<PlanarMirror> mirrors = planar_mirrors(scene, *prepared, curved);
+  std::vector<EnvironmentMapped> mapped;
+  std::vector<std::string> left_out;  // transparent planar mirrors
+  if (options.mode == RenderMode::Full && (draws.mirror || draws.transparency)) {
+    const std::vector<PlanarMirror> mirrors = planar_mirrors(*prepared);
     if (!mirrors.empty()) RVR_TRY(add_mirrors(setup, mirrors, camera, out));
+    mapped = environment_mapped(scene, *prepared, mirrors, left_out);
+    if (!mapped.empty() && options.cube_map_size > 0)
+      RVR_TRY(add_cube_maps(setup, mapped, out));
   }
   out.info["hiz"] = options.hiz ? "on" : "off";
-  note_what_is_left_out(scene, options, *prepared, draws, curved, out.warnings);
+  note_what_is_left_out(scene, options, *prepared, mapped, left_out, out.warnings);
   return out;
 }
 

@@ -70,6 +70,9 @@ struct RenderOptions {
   Supersampling supersampling = Supersampling::Accumulation;
   // Z-buffers in full mode with an aperture: how depth of field is rendered.
   ZBufferDof zbuffer_dof = ZBufferDof::Accumulation;
+  // Z-buffers in full mode: texels per side of the cube environment map drawn for each curved
+  // mirror and transparent object (0: none, their local colour only).
+  int cube_map_size = 256;
   // Tracers: how a ray chooses a texture's level of detail (the z-buffers take theirs from
   // screen-space derivatives; the hybrids' primary hits from their z-buffer's).
   TextureLod texture_lod = TextureLod::Cones;

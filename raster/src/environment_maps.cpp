@@ -1,0 +1,288 @@
+#include "environment_maps.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <glm/ext/matrix_clip_space.hpp>
+#include <glm/ext/matrix_transform.hpp>
+#include <glm/gtc/constants.hpp>
+#include <memory>
+#include <optional>
+
+#include "rvr/core/camera.h"
+#include "rvr/core/check.h"
+#include "rvr/core/image_sample.h"
+#include "rvr/core/shapes/triangle_mesh.h"
+
+namespace rvr {
+
+namespace {
+
+std::string object_label(const Scene& scene, size_t index) {
+  const std::string& name = scene.objects[index].name;
+  return name.empty() ? fmt::format("object#{}", index) : name;
+}
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& s : names) text += (text.empty() ? "" : ", ") + s;
+  return text;
+}
+
+// A mesh's bounds.
+struct Bounds {
+  glm::vec3 lo, hi;
+};
+
+Bounds bounds(const TriangleMesh& mesh) {
+  Bounds b{mesh.positions.front(), mesh.positions.front()};
+  for (const glm::vec3& p : mesh.positions) {
+    b.lo = glm::min(b.lo, p);
+    b.hi = glm::max(b.hi, p);
+  }
+  return b;
+}
+
+// A cube face's axis and the up its view is turned to; face f looks along forward[f].
+struct FaceBasis {
+  glm::dvec3 forward, right, up;
+};
+
+const std::array<FaceBasis, 6>& face_bases() {
+  static const std::array<FaceBasis, 6> bases = [] {
+    const glm::dvec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const glm::dvec3 ups[6] = {{0, 1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}, {0, 1, 0}, {0, 1, 0}};
+    std::array<FaceBasis, 6> b;
+    for (int f = 0; f < 6; ++f) {
+      // glm::lookAt's camera frame: right = forward × up, up = right × forward.
+      b[f].forward = axes[f];
+      b[f].right = glm::normalize(glm::cross(axes[f], ups[f]));
+      b[f].up = glm::cross(b[f].right, axes[f]);
+    }
+    return b;
+  }();
+  return bases;
+}
+
+CubeFace cube_face(int f, const EnvironmentMapped& m, int size, const Camera& camera) {
+  const FaceBasis& b = face_bases()[f];
+  const glm::dvec3 eye(m.centre);
+  CubeFace face;
+  face.face = f;
+  face.near = m.radius > 0.0f ? std::min(0.01f * m.radius, camera.near) : camera.near;
+  face.far = std::max(2.0f * m.reach, face.near * 16.0f);
+  face.view = glm::lookAt(eye, eye + b.forward, b.up);
+  face.projection =
+      glm::perspective(glm::half_pi<double>(), 1.0, double(face.near), double(face.far));
+  face.eye = m.centre;
+  face.size = size;
+  face.hidden = m.object;
+  return face;
+}
+
+// The six faces' colours of one object's map.
+struct CubeMap {
+  int size = 0;
+  std::array<std::vector<glm::vec3>, 6> faces;
+
+  // The map's colour in direction d (not zero): the face of d's largest component (x before y
+  // before z on ties), bilinear between that face's pixel centres, clamped at its edges.
+  glm::vec3 lookup(const glm::dvec3& d) const {
+    const glm::dvec3 a = glm::abs(d);
+    const int axis = a.x >= a.y && a.x >= a.z ? 0 : a.y >= a.z ? 1 : 2;
+    const int f = 2 * axis + (d[axis] < 0.0 ? 1 : 0);
+    const FaceBasis& b = face_bases()[f];
+    const double along = glm::dot(d, b.forward);
+    const double u = glm::dot(d, b.right) / along, v = glm::dot(d, b.up) / along;
+    const double s = double(size);
+    const double x = std::clamp((u + 1.0) * 0.5 * s - 0.5, 0.0, s - 1.0);
+    const double y = std::clamp((1.0 - v) * 0.5 * s - 0.5, 0.0, s - 1.0);
+    const int x0 = int(x), y0 = int(y);
+    const int x1 = std::min(x0 + 1, size - 1), y1 = std::min(y0 + 1, size - 1);
+    const float fx = float(x - x0), fy = float(y - y0);
+    const std::vector<glm::vec3>& c = faces[f];
+    const auto at = [&](int px, int py) { return c[size_t(py) * size_t(size) + size_t(px)]; };
+    return (1.0f - fy) * ((1.0f - fx) * at(x0, y0) + fx * at(x1, y0)) +
+           fy * ((1.0f - fx) * at(x0, y1) + fx * at(x1, y1));
+  }
+};
+
+Expected<CubeMap> draw_cube_map(const EnvironmentMapped& m, int size, const Camera& camera,
+                                const CubeFacePass& pass, EnvironmentStats& stats) {
+  CubeMap map;
+  map.size = size;
+  for (int f = 0; f < 6; ++f) {
+    Expected<FrameBuffers> frame = pass(cube_face(f, m, size, camera));
+    if (!frame) return frame.error();
+    RVR_CHECK(frame->width == size && frame->height == size &&
+                  frame->colour.size() == frame->pixel_count(),
+              "a cube face is a square frame of the map's size with colour at every pixel");
+    map.faces[size_t(f)].assign(frame->colour.begin(), frame->colour.end());
+    ++stats.faces;
+  }
+  return map;
+}
+
+// The direction of the camera's ray through pixel (x, y) of a w × h frame: the line between the
+// points the pixel's centre unprojects to at the near and far planes (with an image sample, the
+// ray from its lens point through its place in the pixel).
+struct PixelRays {
+  glm::dmat4 unproject;
+  int width, height;
+  glm::dvec3 direction(int x, int y) const {
+    const double ndc_x = 2.0 * (x + 0.5) / width - 1.0, ndc_y = 1.0 - 2.0 * (y + 0.5) / height;
+    const glm::dvec4 a = unproject * glm::dvec4(ndc_x, ndc_y, -1.0, 1.0);
+    const glm::dvec4 b = unproject * glm::dvec4(ndc_x, ndc_y, 1.0, 1.0);
+    return glm::normalize(glm::dvec3(b) / b.w - glm::dvec3(a) / a.w);
+  }
+};
+
+PixelRays pixel_rays(const Scene& scene, const RenderOptions& options) {
+  const int w = scene.image.width, h = scene.image.height;
+  const glm::dmat4 view_projection =
+      options.image_sample
+          ? glm::dmat4(sample_projection_matrix(scene.camera, w, h, *options.image_sample)) *
+                glm::dmat4(sample_view_matrix(scene.camera, *options.image_sample))
+          : glm::dmat4(projection_matrix(scene.camera, w, h)) *
+                glm::dmat4(view_matrix(scene.camera));
+  return {glm::inverse(view_projection), w, h};
+}
+
+// The tracer's transmitted direction at the first interface, entering the object (the normal
+// faces the viewer): η = 1/ior; nothing when the ray is totally internally reflected.
+std::optional<glm::dvec3> transmitted(const glm::dvec3& d, const glm::dvec3& n, double ior) {
+  const double eta = 1.0 / ior;
+  const double cos_i = -glm::dot(d, n);
+  const double k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+  if (k < 0.0) return std::nullopt;
+  return glm::normalize(eta * d + (eta * cos_i - std::sqrt(k)) * n);
+}
+
+// For each mapped object, the pixels of `fb` that see it.
+std::vector<std::vector<size_t>> pixels_per_object(const std::vector<EnvironmentMapped>& mapped,
+                                                   const FrameBuffers& fb) {
+  uint32_t last = 0;
+  for (const EnvironmentMapped& m : mapped) last = std::max(last, m.object);
+  std::vector<int> index_of(size_t(last) + 1, -1);
+  for (size_t i = 0; i < mapped.size(); ++i) index_of[mapped[i].object] = int(i);
+  std::vector<std::vector<size_t>> seen(mapped.size());
+  for (size_t p = 0; p < fb.pixel_count(); ++p) {
+    const uint32_t id = fb.object_id[p];
+    if (id <= last && index_of[id] >= 0) seen[size_t(index_of[id])].push_back(p);
+  }
+  return seen;
+}
+
+}  // namespace
+
+std::vector<EnvironmentMapped> environment_mapped(const Scene& scene, const PreparedScene& prepared,
+                                                  const std::vector<PlanarMirror>& planar,
+                                                  std::vector<std::string>& left_out) {
+  std::vector<EnvironmentMapped> mapped;
+  std::vector<Bounds> drawn;  // every drawn object's bounds, for the faces' far planes
+  for (const PreparedObject& p : prepared.objects)
+    if (p.mesh && !p.mesh->positions.empty()) drawn.push_back(bounds(*p.mesh));
+  for (size_t i = 0; i < prepared.objects.size(); ++i) {
+    const PreparedObject& p = prepared.objects[i];
+    if (!p.mesh || p.mesh->positions.empty()) continue;
+    const Material& material = *p.material;
+    const bool is_planar = std::any_of(planar.begin(), planar.end(),
+                                       [&](const PlanarMirror& m) { return m.object == i; });
+    const float mirror = is_planar ? 0.0f : material.mirror;
+    if (is_planar && material.transparency > 0.0f) {
+      left_out.push_back(object_label(scene, i));
+      continue;
+    }
+    if (!(mirror > 0.0f) && !(material.transparency > 0.0f)) continue;
+    const Bounds b = bounds(*p.mesh);
+    const glm::vec3 centre = 0.5f * (b.lo + b.hi);
+    float reach = 0.0f;
+    for (const Bounds& o : drawn) {
+      const glm::vec3 far_corner = glm::max(glm::abs(o.lo - centre), glm::abs(o.hi - centre));
+      reach = std::max(reach, glm::length(far_corner));
+    }
+    mapped.push_back({uint32_t(i), centre, 0.5f * glm::length(b.hi - b.lo), reach, mirror,
+                      material.transparency, material.ior});
+  }
+  return mapped;
+}
+
+Status add_environment_maps(const Scene& scene, const RenderOptions& options,
+                            const std::vector<EnvironmentMapped>& mapped, const CubeFacePass& pass,
+                            FrameBuffers& fb, EnvironmentStats& stats) {
+  const std::vector<std::vector<size_t>> seen = pixels_per_object(mapped, fb);
+  const PixelRays rays = pixel_rays(scene, options);
+  for (size_t i = 0; i < mapped.size(); ++i) {
+    const EnvironmentMapped& m = mapped[i];
+    if (seen[i].empty()) continue;
+    const float kept = 1.0f - m.mirror - m.transparency;  // the local share
+    if (options.max_depth < 1) {  // the tracer's recursion limit: the shares dropped
+      for (size_t p : seen[i]) fb.colour[p] = kept * fb.colour[p];
+      stats.dropped += seen[i].size();
+      continue;
+    }
+    RVR_TRY_ASSIGN(map, draw_cube_map(m, options.cube_map_size, scene.camera, pass, stats));
+    for (size_t p : seen[i]) {
+      const glm::dvec3 d = rays.direction(int(p % size_t(fb.width)), int(p / size_t(fb.width)));
+      const glm::dvec3 n = glm::normalize(glm::dvec3(fb.normal[p]));
+      const glm::dvec3 r = d - 2.0 * glm::dot(d, n) * n;
+      glm::vec3 c = kept * fb.colour[p];
+      if (m.mirror > 0.0f) {
+        c += m.mirror * map->lookup(r);
+        ++stats.reflected;
+      }
+      if (m.transparency > 0.0f) {
+        const std::optional<glm::dvec3> t = transmitted(d, n, double(m.ior));
+        c += m.transparency * map->lookup(t ? *t : r);
+        ++stats.refracted;
+        if (!t) ++stats.total_internal;
+      }
+      fb.colour[p] = c;
+    }
+  }
+  return ok_status();
+}
+
+void record_environment_stats(const EnvironmentStats& stats, double seconds, RenderOutput& out) {
+  out.stats["cube_map.faces"] = double(stats.faces);
+  out.stats["cube_map.reflected_pixels"] = double(stats.reflected);
+  out.stats["cube_map.refracted_pixels"] = double(stats.refracted);
+  out.stats["cube_map.total_internal"] = double(stats.total_internal);
+  out.stats["time.cube_maps"] = seconds;
+}
+
+void note_environment_maps(const Scene& scene, const std::vector<EnvironmentMapped>& mapped,
+                           const std::vector<std::string>& left_out, bool drawn,
+                           std::vector<std::string>& warnings) {
+  if (!left_out.empty())
+    warnings.push_back(fmt::format("transparency not rendered on {} planar mirror{} ({})",
+                                   left_out.size(), left_out.size() == 1 ? "" : "s",
+                                   joined(left_out)));
+  std::vector<std::string> mirrors, clear;
+  for (const EnvironmentMapped& m : mapped) {
+    if (m.mirror > 0.0f) mirrors.push_back(object_label(scene, m.object));
+    if (m.transparency > 0.0f) clear.push_back(object_label(scene, m.object));
+  }
+  if (mirrors.empty() && clear.empty()) return;
+  std::string what;
+  if (!mirrors.empty())
+    what = fmt::format("reflection on {} curved mirror{} ({})", mirrors.size(),
+                       mirrors.size() == 1 ? "" : "s", joined(mirrors));
+  if (!clear.empty())
+    what += fmt::format("{}refraction on {} transparent object{} ({})", what.empty() ? "" : " and ",
+                        clear.size(), clear.size() == 1 ? "" : "s", joined(clear));
+  if (!drawn) {
+    warnings.push_back(what + " not rendered (--cube-map-size 0): local colour only");
+    return;
+  }
+  warnings.push_back(
+      what +
+      " from cube maps drawn at each object's centre: no parallax (the map is seen from the "
+      "centre, not the surface point), no self-reflection, refraction at the first interface "
+      "only, and one bounce (what a map shows keeps its own mirrors' and glass's local colour)");
+}
+
+}  // namespace rvr

@@ -1,0 +1,91 @@
+// Curved mirrors and transparent objects the z-buffer way: a dynamic cube environment map. The
+// scene is drawn six times from the centre of the object's bounds (90° square views along ±x, ±y,
+// ±z, the object itself left out), and each pixel that sees the object looks the map up in the
+// direction of the tracer's reflection ray (reflect(D, N)) and, for a transparent object, of its
+// transmitted ray at the first interface (Snell's law, total internal reflection reflected). The
+// classic approximation's errors are built in: the map is seen from the centre, not from the
+// surface point (parallax), the object does not reflect itself, the ray is bent at the first
+// interface only, and what the map shows keeps its own mirrors' and glass's local colour (one
+// bounce). Both z-buffers (GlRasterizer, SoftRasterizer) draw the faces and composite through
+// this one code.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <glm/glm.hpp>
+#include <string>
+#include <vector>
+
+#include "draw_list_prep.h"
+#include "planar_mirrors.h"
+#include "rvr/core/expected.h"
+#include "rvr/core/framebuffers.h"
+#include "rvr/core/renderer.h"
+#include "rvr/core/scene.h"
+
+namespace rvr {
+
+// An object whose mirror or transparency share a cube map answers.
+struct EnvironmentMapped {
+  uint32_t object = 0;        // index in Scene::objects
+  glm::vec3 centre{0.0f};     // where its map is drawn from: the centre of its drawn bounds
+  float radius = 0.0f;        // half its bounds' diagonal
+  float reach = 0.0f;         // the distance from the centre to the farthest drawn vertex
+  float mirror = 0.0f;        // the share reflected through the map (0 on a planar mirror)
+  float transparency = 0.0f;  // the share transmitted through the map
+  float ior = 1.0f;
+};
+
+// The objects of `prepared` with a mirror share that no planar view answers (`planar`) or with a
+// transparency share, in object order. A transparent planar mirror is left out (its mirror has
+// views of its own) and named in `left_out`.
+std::vector<EnvironmentMapped> environment_mapped(const Scene& scene, const PreparedScene& prepared,
+                                                  const std::vector<PlanarMirror>& planar,
+                                                  std::vector<std::string>& left_out);
+
+// One face of a cube map: the view from `eye` along one axis, 90° square, `size` pixels a side,
+// drawn without object `hidden`. Its near plane lies well inside the object (a hundredth of its
+// radius: the camera's could cut away what the object stands on), its far plane beyond the
+// farthest thing drawn (a reflection ray has no far plane). The frame's row 0 is the top row, as every frame's.
+struct CubeFace {
+  int face = 0;  // 0..5: +x, -x, +y, -y, +z, -z
+  glm::dmat4 view{1.0}, projection{1.0};
+  float near = 0.0f, far = 0.0f;
+  glm::vec3 eye{0.0f};
+  int size = 0;
+  uint32_t hidden = kNoId;
+};
+
+// Draws and shades the scene through `face` (full mode, its mirrors and glass local), returning
+// the frame: colour at every pixel.
+using CubeFacePass = std::function<Expected<FrameBuffers>(const CubeFace&)>;
+
+struct EnvironmentStats {
+  int faces = 0;           // cube faces drawn
+  uint64_t reflected = 0;  // pixels given a reflection from a map
+  uint64_t refracted = 0;  // pixels given a transmitted colour from a map
+  uint64_t total_internal = 0;  // of those, rays reflected by total internal reflection
+  uint64_t dropped = 0;    // pixels at the recursion limit (--max-depth 0): shares dropped
+};
+
+// The camera's frame `fb` (drawn through the camera of `scene`, or the sample
+// `options.image_sample`) with every mapped object's pixels composited as the tracer's shading
+// equation: colour = (1 - mirror - transparency) · local + mirror · map(reflected direction) +
+// transparency · map(transmitted direction). With max_depth 0 the shares are dropped, as the
+// tracer drops them, and no map is drawn.
+Status add_environment_maps(const Scene& scene, const RenderOptions& options,
+                            const std::vector<EnvironmentMapped>& mapped, const CubeFacePass& pass,
+                            FrameBuffers& fb, EnvironmentStats& stats);
+
+// The stats of a render's cube maps (cube_map.faces, cube_map.reflected_pixels,
+// cube_map.refracted_pixels, cube_map.total_internal, time.cube_maps) into `out`.
+void record_environment_stats(const EnvironmentStats& stats, double seconds, RenderOutput& out);
+
+// What a z-buffer says of the objects a cube map answers (what the map cannot show), or leaves
+// local (cube maps off: `drawn` false), and of the transparent planar mirrors left out, into
+// `warnings`.
+void note_environment_maps(const Scene& scene, const std::vector<EnvironmentMapped>& mapped,
+                           const std::vector<std::string>& left_out, bool drawn,
+                           std::vector<std::string>& warnings);
+
+}  // namespace rvr
