@@ -1278,8 +1278,9 @@ TEST_F(Cli, WarningsNameTheirRendererOnce) {
   const std::string note =
       "refraction on 2 transparent objects (slab, glass ball) from cube maps drawn at each "
       "object's centre: no parallax (the map is seen from the centre, not the surface point), no "
-      "self-reflection, refraction at the first interface only, and one bounce (what a map shows "
-      "keeps its own mirrors' and glass's local colour)";
+      "self-reflection, refraction at the first interface only (slab), a sphere's back surface "
+      "shaded as its front, and one bounce (what a map shows keeps its own mirrors' and glass's "
+      "local colour)";
   RunResult r = run("render builtin:glass -r softraster --mode full --spp 2 " +
                     std::string(kSmall) + " -o " + (dir_ / "g.png").string() + " --quiet");
   ASSERT_EQ(r.status, 0) << r.err;

@@ -57,11 +57,10 @@ constexpr std::array kStats = {
     StatDeclaration{"cube_map.reflected_pixels", kCount, "pixels", "z-buffers",
                     "pixels given a reflection looked up in a cube map"},
     StatDeclaration{"cube_map.refracted_pixels", kCount, "pixels", "z-buffers",
-                    "pixels given a transmitted colour looked up in a cube map (at the first "
-                    "interface)"},
+                    "pixels given a transmitted colour looked up in a cube map"},
     StatDeclaration{"cube_map.total_internal", kCount, "pixels", "z-buffers",
-                    "of the refracted pixels, those whose ray is totally internally reflected "
-                    "(looked up in the reflected direction)"},
+                    "totally internally reflected rays among the refracted pixels' (at either "
+                    "interface; looked up in the reflected direction)"},
     // Planar mirrors drawn by the z-buffers (full mode): a reflected view per mirror seen.
     StatDeclaration{"mirror.views", kCount, "views", "z-buffers",
                     "reflected views drawn for planar mirrors: one per mirror seen, per level of "

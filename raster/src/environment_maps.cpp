@@ -129,36 +129,57 @@ Expected<CubeMap> draw_cube_map(const EnvironmentMapped& m, int size, const Came
 // The direction of the camera's ray through pixel (x, y) of a w × h frame: the line between the
 // points the pixel's centre unprojects to at the near and far planes (with an image sample, the
 // ray from its lens point through its place in the pixel).
+struct PixelRay {
+  glm::dvec3 direction;  // unit length
+  glm::dvec3 at_depth;   // the point at view depth `depth` on the ray
+};
+
 struct PixelRays {
-  glm::dmat4 unproject;
+  glm::dmat4 view, unproject;
   int width, height;
-  glm::dvec3 direction(int x, int y) const {
+  // The pixel's ray, and its point at view depth `depth` (depth is affine along a line).
+  PixelRay ray(int x, int y, double depth) const {
     const double ndc_x = 2.0 * (x + 0.5) / width - 1.0, ndc_y = 1.0 - 2.0 * (y + 0.5) / height;
-    const glm::dvec4 a = unproject * glm::dvec4(ndc_x, ndc_y, -1.0, 1.0);
-    const glm::dvec4 b = unproject * glm::dvec4(ndc_x, ndc_y, 1.0, 1.0);
-    return glm::normalize(glm::dvec3(b) / b.w - glm::dvec3(a) / a.w);
+    const glm::dvec4 ha = unproject * glm::dvec4(ndc_x, ndc_y, -1.0, 1.0);
+    const glm::dvec4 hb = unproject * glm::dvec4(ndc_x, ndc_y, 1.0, 1.0);
+    const glm::dvec3 a = glm::dvec3(ha) / ha.w, b = glm::dvec3(hb) / hb.w;
+    const double da = -(view * glm::dvec4(a, 1.0)).z, db = -(view * glm::dvec4(b, 1.0)).z;
+    return {glm::normalize(b - a), a + (depth - da) / (db - da) * (b - a)};
   }
 };
 
 PixelRays pixel_rays(const Scene& scene, const RenderOptions& options) {
   const int w = scene.image.width, h = scene.image.height;
-  const glm::dmat4 view_projection =
+  const glm::dmat4 view = options.image_sample
+                              ? glm::dmat4(sample_view_matrix(scene.camera, *options.image_sample))
+                              : glm::dmat4(view_matrix(scene.camera));
+  const glm::dmat4 projection =
       options.image_sample
-          ? glm::dmat4(sample_projection_matrix(scene.camera, w, h, *options.image_sample)) *
-                glm::dmat4(sample_view_matrix(scene.camera, *options.image_sample))
-          : glm::dmat4(projection_matrix(scene.camera, w, h)) *
-                glm::dmat4(view_matrix(scene.camera));
-  return {glm::inverse(view_projection), w, h};
+          ? glm::dmat4(sample_projection_matrix(scene.camera, w, h, *options.image_sample))
+          : glm::dmat4(projection_matrix(scene.camera, w, h));
+  return {view, glm::inverse(projection * view), w, h};
 }
 
-// The tracer's transmitted direction at the first interface, entering the object (the normal
-// faces the viewer): η = 1/ior; nothing when the ray is totally internally reflected.
-std::optional<glm::dvec3> transmitted(const glm::dvec3& d, const glm::dvec3& n, double ior) {
-  const double eta = 1.0 / ior;
+glm::dvec3 reflected(const glm::dvec3& d, const glm::dvec3& n) {
+  return d - 2.0 * glm::dot(d, n) * n;
+}
+
+// The tracer's transmitted direction through an interface whose normal n faces the incoming
+// ray d, with η the ratio of the indices (1/ior entering, ior leaving); nothing when the ray is
+// totally internally reflected.
+std::optional<glm::dvec3> transmitted(const glm::dvec3& d, const glm::dvec3& n, double eta) {
   const double cos_i = -glm::dot(d, n);
   const double k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
   if (k < 0.0) return std::nullopt;
   return glm::normalize(eta * d + (eta * cos_i - std::sqrt(k)) * n);
+}
+
+// Where a ray from p (on or just inside the sphere) in direction t (unit) leaves the sphere: the
+// farther root of |p + s t - c| = r.
+glm::dvec3 sphere_exit(const glm::dvec3& p, const glm::dvec3& t, const glm::dvec3& c, double r) {
+  const glm::dvec3 o = p - c;
+  const double b = glm::dot(o, t), q = glm::dot(o, o) - r * r;
+  return p + (-b + std::sqrt(std::max(0.0, b * b - q))) * t;
 }
 
 // For each mapped object, the pixels of `fb` that see it.
@@ -199,13 +220,17 @@ std::vector<EnvironmentMapped> environment_mapped(const Scene& scene, const Prep
     if (!(mirror > 0.0f) && !(material.transparency > 0.0f)) continue;
     const Bounds b = bounds(*p.mesh);
     const glm::vec3 centre = 0.5f * (b.lo + b.hi);
+    const Object& object = scene.objects[i];
     float reach = 0.0f;
     for (const Bounds& o : drawn) {
       const glm::vec3 far_corner = glm::max(glm::abs(o.lo - centre), glm::abs(o.hi - centre));
       reach = std::max(reach, glm::length(far_corner));
     }
+    const bool sphere = object.type == ObjectType::Sphere;
     mapped.push_back({uint32_t(i), centre, 0.5f * glm::length(b.hi - b.lo), reach, mirror,
-                      material.transparency, material.ior});
+                      material.transparency, material.ior, sphere,
+                      sphere ? object.sphere.center : glm::vec3(0.0f),
+                      sphere ? object.sphere.radius : 0.0f});
   }
   return mapped;
 }
@@ -226,24 +251,46 @@ Status add_environment_maps(const Scene& scene, const RenderOptions& options,
     }
     RVR_TRY_ASSIGN(map, draw_cube_map(m, options.cube_map_size, scene.camera, pass, stats));
     for (size_t p : seen[i]) {
-      const glm::dvec3 d = rays.direction(int(p % size_t(fb.width)), int(p / size_t(fb.width)));
+      const PixelRay ray =
+          rays.ray(int(p % size_t(fb.width)), int(p / size_t(fb.width)), double(fb.depth[p]));
+      const glm::dvec3& d = ray.direction;
       const glm::dvec3 n = glm::normalize(glm::dvec3(fb.normal[p]));
-      const glm::dvec3 r = d - 2.0 * glm::dot(d, n) * n;
-      glm::vec3 c = kept * fb.colour[p];
+      const glm::dvec3 r = reflected(d, n);
+      const glm::vec3 local = fb.colour[p];
+      glm::vec3 c = kept * local;
       if (m.mirror > 0.0f) {
         c += m.mirror * map->lookup(r);
         ++stats.reflected;
       }
       if (m.transparency > 0.0f) {
-        const std::optional<glm::dvec3> t = transmitted(d, n, double(m.ior));
-        c += m.transparency * map->lookup(t ? *t : r);
         ++stats.refracted;
-        if (!t) ++stats.total_internal;
+        const std::optional<glm::dvec3> t = transmitted(d, n, 1.0 / double(m.ior));
+        if (!t) {
+          ++stats.total_internal;
+          c += m.transparency * map->lookup(r);
+        } else if (!m.sphere) {
+          c += m.transparency * map->lookup(*t);
+        } else {
+          // The second interface: leaving the sphere, the normal facing the ray (inwards).
+          const glm::dvec3 centre(m.sphere_centre);
+          const glm::dvec3 x = sphere_exit(ray.at_depth, *t, centre, double(m.sphere_radius));
+          const glm::dvec3 inward = glm::normalize(centre - x);
+          const glm::dvec3 inner = reflected(*t, inward);
+          const std::optional<glm::dvec3> out = transmitted(*t, inward, double(m.ior));
+          glm::vec3 exit = kept * local + m.mirror * map->lookup(inner);
+          exit += m.transparency * map->lookup(out ? *out : inner);
+          if (!out) ++stats.total_internal;
+          c += m.transparency * exit;
+        }
       }
       fb.colour[p] = c;
     }
   }
   return ok_status();
+}
+
+int cube_face_shadow_map_size(const RenderOptions& options) {
+  return std::max(16, std::min(options.shadow_map_size, options.cube_map_size));
 }
 
 void record_environment_stats(const EnvironmentStats& stats, double seconds, RenderOutput& out) {
@@ -261,10 +308,17 @@ void note_environment_maps(const Scene& scene, const std::vector<EnvironmentMapp
     warnings.push_back(fmt::format("transparency not rendered on {} planar mirror{} ({})",
                                    left_out.size(), left_out.size() == 1 ? "" : "s",
                                    joined(left_out)));
-  std::vector<std::string> mirrors, clear;
+  std::vector<std::string> mirrors, clear, flat_glass;  // flat: bent at one interface only
+  bool clear_spheres = false;
   for (const EnvironmentMapped& m : mapped) {
     if (m.mirror > 0.0f) mirrors.push_back(object_label(scene, m.object));
-    if (m.transparency > 0.0f) clear.push_back(object_label(scene, m.object));
+    if (m.transparency > 0.0f) {
+      clear.push_back(object_label(scene, m.object));
+      if (m.sphere)
+        clear_spheres = true;
+      else
+        flat_glass.push_back(object_label(scene, m.object));
+    }
   }
   if (mirrors.empty() && clear.empty()) return;
   std::string what;
@@ -278,11 +332,15 @@ void note_environment_maps(const Scene& scene, const std::vector<EnvironmentMapp
     warnings.push_back(what + " not rendered (--cube-map-size 0): local colour only");
     return;
   }
-  warnings.push_back(
-      what +
+  what +=
       " from cube maps drawn at each object's centre: no parallax (the map is seen from the "
-      "centre, not the surface point), no self-reflection, refraction at the first interface "
-      "only, and one bounce (what a map shows keeps its own mirrors' and glass's local colour)");
+      "centre, not the surface point), no self-reflection, ";
+  if (!flat_glass.empty())
+    what += fmt::format("refraction at the first interface only ({}), ", joined(flat_glass));
+  if (clear_spheres) what += "a sphere's back surface shaded as its front, ";
+  warnings.push_back(what +
+                     "and one bounce (what a map shows keeps its own mirrors' and glass's local "
+                     "colour)");
 }
 
 }  // namespace rvr

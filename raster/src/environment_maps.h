@@ -2,11 +2,12 @@
 // scene is drawn six times from the centre of the object's bounds (90° square views along ±x, ±y,
 // ±z, the object itself left out), and each pixel that sees the object looks the map up in the
 // direction of the tracer's reflection ray (reflect(D, N)) and, for a transparent object, of its
-// transmitted ray at the first interface (Snell's law, total internal reflection reflected). The
-// classic approximation's errors are built in: the map is seen from the centre, not from the
-// surface point (parallax), the object does not reflect itself, the ray is bent at the first
-// interface only, and what the map shows keeps its own mirrors' and glass's local colour (one
-// bounce). Both z-buffers (GlRasterizer, SoftRasterizer) draw the faces and composite through
+// transmitted ray (Snell's law, total internal reflection reflected): bent at the first
+// interface, and for a sphere bent again where it leaves (the second interface in closed form).
+// The classic approximation's errors are built in: the map is seen from the centre, not from
+// the surface point (parallax), the object does not reflect itself, a closed object other than
+// a sphere bends the ray at its first interface only, and what the map shows keeps its own
+// mirrors' and glass's local colour (one bounce). Both z-buffers (GlRasterizer, SoftRasterizer) draw the faces and composite through
 // this one code.
 #pragma once
 
@@ -34,6 +35,11 @@ struct EnvironmentMapped {
   float mirror = 0.0f;        // the share reflected through the map (0 on a planar mirror)
   float transparency = 0.0f;  // the share transmitted through the map
   float ior = 1.0f;
+  // An analytic sphere (drawn as its tessellation): its transmitted ray leaves it again where
+  // the ray meets the sphere a second time, bent a second time there.
+  bool sphere = false;
+  glm::vec3 sphere_centre{0.0f};
+  float sphere_radius = 0.0f;
 };
 
 // The objects of `prepared` with a mirror share that no planar view answers (`planar`) or with a
@@ -71,11 +77,17 @@ struct EnvironmentStats {
 // The camera's frame `fb` (drawn through the camera of `scene`, or the sample
 // `options.image_sample`) with every mapped object's pixels composited as the tracer's shading
 // equation: colour = (1 - mirror - transparency) · local + mirror · map(reflected direction) +
-// transparency · map(transmitted direction). With max_depth 0 the shares are dropped, as the
+// transparency · map(transmitted direction); through a sphere the transmitted share is what the
+// tracer's exit point returns, the front's local colour standing in for the back's (which no
+// pass shaded). With max_depth 0 the shares are dropped, as the
 // tracer drops them, and no map is drawn.
 Status add_environment_maps(const Scene& scene, const RenderOptions& options,
                             const std::vector<EnvironmentMapped>& mapped, const CubeFacePass& pass,
                             FrameBuffers& fb, EnvironmentStats& stats);
+
+// The shadow-map resolution of a cube map's faces: the map's own (a face texel and a shadow texel
+// then span the same angle), never finer than the camera's shadow maps and at least 16.
+int cube_face_shadow_map_size(const RenderOptions& options);
 
 // The stats of a render's cube maps (cube_map.faces, cube_map.reflected_pixels,
 // cube_map.refracted_pixels, cube_map.total_internal, time.cube_maps) into `out`.

@@ -1217,9 +1217,20 @@ Status GlRasterizer::Impl::add_cube_maps(const ScenePass& camera,
                                          RenderOutput& out) {
   const auto t = Clock::now();
   EnvironmentStats stats;
+  // The faces' own shadow maps, at the map's resolution: drawn by the first face and kept for
+  // the others when they fit one batch.
+  RenderOptions face_options = camera.options;
+  face_options.shadow_map_size = cube_face_shadow_map_size(camera.options);
+  RenderOutput planned;
+  RVR_TRY_ASSIGN(face_shadows, plan_shadows(face_options, camera.upload.samples, planned));
+  for (const std::string& w : planned.warnings)
+    if (std::find(out.warnings.begin(), out.warnings.end(), w) == out.warnings.end())
+      out.warnings.push_back(w);
   const CubeFacePass draw_face = [&](const CubeFace& face) -> Expected<FrameBuffers> {
     RVR_TRY(resize(face.size, face.size, depth_internal_format(camera.depth_format)));
-    ScenePass pass = camera;
+    ScenePass pass{camera.scene,        camera.options, camera.upload, *face_shadows,
+                   camera.view,         camera.projection, camera.depth_format, camera.eye,
+                   camera.width,        camera.height};
     pass.view = glm::mat4(face.view);
     pass.projection = camera.depth_format == DepthFormat::D32FReversed
                           ? reversed_z_projection(glm::mat4(face.projection), face.near, face.far)

@@ -458,6 +458,13 @@ Status add_cube_maps(const RenderSetup& setup, const std::vector<EnvironmentMapp
   const auto t = Clock::now();
   EnvironmentStats stats;
   std::optional<DepthTarget> face_target;
+  // The faces' own shadow cubes, at the map's resolution: drawn once when they fit one batch.
+  RenderOptions face_options = setup.options;
+  face_options.shadow_map_size = cube_face_shadow_map_size(setup.options);
+  KeptShadowCubes face_shadows;
+  const RenderSetup face_setup{setup.scene, face_options,  setup.isa,  setup.kernels,
+                               setup.arena, setup.list,    setup.samples, setup.kept,
+                               face_shadows};
   const CubeFacePass pass = [&](const CubeFace& face) -> Expected<FrameBuffers> {
     MirrorView view;
     view.eye = face.eye;
@@ -466,7 +473,7 @@ Status add_cube_maps(const RenderSetup& setup, const std::vector<EnvironmentMapp
                           face_target};
     RenderOutput drawn_face;
     DrawResult drawn;
-    RVR_TRY(draw_view(setup, view, frame, drawn_face, drawn));
+    RVR_TRY(draw_view(face_setup, view, frame, drawn_face, drawn));
     for (const std::string& w : drawn_face.warnings)
       if (std::find(out.warnings.begin(), out.warnings.end(), w) == out.warnings.end())
         out.warnings.push_back(w);
