@@ -145,7 +145,7 @@ fuzz: deps
 # and interleaving spreads the drift over every benchmark alike.
 # BM_Visibility: the frame chart's z-buffers, tracers and hybrids, without the brute-force and
 # binary-BVH tracers, and without 10^7 triangles for llvmpipe and the hybrids (seconds a frame).
-BENCH_FILTER ?= BM_Frame/(raster|softraster|raytrace|raytrace_bvh2|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_Frame/(hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_Visibility/(softraster|raytrace|embree)/(tessphere|soup)/[0-9]+/1024|BM_Visibility/(raster|hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_DepthComplexity|BM_Effects|BM_Mirrors|BM_Trace|BM_Build|BM_Threads|BM_WriteAovs
+BENCH_FILTER ?= BM_Frame/(raster|softraster|raytrace|raytrace_bvh2|embree|raytrace_none)/(tessphere|soup)/[0-9]+/1024|BM_Frame/(hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_Visibility/(softraster|raytrace|embree)/(tessphere|soup)/[0-9]+/1024|BM_Visibility/(raster|hybrid|hybrid_soft)/(tessphere|soup)/[0-9]{3,7}/1024|BM_DepthComplexity|BM_Effects|BM_Mirrors|BM_CurvedMirrors|BM_Trace|BM_Build|BM_Threads|BM_WriteAovs
 bench: build
 	mkdir -p bench/results bench/charts
 	$(BUILD_DIR)/bin/rvr_bench --benchmark_filter='$(BENCH_FILTER)' --benchmark_min_time=0.2 \

@@ -113,20 +113,28 @@ def depth_complexity(rows, context, out):
 
 
 def mirrors(rows, context, out):
-    """Frame time against the number of flat mirrors (BM_Mirrors): the tracer pays per mirror
-    pixel, a z-buffer a whole view per mirror; where the lines cross is the crossover."""
-    fig, ax = plt.subplots(figsize=(10, 4.5))
-    drawn = plot_renderers_against_n(ax, rows, "BM_Mirrors")
-    ax.set_xscale("log", base=2)
-    ax.set_yscale("log")
-    ax.set_xlabel("flat mirrors N (mirrors:N, 640x480, full mode)")
-    ax.set_ylabel("frame time (ms)")
-    ax.grid(True, alpha=0.3)
-    if drawn:
-        ax.legend()
-    else:
-        ax.text(0.5, 0.5, "no BM_Mirrors rows", ha="center", va="center", transform=ax.transAxes)
-    fig.suptitle("Flat mirrors: a ray per mirror pixel vs a view per mirror\n(" + subtitle(context) + ")")
+    """Frame time against the number of mirrors: flat ones (BM_Mirrors: the tracer pays per mirror
+    pixel, a z-buffer a whole view per mirror) and curved ones (BM_CurvedMirrors: a z-buffer a
+    cube map, six views, per ball); where the lines cross is the crossover."""
+    fig, axes = plt.subplots(1, 2, figsize=(13, 4.5))
+    for ax, family, label, title in [
+            (axes[0], "BM_Mirrors", "flat mirrors N (mirrors:N, 640x480, full mode)",
+             "flat: a ray per mirror pixel vs a view per mirror"),
+            (axes[1], "BM_CurvedMirrors", "mirror balls N (mirror_balls:N, 640x480, full mode)",
+             "curved: a ray per mirror pixel vs a cube map per ball")]:
+        drawn = plot_renderers_against_n(ax, rows, family)
+        ax.set_xscale("log", base=2)
+        ax.set_yscale("log")
+        ax.set_xlabel(label)
+        ax.set_ylabel("frame time (ms)")
+        ax.set_title(title)
+        ax.grid(True, alpha=0.3)
+        if drawn:
+            ax.legend()
+        else:
+            ax.text(0.5, 0.5, "no " + family + " rows", ha="center", va="center",
+                    transform=ax.transAxes)
+    fig.suptitle("Mirrors: the tracer's rays vs the z-buffer's views (" + subtitle(context) + ")")
     fig.tight_layout()
     fig.savefig(out / "mirrors.png", dpi=100)
 

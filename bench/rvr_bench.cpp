@@ -6,6 +6,7 @@
 //   BM_Effects/<effect>                        the tracer on cornell, one effect at a time
 //   BM_Effects/hybrid[_soft]/<effect>          the same frames with the hybrids
 //   BM_Mirrors/<renderer>/<N>                  builtin:mirrors:N, full mode: rays vs views
+//   BM_CurvedMirrors/<renderer>/<N>            builtin:mirror_balls:N, full mode: rays vs cube maps
 //   BM_Trace/<accel>/<rays>/<scene>/<n>        one thread, rays only, no shading
 //   BM_Build/<accel>/<n>                       acceleration structure build
 //   BM_Texture/<renderer>/<lod>                builtin:textured at 640x480, local mode; lod is
@@ -291,6 +292,10 @@ void effect_scene(const std::string& effect, Scene& scene, RenderOptions& option
       if (o.name == "back wall") o.material = scene.objects[6].material;
       if (o.name == "mirror ball") o.material = scene.objects[0].material;
     }
+  } else if (effect == "curved_mirror") {
+    // The ball a mirror, nothing else: the z-buffers answer it with a cube map.
+    for (Material& m : scene.materials)
+      if (m.name == "mirror") m.mirror = 0.85f;
   } else if (effect == "glass") {
     for (Material& m : scene.materials)
       if (m.name == "glass") m.transparency = 0.9f;
@@ -316,6 +321,22 @@ void BM_Mirrors(benchmark::State& state, const std::string& renderer_name) {
   add_counters(state, out, double(scene.image.width) * scene.image.height);
   if (auto it = out.stats.find("mirror.views"); it != out.stats.end())
     state.counters["mirror_views"] = it->second;
+}
+
+// builtin:mirror_balls:N at 640x480 in full mode: the tracer's reflection rays against a
+// z-buffer's cube maps (six views per ball seen). The counter cube_faces is the z-buffer's.
+void BM_CurvedMirrors(benchmark::State& state, const std::string& renderer_name) {
+  Scene scene = builtin("mirror_balls:" + std::to_string(state.range(0)));
+  scene.image.width = 640;
+  scene.image.height = 480;
+  RenderOptions options;
+  options.mode = RenderMode::Full;
+  FrameRenderer renderer(renderer_name, scene, options);
+  PhaseTimes phases;
+  RenderOutput out = time_frames(state, renderer, phases);
+  add_counters(state, out, double(scene.image.width) * scene.image.height);
+  if (auto it = out.stats.find("cube_map.faces"); it != out.stats.end())
+    state.counters["cube_faces"] = it->second;
 }
 
 // The tracer on cornell with exactly one effect switched on.
@@ -719,9 +740,9 @@ void register_all() {
             ->Arg(n)
             ->Unit(benchmark::kMillisecond)
             ->UseRealTime();
-  for (std::string e :
-       {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1", "mirror_depth_2",
-        "mirror_depth_3", "mirror_depth_4", "mirror_depth_5", "planar_mirror", "glass", "dof_16"}) {
+  for (std::string e : {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1",
+                        "mirror_depth_2", "mirror_depth_3", "mirror_depth_4", "mirror_depth_5",
+                        "planar_mirror", "curved_mirror", "glass", "dof_16"}) {
     benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
@@ -739,9 +760,15 @@ void register_all() {
         ->Range(1, 256)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
+  for (std::string r : {"raytrace", "softraster", "raster", "hybrid_soft"})
+    benchmark::RegisterBenchmark(("BM_CurvedMirrors/" + r).c_str(), BM_CurvedMirrors, r)
+        ->RangeMultiplier(4)
+        ->Range(1, 64)
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   // The z-buffers' own answers to the effects they render, by technique: primary visibility,
-  // shadow maps, a flat mirror by reflected views, and depth of field by the accumulation buffer
-  // (raster also by MSAA: a pinhole) or a blur.
+  // shadow maps, a flat mirror by reflected views, a curved mirror and glass by cube maps, and
+  // depth of field by the accumulation buffer (raster also by MSAA: a pinhole) or a blur.
   struct ZBufferEffect {
     std::string renderer, effect, technique;
     Supersampling supersampling = Supersampling::Accumulation;
@@ -752,6 +779,8 @@ void register_all() {
                                         {z, "hard_shadows", "shadow_maps"},
                                         {z, "area_light_4x4", "shadow_maps"},
                                         {z, "planar_mirror", "reflected_views"},
+                                        {z, "curved_mirror", "cube_map"},
+                                        {z, "glass", "cube_map"},
                                         {z, "dof_16", "accumulation"}};
     cases.push_back({z, "dof_16", "blur", Supersampling::Accumulation, ZBufferDof::Blur});
     if (z == "raster") cases.push_back({z, "dof_16", "msaa", Supersampling::Msaa});

@@ -67,6 +67,9 @@ def synthetic_run(new):
     for n in [1, 16, 256]:
         rows.append(row(f"BM_Mirrors/raytrace/{n}", 30.0, not new))
         rows.append(row(f"BM_Mirrors/softraster/{n}", 5.0 * n, not new, mirror_views=float(n)))
+        rows.append(row(f"BM_CurvedMirrors/raytrace/{n}", 30.0, not new))
+        rows.append(row(f"BM_CurvedMirrors/softraster/{n}", 8.0 * n, not new,
+                        cube_faces=6.0 * n))
     rows.append(row("BM_Threads/softraster/1", 50.0, not new))
     rows.append(row("BM_Threads/softraster/2", 27.0, not new))
     context = {"date": "2026-12-01T00:00:00+00:00", "num_cpus": 2, "mhz_per_cpu": 2445}

@@ -82,9 +82,10 @@ std::vector<RendererCase> renderer_cases() {
 // Every built-in scene, sized for the test. `csg` is the one exception, by the format's rule:
 // a csg object has no z-buffer form, so rasterizers skip it (with a warning; tested in
 // test_raster) and there is nothing to agree on.
-const char* kScenes[] = {"cornell",   "spheres",         "occluders:16", "occluders_back:16",
-                         "soup:2000", "tessphere:20000", "effects:5000", "dof",
-                         "discs",     "mirrors:16",      "glass",        "textured"};
+const char* kScenes[] = {"cornell",   "spheres",         "occluders:16",   "occluders_back:16",
+                         "soup:2000", "tessphere:20000", "effects:5000",   "dof",
+                         "discs",     "mirrors:16",      "mirror_balls:4", "glass",
+                         "textured"};
 
 TEST(ConformanceScenes, CoverEveryBuiltinSceneButCsg) {
   std::set<std::string> listed;

@@ -3,6 +3,7 @@
 // is parallax (it sees from the centre, not from the surface point): against an environment far
 // away compared with the object, that error vanishes and the map must give the tracer's colour
 // wherever no edge of the reflected scene passes; near, the error must show.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -24,9 +25,9 @@ namespace rvr {
 namespace {
 
 // An object at the origin (a ball of radius 1, or a sheet: `shape`) inside a box whose six walls
-// only glow, each its own colour, up to `distance` from the centre. No lights and no ambient: a wall's
-// colour is its emission, the object's (1 - mirror - transparency) · its emission plus what its
-// rays meet. The ball as the z-buffers' tessellation in both renderers (SphereMode::Mesh): the
+// only glow, each its own colour, up to `distance` from the centre. No lights and no ambient: a
+// wall's colour is its emission, the object's (1 - mirror - transparency) · its emission plus what
+// its rays meet. The ball as the z-buffers' tessellation in both renderers (SphereMode::Mesh): the
 // same triangles and normals. The camera sees as far as any wall.
 constexpr const char* kBallShape = R"("type": "sphere", "center": [0, 0, 0], "radius": 1)";
 constexpr const char* kSheetShape =
@@ -35,36 +36,37 @@ constexpr const char* kSheetShape =
 std::string box_scene(double distance, const char* shape, const std::string& material) {
   // Each wall at its own distance, so that the box is not centred on the object and every face
   // of its map sees several walls; each a square large enough to close the box.
-  const auto at = [&](double share) { return std::to_string(share * distance); };
-  const std::string s = std::to_string(2.0 * distance);
-  const auto wall = [&](const char* name, const std::string& point, const char* normal) {
-    return std::string(R"({ "name": ")") + name + R"(", "type": "plane", "point": )" + point +
-           R"(, "normal": )" + normal + R"(, "half_size": )" + s + R"(, "material": ")" + name +
-           R"(" })";
+  const auto wall = [&](const char* name, int axis, double share) {
+    double point[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
+    point[axis] = share * distance;
+    normal[axis] = share > 0 ? -1 : 1;
+    return fmt::format(
+        R"({{ "name": "{}", "type": "plane", "point": [{}, {}, {}], "normal": [{}, {}, {}],
+      "half_size": {}, "material": "{}" }})",
+        name, point[0], point[1], point[2], normal[0], normal[1], normal[2], 2.0 * distance, name);
   };
-  return std::string(R"({
+  return fmt::format(R"({{
   "format": "rvr-scene/1",
-  "image": { "width": 160, "height": 120, "background": [0, 0, 0] },
-  "camera": { "eye": [0.6, 0.9, 2.8], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 45,
-              "far": 100000 },
+  "image": {{ "width": 160, "height": 120, "background": [0, 0, 0] }},
+  "camera": {{ "eye": [0.6, 0.9, 2.8], "target": [0, 0, 0], "up": [0, 1, 0], "fov_y_deg": 45,
+              "far": 100000 }},
   "ambient": [0, 0, 0],
-  "materials": {
-    "px": { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.9, 0.1, 0.1] },
-    "nx": { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.1, 0.8, 0.2] },
-    "py": { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.2, 0.3, 0.9] },
-    "ny": { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.8, 0.8, 0.1] },
-    "pz": { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.7, 0.2, 0.8] },
-    "nz": { "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.1, 0.7, 0.7] },
-    "ball": )") + material +
-         R"( },
+  "materials": {{
+    "px": {{ "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.9, 0.1, 0.1] }},
+    "nx": {{ "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.1, 0.8, 0.2] }},
+    "py": {{ "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.2, 0.3, 0.9] }},
+    "ny": {{ "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.8, 0.8, 0.1] }},
+    "pz": {{ "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.7, 0.2, 0.8] }},
+    "nz": {{ "diffuse": [0, 0, 0], "specular": [0, 0, 0], "emission": [0.1, 0.7, 0.7] }},
+    "ball": {}
+  }},
   "objects": [
-    { "name": "ball", )" + shape + R"(, "material": "ball" },
-    )" + wall("px", "[" + at(1.0) + ", 0, 0]", "[-1, 0, 0]") +
-         ",\n" + wall("nx", "[-" + at(0.6) + ", 0, 0]", "[1, 0, 0]") + ",\n" +
-         wall("py", "[0, " + at(0.8) + ", 0]", "[0, -1, 0]") + ",\n" +
-         wall("ny", "[0, -" + at(0.5) + ", 0]", "[0, 1, 0]") + ",\n" +
-         wall("pz", "[0, 0, " + at(0.9) + "]", "[0, 0, -1]") + ",\n" +
-         wall("nz", "[0, 0, -" + at(0.7) + "]", "[0, 0, 1]") + "\n  ]\n}";
+    {{ "name": "ball", {}, "material": "ball" }},
+    {}, {}, {}, {}, {}, {}
+  ]
+}})",
+                     material, shape, wall("px", 0, 1.0), wall("nx", 0, -0.6), wall("py", 1, 0.8),
+                     wall("ny", 1, -0.5), wall("pz", 2, 0.9), wall("nz", 2, -0.7));
 }
 
 constexpr const char* kMirrorBall =
@@ -142,8 +144,8 @@ BallAgreement ball_agreement(const FrameBuffers& z, const FrameBuffers& t) {
 
 class EnvironmentMaps : public ::testing::TestWithParam<const char*> {};
 
-// Walls 5000 to 10^4 radii away: the parallax of a map seen from the centre instead of the surface point
-// is at most 2·10^-4 rad, a tenth of a texel and far less than a pixel's step in reflected or
+// Walls 5000 to 10^4 radii away: the parallax of a map seen from the centre instead of the surface
+// point is at most 2·10^-4 rad, a tenth of a texel and far less than a pixel's step in reflected or
 // transmitted direction. So every pixel of the mirror ball, the glass sheet and the glass ball
 // away from an edge shows the tracer's wall.
 TEST_P(EnvironmentMaps, FarEnvironmentGivesTheTracersColour) {
@@ -164,9 +166,10 @@ TEST_P(EnvironmentMaps, FarEnvironmentGivesTheTracersColour) {
   }
 }
 
-// Walls 1.75 to 3.5 radii away: the map sees them from the centre, the tracer from the surface, and the
-// reflected walls' edges move by up to about 1/1.75 rad, many pixels: more than 1 in 100 ball pixels away from any edge of
-// the tracer's image show another wall. The test sees the technique's known error.
+// Walls 1.75 to 3.5 radii away: the map sees them from the centre, the tracer from the surface, and
+// the reflected walls' edges move by up to about 1/1.75 rad, many pixels: more than 1 in 100 ball
+// pixels away from any edge of the tracer's image show another wall. The test sees the technique's
+// known error.
 TEST_P(EnvironmentMaps, NearEnvironmentShowsTheParallaxError) {
   const Scene scene = load(box_scene(3.5, kBallShape, kMirrorBall));
   const BallAgreement a =
@@ -177,7 +180,8 @@ TEST_P(EnvironmentMaps, NearEnvironmentShowsTheParallaxError) {
 // At the recursion limit the mirrored and transmitted shares are dropped, as the tracer drops
 // them, and no map is drawn.
 TEST_P(EnvironmentMaps, RecursionLimitDropsTheShares) {
-  for (const auto& [shape, material] : {std::pair{kBallShape, kMirrorBall}, {kSheetShape, kGlass}}) {
+  for (const auto& [shape, material] :
+       {std::pair{kBallShape, kMirrorBall}, {kSheetShape, kGlass}}) {
     const Scene scene = load(box_scene(1e4, shape, material));
     const std::string ball = material;
     const RenderOutput z = render(GetParam(), scene, 0);

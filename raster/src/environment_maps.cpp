@@ -26,9 +26,12 @@ std::string object_label(const Scene& scene, size_t index) {
   return name.empty() ? fmt::format("object#{}", index) : name;
 }
 
+// "a, b, c", the first eight names and how many more.
 std::string joined(const std::vector<std::string>& names) {
+  constexpr size_t kNamed = 8;
   std::string text;
-  for (const std::string& s : names) text += (text.empty() ? "" : ", ") + s;
+  for (size_t i = 0; i < names.size() && i < kNamed; ++i) text += (i ? ", " : "") + names[i];
+  if (names.size() > kNamed) text += fmt::format(" and {} more", names.size() - kNamed);
   return text;
 }
 
@@ -53,7 +56,8 @@ struct FaceBasis {
 
 const std::array<FaceBasis, 6>& face_bases() {
   static const std::array<FaceBasis, 6> bases = [] {
-    const glm::dvec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    const glm::dvec3 axes[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
     const glm::dvec3 ups[6] = {{0, 1, 0}, {0, 1, 0}, {0, 0, -1}, {0, 0, 1}, {0, 1, 0}, {0, 1, 0}};
     std::array<FaceBasis, 6> b;
     for (int f = 0; f < 6; ++f) {

@@ -7,8 +7,8 @@
 // The classic approximation's errors are built in: the map is seen from the centre, not from
 // the surface point (parallax), the object does not reflect itself, a closed object other than
 // a sphere bends the ray at its first interface only, and what the map shows keeps its own
-// mirrors' and glass's local colour (one bounce). Both z-buffers (GlRasterizer, SoftRasterizer) draw the faces and composite through
-// this one code.
+// mirrors' and glass's local colour (one bounce). Both z-buffers (GlRasterizer, SoftRasterizer)
+// draw the faces and composite through this one code.
 #pragma once
 
 #include <cstdint>
@@ -52,7 +52,8 @@ std::vector<EnvironmentMapped> environment_mapped(const Scene& scene, const Prep
 // One face of a cube map: the view from `eye` along one axis, 90° square, `size` pixels a side,
 // drawn without object `hidden`. Its near plane lies well inside the object (a hundredth of its
 // radius: the camera's could cut away what the object stands on), its far plane beyond the
-// farthest thing drawn (a reflection ray has no far plane). The frame's row 0 is the top row, as every frame's.
+// farthest thing drawn (a reflection ray has no far plane). The frame's row 0 is the top row, as
+// every frame's.
 struct CubeFace {
   int face = 0;  // 0..5: +x, -x, +y, -y, +z, -z
   glm::dmat4 view{1.0}, projection{1.0};
@@ -67,11 +68,11 @@ struct CubeFace {
 using CubeFacePass = std::function<Expected<FrameBuffers>(const CubeFace&)>;
 
 struct EnvironmentStats {
-  int faces = 0;           // cube faces drawn
-  uint64_t reflected = 0;  // pixels given a reflection from a map
-  uint64_t refracted = 0;  // pixels given a transmitted colour from a map
+  int faces = 0;                // cube faces drawn
+  uint64_t reflected = 0;       // pixels given a reflection from a map
+  uint64_t refracted = 0;       // pixels given a transmitted colour from a map
   uint64_t total_internal = 0;  // of those, rays reflected by total internal reflection
-  uint64_t dropped = 0;    // pixels at the recursion limit (--max-depth 0): shares dropped
+  uint64_t dropped = 0;         // pixels at the recursion limit (--max-depth 0): shares dropped
 };
 
 // The camera's frame `fb` (drawn through the camera of `scene`, or the sample

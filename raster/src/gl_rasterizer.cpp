@@ -28,12 +28,12 @@
 #include "accumulation_buffer.h"
 #include "depth_of_field_blur.h"
 #include "draw_list_prep.h"
+#include "environment_maps.h"
 #include "gl_check.h"
 #include "gl_context.h"
 #include "gl_objects.h"
 #include "gl_program.h"
 #include "gl_shaders.h"
-#include "environment_maps.h"
 #include "planar_mirrors.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/framebuffers.h"
@@ -186,7 +186,7 @@ struct ScenePass {
   const ShadowPlan& shadows;
   glm::mat4 view, projection;
   DepthFormat depth_format;
-  glm::vec3 eye;  // where the pass looks from: the camera's eye or a sample's lens point
+  glm::vec3 eye;      // where the pass looks from: the camera's eye or a sample's lens point
   int width, height;  // the frame's size: the image's, or a cube map face's
   // A planar mirror's view (planar_mirrors.h): only what lies on the positive side of the world
   // plane `keep` is drawn (when `clipped`), and not the mirror `hidden`.
@@ -1228,9 +1228,9 @@ Status GlRasterizer::Impl::add_cube_maps(const ScenePass& camera,
       out.warnings.push_back(w);
   const CubeFacePass draw_face = [&](const CubeFace& face) -> Expected<FrameBuffers> {
     RVR_TRY(resize(face.size, face.size, depth_internal_format(camera.depth_format)));
-    ScenePass pass{camera.scene,        camera.options, camera.upload, *face_shadows,
-                   camera.view,         camera.projection, camera.depth_format, camera.eye,
-                   camera.width,        camera.height};
+    ScenePass pass{camera.scene, camera.options,    camera.upload,       *face_shadows,
+                   camera.view,  camera.projection, camera.depth_format, camera.eye,
+                   camera.width, camera.height};
     pass.view = glm::mat4(face.view);
     pass.projection = camera.depth_format == DepthFormat::D32FReversed
                           ? reversed_z_projection(glm::mat4(face.projection), face.near, face.far)
@@ -1244,7 +1244,8 @@ Status GlRasterizer::Impl::add_cube_maps(const ScenePass& camera,
     RVR_TRY(readback(face.size, face.size, pass, drawn.buffers, passed));
     return std::move(drawn.buffers);
   };
-  RVR_TRY(add_environment_maps(camera.scene, camera.options, mapped, draw_face, out.buffers, stats));
+  RVR_TRY(
+      add_environment_maps(camera.scene, camera.options, mapped, draw_face, out.buffers, stats));
   record_environment_stats(stats, seconds_since(t), out);
   return ok_status();
 }

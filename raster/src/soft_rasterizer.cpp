@@ -21,9 +21,9 @@
 #include <vector>
 
 #include "accumulation_buffer.h"
-#include "environment_maps.h"
 #include "depth_of_field_blur.h"
 #include "draw_list_prep.h"
+#include "environment_maps.h"
 #include "planar_mirrors.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/framebuffers.h"
@@ -379,7 +379,8 @@ Status draw_view(const RenderSetup& setup, const MirrorView& view, const ViewFra
   out.stats["time.setup"] = seconds_since(t);
 
   // Draw: every triangle into the camera's target.
-  DepthTarget& target = camera_target(options, w, h, frame.near, frame.far, setup.kernels, arena, frame.kept);
+  DepthTarget& target =
+      camera_target(options, w, h, frame.near, frame.far, setup.kernels, arena, frame.kept);
   // The fraction in triangles, the speed in fragments.
   if (progress) progress->begin("draw", list.triangles(), "triangles", "fragments");
   drawn = soft::draw_triangles(list, view_projection, target, arena, progress, view.keep);
@@ -420,8 +421,8 @@ Status draw_view(const RenderSetup& setup, const MirrorView& view, const ViewFra
   // Shadows (full mode): the lights, seen through this z-buffer's shadow cubes.
   if (shadows) {
     // The lights' shadow cubes hold every object, the one this view hides included.
-    const VisibleFrame visible{
-        scene, setup.list, target, surfaces ? &*surfaces : nullptr, fb, view.eye};
+    const VisibleFrame visible{scene, setup.list, target, surfaces ? &*surfaces : nullptr,
+                               fb,    view.eye};
     RVR_TRY(add_shadowed_light(visible, setup.samples, options, setup.kernels, arena,
                                &setup.kept_shadows, fb, out));
   }
@@ -462,15 +463,14 @@ Status add_cube_maps(const RenderSetup& setup, const std::vector<EnvironmentMapp
   RenderOptions face_options = setup.options;
   face_options.shadow_map_size = cube_face_shadow_map_size(setup.options);
   KeptShadowCubes face_shadows;
-  const RenderSetup face_setup{setup.scene, face_options,  setup.isa,  setup.kernels,
-                               setup.arena, setup.list,    setup.samples, setup.kept,
-                               face_shadows};
+  const RenderSetup face_setup{setup.scene, face_options,  setup.isa,  setup.kernels, setup.arena,
+                               setup.list,  setup.samples, setup.kept, face_shadows};
   const CubeFacePass pass = [&](const CubeFace& face) -> Expected<FrameBuffers> {
     MirrorView view;
     view.eye = face.eye;
     view.hidden = face.hidden;
-    const ViewFrame frame{face.projection * face.view, face.size, face.size, face.near, face.far,
-                          face_target};
+    const ViewFrame frame{
+        face.projection * face.view, face.size, face.size, face.near, face.far, face_target};
     RenderOutput drawn_face;
     DrawResult drawn;
     RVR_TRY(draw_view(face_setup, view, frame, drawn_face, drawn));
@@ -528,8 +528,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     const std::vector<PlanarMirror> mirrors = planar_mirrors(*prepared);
     if (!mirrors.empty()) RVR_TRY(add_mirrors(setup, mirrors, camera, out));
     mapped = environment_mapped(scene, *prepared, mirrors, left_out);
-    if (!mapped.empty() && options.cube_map_size > 0)
-      RVR_TRY(add_cube_maps(setup, mapped, out));
+    if (!mapped.empty() && options.cube_map_size > 0) RVR_TRY(add_cube_maps(setup, mapped, out));
   }
   out.info["hiz"] = options.hiz ? "on" : "off";
   note_what_is_left_out(scene, options, *prepared, mapped, left_out, out.warnings);

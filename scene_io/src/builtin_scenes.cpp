@@ -167,6 +167,39 @@ Scene cornell() {
   return s;
 }
 
+// N small mirror balls (k x k cells, k = ceil(sqrt(N)), filled row by row from the back) on a
+// floor between coloured walls: the tracer pays a reflection ray per mirror pixel whatever N
+// is, a z-buffer a cube map (six views) per ball seen.
+Scene mirror_balls(size_t n) {
+  Scene s = base_scene("mirror_balls:" + std::to_string(n));
+  add_floor(s, {0.6f, 0.6f, 0.55f}, {0, 0, 0}, 6.0f);
+  uint32_t mirror = add_material(s, "mirror", {0.1f, 0.1f, 0.1f}, {0.9f, 0.9f, 0.9f}, 200.0f);
+  s.materials[mirror].mirror = 0.85f;
+  const uint32_t red = add_material(s, "red", {0.7f, 0.1f, 0.1f});
+  const uint32_t blue = add_material(s, "blue", {0.15f, 0.25f, 0.75f});
+  const uint32_t teal = add_material(s, "teal", {0.2f, 0.5f, 0.5f});
+  add_quad(s, "back wall", red, {-4.0f, 0.0f, -3.0f}, {4.0f, 0.0f, -3.0f}, {4.0f, 4.0f, -3.0f},
+           {-4.0f, 4.0f, -3.0f});
+  add_quad(s, "left wall", blue, {-4.0f, 0.0f, 5.0f}, {-4.0f, 0.0f, -3.0f}, {-4.0f, 4.0f, -3.0f},
+           {-4.0f, 4.0f, 5.0f});
+  add_quad(s, "backdrop", teal, {4.0f, 0.0f, 8.0f}, {-4.0f, 0.0f, 8.0f}, {-4.0f, 4.0f, 8.0f},
+           {4.0f, 4.0f, 8.0f});
+  const size_t k = size_t(std::ceil(std::sqrt(double(n))));
+  // The balls fill x in [-2.5, 2.5], z in [-2, 2], each a third of its cell across.
+  const float cell = 5.0f / float(k), depth = 4.0f / float(k);
+  const float r = 0.3f * std::min(cell, depth);
+  for (size_t i = 0; i < n; ++i) {
+    const size_t row = i / k, column = i % k;
+    const glm::vec3 centre(-2.5f + (float(column) + 0.5f) * cell, r,
+                           -2.0f + (float(row) + 0.5f) * depth);
+    add_sphere(s, "ball " + std::to_string(i), mirror, centre, r);
+  }
+  look_at(s, {0.5f, 3.0f, 6.0f}, {0.0f, 0.3f, 0.0f}, 50.0f, 0.1f, 100.0f);
+  s.ambient = {0.05f, 0.05f, 0.05f};
+  add_point_light(s, {2.0f, 5.0f, 4.0f}, {40.0f, 40.0f, 40.0f});
+  return s;
+}
+
 Scene spheres() {
   Scene s = base_scene("spheres");
   add_floor(s, {0.6f, 0.6f, 0.55f}, {0, 0, 0}, 8.0f);
@@ -517,6 +550,9 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
       {"mirrors:N",
        "a wall of N flat square mirrors, each turned its own way, facing three balls (default "
        "16; 1: one large mirror)"},
+      {"mirror_balls:N",
+       "N small mirror balls on a floor between coloured walls (default 16): a z-buffer draws a "
+       "cube map per ball"},
       {"dof", "spheres at several depths, thin lens focused on the middle one, 16 samples"},
       {"glass", "a glass slab and a glass sphere in front of coloured quads"},
       {"textured",
@@ -559,6 +595,14 @@ Expected<Scene> make_builtin_scene(const std::string& spec) {
       return bad_input("builtin:" + spec + ": at most " + std::to_string(kMaxMirrors) +
                        " mirrors, got " + std::to_string(count));
     return mirrors(has_count ? count : 16);
+  }
+  if (name == "mirror_balls") {
+    // Each ball seen costs a z-buffer six views.
+    constexpr size_t kMaxBalls = 1024;
+    if (count > kMaxBalls)
+      return bad_input("builtin:" + spec + ": at most " + std::to_string(kMaxBalls) +
+                       " balls, got " + std::to_string(count));
+    return mirror_balls(has_count ? count : 16);
   }
   if (name == "dof") return has_count ? no_count() : Expected<Scene>(dof());
   if (name == "glass") return has_count ? no_count() : Expected<Scene>(glass());
