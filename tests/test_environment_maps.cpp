@@ -10,7 +10,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 

@@ -6,15 +6,15 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
-#include <glm/ext/matrix_clip_space.hpp>
-#include <glm/ext/matrix_transform.hpp>
-#include <glm/gtc/constants.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <map>
 #include <memory>
 #include <optional>
 
 #include "rvr/core/camera.h"
 #include "rvr/core/check.h"
 #include "rvr/core/image_sample.h"
+#include "rvr/core/shapes/sphere.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr {
@@ -79,8 +79,7 @@ CubeFace cube_face(int f, const EnvironmentMapped& m, int size, const Camera& ca
   face.near = m.radius > 0.0f ? std::min(0.01f * m.radius, camera.near) : camera.near;
   face.far = std::max(2.0f * m.reach, face.near * 16.0f);
   face.view = glm::lookAt(eye, eye + b.forward, b.up);
-  face.projection =
-      glm::perspective(glm::half_pi<double>(), 1.0, double(face.near), double(face.far));
+  face.projection = glm::perspective(glm::radians(90.0), 1.0, double(face.near), double(face.far));
   face.eye = m.centre;
   face.size = size;
   face.hidden = m.object;

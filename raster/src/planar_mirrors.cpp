@@ -1,12 +1,11 @@
 #include "planar_mirrors.h"
 
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <map>
 #include <memory>
+#include <string>
 
 #include "rvr/core/check.h"
 #include "rvr/core/scene.h"

@@ -11,14 +11,12 @@
 #include <functional>
 #include <glm/glm.hpp>
 #include <optional>
-#include <string>
 #include <vector>
 
 #include "draw_list_prep.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
-#include "rvr/core/scene.h"
 
 namespace rvr {
 
