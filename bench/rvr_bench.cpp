@@ -306,11 +306,13 @@ void effect_scene(const std::string& effect, Scene& scene, RenderOptions& option
   }  // "hard_shadows": the point light in full mode
 }
 
-// builtin:mirrors:N at 640x480 in full mode: the tracer's reflection rays (one per mirror pixel,
-// whatever N) against a z-buffer's reflected views (one whole view per mirror seen). The
-// counter mirror_views is the z-buffer's view count.
-void BM_Mirrors(benchmark::State& state, const std::string& renderer_name) {
-  Scene scene = builtin("mirrors:" + std::to_string(state.range(0)));
+// builtin:<family>:N at 640x480 in full mode, N = the benchmark's argument: the tracer's
+// reflection rays (one per mirror pixel, whatever N) against a z-buffer's views of the mirrors.
+// The renderer's stat `views` (when it reports it) becomes the counter `counter`.
+void BM_MirrorCount(benchmark::State& state, const std::string& renderer_name,
+                    const std::string& family, const std::string& views,
+                    const std::string& counter) {
+  Scene scene = builtin(family + ":" + std::to_string(state.range(0)));
   scene.image.width = 640;
   scene.image.height = 480;
   RenderOptions options;
@@ -319,24 +321,18 @@ void BM_Mirrors(benchmark::State& state, const std::string& renderer_name) {
   PhaseTimes phases;
   RenderOutput out = time_frames(state, renderer, phases);
   add_counters(state, out, double(scene.image.width) * scene.image.height);
-  if (auto it = out.stats.find("mirror.views"); it != out.stats.end())
-    state.counters["mirror_views"] = it->second;
+  if (auto it = out.stats.find(views); it != out.stats.end()) state.counters[counter] = it->second;
 }
 
-// builtin:mirror_balls:N at 640x480 in full mode: the tracer's reflection rays against a
-// z-buffer's cube maps (six views per ball seen). The counter cube_faces is the z-buffer's.
+// BM_Mirrors: builtin:mirrors:N, flat mirrors, a whole reflected view per mirror seen
+// (mirror_views). BM_CurvedMirrors: builtin:mirror_balls:N, a cube map of six views per ball
+// seen (cube_faces).
+void BM_Mirrors(benchmark::State& state, const std::string& renderer_name) {
+  BM_MirrorCount(state, renderer_name, "mirrors", "mirror.views", "mirror_views");
+}
+
 void BM_CurvedMirrors(benchmark::State& state, const std::string& renderer_name) {
-  Scene scene = builtin("mirror_balls:" + std::to_string(state.range(0)));
-  scene.image.width = 640;
-  scene.image.height = 480;
-  RenderOptions options;
-  options.mode = RenderMode::Full;
-  FrameRenderer renderer(renderer_name, scene, options);
-  PhaseTimes phases;
-  RenderOutput out = time_frames(state, renderer, phases);
-  add_counters(state, out, double(scene.image.width) * scene.image.height);
-  if (auto it = out.stats.find("cube_map.faces"); it != out.stats.end())
-    state.counters["cube_faces"] = it->second;
+  BM_MirrorCount(state, renderer_name, "mirror_balls", "cube_map.faces", "cube_faces");
 }
 
 // The tracer on cornell with exactly one effect switched on.

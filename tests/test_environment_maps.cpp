@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "colour_edges.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
@@ -101,33 +102,13 @@ RenderOutput render(const std::string& renderer, const Scene& scene, int max_dep
   return test::table_render(renderer, scene, options);
 }
 
-float colour_difference(const FrameBuffers& a, const FrameBuffers& b, size_t i) {
-  const glm::vec3 d = glm::abs(a.colour[i] - b.colour[i]);
-  return std::max({d.x, d.y, d.z});
-}
-
 // A colour the two compute from the same wall: float rounding of the bilinear weights and of
 // the shading sum. The walls' colours differ by 0.1 or more in some channel.
 constexpr float kSameColour = 1e-4f;
 
-// Whether pixel (x, y) of the tracer's frame lies beside an edge of what it shows: a neighbour
-// of another colour (the reflected walls' edges, the ball's outline). There a pixel's one ray
-// and the map's bilinear texels may fall on either side.
-bool beside_an_edge(const FrameBuffers& fb, int x, int y) {
-  const size_t i = size_t(y) * size_t(fb.width) + size_t(x);
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int nx = x + dx, ny = y + dy;
-      if (nx < 0 || ny < 0 || nx >= fb.width || ny >= fb.height) continue;
-      const size_t j = size_t(ny) * size_t(fb.width) + size_t(nx);
-      const glm::vec3 d = glm::abs(fb.colour[i] - fb.colour[j]);
-      if (std::max({d.x, d.y, d.z}) > kSameColour) return true;
-    }
-  return false;
-}
-
 // The ball's pixels in both frames, and of those the ones away from every edge of the tracer's
-// image whose colour is not the tracer's.
+// image (no neighbour of another colour: there a pixel's one ray and the map's bilinear texels
+// may fall on either side) whose colour is not the tracer's.
 struct BallAgreement {
   size_t ball = 0, away_from_edges = 0, differing = 0;
 };
@@ -136,9 +117,11 @@ BallAgreement ball_agreement(const FrameBuffers& z, const FrameBuffers& t) {
   for (int y = 0; y < t.height; ++y)
     for (int x = 0; x < t.width; ++x) {
       const size_t i = size_t(y) * size_t(t.width) + size_t(x);
-      if (t.object_id[i] != kBall || z.object_id[i] != kBall || beside_an_edge(t, x, y)) continue;
+      if (t.object_id[i] != kBall || z.object_id[i] != kBall ||
+          test::beside_an_edge(t, x, y, kSameColour))
+        continue;
       ++a.away_from_edges;
-      a.differing += colour_difference(z, t, i) > kSameColour;
+      a.differing += test::colour_difference(z, t, i) > kSameColour;
     }
   for (size_t i = 0; i < t.pixel_count(); ++i) a.ball += t.object_id[i] == kBall;
   return a;

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "colour_edges.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
@@ -82,25 +83,6 @@ RenderOutput render(const std::string& renderer, const Scene& scene, int max_dep
   return test::table_render(renderer, scene, options);
 }
 
-float colour_difference(const FrameBuffers& a, const FrameBuffers& b, size_t i) {
-  const glm::vec3 d = glm::abs(a.colour[i] - b.colour[i]);
-  return std::max({d.x, d.y, d.z});
-}
-
-// Whether pixel (x, y) of `fb` lies beside an edge of its image: a neighbour of another colour.
-bool beside_an_edge(const FrameBuffers& fb, int x, int y) {
-  const size_t i = size_t(y) * size_t(fb.width) + size_t(x);
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int nx = x + dx, ny = y + dy;
-      if (nx < 0 || ny < 0 || nx >= fb.width || ny >= fb.height) continue;
-      const size_t j = size_t(ny) * size_t(fb.width) + size_t(nx);
-      const glm::vec3 d = glm::abs(fb.colour[i] - fb.colour[j]);
-      if (std::max({d.x, d.y, d.z}) > kSameColour) return true;
-    }
-  return false;
-}
-
 // The same mirrors with the balls lit by a point light above them: a Blinn-Phong highlight,
 // which moves with the eye, and no diffuse term, so that where the balls shadow their own far
 // sides (shadow maps and shadow rays cut the terminator differently) the light adds nothing.
@@ -123,7 +105,7 @@ Scene two_mirrors_lit() {
 // How many pixels' colours differ by more than `by`.
 size_t pixels_differing(const FrameBuffers& a, const FrameBuffers& b, float by) {
   size_t n = 0;
-  for (size_t i = 0; i < b.pixel_count(); ++i) n += colour_difference(a, b, i) > by;
+  for (size_t i = 0; i < b.pixel_count(); ++i) n += test::colour_difference(a, b, i) > by;
   return n;
 }
 
@@ -137,9 +119,9 @@ Disagreement disagreement(const FrameBuffers& a, const FrameBuffers& b) {
   for (int y = 0; y < b.height; ++y)
     for (int x = 0; x < b.width; ++x) {
       const size_t i = size_t(y) * size_t(b.width) + size_t(x);
-      if (colour_difference(a, b, i) <= kSameColour) continue;
+      if (test::colour_difference(a, b, i) <= kSameColour) continue;
       ++d.differing;
-      if (!beside_an_edge(b, x, y)) ++d.away_from_edges;
+      if (!test::beside_an_edge(b, x, y, kSameColour)) ++d.away_from_edges;
     }
   return d;
 }

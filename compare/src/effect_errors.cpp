@@ -3,12 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <glm/glm.hpp>
 #include <initializer_list>
 #include <iterator>
 #include <limits>
 
-#include "rvr/core/srgb.h"
+#include "dimmed_backdrop.h"
 
 namespace rvr {
 
@@ -93,14 +92,7 @@ Image effect_mask_image(const Scene& scene, RenderMode mode, const FrameBuffers&
       std::copy(kEffectKeys[shown].rgb, kEffectKeys[shown].rgb + 3, p);
       continue;
     }
-    // Display-referred grey, dimmed so the masks stand out: the sRGB encoding of half of the
-    // frame's linear luminance.
-    float lum = 0.0f;
-    if (i < mask_from.colour.size()) {
-      const glm::vec3 c = glm::clamp(mask_from.colour[i], glm::vec3(0.0f), glm::vec3(1.0f));
-      lum = 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
-    }
-    p[0] = p[1] = p[2] = srgb_encode(0.5f * lum);
+    p[0] = p[1] = p[2] = dimmed_grey(mask_from, i);
   }
   return img;
 }

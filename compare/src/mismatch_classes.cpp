@@ -11,12 +11,12 @@
 #include <utility>
 #include <vector>
 
+#include "dimmed_backdrop.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/check.h"
 #include "rvr/core/shapes.h"
 #include "rvr/core/shapes/shape_geometry.h"
 #include "rvr/core/shapes/triangle_mesh.h"
-#include "rvr/core/srgb.h"
 
 namespace rvr {
 
@@ -358,14 +358,7 @@ Image mismatch_class_image(const FrameBuffers& a, const std::vector<MismatchClas
       std::copy(rgb.begin(), rgb.end(), p);
       continue;
     }
-    // Display-referred grey, dimmed so the classes stand out: the sRGB encoding of half of a's
-    // linear luminance.
-    float lum = 0.0f;
-    if (i < a.colour.size()) {
-      const glm::vec3 c3 = glm::clamp(a.colour[i], glm::vec3(0.0f), glm::vec3(1.0f));
-      lum = 0.2126f * c3.r + 0.7152f * c3.g + 0.0722f * c3.b;
-    }
-    p[0] = p[1] = p[2] = srgb_encode(0.5f * lum);
+    p[0] = p[1] = p[2] = dimmed_grey(a, i);
   }
   return img;
 }
