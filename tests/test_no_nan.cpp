@@ -81,6 +81,10 @@ TEST(NoNan, AnyRendererAnySceneAnyMode) {
         ASSERT_TRUE(renderer.ok());
         RenderOptions options;
         options.mode = mode;
+        // Cube maps at a 64x48 frame's worth. GL's (llvmpipe: a whole pass per face, its
+        // targets resized to the face) cost this test minutes; their values are held to the
+        // tracer by test_environment_maps, so here only softraster draws them.
+        options.cube_map_size = info.name.rfind("softraster", 0) == 0 ? 16 : 0;
         for (SphereMode spheres : {SphereMode::Analytic, SphereMode::Mesh}) {
           options.spheres = spheres;
           Expected<RenderOutput> out = renderer.value()->render(scene, options);
