@@ -6,11 +6,12 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <glm/glm.hpp>
 #include <initializer_list>
+#include <map>
+#include <memory>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -21,6 +22,7 @@
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/texture.h"
 #include "rvr/scene_io/scene_loader.h"
 #include "table_render.h"
 
