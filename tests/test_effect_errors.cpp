@@ -100,8 +100,8 @@ TEST(EffectErrors, TheLensCoversEveryPixelAndMasksFollowTheGivenFrame) {
   // The same colours, the mask from a frame in which pixel 4 shows the mirror too.
   FrameBuffers masks = a;
   masks.object_id[4] = 1;
-  const EffectError* wider =
-      find(effect_errors(scene, RenderMode::Full, masks, a, b), "reflection");
+  const std::vector<EffectError> wider_errors = effect_errors(scene, RenderMode::Full, masks, a, b);
+  const EffectError* wider = find(wider_errors, "reflection");
   ASSERT_NE(wider, nullptr);
   EXPECT_EQ(wider->pixels, 2u);
   EXPECT_NEAR(wider->rmse, 0.4 / std::sqrt(6.0), 1e-6);
