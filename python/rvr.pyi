@@ -189,8 +189,8 @@ def render(
     (visibility, local, full) on THREADS worker threads (0: every core). Other keyword options
     are the command line's of the same names: accel, spheres, sphere_segments, triangle_test,
     texture_lod, max_depth, seed, shadow_map_size, cube_map_size, shadow_bias, shadow_pcf,
-    hiz, depth_format, supersampling, zbuffer_dof, gl. One the renderer does not read is named in
-    Render.warnings. The GIL is released while rendering; Ctrl-C cancels the render (it stops
+    hiz, depth_format, supersampling, zbuffer_dof, zbuffer_reflection, gl. One the renderer
+    does not read is named in Render.warnings. The GIL is released while rendering; Ctrl-C cancels the render (it stops
     at its next tile or chunk) and raises KeyboardInterrupt."""
 
 def _running_renders() -> int:

@@ -42,6 +42,7 @@ const std::vector<std::string_view> kTextureLods = {"cones", "differentials", "n
 const std::vector<std::string_view> kDepthFormats = {"d24", "d32f", "d32f_reversed"};
 const std::vector<std::string_view> kSupersamplings = {"accumulation", "msaa"};
 const std::vector<std::string_view> kZBufferDofs = {"accumulation", "blur"};
+const std::vector<std::string_view> kZBufferReflections = {"cube_map", "ssr"};
 const std::vector<std::string_view> kOnOff = {"on", "off"};
 
 // Each entry's store and show convert between the table's values and RenderOptions' members;
@@ -200,6 +201,17 @@ std::vector<RenderOptionSpec> zbuffer_options() {
        .readers = kZBuffers,
        .store = [](O& o, U i, double) { o.zbuffer_dof = ZBufferDof(i); },
        .show = [](const O& o) { return choice_text(kZBufferDofs, size_t(o.zbuffer_dof)); }},
+      {.name = "zbuffer_reflection",
+       .type = OptionType::Choice,
+       .choices = kZBufferReflections,
+       .help = "z-buffers' curved mirrors: cube_map (a cube environment map per mirror: "
+               "default) | ssr (screen-space reflections over the camera's frame)",
+       .readers = kZBuffers,
+       .store = [](O& o, U i, double) { o.zbuffer_reflection = ZBufferReflection(i); },
+       .show =
+           [](const O& o) {
+             return choice_text(kZBufferReflections, size_t(o.zbuffer_reflection));
+           }},
   };
 }
 

@@ -61,6 +61,18 @@ constexpr std::array kStats = {
     StatDeclaration{"cube_map.total_internal", kCount, "pixels", "z-buffers",
                     "totally internally reflected rays among the refracted pixels' (at either "
                     "interface; looked up in the reflected direction)"},
+    StatDeclaration{"ssr.hits", kCount, "pixels", "z-buffers",
+                    "curved-mirror pixels whose screen-space reflection ray meets a surface the "
+                    "frame holds (--zbuffer-reflection ssr)"},
+    StatDeclaration{"ssr.background", kCount, "pixels", "z-buffers",
+                    "curved-mirror pixels whose screen-space ray stays in front of everything to "
+                    "the end of the scene: nothing met"},
+    StatDeclaration{"ssr.off_screen", kCount, "pixels", "z-buffers",
+                    "curved-mirror pixels whose screen-space ray leaves the view (or turns "
+                    "behind the camera) first: a miss"},
+    StatDeclaration{"ssr.hidden", kCount, "pixels", "z-buffers",
+                    "curved-mirror pixels whose screen-space ray passes behind a surface first: "
+                    "what it meets is hidden, a miss"},
     // Planar mirrors drawn by the z-buffers (full mode): a reflected view per mirror seen.
     StatDeclaration{"mirror.views", kCount, "views", "z-buffers",
                     "reflected views drawn for planar mirrors: one per mirror seen, per level of "

@@ -11,11 +11,13 @@
 #include <memory>
 #include <optional>
 
+#include "pass_camera.h"
 #include "rvr/core/camera.h"
 #include "rvr/core/check.h"
 #include "rvr/core/image_sample.h"
 #include "rvr/core/shapes/sphere.h"
 #include "rvr/core/shapes/triangle_mesh.h"
+#include "screen_space_reflections.h"
 
 namespace rvr {
 
@@ -129,40 +131,6 @@ Expected<CubeMap> draw_cube_map(const EnvironmentMapped& m, int size, const Came
   return map;
 }
 
-// The direction of the camera's ray through pixel (x, y) of a w × h frame: the line between the
-// points the pixel's centre unprojects to at the near and far planes (with an image sample, the
-// ray from its lens point through its place in the pixel).
-struct PixelRay {
-  glm::dvec3 direction;  // unit length
-  glm::dvec3 at_depth;   // the point at view depth `depth` on the ray
-};
-
-struct PixelRays {
-  glm::dmat4 view, unproject;
-  int width, height;
-  // The pixel's ray, and its point at view depth `depth` (depth is affine along a line).
-  PixelRay ray(int x, int y, double depth) const {
-    const double ndc_x = 2.0 * (x + 0.5) / width - 1.0, ndc_y = 1.0 - 2.0 * (y + 0.5) / height;
-    const glm::dvec4 ha = unproject * glm::dvec4(ndc_x, ndc_y, -1.0, 1.0);
-    const glm::dvec4 hb = unproject * glm::dvec4(ndc_x, ndc_y, 1.0, 1.0);
-    const glm::dvec3 a = glm::dvec3(ha) / ha.w, b = glm::dvec3(hb) / hb.w;
-    const double da = -(view * glm::dvec4(a, 1.0)).z, db = -(view * glm::dvec4(b, 1.0)).z;
-    return {glm::normalize(b - a), a + (depth - da) / (db - da) * (b - a)};
-  }
-};
-
-PixelRays pixel_rays(const Scene& scene, const RenderOptions& options) {
-  const int w = scene.image.width, h = scene.image.height;
-  const glm::dmat4 view = options.image_sample
-                              ? glm::dmat4(sample_view_matrix(scene.camera, *options.image_sample))
-                              : glm::dmat4(view_matrix(scene.camera));
-  const glm::dmat4 projection =
-      options.image_sample
-          ? glm::dmat4(sample_projection_matrix(scene.camera, w, h, *options.image_sample))
-          : glm::dmat4(projection_matrix(scene.camera, w, h));
-  return {view, glm::inverse(projection * view), w, h};
-}
-
 glm::dvec3 reflected(const glm::dvec3& d, const glm::dvec3& n) {
   return d - 2.0 * glm::dot(d, n) * n;
 }
@@ -242,7 +210,17 @@ Status add_environment_maps(const Scene& scene, const RenderOptions& options,
                             const std::vector<EnvironmentMapped>& mapped, const CubeFacePass& pass,
                             FrameBuffers& fb, EnvironmentStats& stats) {
   const std::vector<std::vector<size_t>> seen = pixels_per_object(mapped, fb);
-  const PixelRays rays = pixel_rays(scene, options);
+  const PassCamera camera = pass_camera(scene, options);
+  // Screen-space reflections march over the frame as the camera drew it, before any reflection.
+  const bool ssr = options.zbuffer_reflection == ZBufferReflection::Ssr;
+  FrameBuffers drawn;
+  if (ssr) {
+    drawn.width = fb.width;
+    drawn.height = fb.height;
+    drawn.colour = fb.colour;
+    drawn.depth = fb.depth;
+    drawn.object_id = fb.object_id;
+  }
   for (size_t i = 0; i < mapped.size(); ++i) {
     const EnvironmentMapped& m = mapped[i];
     if (seen[i].empty()) continue;
@@ -252,16 +230,30 @@ Status add_environment_maps(const Scene& scene, const RenderOptions& options,
       stats.dropped += seen[i].size();
       continue;
     }
-    RVR_TRY_ASSIGN(map, draw_cube_map(m, options.cube_map_size, scene.camera, pass, stats));
+    // The map: for the transmitted share, and for the mirrored one unless the frame answers it.
+    std::optional<CubeMap> map;
+    if (m.transparency > 0.0f || !ssr) {
+      RVR_TRY_ASSIGN(drawn_map, draw_cube_map(m, options.cube_map_size, scene.camera, pass, stats));
+      map = std::move(*drawn_map);
+    }
+    const ScreenSpaceReflections screen(drawn, camera, double(scene.camera.near),
+                                        2.0 * double(m.reach));
     for (size_t p : seen[i]) {
       const PixelRay ray =
-          rays.ray(int(p % size_t(fb.width)), int(p / size_t(fb.width)), double(fb.depth[p]));
+          camera.ray(int(p % size_t(fb.width)), int(p / size_t(fb.width)), double(fb.depth[p]));
       const glm::dvec3& d = ray.direction;
       const glm::dvec3 n = glm::normalize(glm::dvec3(fb.normal[p]));
       const glm::dvec3 r = reflected(d, n);
       const glm::vec3 local = fb.colour[p];
       glm::vec3 c = kept * local;
-      if (m.mirror > 0.0f) {
+      if (m.mirror > 0.0f && ssr) {
+        glm::vec3 shown = scene.image.background;  // what a miss shows: nothing met
+        const SsrOutcome outcome = screen.trace(ray.at_depth, r, m.object, shown);
+        if (outcome == SsrOutcome::OffScreen || outcome == SsrOutcome::Hidden)
+          shown = scene.image.background;
+        ++stats.ssr[size_t(outcome)];
+        c += m.mirror * shown;
+      } else if (m.mirror > 0.0f) {
         c += m.mirror * map->lookup(r);
         ++stats.reflected;
       }
@@ -302,19 +294,37 @@ void record_environment_stats(const EnvironmentStats& stats, double seconds, Ren
   out.stats["cube_map.refracted_pixels"] = double(stats.refracted);
   out.stats["cube_map.total_internal"] = double(stats.total_internal);
   out.stats["time.cube_maps"] = seconds;
+  const uint64_t marched = stats.ssr[0] + stats.ssr[1] + stats.ssr[2] + stats.ssr[3];
+  if (marched == 0) return;
+  out.stats["ssr.hits"] = double(stats.ssr[size_t(SsrOutcome::Hit)]);
+  out.stats["ssr.background"] = double(stats.ssr[size_t(SsrOutcome::Background)]);
+  out.stats["ssr.off_screen"] = double(stats.ssr[size_t(SsrOutcome::OffScreen)]);
+  out.stats["ssr.hidden"] = double(stats.ssr[size_t(SsrOutcome::Hidden)]);
+  const auto share = [&](SsrOutcome o) {
+    return 100.0 * double(stats.ssr[size_t(o)]) / double(marched);
+  };
+  out.warnings.push_back(fmt::format(
+      "screen-space reflections: {:.1f}% of curved-mirror pixels reflect points outside the view "
+      "and {:.1f}% points hidden behind other surfaces (both shown as the background)",
+      share(SsrOutcome::OffScreen), share(SsrOutcome::Hidden)));
 }
 
-void note_environment_maps(const Scene& scene, const std::vector<EnvironmentMapped>& mapped,
-                           const std::vector<std::string>& left_out, bool drawn,
+void note_environment_maps(const Scene& scene, const RenderOptions& options,
+                           const std::vector<EnvironmentMapped>& mapped,
+                           const std::vector<std::string>& left_out,
                            std::vector<std::string>& warnings) {
+  const bool drawn = options.cube_map_size > 0;
+  const bool ssr = options.zbuffer_reflection == ZBufferReflection::Ssr;
   if (!left_out.empty())
     warnings.push_back(fmt::format("transparency not rendered on {} planar mirror{} ({})",
                                    left_out.size(), left_out.size() == 1 ? "" : "s",
                                    joined(left_out)));
   std::vector<std::string> mirrors, clear, flat_glass;  // flat: bent at one interface only
+  std::vector<std::string> screen;                      // curved mirrors reflected in screen space
   bool clear_spheres = false;
   for (const EnvironmentMapped& m : mapped) {
-    if (m.mirror > 0.0f) mirrors.push_back(object_label(scene, m.object));
+    if (m.mirror > 0.0f && ssr) screen.push_back(object_label(scene, m.object));
+    if (m.mirror > 0.0f && !ssr) mirrors.push_back(object_label(scene, m.object));
     if (m.transparency > 0.0f) {
       clear.push_back(object_label(scene, m.object));
       if (m.sphere)
@@ -323,6 +333,11 @@ void note_environment_maps(const Scene& scene, const std::vector<EnvironmentMapp
         flat_glass.push_back(object_label(scene, m.object));
     }
   }
+  if (!screen.empty() && drawn)
+    warnings.push_back(fmt::format(
+        "reflection on {} curved mirror{} ({}) by screen-space reflections: only what the camera "
+        "sees, one bounce",
+        screen.size(), screen.size() == 1 ? "" : "s", joined(screen)));
   if (mirrors.empty() && clear.empty()) return;
   std::string what;
   if (!mirrors.empty())

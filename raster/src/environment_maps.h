@@ -73,6 +73,9 @@ struct EnvironmentStats {
   uint64_t refracted = 0;       // pixels given a transmitted colour from a map
   uint64_t total_internal = 0;  // of those, rays reflected by total internal reflection
   uint64_t dropped = 0;         // pixels at the recursion limit (--max-depth 0): shares dropped
+  // Curved-mirror pixels reflected by screen-space reflections, by SsrOutcome: hit,
+  // background, off screen, hidden.
+  uint64_t ssr[4] = {0, 0, 0, 0};
 };
 
 // The camera's frame `fb` (drawn through the camera of `scene`, or the sample
@@ -95,10 +98,12 @@ int cube_face_shadow_map_size(const RenderOptions& options);
 void record_environment_stats(const EnvironmentStats& stats, double seconds, RenderOutput& out);
 
 // What a z-buffer says of the objects a cube map answers (what the map cannot show), or leaves
-// local (cube maps off: `drawn` false), and of the transparent planar mirrors left out, into
+// local (cube maps off: --cube-map-size 0), reflects in screen space (--zbuffer-reflection ssr),
+// and of the transparent planar mirrors left out, into
 // `warnings`.
-void note_environment_maps(const Scene& scene, const std::vector<EnvironmentMapped>& mapped,
-                           const std::vector<std::string>& left_out, bool drawn,
+void note_environment_maps(const Scene& scene, const RenderOptions& options,
+                           const std::vector<EnvironmentMapped>& mapped,
+                           const std::vector<std::string>& left_out,
                            std::vector<std::string>& warnings);
 
 }  // namespace rvr

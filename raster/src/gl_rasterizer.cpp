@@ -222,7 +222,7 @@ void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& opt
   if (!upload.prepared.skipped_csg.empty())
     warnings.push_back(skipped_csg_warning(upload.prepared.skipped_csg));
   if (options.mode != RenderMode::Full) return;
-  note_environment_maps(scene, mapped, left_out, options.cube_map_size > 0, warnings);
+  note_environment_maps(scene, options, mapped, left_out, warnings);
   if (scene.camera.aperture_radius > 0.0f) {
     if (scene.image.samples_per_pixel == 1)
       warnings.push_back(kDepthOfFieldNeedsSamples);

@@ -301,7 +301,7 @@ void note_what_is_left_out(const Scene& scene, const RenderOptions& options,
                            std::vector<std::string>& warnings) {
   if (!prepared.skipped_csg.empty()) warnings.push_back(skipped_csg_warning(prepared.skipped_csg));
   if (options.mode == RenderMode::Full) {
-    note_environment_maps(scene, mapped, left_out, options.cube_map_size > 0, warnings);
+    note_environment_maps(scene, options, mapped, left_out, warnings);
     if (scene.camera.aperture_radius > 0.0f && scene.image.samples_per_pixel == 1)
       warnings.push_back(kDepthOfFieldNeedsSamples);
   }

@@ -37,6 +37,9 @@ enum class Supersampling { Accumulation, Msaa };
 // pass through its lens point; Blur: pinhole passes, then the image blurred by each pixel's
 // circle of confusion (a post-process).
 enum class ZBufferDof { Accumulation, Blur };
+// How a z-buffer renders curved mirrors (docs/cli.md, --zbuffer-reflection). CubeMap: a cube
+// environment map per mirror; Ssr: screen-space reflections over the camera's own frame.
+enum class ZBufferReflection { CubeMap, Ssr };
 
 const char* to_string(RenderMode mode);
 const char* to_string(AccelKind accel);     // bvh, bvh2, none, embree
@@ -73,6 +76,8 @@ struct RenderOptions {
   // Z-buffers in full mode: texels per side of the cube environment map drawn for each curved
   // mirror and transparent object (0: none, their local colour only).
   int cube_map_size = 256;
+  // Z-buffers in full mode: how curved mirrors are reflected (flat ones always by views).
+  ZBufferReflection zbuffer_reflection = ZBufferReflection::CubeMap;
   // Tracers: how a ray chooses a texture's level of detail (the z-buffers take theirs from
   // screen-space derivatives; the hybrids' primary hits from their z-buffer's).
   TextureLod texture_lod = TextureLod::Cones;
