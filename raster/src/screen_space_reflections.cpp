@@ -44,9 +44,10 @@ SsrOutcome ScreenSpaceReflections::trace(const glm::dvec3& p, const glm::dvec3& 
     const double s = double(i) / double(steps);
     const double x = x0 + s * (x1 - x0), y = y0 + s * (y1 - y0);
     const double ray_depth = 1.0 / (k0 + s * (k1 - k0));
-    const int px = int(std::floor(x)), py = int(std::floor(y));
-    if (px < 0 || py < 0 || px >= camera_.width || py >= camera_.height)
+    // Compared as doubles first: a point near the eye's plane lands far out, past any int.
+    if (!(x >= 0.0 && y >= 0.0 && x < camera_.width && y < camera_.height))
       return SsrOutcome::OffScreen;
+    const int px = int(x), py = int(y);
     const size_t o = size_t(py) * size_t(camera_.width) + size_t(px);
     const double stored = frame_.depth[o];  // +inf on the background
     const double step = std::abs(ray_depth - previous);
