@@ -67,6 +67,7 @@ TEST(StatsTable, EveryStatReportedIsDeclaredAndEveryDeclaredOneReported) {
         RendererConfig config;
         RenderOptions options;
         options.mode = mode;
+        options.cube_map_size = 16;  // the stats are the same at any size; small faces are quick
         choice.apply(config, options);
         Expected<std::unique_ptr<Renderer>> renderer = make_renderer(choice.info->name, config);
         ASSERT_TRUE(renderer.ok()) << choice.name << ": " << renderer.error().message;
@@ -80,23 +81,32 @@ TEST(StatsTable, EveryStatReportedIsDeclaredAndEveryDeclaredOneReported) {
         }
       }
   }
-  // The z-buffers' depth of field by blur (an option's technique, not a variant).
-  Scene dof = make_builtin_scene("dof").value();
-  dof.image.width = 32;
-  dof.image.height = 24;
-  for (const char* zbuffer : {"raster", "softraster"}) {
-    RenderOptions options;
-    options.mode = RenderMode::Full;
-    options.zbuffer_dof = ZBufferDof::Blur;
-    Expected<std::unique_ptr<Renderer>> renderer = make_renderer(zbuffer, RendererConfig{});
-    ASSERT_TRUE(renderer.ok()) << zbuffer;
-    Expected<RenderOutput> out = (*renderer)->render(dof, options);
-    ASSERT_TRUE(out.ok()) << zbuffer << ": " << out.error().message;
-    for (const auto& [name, value] : out->stats) {
-      EXPECT_NE(find_stat(name), nullptr) << zbuffer << " with a blur reports '" << name << "'";
-      if (const StatDeclaration* s = find_stat(name)) reported.insert(std::string(s->name));
+  // The z-buffers' techniques an option chooses (not variants): depth of field by blur, and
+  // screen-space reflections.
+  auto add_technique = [&](const char* scene_name, const char* technique,
+                           void (*choose)(RenderOptions&)) {
+    Scene scene = make_builtin_scene(scene_name).value();
+    scene.image.width = 32;
+    scene.image.height = 24;
+    for (const char* zbuffer : {"raster", "softraster"}) {
+      RenderOptions options;
+      options.mode = RenderMode::Full;
+      options.cube_map_size = 16;
+      choose(options);
+      Expected<std::unique_ptr<Renderer>> renderer = make_renderer(zbuffer, RendererConfig{});
+      ASSERT_TRUE(renderer.ok()) << zbuffer;
+      Expected<RenderOutput> out = (*renderer)->render(scene, options);
+      ASSERT_TRUE(out.ok()) << zbuffer << ": " << out.error().message;
+      for (const auto& [name, value] : out->stats) {
+        EXPECT_NE(find_stat(name), nullptr)
+            << zbuffer << " with " << technique << " reports '" << name << "'";
+        if (const StatDeclaration* s = find_stat(name)) reported.insert(std::string(s->name));
+      }
     }
-  }
+  };
+  add_technique("dof", "a blur", [](RenderOptions& o) { o.zbuffer_dof = ZBufferDof::Blur; });
+  add_technique("cornell", "screen-space reflections",
+                [](RenderOptions& o) { o.zbuffer_reflection = ZBufferReflection::Ssr; });
   for (const StatDeclaration& s : stat_declarations())
     EXPECT_TRUE(reported.count(std::string(s.name)))
         << "'" << s.name << "' is declared, but no renderer reported it";

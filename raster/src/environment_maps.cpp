@@ -10,11 +10,10 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <utility>
 
 #include "pass_camera.h"
-#include "rvr/core/camera.h"
 #include "rvr/core/check.h"
-#include "rvr/core/image_sample.h"
 #include "rvr/core/shapes/sphere.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "screen_space_reflections.h"

@@ -1,5 +1,7 @@
 #include "pass_camera.h"
 
+#include <optional>
+
 #include "rvr/core/camera.h"
 #include "rvr/core/image_sample.h"
 
