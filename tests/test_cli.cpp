@@ -448,19 +448,19 @@ TEST_F(Cli, ModelWithOnlyACameraIsExit2NoTriangles) {
 }
 
 // Every pair of three renderers is compared, the first pair also at the top level; --fail-on
-// fails on the chosen classes only. A z-buffer skips builtin:csg's csg objects, which the tracers
-// draw in front of the floor and wall: softraster shows those farther surfaces there, occlusion
-// mismatches and no coverage ones (something lies behind every csg pixel); raytrace against
-// itself has none.
+// fails on the chosen classes only. raster (OpenGL) skips builtin:csg's csg objects, which the
+// tracers draw in front of the floor and wall: raster shows those farther surfaces there,
+// occlusion mismatches and no coverage ones (something lies behind every csg pixel); raytrace
+// against itself has none.
 TEST_F(Cli, EveryPairIsComparedAndFailOnChoosesClasses) {
   const std::string csg = "compare builtin:csg --width 64 --height 48 ";
   fs::path out = dir_ / "three";
-  RunResult r = run(csg + "-r softraster,raytrace,raytrace -o " + out.string());
+  RunResult r = run(csg + "-r raster,raytrace,raytrace -o " + out.string());
   ASSERT_EQ(r.status, 0) << r.err;
   nlohmann::json m = nlohmann::json::parse(slurp(out / "metrics.json"));
   ASSERT_EQ(m["pairs"].size(), 3u);
-  EXPECT_EQ(m["pairs"][0]["compared"], nlohmann::json({"softraster", "raytrace"}));
-  EXPECT_EQ(m["pairs"][1]["compared"], nlohmann::json({"softraster", "raytrace-2"}));
+  EXPECT_EQ(m["pairs"][0]["compared"], nlohmann::json({"raster", "raytrace"}));
+  EXPECT_EQ(m["pairs"][1]["compared"], nlohmann::json({"raster", "raytrace-2"}));
   EXPECT_EQ(m["pairs"][2]["compared"], nlohmann::json({"raytrace", "raytrace-2"}));
   EXPECT_EQ(m["pairs"][0]["visibility"], m["visibility"]);
   EXPECT_EQ(m["pairs"][2]["visibility"]["id_agreement"].get<double>(), 1.0);
@@ -471,19 +471,19 @@ TEST_F(Cli, EveryPairIsComparedAndFailOnChoosesClasses) {
       EXPECT_TRUE(fs::exists(out / file.get<std::string>())) << file;
   EXPECT_NE(r.out.find("raytrace vs raytrace-2"), std::string::npos) << r.out;
   // The z-buffer says what it skipped, in its renderer's warnings; the tracers have none.
-  ASSERT_EQ(m["renderers"]["softraster"]["warnings"].size(), 1u);
-  EXPECT_EQ(m["renderers"]["softraster"]["warnings"][0],
+  ASSERT_EQ(m["renderers"]["raster"]["warnings"].size(), 1u);
+  EXPECT_EQ(m["renderers"]["raster"]["warnings"][0],
             "csg objects have no z-buffer form: skipped 4 (union, intersection, difference, "
             "nested)");
   EXPECT_TRUE(m["renderers"]["raytrace"]["warnings"].empty());
   EXPECT_TRUE(m["renderers"]["raytrace-2"]["warnings"].empty());
 
-  RunResult occlusion = run(csg + "-r softraster,raytrace --fail-on occlusion,coverage -o " +
+  RunResult occlusion = run(csg + "-r raster,raytrace --fail-on occlusion,coverage -o " +
                             (dir_ / "occlusion").string());
   EXPECT_EQ(occlusion.status, 1) << occlusion.err;
   EXPECT_NE(occlusion.err.find("occlusion mismatches"), std::string::npos) << occlusion.err;
   RunResult coverage =
-      run(csg + "-r softraster,raytrace --fail-on coverage -o " + (dir_ / "coverage").string());
+      run(csg + "-r raster,raytrace --fail-on coverage -o " + (dir_ / "coverage").string());
   EXPECT_EQ(coverage.status, 0) << coverage.err;
   RunResult same = run(csg +
                        "-r raytrace,raytrace --fail-on edge,depth_precision,occlusion,"

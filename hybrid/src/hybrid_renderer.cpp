@@ -149,7 +149,8 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   for (const Object& obj : scene.objects) csg += obj.type == ObjectType::Csg;
   if (csg > 0)
     o.warnings.push_back("csg objects (" + std::to_string(csg) +
-                         ") have no z-buffer form: the tracer intersects them for every pixel");
+                         "): the tracer intersects them for every pixel, whatever the z-buffer "
+                         "drew there");
   return out;
 }
 

@@ -10,7 +10,9 @@
 
 #include "rvr/core/check.h"
 #include "rvr/core/shapes.h"
+#include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/shape_geometry.h"
+#include "rvr/core/tessellate.h"
 
 namespace rvr {
 
@@ -26,7 +28,21 @@ Expected<const Material*> object_material(const Scene& scene, const Object& o,
   return &fallback;  // a hand-made scene with no material list: the built-in grey
 }
 
-// How the skipped-CSG warning names an object.
+// The leaves of a CSG tree (depth-first) as UV spheres of `segments` longitudes, one mesh after
+// another in one mesh.
+TriangleMesh csg_leaf_meshes(const CsgNode* root, int segments) {
+  TriangleMesh all;
+  for (const Sphere& leaf : csg_leaves(root)) {
+    const TriangleMesh m = tessellate_sphere(leaf, segments);
+    const uint32_t base = uint32_t(all.positions.size());
+    all.positions.insert(all.positions.end(), m.positions.begin(), m.positions.end());
+    all.normals.insert(all.normals.end(), m.normals.begin(), m.normals.end());
+    for (const glm::uvec3& t : m.triangles) all.triangles.push_back(t + base);
+  }
+  return all;
+}
+
+// How a warning names a CSG object.
 std::string object_label(const Object& o, size_t index) {
   return o.name.empty() ? fmt::format("csg#{}", index) : o.name;
 }
@@ -63,12 +79,19 @@ Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
     PreparedObject& p = prepared.objects[i];
     RVR_TRY_ASSIGN(material, object_material(scene, o, *prepared.fallback));
     p.material = *material;
-    TriangleForm form =
-        visit_shape(o, [&](const auto& shape) { return shape.triangle_form(tessellation); });
-    if (!form.mesh) {
-      prepared.skipped_csg.push_back(object_label(o, i));
+    if (o.type == ObjectType::Csg) {
+      prepared.csg_labels.push_back(object_label(o, i));
+      auto leaves = std::make_unique<TriangleMesh>(csg_leaf_meshes(o.csg.get(), sphere_segments));
+      p.mesh = leaves.get();
+      p.smooth = true;
+      p.csg = o.csg.get();
+      p.csg_leaf_triangles = uint32_t(sphere_triangle_count(sphere_segments));
+      prepared.tessellations.push_back(std::move(leaves));
       continue;
     }
+    TriangleForm form =
+        visit_shape(o, [&](const auto& shape) { return shape.triangle_form(tessellation); });
+    RVR_CHECK(form.mesh != nullptr, "every shape but a CSG solid has a triangle form");
     p.mesh = form.mesh;
     p.own_mesh = form.is_object_mesh;
     p.names_triangles = form.names_triangles;

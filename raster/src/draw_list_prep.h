@@ -16,7 +16,9 @@
 
 namespace rvr {
 
-// One scene object as a z-buffer draws it. `mesh` null: nothing to draw (a CSG object).
+// One scene object as a z-buffer draws it. A CSG object (`csg` not null): `mesh` holds its
+// leaves' tessellations one after another, `csg_leaf_triangles` triangles each (depth-first
+// order), drawn leaf by leaf and combined per pixel (csg_leaves.h), not as one mesh.
 struct PreparedObject {
   const Material* material = nullptr;
   const TriangleMesh* mesh = nullptr;  // the object's own mesh, or a tessellation of the scene
@@ -27,13 +29,15 @@ struct PreparedObject {
   // that the two loop orders name the same facet. Otherwise (an analytic sphere, a square) the
   // tracer sees one primitive and the z-buffers write 0.
   bool names_triangles = false;
+  const CsgNode* csg = nullptr;
+  uint32_t csg_leaf_triangles = 0;
 };
 
 // A scene prepared for a z-buffer. Owns the tessellations and the fallback material the objects
 // point to, so it must outlive every use of them; moving it keeps the pointers valid.
 struct PreparedScene {
-  std::vector<PreparedObject> objects;   // one per scene object, in scene order
-  std::vector<std::string> skipped_csg;  // how the skipped-CSG warning names each skipped object
+  std::vector<PreparedObject> objects;  // one per scene object, in scene order
+  std::vector<std::string> csg_labels;  // how a warning names each CSG object, in scene order
   std::vector<std::unique_ptr<const TriangleMesh>> tessellations;
   std::unique_ptr<const Material> fallback;  // the built-in grey
 };

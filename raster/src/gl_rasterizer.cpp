@@ -219,8 +219,8 @@ void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& opt
                                     const std::vector<EnvironmentMapped>& mapped,
                                     const std::vector<std::string>& left_out,
                                     std::vector<std::string>& warnings) {
-  if (!upload.prepared.skipped_csg.empty())
-    warnings.push_back(skipped_csg_warning(upload.prepared.skipped_csg));
+  if (!upload.prepared.csg_labels.empty())
+    warnings.push_back(skipped_csg_warning(upload.prepared.csg_labels));
   if (options.mode != RenderMode::Full) return;
   note_environment_maps(scene, options, mapped, left_out, warnings);
   if (scene.camera.aperture_radius > 0.0f) {
@@ -659,7 +659,7 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
     const PreparedObject& p = up.prepared.objects[i];
-    if (!p.mesh) continue;  // CSG: skipped, named in the warning
+    if (!p.mesh || p.csg) continue;  // CSG: skipped, named in the warning
     DrawItem d;
     d.object = uint32_t(i);
     d.first = GLint(vertices.size());

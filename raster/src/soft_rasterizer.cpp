@@ -36,6 +36,7 @@
 #include "rvr/core/surface_colour.h"
 #include "rvr/core/timer.h"
 #include "shadow_plan.h"
+#include "soft/csg_pass.h"
 #include "soft/deferred_shading.h"
 #include "soft/draw_triangles.h"
 #include "soft/fill_dispatch.h"
@@ -68,7 +69,7 @@ Status check_image_size(int w, int h) {
 // drawn material is a mirror or transparent (effects a z-buffer leaves out).
 struct SceneDraws {
   DrawList list;
-  bool mirror = false, transparency = false;
+  bool mirror = false, transparency = false, csg = false;
 };
 
 SceneDraws scene_draws(const PreparedScene& prepared) {
@@ -82,6 +83,9 @@ SceneDraws scene_draws(const PreparedScene& prepared) {
     d.mesh = p.mesh;
     d.smooth = p.smooth;
     d.use_primitive_id = p.names_triangles;
+    d.csg = p.csg;
+    draws.csg |= p.csg != nullptr;
+    d.csg_leaf_triangles = p.csg_leaf_triangles;
     draws.mirror |= d.material->mirror > 0.0f;
     draws.transparency |= d.material->transparency > 0.0f;
   }
@@ -292,14 +296,21 @@ void record_draw_stats(const DrawResult& drawn, const DepthTarget& target, size_
   out.stats["memory.raster_bytes"] = double(target.bytes() + drawn.peak_chunk_bytes);
 }
 
+// The CSG pass's counts: its leaf passes' work and the pixels it wrote.
+void record_csg_stats(const soft::CsgPassResult& csg, double seconds, RenderOutput& out) {
+  out.stats["csg.objects"] = double(csg.objects);
+  out.stats["csg.leaf_passes"] = double(csg.leaf_passes);
+  out.stats["csg.fragments"] = double(csg.drawn.counters.generated);
+  out.stats["csg.pixels"] = double(csg.pixels);
+  out.stats["time.csg"] = seconds;
+}
+
 // What this z-buffer leaves out of the scene. The warnings do not name the renderer: whoever
 // prints them says whose they are.
 void note_what_is_left_out(const Scene& scene, const RenderOptions& options,
-                           const PreparedScene& prepared,
                            const std::vector<EnvironmentMapped>& mapped,
                            const std::vector<std::string>& left_out,
                            std::vector<std::string>& warnings) {
-  if (!prepared.skipped_csg.empty()) warnings.push_back(skipped_csg_warning(prepared.skipped_csg));
   if (options.mode == RenderMode::Full) {
     note_environment_maps(scene, options, mapped, left_out, warnings);
     if (scene.camera.aperture_radius > 0.0f && scene.image.samples_per_pixel == 1)
@@ -320,6 +331,7 @@ struct RenderSetup {
   const soft::FillKernels& kernels;
   tbb::task_arena& arena;
   const DrawList& list;
+  bool csg;                                 // some object of `list` is a CSG solid
   const std::vector<LightSample>& samples;  // empty: no shading
   std::optional<DepthTarget>& kept;
   KeptShadowCubes& kept_shadows;
@@ -385,6 +397,12 @@ Status draw_view(const RenderSetup& setup, const MirrorView& view, const ViewFra
   if (progress) progress->begin("draw", list.triangles(), "triangles", "fragments");
   drawn = soft::draw_triangles(list, view_projection, target, arena, progress, view.keep);
   if (is_cancelled(progress)) return cancelled_error();
+  if (setup.csg) {
+    const auto t_csg = Clock::now();
+    const soft::CsgPassResult csg =
+        soft::draw_csg_objects(list, view_projection, view.eye, view.keep, target, arena);
+    record_csg_stats(csg, seconds_since(t_csg), out);
+  }
   out.stats["time.setup"] += drawn.setup_seconds;
   out.stats["time.bin"] = drawn.bin_seconds;
   out.stats["time.raster"] = drawn.raster_seconds;
@@ -463,8 +481,9 @@ Status add_cube_maps(const RenderSetup& setup, const std::vector<EnvironmentMapp
   RenderOptions face_options = setup.options;
   face_options.shadow_map_size = cube_face_shadow_map_size(setup.options);
   KeptShadowCubes face_shadows;
-  const RenderSetup face_setup{setup.scene, face_options,  setup.isa,  setup.kernels, setup.arena,
-                               setup.list,  setup.samples, setup.kept, face_shadows};
+  const RenderSetup face_setup{setup.scene, face_options, setup.isa, setup.kernels,
+                               setup.arena, setup.list,   setup.csg, setup.samples,
+                               setup.kept,  face_shadows};
   const CubeFacePass pass = [&](const CubeFace& face) -> Expected<FrameBuffers> {
     MirrorView view;
     view.eye = face.eye;
@@ -508,9 +527,9 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
       shade ? light_samples(scene.lights) : std::vector<LightSample>{};
   const double prepare_seconds = seconds_since(t);
   KeptShadowCubes own_shadows;  // shared by the camera's view and its mirrors' views
-  const RenderSetup setup{scene,   options, isa,
-                          kernels, arena,   draws.list,
-                          samples, kept,    kept_shadows ? *kept_shadows : own_shadows};
+  const RenderSetup setup{
+      scene,      options,   isa,     kernels, arena,
+      draws.list, draws.csg, samples, kept,    kept_shadows ? *kept_shadows : own_shadows};
   out.info["depth_format"] =
       options.depth_format ? to_string(*options.depth_format) : "exact (view depth, double)";
 
@@ -531,7 +550,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     if (!mapped.empty() && options.cube_map_size > 0) RVR_TRY(add_cube_maps(setup, mapped, out));
   }
   out.info["hiz"] = options.hiz ? "on" : "off";
-  note_what_is_left_out(scene, options, *prepared, mapped, left_out, out.warnings);
+  note_what_is_left_out(scene, options, mapped, left_out, out.warnings);
   return out;
 }
 

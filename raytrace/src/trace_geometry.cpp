@@ -53,7 +53,11 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
       if constexpr (requires { shape.traced(); }) {
         if (shape.traced_analytically(tessellation)) {
           object_analytic_[id] = uint32_t(analytic_.size());
-          analytic_.push_back({id, TracedShape(shape.traced())});
+          // A CSG solid's leaves follow --spheres too (traced(options)).
+          if constexpr (requires { shape.traced(tessellation); })
+            analytic_.push_back({id, TracedShape(shape.traced(tessellation))});
+          else
+            analytic_.push_back({id, TracedShape(shape.traced())});
           return;
         }
       }
@@ -423,6 +427,9 @@ SurfaceHit TraceGeometry::surface(const Ray& ray, const HitRecord& hit) const {
         [&](const auto& shape) { return shape.normal_at(s.position, shape_hit); }, a.shape);
     s.geometric_normal = glm::normalize(s.geometric_normal);
     s.shading_normal = s.geometric_normal;
+    // A CSG solid of tessellated leaves: interpolated normals on flat triangles.
+    if (const auto* csg = std::get_if<CsgSolid::Traced>(&a.shape))
+      s.geometric_normal = csg->geometric_normal_at(s.position, shape_hit);
   }
   s.material = object_material_[s.object];
   return s;

@@ -409,8 +409,8 @@ DrawList make_draw_list(std::vector<DrawObject> objects) {
   list.objects = std::move(objects);
   list.first.assign(list.objects.size() + 1, 0);
   for (size_t i = 0; i < list.objects.size(); ++i) {
-    const TriangleMesh* m = list.objects[i].mesh;
-    list.first[i + 1] = list.first[i] + (m ? m->triangles.size() : 0);
+    const DrawObject& d = list.objects[i];
+    list.first[i + 1] = list.first[i] + (d.mesh && !d.csg ? d.mesh->triangles.size() : 0);
   }
   return list;
 }

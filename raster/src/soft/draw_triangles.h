@@ -12,22 +12,29 @@
 
 #include "rvr/core/progress.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "soft/tile_raster.h"
 
 namespace rvr::soft {
 
-// What is drawn of one object; tessellated shapes point into meshes the renderer owns.
+// What is drawn of one object; tessellated shapes point into meshes the renderer owns. A CSG
+// object (`csg` not null) is not in the triangle stream: its mesh, the leaves' tessellations of
+// `csg_leaf_triangles` triangles each, is drawn by the CSG pass (csg_pass.h), which writes its
+// triangles' ids for shading.
 struct DrawObject {
-  const TriangleMesh* mesh = nullptr;  // null: nothing to draw (a CSG object)
+  const TriangleMesh* mesh = nullptr;  // null: nothing to draw
   const Material* material = nullptr;
   bool smooth = false;
   bool use_primitive_id = false;
+  const CsgNode* csg = nullptr;
+  uint32_t csg_leaf_triangles = 0;
 };
 
 struct DrawList {
   std::vector<DrawObject> objects;
-  std::vector<size_t> first;  // first[i]: submission index of object i's triangle 0
+  std::vector<size_t> first;  // first[i]: submission index of object i's triangle 0 (a CSG
+                              // object submits none)
   size_t triangles() const { return first.empty() ? 0 : first.back(); }
 };
 

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "shadow_plan.h"
+#include "soft/csg_pass.h"
 
 namespace rvr::soft {
 namespace {
@@ -32,6 +33,11 @@ void ShadowCube::build(const DrawList& list, const glm::vec3& light, const Shado
     arena.execute([&] { scratch.clear(); });
     const glm::dmat4 view = glm::dmat4(glm::mat4(cube_face_rotations()[size_t(f)])) * to_light;
     DrawResult r = draw_triangles(list, settings.projection * view, scratch, arena, nullptr);
+    // CSG solids cast their shadows too, resolved as the camera's view resolves them.
+    const CsgPassResult csg =
+        draw_csg_objects(list, settings.projection * view, light, std::nullopt, scratch, arena);
+    r.set_up += csg.drawn.set_up;
+    r.counters.generated += csg.drawn.counters.generated;
     work.set_up += r.set_up;
     work.counters.generated += r.counters.generated;
     work.counters.blocks_rejected += r.counters.blocks_rejected;

@@ -92,6 +92,26 @@ class DepthTarget {
       for (int x = x0; x < x1; ++x) out[x] = float(fragments[x]) + reject;
     }
   }
+  // A surface found after every draw into the target (a CSG solid's, csg_pass.h) written at
+  // pixel i over what was drawn there (a depth-only target: its depth alone). The blocks' hi-z
+  // bounds are not updated: nothing is drawn into the target after it.
+  void set_surface(size_t i, double depth, uint32_t object, uint32_t primitive,
+                   const glm::vec3& barycentric) {
+    depth_[i] = depth;
+    if (depth_only_) return;
+    object_[i] = object;
+    primitive_[i] = primitive;
+    bary_[3 * i] = barycentric.x;
+    bary_[3 * i + 1] = barycentric.y;
+    bary_[3 * i + 2] = barycentric.z;
+  }
+  // Fragments drawn at pixel i outside this target (a CSG solid's leaf passes), counted in its
+  // cost.
+  void add_fragments(size_t i, uint32_t fragments) {
+    if (!depth_only_) fragments_[i] += fragments;
+  }
+  double near_plane() const { return near_; }
+  double far_plane() const { return far_; }
   // The per-pixel arrays above, row-major, for passes that walk whole rows.
   const double* depths() const { return depth_.data(); }
   const uint32_t* objects() const { return object_.data(); }

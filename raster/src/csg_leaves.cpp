@@ -1,0 +1,24 @@
+#include "csg_leaves.h"
+
+namespace rvr {
+
+CsgLeafFaces split_by_facing(const TriangleMesh& mesh, uint32_t first, uint32_t count,
+                             const glm::vec3& centre, const glm::vec3& eye) {
+  CsgLeafFaces faces;
+  // Both halves keep the whole vertex list, which the triangles index.
+  faces.front.positions = mesh.positions;
+  faces.back.positions = mesh.positions;
+  for (uint32_t k = 0; k < count; ++k) {
+    const glm::uvec3& t = mesh.triangles[first + k];
+    const glm::dvec3 p0(mesh.positions[t.x]), p1(mesh.positions[t.y]), p2(mesh.positions[t.z]);
+    glm::dvec3 n = glm::cross(p1 - p0, p2 - p0);
+    // Outward, whatever the winding: the centre lies inside the convex mesh.
+    if (glm::dot(n, (p0 + p1 + p2) / 3.0 - glm::dvec3(centre)) < 0.0) n = -n;
+    const bool faces_eye = glm::dot(n, glm::dvec3(eye) - p0) > 0.0;
+    (faces_eye ? faces.front : faces.back).triangles.push_back(t);
+    (faces_eye ? faces.front_triangle : faces.back_triangle).push_back(k);
+  }
+  return faces;
+}
+
+}  // namespace rvr

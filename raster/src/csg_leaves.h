@@ -1,0 +1,30 @@
+// CSG in a z-buffer, after Goldfeather et al. for convex primitives: every leaf of rvr's CSG
+// trees is a sphere, drawn as its tessellation, a closed convex mesh. Along a pixel's ray such
+// a mesh is entered once, at its nearest triangle that faces the eye, and left once, at its
+// nearest triangle that faces away. So two ordinary depth passes per leaf, one over each half
+// of its triangles, give every pixel that leaf's interval, and the tree combines the intervals
+// per pixel as the tracer combines them per ray (first_csg_boundary). The surface found is
+// written into the frame where it is nearer than what the frame holds.
+#pragma once
+
+#include <cstdint>
+#include <glm/glm.hpp>
+#include <vector>
+
+#include "rvr/core/shapes/triangle_mesh.h"
+
+namespace rvr {
+
+// One leaf's triangles split by which side of them an eye is on. `front_triangle[j]` is the
+// index in the leaf's mesh of `front.triangles[j]` (the same for `back`).
+struct CsgLeafFaces {
+  TriangleMesh front, back;
+  std::vector<uint32_t> front_triangle, back_triangle;
+};
+
+// The triangles `first` .. `first + count` of `mesh` (a leaf's closed convex tessellation around
+// `centre`) that face `eye` and those that face away, each with the positions it indexes.
+CsgLeafFaces split_by_facing(const TriangleMesh& mesh, uint32_t first, uint32_t count,
+                             const glm::vec3& centre, const glm::vec3& eye);
+
+}  // namespace rvr
