@@ -325,11 +325,11 @@ TEST_F(Cli, CompareWritesEverythingAndThresholdGivesExit1) {
   EXPECT_EQ(over_one.status, 2) << over_one.err;
 }
 
-// --fail-below-agreement on pairs whose agreement is known without rendering: a z-buffer skips
-// the csg scene's one csg object (the format's rule) that the tracer draws, so they must
-// disagree; a renderer against itself agrees exactly (1 is not below 1).
+// --fail-below-agreement on pairs whose agreement is known without rendering: raster (OpenGL)
+// skips the csg scene's csg objects that the tracer draws, so they must disagree; a renderer
+// against itself agrees exactly (1 is not below 1).
 TEST_F(Cli, AgreementThresholdGivesExit1OnlyWhenCrossed) {
-  const std::string csg = "compare builtin:csg -r softraster,raytrace --width 64 --height 48 ";
+  const std::string csg = "compare builtin:csg -r raster,raytrace --width 64 --height 48 ";
   RunResult below = run(csg + "--fail-below-agreement 0.9 -o " + (dir_ / "below").string());
   EXPECT_EQ(below.status, 1) << below.err;
   // The outputs are written all the same, and they show why.

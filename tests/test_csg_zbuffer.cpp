@@ -7,10 +7,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <glm/glm.hpp>
+#include <initializer_list>
 #include <memory>
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "rvr/core/camera.h"
 #include "rvr/core/expected.h"

@@ -12,6 +12,7 @@
 #include "rvr/core/shapes.h"
 #include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/shape_geometry.h"
+#include "rvr/core/shapes/sphere.h"
 #include "rvr/core/tessellate.h"
 
 namespace rvr {

@@ -5,6 +5,8 @@
 // warning.
 #pragma once
 
+#include <stdint.h>
+
 #include <memory>
 #include <string>
 #include <vector>
@@ -12,6 +14,7 @@
 #include "rvr/core/expected.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr {

@@ -2,7 +2,6 @@
 
 #include <stddef.h>
 
-#include <algorithm>
 #include <cmath>
 #include <glm/glm.hpp>
 

@@ -5,12 +5,15 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <initializer_list>
 #include <limits>
-#include <utility>
+#include <memory>
 #include <vector>
 
 #include "csg_leaves.h"
 #include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr::soft {
 namespace {

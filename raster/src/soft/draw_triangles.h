@@ -3,6 +3,7 @@
 // shadow cube go through it.
 #pragma once
 
+#include <stdint.h>
 #include <tbb/task_arena.h>
 
 #include <cstddef>

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 #include <limits>
+#include <optional>
 
 #include "shadow_plan.h"
 #include "soft/csg_pass.h"
