@@ -57,6 +57,8 @@
 #include "rvr/core/ray.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/sphere.h"
 #include "rvr/core/texture.h"
 #include "rvr/image_codec/image_io.h"
 #include "rvr/raytrace/bvh.h"
@@ -299,6 +301,26 @@ void effect_scene(const std::string& effect, Scene& scene, RenderOptions& option
   } else if (effect == "glass") {
     for (Material& m : scene.materials)
       if (m.name == "glass") m.transparency = 0.9f;
+  } else if (effect == "csg") {
+    // The mirror ball, matt, with a ball of 0.7 its radius cut out of its front: a CSG
+    // difference the z-buffers draw leaf by leaf (softraster; raster skips CSG).
+    for (Object& o : scene.objects)
+      if (o.name == "mirror ball") {
+        const Sphere ball = o.sphere;
+        auto leaf = [](const Sphere& s) {
+          auto n = std::make_shared<CsgNode>();
+          n->sphere = s;
+          return n;
+        };
+        auto cut = std::make_shared<CsgNode>();
+        cut->is_leaf = false;
+        cut->op = CsgOp::Difference;
+        cut->a = leaf(ball);
+        cut->b = leaf({ball.center + glm::vec3(0.0f, 0.3f, 0.8f) * ball.radius, 0.7f * ball.radius});
+        o.type = ObjectType::Csg;
+        o.csg = cut;
+        o.material = scene.objects[0].material;
+      }
   } else if (effect == "dof_16") {
     scene.camera.aperture_radius = 0.08f;
     scene.camera.focus_distance = 9.5f;
@@ -738,7 +760,7 @@ void register_all() {
             ->UseRealTime();
   for (std::string e : {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1",
                         "mirror_depth_2", "mirror_depth_3", "mirror_depth_4", "mirror_depth_5",
-                        "planar_mirror", "curved_mirror", "glass", "dof_16"}) {
+                        "planar_mirror", "curved_mirror", "glass", "csg", "dof_16"}) {
     benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
@@ -763,8 +785,9 @@ void register_all() {
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   // The z-buffers' own answers to the effects they render, by technique: primary visibility,
-  // shadow maps, a flat mirror by reflected views, a curved mirror and glass by cube maps, and
-  // depth of field by the accumulation buffer (raster also by MSAA: a pinhole) or a blur.
+  // shadow maps, a flat mirror by reflected views, a curved mirror and glass by cube maps, a
+  // CSG solid by its leaves' intervals (softraster), and depth of field by the accumulation
+  // buffer (raster also by MSAA: a pinhole) or a blur.
   struct ZBufferEffect {
     std::string renderer, effect, technique;
     Supersampling supersampling = Supersampling::Accumulation;
@@ -778,6 +801,7 @@ void register_all() {
                                         {z, "curved_mirror", "cube_map"},
                                         {z, "glass", "cube_map"},
                                         {z, "dof_16", "accumulation"}};
+    if (z == "softraster") cases.push_back({z, "csg", "leaf_intervals"});  // raster skips CSG
     cases.push_back({z, "dof_16", "blur", Supersampling::Accumulation, ZBufferDof::Blur});
     if (z == "raster") cases.push_back({z, "dof_16", "msaa", Supersampling::Msaa});
     for (const ZBufferEffect& c : cases)
