@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <initializer_list>
 #include <limits>
@@ -40,32 +41,77 @@ struct LeafLayer {
   }
 };
 
-// The pixels `scratch` covers after a pass, kept as a layer; `triangle_of` maps the pass's
-// primitive to the leaf's triangle in the object's mesh.
-LeafLayer keep_layer(const DepthTarget& scratch, const std::vector<uint32_t>& triangle_of,
-                     uint32_t first_triangle) {
+// Where a leaf can show in a view of width x height pixels: the pixel box around the
+// projection of its sphere's bounding cube, a pixel wider on each side; the whole frame when a
+// corner lies behind the eye's plane (its projection is unbounded); empty off screen.
+struct PixelBox {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool empty() const { return x0 >= x1 || y0 >= y1; }
+};
+
+PixelBox leaf_box(const Sphere& leaf, const glm::dmat4& view_projection, int width, int height) {
+  double lo_x = INFINITY, lo_y = INFINITY, hi_x = -INFINITY, hi_y = -INFINITY;
+  for (int corner = 0; corner < 8; ++corner) {
+    const glm::dvec3 offset(corner & 1 ? 1.0 : -1.0, corner & 2 ? 1.0 : -1.0,
+                            corner & 4 ? 1.0 : -1.0);
+    const glm::dvec4 clip =
+        view_projection * glm::dvec4(glm::dvec3(leaf.center) + double(leaf.radius) * offset, 1.0);
+    if (!(clip.w > 0.0)) return {0, 0, width, height};
+    const double px = (clip.x / clip.w + 1.0) * 0.5 * width;
+    const double py = (1.0 - clip.y / clip.w) * 0.5 * height;
+    lo_x = std::min(lo_x, px);
+    hi_x = std::max(hi_x, px);
+    lo_y = std::min(lo_y, py);
+    hi_y = std::max(hi_y, py);
+  }
+  auto clamp_to = [](double v, int n) { return int(std::clamp(v, 0.0, double(n))); };
+  return {clamp_to(std::floor(lo_x) - 1.0, width), clamp_to(std::floor(lo_y) - 1.0, height),
+          clamp_to(std::ceil(hi_x) + 1.0, width), clamp_to(std::ceil(hi_y) + 1.0, height)};
+}
+
+// The view-projection that draws `box` of a width x height view into a target of the box's
+// size: clip space scaled and shifted so that the box's pixel centres are the target's, at whole
+// pixel offsets (the same centres the view samples).
+glm::dmat4 crop_to(const PixelBox& box, int width, int height, const glm::dmat4& view_projection) {
+  const double bw = box.x1 - box.x0, bh = box.y1 - box.y0;
+  glm::dmat4 crop(1.0);
+  crop[0][0] = width / bw;
+  crop[3][0] = (width - 2.0 * box.x0) / bw - 1.0;
+  crop[1][1] = height / bh;
+  crop[3][1] = 1.0 - height / bh + 2.0 * box.y0 / bh;
+  return crop * view_projection;
+}
+
+// What `scratch` (drawn as `box` of the view) holds after a pass, kept as a layer over the
+// pixels it covered (the box can be the whole frame, the leaf a few pixels of it);
+// `triangle_of` maps the pass's primitive to the leaf's triangle in the object's mesh.
+LeafLayer keep_layer(const DepthTarget& scratch, const PixelBox& box,
+                     const std::vector<uint32_t>& triangle_of, uint32_t first_triangle) {
   const int w = scratch.width(), h = scratch.height();
-  LeafLayer layer;
-  layer.x0 = w;
-  layer.y0 = h;
+  int x0 = w, y0 = h, x1 = 0, y1 = 0;
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x)
       if (scratch.covered(size_t(y) * size_t(w) + size_t(x))) {
-        layer.x0 = std::min(layer.x0, x);
-        layer.x1 = std::max(layer.x1, x + 1);
-        layer.y0 = std::min(layer.y0, y);
-        layer.y1 = std::max(layer.y1, y + 1);
+        x0 = std::min(x0, x);
+        x1 = std::max(x1, x + 1);
+        y0 = std::min(y0, y);
+        y1 = std::max(y1, y + 1);
       }
-  if (layer.empty()) return LeafLayer{};
-  const size_t n = size_t(layer.x1 - layer.x0) * size_t(layer.y1 - layer.y0);
+  if (x0 >= x1 || y0 >= y1) return LeafLayer{};
+  LeafLayer layer;
+  layer.x0 = box.x0 + x0;
+  layer.y0 = box.y0 + y0;
+  layer.x1 = box.x0 + x1;
+  layer.y1 = box.y0 + y1;
+  const size_t n = size_t(x1 - x0) * size_t(y1 - y0);
   layer.depth.assign(n, kInfinity);
   layer.triangle.assign(n, 0);
   layer.barycentric.assign(n, glm::vec3(0.0f));
-  for (int y = layer.y0; y < layer.y1; ++y)
-    for (int x = layer.x0; x < layer.x1; ++x) {
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) {
       const size_t i = size_t(y) * size_t(w) + size_t(x);
       if (!scratch.covered(i)) continue;
-      const size_t k = size_t(layer.at(x, y));
+      const size_t k = size_t(y - y0) * size_t(x1 - x0) + size_t(x - x0);
       layer.depth[k] = scratch.depth(i);
       layer.triangle[k] = first_triangle + triangle_of[scratch.primitive(i)];
       layer.barycentric[k] = scratch.barycentric(i);
@@ -73,19 +119,28 @@ LeafLayer keep_layer(const DepthTarget& scratch, const std::vector<uint32_t>& tr
   return layer;
 }
 
-// One half of a leaf drawn alone into `scratch`, kept as a layer.
+// One half of a leaf drawn alone into a target of its box's size, kept as a layer.
 LeafLayer draw_half(const TriangleMesh& half, const std::vector<uint32_t>& triangle_of,
-                    uint32_t first_triangle, const DrawObject& object,
-                    const glm::dmat4& view_projection, const std::optional<glm::dvec4>& keep,
-                    DepthTarget& scratch, tbb::task_arena& arena, CsgPassResult& result) {
-  arena.execute([&] { scratch.clear(); });
+                    uint32_t first_triangle, const DrawObject& object, const PixelBox& box,
+                    const glm::dmat4& box_projection, const std::optional<glm::dvec4>& keep,
+                    const DepthTarget& target, std::optional<DepthTarget>& scratch,
+                    tbb::task_arena& arena, CsgPassResult& result) {
   result.leaf_passes++;
-  if (half.triangles.empty()) return LeafLayer{};
+  if (half.triangles.empty() || box.empty()) return LeafLayer{};
+  const int bw = box.x1 - box.x0, bh = box.y1 - box.y0;
+  // One scratch target for every pass of the call (the same planes and kernels), resized.
+  arena.execute([&] {
+    if (scratch)
+      scratch->resize(bw, bh);
+    else
+      scratch.emplace(bw, bh, target.near_plane(), target.far_plane(), /*hiz=*/false,
+                      target.kernels());
+  });
   DrawObject d;
   d.mesh = &half;
   d.material = object.material;
   const DrawList one = make_draw_list({d});
-  const DrawResult drawn = draw_triangles(one, view_projection, scratch, arena, nullptr, keep);
+  const DrawResult drawn = draw_triangles(one, box_projection, *scratch, arena, nullptr, keep);
   result.drawn.clipped += drawn.clipped;
   result.drawn.set_up += drawn.set_up;
   result.drawn.peak_chunk_bytes = std::max(result.drawn.peak_chunk_bytes, drawn.peak_chunk_bytes);
@@ -93,7 +148,7 @@ LeafLayer draw_half(const TriangleMesh& half, const std::vector<uint32_t>& trian
   result.drawn.bin_seconds += drawn.bin_seconds;
   result.drawn.raster_seconds += drawn.raster_seconds;
   result.drawn.counters.generated += drawn.counters.generated;
-  return keep_layer(scratch, triangle_of, first_triangle);
+  return keep_layer(*scratch, box, triangle_of, first_triangle);
 }
 
 // Each pixel of the leaves' boxes: the leaves' intervals from their layers (a half not seen
@@ -161,11 +216,6 @@ CsgPassResult draw_csg_objects(const DrawList& list, const glm::dmat4& view_proj
   for (size_t o = 0; o < list.objects.size(); ++o) {
     const DrawObject& object = list.objects[o];
     if (!object.csg || !object.mesh) continue;
-    if (!scratch)
-      arena.execute([&] {
-        scratch.emplace(target.width(), target.height(), target.near_plane(), target.far_plane(),
-                        /*hiz=*/false, target.kernels());
-      });
     result.objects++;
     const std::vector<Sphere> leaves = csg_leaves(object.csg);
     std::vector<LeafLayer> front(leaves.size()), back(leaves.size());
@@ -173,10 +223,14 @@ CsgPassResult draw_csg_objects(const DrawList& list, const glm::dmat4& view_proj
       const uint32_t first = uint32_t(k) * object.csg_leaf_triangles;
       const CsgLeafFaces faces =
           split_by_facing(*object.mesh, first, object.csg_leaf_triangles, leaves[k].center, eye);
-      front[k] = draw_half(faces.front, faces.front_triangle, first, object, view_projection, keep,
-                           *scratch, arena, result);
-      back[k] = draw_half(faces.back, faces.back_triangle, first, object, view_projection, keep,
-                          *scratch, arena, result);
+      const PixelBox box = leaf_box(leaves[k], view_projection, target.width(), target.height());
+      const glm::dmat4 box_projection =
+          box.empty() ? view_projection
+                      : crop_to(box, target.width(), target.height(), view_projection);
+      front[k] = draw_half(faces.front, faces.front_triangle, first, object, box, box_projection,
+                           keep, target, scratch, arena, result);
+      back[k] = draw_half(faces.back, faces.back_triangle, first, object, box, box_projection, keep,
+                          target, scratch, arena, result);
     }
     result.pixels += combine_leaves(uint32_t(o), object.csg, front, back, target, arena);
   }

@@ -33,6 +33,18 @@ DepthTarget::DepthTarget(int width, int height, double near_plane, double far_pl
   clear();
 }
 
+void DepthTarget::resize(int width, int height) {
+  RVR_CHECK(width > 0 && height > 0 && width <= kMaxImageSide && height <= kMaxImageSide,
+            "the renderer refuses frames outside 1..kMaxImageSide: ", width, "x", height);
+  width_ = width;
+  height_ = height;
+  tiles_x_ = (width + kTile - 1) / kTile;
+  tiles_y_ = (height + kTile - 1) / kTile;
+  blocks_x_ = (width + kBlock - 1) / kBlock;
+  blocks_y_ = (height + kBlock - 1) / kBlock;
+  clear();
+}
+
 void DepthTarget::clear() {
   const size_t n = size_t(width_) * size_t(height_);
   // Sized without a serial fill (tens of MB at 1024x768: a serial fill would be a serial share

@@ -37,6 +37,9 @@ class DepthTarget {
               const FillKernels& kernels, bool depth_only = false);
   // Back to nothing drawn, for the next pass through the same target.
   void clear();
+  // Re-dimensioned to width x height (the same planes, hi-z and kernels) and cleared, keeping
+  // its arrays' memory: passes of changing sizes through one target allocate once.
+  void resize(int width, int height);
   // What the depth test compares from now on (fill_kernel.h: kDepthExact, kDepthD24, ...).
   void set_depth_format(int format) {
     depth_format_ = format;
