@@ -316,7 +316,8 @@ void effect_scene(const std::string& effect, Scene& scene, RenderOptions& option
         cut->is_leaf = false;
         cut->op = CsgOp::Difference;
         cut->a = leaf(ball);
-        cut->b = leaf({ball.center + glm::vec3(0.0f, 0.3f, 0.8f) * ball.radius, 0.7f * ball.radius});
+        cut->b =
+            leaf({ball.center + glm::vec3(0.0f, 0.3f, 0.8f) * ball.radius, 0.7f * ball.radius});
         o.type = ObjectType::Csg;
         o.csg = cut;
         o.material = scene.objects[0].material;
@@ -745,6 +746,36 @@ void register_frame_sweep(const FrameSweep& sweep) {
     for (std::string s : {"tessphere", "soup"}) add(info.name, s, 10000000L, 1024L);
 }
 
+// The z-buffers' own answers to the effects they render, by technique: primary visibility,
+// shadow maps, a flat mirror by reflected views, a curved mirror and glass by cube maps, a
+// CSG solid by its leaves' intervals (softraster), and depth of field by the accumulation
+// buffer (raster also by MSAA: a pinhole) or a blur.
+void register_zbuffer_effects() {
+  struct ZBufferEffect {
+    std::string renderer, effect, technique;
+    Supersampling supersampling = Supersampling::Accumulation;
+    ZBufferDof dof = ZBufferDof::Accumulation;
+  };
+  for (const std::string z : {"raster", "softraster"}) {
+    std::vector<ZBufferEffect> cases = {{z, "primary", "zbuffer"},
+                                        {z, "hard_shadows", "shadow_maps"},
+                                        {z, "area_light_4x4", "shadow_maps"},
+                                        {z, "planar_mirror", "reflected_views"},
+                                        {z, "curved_mirror", "cube_map"},
+                                        {z, "glass", "cube_map"},
+                                        {z, "dof_16", "accumulation"}};
+    if (z == "softraster") cases.push_back({z, "csg", "leaf_intervals"});  // raster skips CSG
+    cases.push_back({z, "dof_16", "blur", Supersampling::Accumulation, ZBufferDof::Blur});
+    if (z == "raster") cases.push_back({z, "dof_16", "msaa", Supersampling::Msaa});
+    for (const ZBufferEffect& c : cases)
+      benchmark::RegisterBenchmark(
+          bench_name({"BM_Effects", c.renderer, c.effect, c.technique}).c_str(), BM_EffectsWith,
+          c.renderer, c.effect, c.supersampling, c.dof)
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
+  }
+}
+
 void register_all() {
   register_frame_sweep(kFrameSweep);
   register_frame_sweep(kVisibilitySweep);
@@ -784,33 +815,7 @@ void register_all() {
         ->Range(1, 64)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
-  // The z-buffers' own answers to the effects they render, by technique: primary visibility,
-  // shadow maps, a flat mirror by reflected views, a curved mirror and glass by cube maps, a
-  // CSG solid by its leaves' intervals (softraster), and depth of field by the accumulation
-  // buffer (raster also by MSAA: a pinhole) or a blur.
-  struct ZBufferEffect {
-    std::string renderer, effect, technique;
-    Supersampling supersampling = Supersampling::Accumulation;
-    ZBufferDof dof = ZBufferDof::Accumulation;
-  };
-  for (const std::string z : {"raster", "softraster"}) {
-    std::vector<ZBufferEffect> cases = {{z, "primary", "zbuffer"},
-                                        {z, "hard_shadows", "shadow_maps"},
-                                        {z, "area_light_4x4", "shadow_maps"},
-                                        {z, "planar_mirror", "reflected_views"},
-                                        {z, "curved_mirror", "cube_map"},
-                                        {z, "glass", "cube_map"},
-                                        {z, "dof_16", "accumulation"}};
-    if (z == "softraster") cases.push_back({z, "csg", "leaf_intervals"});  // raster skips CSG
-    cases.push_back({z, "dof_16", "blur", Supersampling::Accumulation, ZBufferDof::Blur});
-    if (z == "raster") cases.push_back({z, "dof_16", "msaa", Supersampling::Msaa});
-    for (const ZBufferEffect& c : cases)
-      benchmark::RegisterBenchmark(
-          bench_name({"BM_Effects", c.renderer, c.effect, c.technique}).c_str(), BM_EffectsWith,
-          c.renderer, c.effect, c.supersampling, c.dof)
-          ->Unit(benchmark::kMillisecond)
-          ->UseRealTime();
-  }
+  register_zbuffer_effects();
   for (const auto& [name, aovs] : std::vector<std::pair<std::string, std::vector<std::string>>>{
            {"image", {}},
            {"depth", {"depth"}},
