@@ -748,7 +748,7 @@ void register_frame_sweep(const FrameSweep& sweep) {
 
 // The z-buffers' own answers to the effects they render, by technique: primary visibility,
 // shadow maps, a flat mirror by reflected views, a curved mirror and glass by cube maps, a
-// CSG solid by its leaves' intervals (softraster), and depth of field by the accumulation
+// CSG solid by its leaves' intervals, and depth of field by the accumulation
 // buffer (raster also by MSAA: a pinhole) or a blur.
 void register_zbuffer_effects() {
   struct ZBufferEffect {
@@ -757,15 +757,16 @@ void register_zbuffer_effects() {
     ZBufferDof dof = ZBufferDof::Accumulation;
   };
   for (const std::string z : {"raster", "softraster"}) {
-    std::vector<ZBufferEffect> cases = {{z, "primary", "zbuffer"},
-                                        {z, "hard_shadows", "shadow_maps"},
-                                        {z, "area_light_4x4", "shadow_maps"},
-                                        {z, "planar_mirror", "reflected_views"},
-                                        {z, "curved_mirror", "cube_map"},
-                                        {z, "glass", "cube_map"},
-                                        {z, "dof_16", "accumulation"}};
-    if (z == "softraster") cases.push_back({z, "csg", "leaf_intervals"});  // raster skips CSG
-    cases.push_back({z, "dof_16", "blur", Supersampling::Accumulation, ZBufferDof::Blur});
+    std::vector<ZBufferEffect> cases = {
+        {z, "primary", "zbuffer"},
+        {z, "hard_shadows", "shadow_maps"},
+        {z, "area_light_4x4", "shadow_maps"},
+        {z, "planar_mirror", "reflected_views"},
+        {z, "curved_mirror", "cube_map"},
+        {z, "glass", "cube_map"},
+        {z, "dof_16", "accumulation"},
+        {z, "csg", "leaf_intervals"},
+        {z, "dof_16", "blur", Supersampling::Accumulation, ZBufferDof::Blur}};
     if (z == "raster") cases.push_back({z, "dof_16", "msaa", Supersampling::Msaa});
     for (const ZBufferEffect& c : cases)
       benchmark::RegisterBenchmark(

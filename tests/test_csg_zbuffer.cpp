@@ -1,5 +1,6 @@
-// CSG in softraster (raster/src/soft/csg_pass.h): a difference of two spheres against its closed
-// form, and builtin:csg against the tracer intersecting the same tessellated leaves.
+// CSG in both z-buffers (raster/src/csg_leaves.h; softraster's raster/src/soft/csg_pass.h,
+// raster's resolve_csg in raster/src/gl_rasterizer.cpp): a difference of two spheres against its
+// closed form, and builtin:csg against the tracer intersecting the same tessellated leaves.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,10 +18,12 @@
 #include "rvr/core/camera.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
+#include "rvr/core/gl_backend.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
 #include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/sphere.h"
+#include "rvr/raster/gl_rasterizer.h"
 #include "rvr/raster/soft_rasterizer.h"
 #include "rvr/raytrace/ray_tracer.h"
 #include "rvr/scene_io/scene_loader.h"
@@ -47,14 +50,22 @@ double line_distance(const glm::dvec3& o, const glm::dvec3& d, const glm::dvec3&
   return glm::length(glm::cross(c - o, d)) / glm::length(d);
 }
 
-Expected<RenderOutput> render_soft(const Scene& scene, RenderMode mode, int segments) {
+// The z-buffer named `zbuffer` (softraster or raster, on OSMesa) with tessellated spheres.
+Expected<RenderOutput> render_zbuffer(const std::string& zbuffer, const Scene& scene,
+                                      RenderMode mode, int segments) {
   RenderOptions options;
   options.mode = mode;
   options.sphere_segments = segments;
   options.spheres = SphereMode::Mesh;
+  if (zbuffer == "raster") {
+    GlRasterizer gl(GlBackend::OsMesa);
+    return gl.render(scene, options);
+  }
   SoftRasterizer soft;
   return soft.render(scene, options);
 }
+
+class CsgZBuffer : public ::testing::TestWithParam<std::string> {};
 
 // A − B, sphere A (centre 0, radius 1) with sphere B (centre (0.35, 0.2, 0.55), radius 0.7)
 // cut out of its front, seen from z = 5, partly behind a square. At each pixel the first
@@ -70,7 +81,7 @@ Expected<RenderOutput> render_soft(const Scene& scene, RenderMode mode, int segm
 // radial one), away from the silhouettes' band of either sphere (where the ray's distance to
 // the centre lies between r cos(arc) and r: the tessellation may hit or miss there) and away
 // from where the closed form's case changes within the tolerance.
-TEST(CsgZBuffer, DifferenceOfTwoSpheresHasItsClosedFormDepthNormalAndId) {
+TEST_P(CsgZBuffer, DifferenceOfTwoSpheresHasItsClosedFormDepthNormalAndId) {
   Scene scene = test::empty_scene(96, 96, {0, 0, 5}, {0, 0, 0}, 30.0f);
   const glm::dvec3 ca(0.0), cb(0.35, 0.2, 0.55);
   const double ra = 1.0, rb = 0.7;
@@ -98,7 +109,7 @@ TEST(CsgZBuffer, DifferenceOfTwoSpheresHasItsClosedFormDepthNormalAndId) {
   constexpr int kSegments = 256;
   const double arc = std::sqrt(2.0) * 2.0 * kPi / kSegments;
   const double radial = 1.0 - std::cos(arc);  // per unit radius
-  Expected<RenderOutput> out = render_soft(scene, RenderMode::Local, kSegments);
+  Expected<RenderOutput> out = render_zbuffer(GetParam(), scene, RenderMode::Local, kSegments);
   ASSERT_TRUE(out.ok()) << out.error().message;
   const FrameBuffers& fb = out->buffers;
   const CameraFrame frame = make_camera_frame(scene.camera, fb.width, fb.height);
@@ -176,22 +187,22 @@ TEST(CsgZBuffer, DifferenceOfTwoSpheresHasItsClosedFormDepthNormalAndId) {
 // triangles, so, as in test_conformance, ids agree but for fill-rule ties (>= 0.999; measured
 // 1.0 at 320x240), depths to 1e-3 relative (measured 8e-6) and, away from id edges, colours to
 // 1e-3 per channel (the conformance bound; measured 2.5e-5).
-TEST(CsgZBuffer, SoftrasterAgreesWithTheTracerOnTheSameTessellatedLeaves) {
+TEST_P(CsgZBuffer, AgreesWithTheTracerOnTheSameTessellatedLeaves) {
   Expected<Scene> loaded = make_builtin_scene("csg");
   ASSERT_TRUE(loaded.ok());
   Scene scene = *loaded;
   scene.image.width = 240;
   scene.image.height = 180;
   constexpr int kSegments = 48;
-  Expected<RenderOutput> soft = render_soft(scene, RenderMode::Local, kSegments);
+  Expected<RenderOutput> drawn = render_zbuffer(GetParam(), scene, RenderMode::Local, kSegments);
   RenderOptions options;
   options.mode = RenderMode::Local;
   options.sphere_segments = kSegments;
   options.spheres = SphereMode::Mesh;
   RayTracer tracer;
   Expected<RenderOutput> traced = tracer.render(scene, options);
-  ASSERT_TRUE(soft.ok() && traced.ok());
-  const FrameBuffers &z = soft->buffers, &t = traced->buffers;
+  ASSERT_TRUE(drawn.ok() && traced.ok());
+  const FrameBuffers &z = drawn->buffers, &t = traced->buffers;
   const int w = z.width, h = z.height;
   size_t agree = 0, csg = 0, compared_colour = 0;
   double worst_depth = 0.0, worst_colour = 0.0;
@@ -224,6 +235,11 @@ TEST(CsgZBuffer, SoftrasterAgreesWithTheTracerOnTheSameTessellatedLeaves) {
   EXPECT_LE(worst_depth, 1e-3);
   EXPECT_LE(worst_colour, 1e-3);
 }
+
+INSTANTIATE_TEST_SUITE_P(BothZBuffers, CsgZBuffer, ::testing::Values("softraster", "raster"),
+                         [](const ::testing::TestParamInfo<std::string>& info) {
+                           return info.param;
+                         });
 
 }  // namespace
 }  // namespace rvr

@@ -179,7 +179,7 @@ INSTANTIATE_TEST_SUITE_P(EveryBuiltinScene, HybridFullMode,
                                   std::get<1>(info.param);
                          });
 
-// CSG has no z-buffer form: the tracer finds it for the pixels where it is nearer.
+// The hybrids intersect CSG solids for every pixel, whatever their z-buffer drew there, and say so.
 TEST(Hybrid, TracesCsgWhereTheZBufferDrawsNothing) {
   Scene scene = small_scene("csg");
   for (const char* hybrid : {"hybrid", "hybrid_soft"}) {

@@ -38,10 +38,14 @@ ReportInput report_input(const Scene& scene, const CompareResult& result,
   report.warnings = scene.warnings;
   report.warnings.insert(report.warnings.end(), result.warnings.begin(), result.warnings.end());
   std::vector<std::string> names;
-  for (const ComparedRenderer& c : result.renderers) {
+  for (const ComparedRenderer& c : result.renderers) names.push_back(c.name);
+  // A renderer compared twice writes its images under its key (raytrace-2), not over the first's.
+  const std::vector<std::string> keys = renderer_keys(names);
+  for (size_t i = 0; i < result.renderers.size(); ++i) {
+    const ComparedRenderer& c = result.renderers[i];
     ReportRenderer r;
     r.name = c.name;
-    r.image_file = r.name + ".png";
+    r.image_file = keys[i] + ".png";
     r.seconds = c.seconds;
     r.warnings = c.output.warnings;
     r.stats = c.output.stats;
@@ -49,14 +53,12 @@ ReportInput report_input(const Scene& scene, const CompareResult& result,
     r.depth_format = to_string(depth_store_of(c.name, c.output));
     r.stats["time.load"] = context.load_seconds;
     if (c.has_cost) {
-      r.cost_file = r.name + ".cost.png";
+      r.cost_file = keys[i] + ".cost.png";
       r.cost_scale = c.cost_scale;
       r.cost_mean = c.cost_mean;
     }
     report.renderers.push_back(r);
-    names.push_back(c.name);
   }
-  const std::vector<std::string> keys = renderer_keys(names);
   for (size_t k = 0; k < result.pairs.size(); ++k) {
     const ComparedPair& p = result.pairs[k];
     ReportPair rp;

@@ -61,15 +61,16 @@ constexpr std::array kStats = {
     StatDeclaration{"cube_map.total_internal", kCount, "pixels", "z-buffers",
                     "totally internally reflected rays among the refracted pixels' (at either "
                     "interface; looked up in the reflected direction)"},
-    // CSG solids drawn by softraster: two depth passes per leaf, combined per pixel.
-    StatDeclaration{"csg.objects", kCount, "objects", "softraster",
-                    "CSG objects drawn, leaf by leaf, in the camera's view"},
-    StatDeclaration{"csg.leaf_passes", kCount, "passes", "softraster",
-                    "depth passes over the CSG leaves' tessellations: two per leaf (the "
-                    "triangles facing the eye, then those facing away)"},
+    // CSG solids drawn by the z-buffers: two depth passes per leaf, combined per pixel.
+    StatDeclaration{"csg.objects", kCount, "objects", "z-buffers",
+                    "CSG objects drawn, leaf by leaf"},
+    StatDeclaration{"csg.leaf_passes", kCount, "passes", "z-buffers",
+                    "depth passes over the CSG leaves' tessellations: two per leaf and view (the "
+                    "triangles facing the eye, then those facing away); `raster` counts every "
+                    "view it drew (camera, mirror views, cube faces)"},
     StatDeclaration{"csg.fragments", kCount, "fragments", "softraster",
                     "fragments the CSG leaf passes generated"},
-    StatDeclaration{"csg.pixels", kCount, "pixels", "softraster",
+    StatDeclaration{"csg.pixels", kCount, "pixels", "z-buffers",
                     "pixels where a CSG surface was nearer than the rest of the frame"},
     StatDeclaration{"ssr.hits", kCount, "pixels", "z-buffers",
                     "curved-mirror pixels whose screen-space reflection ray meets a surface the "
@@ -198,8 +199,9 @@ constexpr std::array kStats = {
     StatDeclaration{"time.cube_maps", kSeconds, "s", "z-buffers",
                     "cube maps of curved mirrors and transparent objects, drawn, shaded and "
                     "looked up"},
-    StatDeclaration{"time.csg", kSeconds, "s", "softraster",
-                    "CSG solids: their leaves' depth passes and the per-pixel combination"},
+    StatDeclaration{"time.csg", kSeconds, "s", "z-buffers",
+                    "CSG solids: their leaves' depth passes and the per-pixel combination "
+                    "(`raster`: with the readback of each pass, part of `time.render`)"},
     StatDeclaration{"time.zbuffer", kSeconds, "s", "hybrids", "the z-buffer passes"},
     StatDeclaration{"time.trace", kSeconds, "s", "hybrids",
                     "the tracer's part: hits rebuilt, rays traced, shading"},

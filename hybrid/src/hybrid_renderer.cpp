@@ -138,11 +138,9 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   for (const auto& [key, value] : zbuffer->info) o.info["zbuffer." + key] = value;
   o.info["zbuffer"] = rasterizer_->name();
   for (const std::string& w : zbuffer->warnings) {
-    // The tracer draws what the z-buffer skipped (CSG) and takes every sample it did not
-    // (softraster's single sample): only the z-buffer's other notes concern the image.
-    if (w.starts_with("csg objects have no z-buffer form") ||
-        w.ends_with("multisampling is not implemented, rendered 1"))
-      continue;
+    // The tracer takes every sample the z-buffer did not (softraster's single sample): only
+    // the z-buffer's other notes concern the image.
+    if (w.ends_with("multisampling is not implemented, rendered 1")) continue;
     o.warnings.push_back("z-buffer: " + w);
   }
   size_t csg = 0;

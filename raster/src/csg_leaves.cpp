@@ -1,5 +1,7 @@
 #include "csg_leaves.h"
 
+#include <limits>
+
 namespace rvr {
 
 CsgLeafFaces split_by_facing(const TriangleMesh& mesh, uint32_t first, uint32_t count,
@@ -19,6 +21,18 @@ CsgLeafFaces split_by_facing(const TriangleMesh& mesh, uint32_t first, uint32_t 
     (faces_eye ? faces.front_triangle : faces.back_triangle).push_back(k);
   }
   return faces;
+}
+
+CsgInterval pixel_interval(double enter, double leave, uint32_t enter_facet, uint32_t leave_facet) {
+  const double infinity = std::numeric_limits<double>::infinity();
+  CsgInterval interval;
+  const bool entered = enter < infinity, left = leave < infinity;
+  interval.hit = entered || left;
+  interval.enter = entered ? enter : -infinity;
+  interval.leave = leave;
+  interval.enter_facet = enter_facet;
+  interval.leave_facet = leave_facet;
+  return interval;
 }
 
 }  // namespace rvr

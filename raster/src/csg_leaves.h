@@ -11,6 +11,7 @@
 #include <glm/glm.hpp>
 #include <vector>
 
+#include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr {
@@ -26,5 +27,12 @@ struct CsgLeafFaces {
 // `centre`) that face `eye` and those that face away, each with the positions it indexes.
 CsgLeafFaces split_by_facing(const TriangleMesh& mesh, uint32_t first, uint32_t count,
                              const glm::vec3& centre, const glm::vec3& eye);
+
+// A leaf's interval along a pixel's ray from what its two depth passes left at the pixel: the
+// nearest depth of its triangles facing the eye (`enter`, on triangle `enter_facet`) and of those
+// facing away (`leave`, on `leave_facet`), +inf where that half covered nothing. A convex leaf
+// whose front half is not seen where its back half is was entered before the near plane; one
+// whose back half is not seen is left past the far plane.
+CsgInterval pixel_interval(double enter, double leave, uint32_t enter_facet, uint32_t leave_facet);
 
 }  // namespace rvr

@@ -105,10 +105,11 @@ Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
   return prepared;
 }
 
-std::string skipped_csg_warning(const std::vector<std::string>& labels) {
+std::string csg_casts_no_shadow_warning(const std::vector<std::string>& labels) {
   std::string names;
   for (const std::string& s : labels) names += (names.empty() ? "" : ", ") + s;
-  return fmt::format("csg objects have no z-buffer form: skipped {} ({})", labels.size(), names);
+  return fmt::format("csg objects cast no shadow in raster's shadow maps: {} ({})", labels.size(),
+                     names);
 }
 
 }  // namespace rvr

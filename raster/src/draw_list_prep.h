@@ -51,7 +51,9 @@ struct PreparedScene {
 Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
                                         int sphere_segments);
 
-// The warning for the CSG objects a z-buffer cannot draw (`labels` not empty).
-std::string skipped_csg_warning(const std::vector<std::string>& labels);
+// The warning for the CSG objects that raster (GL) leaves out of its shadow maps (`labels` not
+// empty): its maps keep each texel's nearest distance over all triangles drawn, not a tree's
+// combination of leaf intervals.
+std::string csg_casts_no_shadow_warning(const std::vector<std::string>& labels);
 
 }  // namespace rvr

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "accumulation_buffer.h"
+#include "csg_leaves.h"
 #include "depth_of_field_blur.h"
 #include "draw_list_prep.h"
 #include "environment_maps.h"
@@ -39,6 +40,8 @@
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/image_sample.h"
 #include "rvr/core/progress.h"
+#include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/sphere.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/surface_colour.h"
 #include "rvr/core/texture.h"
@@ -78,6 +81,11 @@ struct DrawItem {
   bool use_primitive_id = false;
   GLuint texture = 0;  // the material's texture, 0: not textured
   bool coloured = false;
+  // A CSG solid: its leaves' tessellations one after the other, `leaf_triangles` each; its
+  // winners texture is Impl::csg_winners[csg_slot].
+  const CsgNode* csg = nullptr;
+  uint32_t leaf_triangles = 0;
+  size_t csg_slot = 0;
 };
 
 struct SceneUniforms {
@@ -85,13 +93,15 @@ struct SceneUniforms {
         smooth = -1, use_primitive_id = -1, object_id = -1, diffuse = -1, specular = -1,
         emission = -1, shininess = -1, lights = -1, light_first = -1, light_end = -1, base = -1,
         shadows = -1, shadow_maps = -1, face_rotation = -1, shadow_bias = -1, shadow_texel = -1,
-        shadow_pcf = -1, textured = -1, coloured = -1, texture = -1, keep = -1;
+        shadow_pcf = -1, textured = -1, coloured = -1, texture = -1, keep = -1, csg_half = -1,
+        csg_centre = -1, csg_masked = -1, csg_winners = -1;
 };
 
 // Texture units of the scene pass.
 constexpr GLint kLightUnit = 0;
 constexpr GLint kShadowUnit = 1;
 constexpr GLint kTextureUnit = 2;
+constexpr GLint kCsgUnit = 3;
 
 // Shadow maps (full mode). Every light sample (a point light, or one stratum centre of an area
 // light) gets a full cube: six 90 degree faces around the sample, stored as six layers of one
@@ -163,10 +173,20 @@ void append_surface(const TriangleMesh& mesh, const Material& m, bool textured,
 // What upload() made of the scene: one draw per object, the CSG objects it could not draw, the
 // light samples it put in the light buffer (none in visibility mode).
 struct SceneUpload {
-  std::vector<DrawItem> draws;
+  std::vector<DrawItem> draws;  // the CSG solids' last
+  size_t csg_solids = 0;
+  // The vertices of every object but the CSG solids, which come after them: what the shadow
+  // maps draw and triangles.submitted counts (the solids' leaves count in csg.*).
+  GLsizei plain_vertices = 0;
   PreparedScene prepared;  // the draws' materials and the skipped CSG objects
   std::vector<LightSample> samples;
   bool textured = false;  // some object is textured: the lod target is drawn and read back
+};
+
+// What the CSG passes of one render did, over every view it drew.
+struct CsgCounts {
+  size_t leaf_passes = 0;
+  double seconds = 0.0;
 };
 
 // Full mode's shadow maps: their side, how many light samples share one batch of maps, and the
@@ -219,9 +239,9 @@ void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& opt
                                     const std::vector<EnvironmentMapped>& mapped,
                                     const std::vector<std::string>& left_out,
                                     std::vector<std::string>& warnings) {
-  if (!upload.prepared.csg_labels.empty())
-    warnings.push_back(skipped_csg_warning(upload.prepared.csg_labels));
   if (options.mode != RenderMode::Full) return;
+  if (!upload.prepared.csg_labels.empty() && !upload.samples.empty())
+    warnings.push_back(csg_casts_no_shadow_warning(upload.prepared.csg_labels));
   note_environment_maps(scene, options, mapped, left_out, warnings);
   if (scene.camera.aperture_radius > 0.0f) {
     if (scene.image.samples_per_pixel == 1)
@@ -309,6 +329,9 @@ struct GlRasterizer::Impl {
   std::vector<SurfaceVertex> surface_vertices;
   std::vector<uint32_t> scratch;  // one-channel readback
   std::vector<glm::vec4> scratch_rgba;
+  // CSG: a winners texture per solid (resolve_csg), and what the passes of one render counted.
+  std::vector<GlTexture> csg_winners;
+  CsgCounts csg_counts;
 
   ~Impl() { release(); }
 
@@ -339,7 +362,10 @@ struct GlRasterizer::Impl {
   Expected<ShadowPlan> plan_shadows(const RenderOptions& options,
                                     const std::vector<LightSample>& samples, RenderOutput& out);
   Status scene_passes(const ScenePass& pass, int msaa, RenderOutput& out);
+  void use_scene_program(const ScenePass& pass, bool shade_pass, size_t first, size_t end,
+                         bool base);
   void draw_scene(const ScenePass& pass, bool shade_pass, size_t first, size_t end, bool base);
+  Status resolve_csg(const ScenePass& pass, GLenum nearer, GLfloat depth_clear);
   void clear_scene_targets(const Scene& scene, GLfloat depth_clear);
   void draw_to_every_target();
   Status cost_pass(const ScenePass& pass);
@@ -404,6 +430,10 @@ Status GlRasterizer::Impl::create_resources() {
   su.textured = loc("u_textured");
   su.coloured = loc("u_coloured");
   su.texture = loc("u_texture");
+  su.csg_half = loc("u_csg_half");
+  su.csg_centre = loc("u_csg_centre");
+  su.csg_masked = loc("u_csg_masked");
+  su.csg_winners = loc("u_csg_winners");
   cost_view = gl().GetUniformLocation(cost_program, "u_view");
   cost_projection = gl().GetUniformLocation(cost_program, "u_projection");
 
@@ -622,6 +652,7 @@ void GlRasterizer::Impl::for_each_object(F f) {
   f(light_texture);
   f(query);
   for (GlTexture& texture : textures) f(texture);
+  for (GlTexture& texture : csg_winners) f(texture);
   for (GlFramebuffer* fbo : {&scene_fbo, &cost_fbo, &msaa_fbo, &shadow_fbo}) f(*fbo);
   for (GlRenderbuffer* rb : {&depth_buffer, &msaa_colour, &msaa_depth}) f(*rb);
   for (GlRenderbuffer& target : targets) f(target);
@@ -642,6 +673,7 @@ void GlRasterizer::Impl::release() {
   shadow_size = shadow_layers = 0;
   textures.clear();
   texture_sources.clear();
+  csg_winners.clear();
   width = height = 0;
 }
 
@@ -656,16 +688,25 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
   if (varies) RVR_TRY(upload_textures(scene));
   RVR_TRY_ASSIGN(prepared, prepare_objects(scene, options.spheres, options.sphere_segments));
   up.prepared = std::move(*prepared);
-  for (size_t i = 0; i < scene.objects.size(); ++i) {
+  // The CSG solids after every other object: the shadow maps draw the vertices before them.
+  std::vector<size_t> order;
+  for (bool csg : {false, true})
+    for (size_t i = 0; i < scene.objects.size(); ++i)
+      if ((up.prepared.objects[i].csg != nullptr) == csg) order.push_back(i);
+  for (size_t i : order) {
     const Object& o = scene.objects[i];
     const PreparedObject& p = up.prepared.objects[i];
-    if (!p.mesh || p.csg) continue;  // CSG: skipped, named in the warning
+    if (!p.mesh) continue;
+    if (!p.csg) up.plain_vertices = GLsizei(vertices.size() + 3 * p.mesh->triangles.size());
     DrawItem d;
     d.object = uint32_t(i);
     d.first = GLint(vertices.size());
     d.material = p.material;
     d.smooth = p.smooth;
     d.use_primitive_id = p.names_triangles;
+    d.csg = p.csg;
+    d.leaf_triangles = p.csg_leaf_triangles;
+    if (p.csg) d.csg_slot = up.csg_solids++;
     append_mesh(*p.mesh, vertices);
     if (varies && p.own_mesh) {
       const bool tex = textured(scene, o);
@@ -782,9 +823,9 @@ Expected<ShadowPlan> GlRasterizer::Impl::plan_shadows(const RenderOptions& optio
   return plan;
 }
 
-// One draw of every object with the scene program; the caller sets the pass's state.
-void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size_t first,
-                                    size_t end, bool base) {
+// The scene program's uniforms for a pass, but the object's.
+void GlRasterizer::Impl::use_scene_program(const ScenePass& pass, bool shade_pass, size_t first,
+                                           size_t end, bool base) {
   const std::array<glm::mat3, 6>& rotations = cube_face_rotations();
   const Scene& scene = pass.scene;
   gl().UseProgram(scene_program);
@@ -809,9 +850,23 @@ void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size
                  pass.shadows.map_size > 0 ? 2.0f / float(pass.shadows.map_size) : 0.0f);
   gl().Uniform1i(su.shadow_pcf, pass.options.shadow_pcf ? 1 : 0);
   gl().Uniform1i(su.texture, kTextureUnit);
-  gl().ActiveTexture(GLenum(GL_TEXTURE0 + kTextureUnit));
+  gl().Uniform1i(su.csg_winners, kCsgUnit);
+  gl().Uniform1i(su.csg_half, 0);
+}
+
+// One draw of every object with the scene program; the caller sets the pass's state. A CSG
+// solid is drawn masked by its winners (resolve_csg).
+void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size_t first,
+                                    size_t end, bool base) {
+  use_scene_program(pass, shade_pass, first, end, base);
   for (const DrawItem& d : pass.upload.draws) {
     if (d.object == pass.hidden) continue;
+    gl().Uniform1i(su.csg_masked, d.csg ? 1 : 0);
+    if (d.csg) {
+      gl().ActiveTexture(GLenum(GL_TEXTURE0 + kCsgUnit));
+      gl().BindTexture(GL_TEXTURE_2D, csg_winners[d.csg_slot]);
+    }
+    gl().ActiveTexture(GLenum(GL_TEXTURE0 + kTextureUnit));
     gl().Uniform1i(su.textured, d.texture != 0 ? 1 : 0);
     gl().Uniform1i(su.coloured, d.coloured ? 1 : 0);
     gl().BindTexture(GL_TEXTURE_2D, d.texture);
@@ -825,6 +880,87 @@ void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size
     gl().DrawArrays(GL_TRIANGLES, d.first, d.count);
   }
   gl().ActiveTexture(GL_TEXTURE0);
+}
+
+// CSG solids in this pass's view (csg_leaves.h): each leaf's two halves drawn alone into the
+// view-depth and primitive targets and read back, the leaves' intervals combined per pixel by
+// the tree (first_csg_boundary, as the tracer combines a ray's), and the triangle of each
+// pixel's first boundary put in the solid's winners texture. The passes that draw the frame
+// then draw the solid's triangles masked by it, shaded and depth-tested like any triangle.
+Status GlRasterizer::Impl::resolve_csg(const ScenePass& pass, GLenum nearer, GLfloat depth_clear) {
+  const auto t = Clock::now();
+  const int w = pass.width, h = pass.height;
+  const size_t n = size_t(w) * size_t(h);
+  const float infinity = std::numeric_limits<float>::infinity();
+  const GLfloat far_view[4] = {infinity, 0.0f, 0.0f, 0.0f};
+  use_scene_program(pass, false, 0, 0, true);
+  gl().Uniform1i(su.csg_masked, 0);
+  gl().Uniform1i(su.use_primitive_id, 1);
+  gl().Uniform1i(su.textured, 0);
+  gl().Uniform1i(su.coloured, 0);
+  gl().BindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+  const std::array<GLenum, kViewDepth + 1> outputs{GL_NONE, GL_NONE,
+                                                   GLenum(GL_COLOR_ATTACHMENT0 + kPrimitiveId),
+                                                   GLenum(GL_COLOR_ATTACHMENT0 + kViewDepth)};
+  gl().DrawBuffers(GLsizei(outputs.size()), outputs.data());
+  gl().DepthFunc(nearer);
+  gl().DepthMask(GL_TRUE);
+  gl().PixelStorei(GL_PACK_ALIGNMENT, 1);
+  csg_winners.resize(pass.upload.csg_solids);
+  std::vector<float> depth;       // per half of each leaf, n each
+  std::vector<uint32_t> facet;    // the triangle there, in the leaf
+  std::vector<uint32_t> winners;  // per pixel
+  for (const DrawItem& d : pass.upload.draws) {
+    if (!d.csg || d.object == pass.hidden) continue;
+    const std::vector<Sphere> leaves = csg_leaves(d.csg);
+    depth.resize(2 * leaves.size() * n);
+    facet.resize(2 * leaves.size() * n);
+    for (size_t k = 0; k < leaves.size(); ++k)
+      for (size_t half = 0; half < 2; ++half) {
+        gl().ClearBufferfv(GL_COLOR, kViewDepth, far_view);
+        gl().ClearBufferfv(GL_DEPTH, 0, &depth_clear);
+        gl().Uniform3fv(su.csg_centre, 1, glm::value_ptr(leaves[k].center));
+        gl().Uniform1i(su.csg_half, GLint(half + 1));
+        gl().DrawArrays(GL_TRIANGLES, d.first + GLint(3 * k * d.leaf_triangles),
+                        GLsizei(3 * d.leaf_triangles));
+        const size_t layer = (2 * k + half) * n;
+        gl().ReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + kViewDepth));
+        gl().ReadPixels(0, 0, w, h, GL_RED, GL_FLOAT, depth.data() + layer);
+        gl().ReadBuffer(GLenum(GL_COLOR_ATTACHMENT0 + kPrimitiveId));
+        gl().ReadPixels(0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, facet.data() + layer);
+        csg_counts.leaf_passes++;
+      }
+    winners.assign(n, 0);
+    std::vector<CsgInterval> intervals(leaves.size());
+    for (size_t i = 0; i < n; ++i) {
+      bool seen = false;
+      for (size_t k = 0; k < leaves.size(); ++k) {
+        const size_t front = 2 * k * n + i, back = front + n;
+        intervals[k] = pixel_interval(depth[front], depth[back], facet[front], facet[back]);
+        seen = seen || intervals[k].hit;
+      }
+      CsgBoundary b;
+      if (seen && first_csg_boundary(d.csg, intervals.data(), std::numeric_limits<double>::lowest(),
+                                     std::numeric_limits<double>::infinity(), b))
+        winners[i] = b.leaf * d.leaf_triangles + b.facet + 1;
+    }
+    GlTexture& texture = csg_winners[d.csg_slot];
+    if (!texture) texture = GlTexture::generate();
+    gl().ActiveTexture(GLenum(GL_TEXTURE0 + kCsgUnit));
+    gl().BindTexture(GL_TEXTURE_2D, texture);
+    gl().PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    gl().TexImage2D(GL_TEXTURE_2D, 0, GL_R32UI, w, h, 0, GL_RED_INTEGER, GL_UNSIGNED_INT,
+                    winners.data());
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    gl().ActiveTexture(GL_TEXTURE0);
+  }
+  gl().Uniform1i(su.csg_half, 0);
+  draw_to_every_target();
+  RVR_GL_CHECK("csg passes");
+  csg_counts.seconds += seconds_since(t);
+  return ok_status();
 }
 
 void GlRasterizer::Impl::clear_scene_targets(const Scene& scene, GLfloat depth_clear) {
@@ -894,7 +1030,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
       auto ts = Clock::now();
       use_depth_convention(false);
       RVR_TRY(render_shadow_maps(samples, first, end, shadows.light_projection,
-                                 GLsizei(vertices.size())));
+                                 pass.upload.plain_vertices));
       gl().Finish();
       shadow_time += seconds_since(ts);
       shadow_maps_kept = batches == 1 && keep_shadow_maps;
@@ -903,6 +1039,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
     gl().Viewport(0, 0, w, h);
     gl().Enable(GL_DEPTH_TEST);
     if (b == 0) {
+      if (pass.upload.csg_solids > 0) RVR_TRY(resolve_csg(pass, nearer, depth_clear));
       // Base pass: emission, ambient and the first batch of lights; ids etc. when single-sampled.
       gl().DepthFunc(nearer);
       gl().DepthMask(GL_TRUE);
@@ -1077,6 +1214,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
   if (w < 1 || h < 1) return bad_input(fmt::format("image size {}x{} is empty", w, h));
   RenderOutput out;
   ProgressSink* progress = options.progress;  // null when nobody is watching
+  csg_counts = CsgCounts{};
 
   // --- setup: context, programs (first call only), render targets (on size change)
   if (progress) progress->begin("setup");
@@ -1158,7 +1296,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
     generated += double(fb.cost[i]);
     covered += fb.object_id[i] != kNoId ? 1 : 0;
   }
-  const size_t triangles_submitted = vertices.size() / 3;  // three vertices each, no index
+  const size_t triangles_submitted = size_t(uploaded->plain_vertices) / 3;  // no index
   out.stats["triangles.submitted"] = double(triangles_submitted);
   if (options.cost_aov) {  // counted by the cost pass only
     out.stats["fragments.generated"] = generated;
@@ -1166,6 +1304,8 @@ Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
   }
   out.stats["fragments.passed"] = double(passed);
   out.stats["pixels.covered"] = double(covered);
+  size_t csg_pixels = 0;
+  for (uint32_t id : fb.object_id) csg_pixels += id != kNoId && uploaded->prepared.objects[id].csg;
 
   std::vector<EnvironmentMapped> mapped;
   std::vector<std::string> left_out;  // transparent planar mirrors
@@ -1177,6 +1317,12 @@ Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
     if (!mapped.empty() && options.cube_map_size > 0) RVR_TRY(add_cube_maps(pass, mapped, out));
   }
   note_what_a_zbuffer_leaves_out(scene, options, *uploaded, mapped, left_out, out.warnings);
+  if (uploaded->csg_solids > 0) {  // over every view drawn: the camera's, mirrors', cube faces'
+    out.stats["csg.objects"] = double(uploaded->csg_solids);
+    out.stats["csg.leaf_passes"] = double(csg_counts.leaf_passes);
+    out.stats["csg.pixels"] = double(csg_pixels);
+    out.stats["time.csg"] = csg_counts.seconds;
+  }
   return out;
 }
 

@@ -104,6 +104,17 @@ uniform float u_shadow_bias;       // constant part, world units
 uniform float u_shadow_texel;      // 2 / map size: a texel's largest extent in tan units
 uniform bool u_shadow_pcf;
 
+// CSG solids (csg_leaves.h). A leaf's depth pass keeps the fragments of its triangles that face
+// the eye (u_csg_half 1) or of those that face away (2), outward taken from the leaf's centre:
+// the centre lies inside every face's plane of the convex tessellation, so the test's sign is
+// the triangle's at each of its fragments. The passes that draw the frame keep a solid's
+// fragment only on the triangle where the tree puts the solid's first boundary at that pixel
+// (u_csg_winners: that triangle's index in the solid's draw + 1, 0: no boundary).
+uniform int u_csg_half;
+uniform vec3 u_csg_centre;
+uniform bool u_csg_masked;
+uniform usampler2D u_csg_winners;
+
 layout(location = 0) out vec4 o_colour;
 layout(location = 1) out uint o_object_id;
 layout(location = 2) out uint o_primitive_id;
@@ -199,7 +210,21 @@ float texture_lod() {
 #endif
 }
 
+// Whether this fragment of a CSG leaf belongs to the pass (see u_csg_half, u_csg_masked).
+bool csg_keeps() {
+  if (u_csg_half != 0) {
+    vec3 outward = v_geometric_normal;
+    if (dot(outward, v_world - u_csg_centre) < 0.0) outward = -outward;
+    bool faces_eye = dot(outward, u_eye - v_world) > 0.0;
+    if (faces_eye != (u_csg_half == 1)) return false;
+  }
+  if (u_csg_masked)
+    return texelFetch(u_csg_winners, ivec2(gl_FragCoord.xy), 0).r == uint(gl_PrimitiveID) + 1u;
+  return true;
+}
+
 void main() {
+  if (!csg_keeps()) discard;
   // u_textured is uniform: its branch is uniform control flow, where derivatives are defined.
   float lod = uintBitsToFloat(0x7fc00000u);  // NaN: not textured
   g_diffuse = u_diffuse;

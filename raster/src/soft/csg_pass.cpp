@@ -178,11 +178,8 @@ size_t combine_leaves(uint32_t object_id, const CsgNode* root, const std::vector
           uint32_t fragments = 0;
           for (size_t k = 0; k < leaves; ++k) {
             const double enter = front[k].depth_at(x, y), leave = back[k].depth_at(x, y);
-            const bool entered = enter < kInfinity, left = leave < kInfinity;
-            fragments += uint32_t(entered) + uint32_t(left);
-            intervals[k].hit = entered || left;
-            intervals[k].enter = entered ? enter : -kInfinity;
-            intervals[k].leave = leave;
+            fragments += uint32_t(enter < kInfinity) + uint32_t(leave < kInfinity);
+            intervals[k] = pixel_interval(enter, leave, 0, 0);
           }
           if (fragments == 0) continue;
           const size_t i = size_t(y) * width + size_t(x);
