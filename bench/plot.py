@@ -2,8 +2,8 @@
 """Charts from an rvr_bench JSON file (Google Benchmark's --benchmark_out format).
 
 usage: plot.py RESULTS.json OUT_DIR
-Writes frame_vs_triangles.png, depth_complexity.png, effects.png, hybrid_wins.png, ours_vs_embree.png,
-threads.png and targets.md (issue 4's ratios, measured in this one run), and prints the ratios.
+Writes frame_vs_triangles.png, depth_complexity.png, effects.png, effects.md (each technique's cost
+and error), hybrid_wins.png, ours_vs_embree.png, threads.png and targets.md (issue 4's ratios, measured in this one run), and prints the ratios.
 """
 import json
 import sys
@@ -159,6 +159,41 @@ def effect_rows(rows):
     rank = {n: i for i, n in enumerate(order)}
     return {r: dict(sorted(e.items(), key=lambda kv: rank.get(kv[0], len(order))))
             for r, e in table.items()}
+
+
+def effects_table(rows, context, out):
+    """effects.md: per effect, each technique's frame time, its ratio to the tracer's frame with
+    that effect (BM_Effects/<effect>), and its error against the tracer's frame: the PSNR inside
+    the effect's mask (effect_psnr_db: reflection, refraction, lens, csg) and over the whole image
+    (psnr_db), as rvr_bench measures them once per row. Cost and error on one page."""
+    tracer = {}
+    techniques = defaultdict(list)
+    for b in rows:
+        p = parts(b)
+        if p[0] != "BM_Effects":
+            continue
+        if len(p) == 2:
+            tracer[p[1]] = ms(b)
+        elif len(p) in (3, 4):
+            label = p[1] if len(p) == 3 else f"{p[1]} ({p[3]})"
+            techniques[p[2]].append((label, ms(b), b.get("effect_psnr_db"), b.get("psnr_db")))
+
+    def db(v):
+        return "-" if v is None else ("identical" if v >= 999 else f"{v:.1f}")
+
+    lines = [f"# What each technique costs and how far it is from the tracer ({subtitle(context)})", "",
+             "cornell, 640x480, full mode (`primary`: local mode) (`BM_Effects`); PSNR against the tracer's frame, linear RGB, "
+             "peak 1: inside the effect's mask where it has one, and over the whole image.", "",
+             "| effect | renderer (technique) | ms | × tracer | PSNR in mask (dB) | PSNR image (dB) |",
+             "|---|---|---|---|---|---|"]
+    for effect in list(tracer) + [e for e in techniques if e not in tracer]:
+        if effect in tracer:
+            lines.append(f"| {effect} | raytrace | {tracer[effect]:.1f} | 1 | reference | reference |")
+        for label, t, mask_db, image_db in techniques.get(effect, []):
+            ratio = f"{t / tracer[effect]:.2f}" if effect in tracer else "-"
+            lines.append(f"| {effect} | {label} | {t:.1f} | {ratio} | {db(mask_db)} | {db(image_db)} |")
+    text = "\n".join(lines) + "\n"
+    (out / "effects.md").write_text(text)
 
 
 HYBRIDS = [("hybrid", "tab:blue", "hybrid (GL z-buffer + rays)"),
@@ -453,8 +488,8 @@ def main():
     context, rows = load(sys.argv[1])
     out = Path(sys.argv[2])
     out.mkdir(parents=True, exist_ok=True)
-    for chart in (frame_vs_triangles, depth_complexity, effects, mirrors, hybrid_wins, ours_vs_embree,
-                  threads, targets):
+    for chart in (frame_vs_triangles, depth_complexity, effects, effects_table, mirrors, hybrid_wins,
+                  ours_vs_embree, threads, targets):
         chart(rows, context, out)
     print(f"wrote charts to {out}/")
 

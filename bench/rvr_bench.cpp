@@ -50,7 +50,10 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/compare/compare.h"
+#include "rvr/compare/effect_errors.h"
 #include "rvr/core/camera.h"
+#include "rvr/core/check.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/isa.h"
@@ -303,7 +306,7 @@ void effect_scene(const std::string& effect, Scene& scene, RenderOptions& option
       if (m.name == "glass") m.transparency = 0.9f;
   } else if (effect == "csg") {
     // The mirror ball, matt, with a ball of 0.7 its radius cut out of its front: a CSG
-    // difference the z-buffers draw leaf by leaf (softraster; raster skips CSG).
+    // difference the z-buffers draw leaf by leaf.
     for (Object& o : scene.objects)
       if (o.name == "mirror ball") {
         const Sphere ball = o.sphere;
@@ -419,9 +422,34 @@ void BM_WriteAovs(benchmark::State& state, const std::vector<std::string>& aovs)
   state.counters["MB"] = bytes / 1e6;
 }
 
+// The frame's error against the tracer's frame of the same scene and options, rendered once
+// and untimed: psnr_db over the whole image and, when the effect has a mask (effect_errors.h:
+// reflection, refraction, lens, csg), effect_psnr_db inside it over effect_pixels pixels; 999
+// for identical, as metrics.json writes it. So each technique's row holds its cost and error.
+void add_error_counters(benchmark::State& state, const Scene& scene, const RenderOptions& options,
+                        const RenderOutput& out) {
+  RayTracer tracer;
+  Expected<RenderOutput> reference = tracer.render(scene, options);
+  if (!reference) {
+    state.SkipWithError("the tracer's reference frame failed");
+    return;
+  }
+  RVR_CHECK(reference->buffers.pixel_count() == out.buffers.pixel_count(),
+            "the reference frame has the frame's size");
+  auto finite = [](double db) { return std::isfinite(db) ? db : 999.0; };
+  const ComparisonMetrics m = compare_buffers(out.buffers, reference->buffers);
+  state.counters["psnr_db"] = finite(m.colour.psnr_db);
+  const std::vector<EffectError> effects =
+      effect_errors(scene, options.mode, reference->buffers, out.buffers, reference->buffers);
+  if (effects.empty()) return;
+  state.counters["effect_psnr_db"] = finite(effects.front().psnr_db);
+  state.counters["effect_pixels"] = double(effects.front().pixels);
+}
+
 // The same frames with another renderer of the table (the hybrid: the z-buffer finds the
-// primary hits, the tracer does the effect), built afresh each frame as the tracer's are. The
-// split of its time: zbuffer_ms (visibility passes) and trace_ms (hits rebuilt, shading, rays).
+// primary hits, the tracer does the effect; a z-buffer's technique), built afresh each frame as
+// the tracer's are. The split of its time: zbuffer_ms (visibility passes) and trace_ms (hits
+// rebuilt, shading, rays); its error against the tracer (add_error_counters).
 void BM_EffectsWith(benchmark::State& state, const std::string& renderer_name,
                     const std::string& effect, Supersampling supersampling, ZBufferDof dof) {
   Scene scene;
@@ -439,6 +467,7 @@ void BM_EffectsWith(benchmark::State& state, const std::string& renderer_name,
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
   phases.report(state);
+  add_error_counters(state, scene, options, out);
 }
 
 std::vector<Ray> make_rays(const Scene& scene, const std::string& kind) {

@@ -21,7 +21,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-CHARTS = ["frame_vs_triangles.png", "depth_complexity.png", "effects.png", "mirrors.png",
+CHARTS = ["frame_vs_triangles.png", "depth_complexity.png", "effects.png", "effects.md",
+          "mirrors.png",
           "hybrid_wins.png",
           "ours_vs_embree.png", "threads.png", "targets.md"]
 FAILURES = []
@@ -62,8 +63,13 @@ def synthetic_run(new):
         rows.append(row(f"BM_Effects/{effect}", 30.0, not new))
         rows.append(row(f"BM_Effects/hybrid_soft/{effect}", 40.0, not new, zbuffer_ms=10.0,
                         trace_ms=28.0))
-    # A z-buffer's technique for an effect it renders (four parts: renderer, effect, technique).
-    rows.append(row("BM_Effects/softraster/hard_shadows/shadow_maps", 25.0, not new))
+    # A z-buffer's technique for an effect it renders (four parts: renderer, effect, technique),
+    # with its error against the tracer (the whole image's only: shadows have no effect mask).
+    rows.append(row("BM_Effects/softraster/hard_shadows/shadow_maps", 25.0, not new,
+                    psnr_db=41.25))
+    rows.append(row("BM_Effects/glass", 60.0, not new))
+    rows.append(row("BM_Effects/raster/glass/cube_map", 90.0, not new, effect_psnr_db=18.22,
+                    psnr_db=999.0))
     for n in [1, 16, 256]:
         rows.append(row(f"BM_Mirrors/raytrace/{n}", 30.0, not new))
         rows.append(row(f"BM_Mirrors/softraster/{n}", 5.0 * n, not new, mirror_views=float(n)))
@@ -97,6 +103,13 @@ def check_run(plot, work, new):
     for chart in CHARTS:
         if not (out / chart).is_file() or (out / chart).stat().st_size == 0:
             failure(f"{label}: {chart} not written")
+    # effects.md: each technique beside the tracer's frame with the same effect, cost and error.
+    table = (out / "effects.md").read_text() if (out / "effects.md").is_file() else ""
+    for want in ["| hard_shadows | softraster (shadow_maps) | 25.0 | 0.83 | - | 41.2 |",
+                 "| glass | raster (cube_map) | 90.0 | 1.50 | 18.2 | identical |",
+                 "| glass | raytrace | 60.0 | 1 | reference | reference |"]:
+        if want not in table:
+            failure(f"{label}: effects.md has no line {want!r}:\n{table}")
     frame = png_size(out / "frame_vs_triangles.png")
     hybrid = png_size(out / "hybrid_wins.png")
     # figsize x dpi 100: the frame chart 4.5 in a row of panels, the hybrid chart 13 or 19 wide.

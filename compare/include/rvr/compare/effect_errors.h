@@ -32,7 +32,7 @@ struct EffectError {
 // - reflection: a material with mirror > 0; refraction: transparency > 0 (full mode only:
 //   the other modes shade neither);
 // - lens: every pixel, in full mode with aperture_radius > 0 and samples_per_pixel > 1;
-// - csg: a CSG object (any mode: only the tracers draw one).
+// - csg: a CSG object (any mode).
 // A pixel whose colour depends on an effect only after another bounce (a mirror seen through
 // glass) counts under the first surface's effects alone. The frames must have one size.
 std::vector<EffectError> effect_errors(const Scene& scene, RenderMode mode,
