@@ -153,12 +153,16 @@ def effect_rows(rows):
             table[p[1]][p[2]] = ms(b)
         elif len(p) == 4:
             table[f"{p[1]} ({p[3]})"][p[2]] = ms(b)
-    # Registration order (the JSON's is the random interleaving's): cheapest effect first.
-    order = ["primary", "hard_shadows", "area_light_4x4"] + [f"mirror_depth_{d}" for d in range(1, 6)]
-    order += ["planar_mirror", "glass", "dof_16"]
-    rank = {n: i for i, n in enumerate(order)}
-    return {r: dict(sorted(e.items(), key=lambda kv: rank.get(kv[0], len(order))))
-            for r, e in table.items()}
+    return {r: dict(sorted(e.items(), key=lambda kv: effect_rank(kv[0]))) for r, e in table.items()}
+
+
+# Registration order (the JSON's is the random interleaving's): cheapest effect first.
+EFFECT_ORDER = (["primary", "hard_shadows", "area_light_4x4"] + [f"mirror_depth_{d}" for d in range(1, 6)]
+                + ["planar_mirror", "curved_mirror", "glass", "dof_16", "csg"])
+
+
+def effect_rank(effect):
+    return EFFECT_ORDER.index(effect) if effect in EFFECT_ORDER else len(EFFECT_ORDER)
 
 
 def effects_table(rows, context, out):
@@ -186,10 +190,10 @@ def effects_table(rows, context, out):
              "peak 1: inside the effect's mask where it has one, and over the whole image.", "",
              "| effect | renderer (technique) | ms | × tracer | PSNR in mask (dB) | PSNR image (dB) |",
              "|---|---|---|---|---|---|"]
-    for effect in list(tracer) + [e for e in techniques if e not in tracer]:
+    for effect in sorted(set(tracer) | set(techniques), key=lambda e: (effect_rank(e), e)):
         if effect in tracer:
             lines.append(f"| {effect} | raytrace | {tracer[effect]:.1f} | 1 | reference | reference |")
-        for label, t, mask_db, image_db in techniques.get(effect, []):
+        for label, t, mask_db, image_db in sorted(techniques.get(effect, [])):
             ratio = f"{t / tracer[effect]:.2f}" if effect in tracer else "-"
             lines.append(f"| {effect} | {label} | {t:.1f} | {ratio} | {db(mask_db)} | {db(image_db)} |")
     text = "\n".join(lines) + "\n"

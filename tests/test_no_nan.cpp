@@ -85,6 +85,13 @@ TEST(NoNan, AnyRendererAnySceneAnyMode) {
         // targets resized to the face) cost this test minutes; their values are held to the
         // tracer by test_environment_maps, so here only softraster draws them.
         options.cube_map_size = info.name.rfind("softraster", 0) == 0 ? 16 : 0;
+        // Shadow maps at a 64x48 frame's worth too: at the default 1024 texels a side, each
+        // light sample's six faces are 300 times the frame, and cornell's area light has 16
+        // samples. The values are as finite at 64 (shadow agreement is test_shadow_agreement's).
+        options.shadow_map_size = 64;
+        // Coarse spheres: mirror_balls:300 draws every ball into six cube faces of each ball in
+        // view, each at the default 64 longitudes 3968 triangles.
+        options.sphere_segments = 16;
         for (SphereMode spheres : {SphereMode::Analytic, SphereMode::Mesh}) {
           options.spheres = spheres;
           Expected<RenderOutput> out = renderer.value()->render(scene, options);
