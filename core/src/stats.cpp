@@ -67,7 +67,7 @@ constexpr std::array kStats = {
     StatDeclaration{"csg.leaf_passes", kCount, "passes", "z-buffers",
                     "depth passes over the CSG leaves' tessellations: two per leaf and view (the "
                     "triangles facing the eye, then those facing away); `raster` counts every "
-                    "view it drew (camera, mirror views, cube faces)"},
+                    "view it drew (camera, mirror views, cube faces, shadow-cube faces)"},
     StatDeclaration{"csg.fragments", kCount, "fragments", "softraster",
                     "fragments the CSG leaf passes generated"},
     StatDeclaration{"csg.pixels", kCount, "pixels", "z-buffers",
@@ -201,7 +201,8 @@ constexpr std::array kStats = {
                     "looked up"},
     StatDeclaration{"time.csg", kSeconds, "s", "z-buffers",
                     "CSG solids: their leaves' depth passes and the per-pixel combination "
-                    "(`raster`: with the readback of each pass, part of `time.render`)"},
+                    "(`raster`: with the readback of each pass, part of `time.render` and, for the "
+                    "shadow cubes' faces, of `time.shadow_maps`)"},
     StatDeclaration{"time.zbuffer", kSeconds, "s", "hybrids", "the z-buffer passes"},
     StatDeclaration{"time.trace", kSeconds, "s", "hybrids",
                     "the tracer's part: hits rebuilt, rays traced, shading"},

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "rvr/core/shapes/csg.h"
+#include "rvr/core/shapes/sphere.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 
 namespace rvr {
@@ -27,6 +28,17 @@ struct CsgLeafFaces {
 // `centre`) that face `eye` and those that face away, each with the positions it indexes.
 CsgLeafFaces split_by_facing(const TriangleMesh& mesh, uint32_t first, uint32_t count,
                              const glm::vec3& centre, const glm::vec3& eye);
+
+// Where a leaf can show in a view of width x height pixels, rows from the top: the pixel box
+// around the projection of its sphere's bounding cube, a pixel wider on each side; the whole
+// frame when a corner lies behind the eye's plane (its projection is unbounded); empty off
+// screen. [x0, x1) x [y0, y1).
+struct PixelBox {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  bool empty() const { return x0 >= x1 || y0 >= y1; }
+};
+
+PixelBox leaf_box(const Sphere& leaf, const glm::dmat4& view_projection, int width, int height);
 
 // A leaf's interval along a pixel's ray from what its two depth passes left at the pixel: the
 // nearest depth of its triangles facing the eye (`enter`, on triangle `enter_facet`) and of those

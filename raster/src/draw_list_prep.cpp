@@ -43,11 +43,6 @@ TriangleMesh csg_leaf_meshes(const CsgNode* root, int segments) {
   return all;
 }
 
-// How a warning names a CSG object.
-std::string object_label(const Object& o, size_t index) {
-  return o.name.empty() ? fmt::format("csg#{}", index) : o.name;
-}
-
 // Whether the mesh's attributes match its positions and its triangles index only those.
 Status check_mesh(const TriangleMesh& m, const std::string& name) {
   const size_t n = m.positions.size();
@@ -81,7 +76,6 @@ Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
     RVR_TRY_ASSIGN(material, object_material(scene, o, *prepared.fallback));
     p.material = *material;
     if (o.type == ObjectType::Csg) {
-      prepared.csg_labels.push_back(object_label(o, i));
       auto leaves = std::make_unique<TriangleMesh>(csg_leaf_meshes(o.csg.get(), sphere_segments));
       p.mesh = leaves.get();
       p.smooth = true;
@@ -103,13 +97,6 @@ Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
   RVR_CHECK(prepared.objects.size() == scene.objects.size(),
             "one prepared entry per scene object, so its index is the object id");
   return prepared;
-}
-
-std::string csg_casts_no_shadow_warning(const std::vector<std::string>& labels) {
-  std::string names;
-  for (const std::string& s : labels) names += (names.empty() ? "" : ", ") + s;
-  return fmt::format("csg objects cast no shadow in raster's shadow maps: {} ({})", labels.size(),
-                     names);
 }
 
 }  // namespace rvr

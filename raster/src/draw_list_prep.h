@@ -40,7 +40,6 @@ struct PreparedObject {
 // point to, so it must outlive every use of them; moving it keeps the pointers valid.
 struct PreparedScene {
   std::vector<PreparedObject> objects;  // one per scene object, in scene order
-  std::vector<std::string> csg_labels;  // how a warning names each CSG object, in scene order
   std::vector<std::unique_ptr<const TriangleMesh>> tessellations;
   std::unique_ptr<const Material> fallback;  // the built-in grey
 };
@@ -50,10 +49,5 @@ struct PreparedScene {
 // coordinates or vertex colours do not match its positions, or whose triangles index past them.
 Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
                                         int sphere_segments);
-
-// The warning for the CSG objects that raster (GL) leaves out of its shadow maps (`labels` not
-// empty): its maps keep each texel's nearest distance over all triangles drawn, not a tree's
-// combination of leaf intervals.
-std::string csg_casts_no_shadow_warning(const std::vector<std::string>& labels);
 
 }  // namespace rvr

@@ -235,13 +235,10 @@ glm::mat4 reversed_z_projection(glm::mat4 projection, float near_plane, float fa
 
 // What a z-buffer cannot do, named for this scene only (shadows it does, with shadow maps).
 void note_what_a_zbuffer_leaves_out(const Scene& scene, const RenderOptions& options,
-                                    const SceneUpload& upload,
                                     const std::vector<EnvironmentMapped>& mapped,
                                     const std::vector<std::string>& left_out,
                                     std::vector<std::string>& warnings) {
   if (options.mode != RenderMode::Full) return;
-  if (!upload.prepared.csg_labels.empty() && !upload.samples.empty())
-    warnings.push_back(csg_casts_no_shadow_warning(upload.prepared.csg_labels));
   note_environment_maps(scene, options, mapped, left_out, warnings);
   if (scene.camera.aperture_radius > 0.0f) {
     if (scene.image.samples_per_pixel == 1)
@@ -288,7 +285,8 @@ struct GlRasterizer::Impl {
   GlProgram scene_program, cost_program, shadow_program;
   SceneUniforms su;
   GLint cost_view = -1, cost_projection = -1;
-  GLint shadow_light = -1, shadow_rotation = -1, shadow_projection = -1;
+  GLint shadow_light = -1, shadow_rotation = -1, shadow_projection = -1, shadow_csg_half = -1,
+        shadow_csg_centre = -1;
   GlVertexArray vao;
   GlBuffer vertex_buffer, light_buffer;
   GlTexture light_texture;
@@ -329,8 +327,12 @@ struct GlRasterizer::Impl {
   std::vector<SurfaceVertex> surface_vertices;
   std::vector<uint32_t> scratch;  // one-channel readback
   std::vector<glm::vec4> scratch_rgba;
-  // CSG: a winners texture per solid (resolve_csg), and what the passes of one render counted.
+  // CSG: a winners texture per solid (resolve_csg), a scratch shadow face for the leaves' passes
+  // (add_csg_to_shadow_face), and what the passes of one render counted.
   std::vector<GlTexture> csg_winners;
+  GlFramebuffer csg_shadow_fbo;
+  GlTexture csg_shadow_face;
+  int csg_shadow_size = 0;
   CsgCounts csg_counts;
 
   ~Impl() { release(); }
@@ -345,7 +347,10 @@ struct GlRasterizer::Impl {
   Status ensure_msaa(int samples);
   Status ensure_shadow_maps(int size, int layers);
   Status render_shadow_maps(const std::vector<LightSample>& samples, size_t first, size_t end,
-                            const glm::mat4& projection, GLsizei vertex_count);
+                            const glm::mat4& projection, const SceneUpload& upload);
+  Status add_csg_to_shadow_face(const SceneUpload& upload, const glm::vec3& light,
+                                const glm::mat3& rotation, const glm::mat4& projection,
+                                GLint layer);
   void release_msaa();
   void release_shadow_maps();
   void release_targets();
@@ -401,6 +406,8 @@ Status GlRasterizer::Impl::create_resources() {
   shadow_light = gl().GetUniformLocation(shadow_program, "u_light");
   shadow_rotation = gl().GetUniformLocation(shadow_program, "u_rotation");
   shadow_projection = gl().GetUniformLocation(shadow_program, "u_projection");
+  shadow_csg_half = gl().GetUniformLocation(shadow_program, "u_csg_half");
+  shadow_csg_centre = gl().GetUniformLocation(shadow_program, "u_csg_centre");
 
   auto loc = [&](const char* name) { return gl().GetUniformLocation(scene_program, name); };
   su.view = loc("u_view");
@@ -606,7 +613,7 @@ void GlRasterizer::Impl::release_shadow_maps() {
 // triangle into every face, keeping the smallest distance per texel (GL_MIN blending).
 Status GlRasterizer::Impl::render_shadow_maps(const std::vector<LightSample>& samples, size_t first,
                                               size_t end, const glm::mat4& projection,
-                                              GLsizei vertex_count) {
+                                              const SceneUpload& upload) {
   const std::array<glm::mat3, 6>& rotations = cube_face_rotations();
   gl().BindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
   gl().Viewport(0, 0, shadow_size, shadow_size);
@@ -625,13 +632,126 @@ Status GlRasterizer::Impl::render_shadow_maps(const std::vector<LightSample>& sa
                                    GLint(6 * (i - first) + f));
       gl().ClearBufferfv(GL_COLOR, 0, nothing);
       gl().UniformMatrix3fv(shadow_rotation, 1, GL_FALSE, glm::value_ptr(rotations[f]));
-      if (vertex_count > 0) gl().DrawArrays(GL_TRIANGLES, 0, vertex_count);
+      gl().Uniform1i(shadow_csg_half, 0);
+      if (upload.plain_vertices > 0) gl().DrawArrays(GL_TRIANGLES, 0, upload.plain_vertices);
+      if (upload.csg_solids > 0)
+        RVR_TRY(add_csg_to_shadow_face(upload, samples[i].position, rotations[f], projection,
+                                       GLint(6 * (i - first) + f)));
     }
   }
   gl().BlendEquation(GL_FUNC_ADD);
   gl().Disable(GL_BLEND);
   gl().DepthMask(GL_TRUE);
   RVR_GL_CHECK("shadow maps");
+  return ok_status();
+}
+
+// The CSG solids of `upload` into one face of a light sample's shadow cube: layer `layer` of
+// shadow_texture, attached to shadow_fbo and holding the nearest distance of every other
+// triangle. Each leaf's halves (facing the light, then away) are drawn alone into a scratch face
+// and read back over the leaf's box, the intervals combined per texel by the tree as the camera's
+// pass combines them, and the first boundary's distance kept where it is nearer than the face's.
+Status GlRasterizer::Impl::add_csg_to_shadow_face(const SceneUpload& upload, const glm::vec3& light,
+                                                  const glm::mat3& rotation,
+                                                  const glm::mat4& projection, GLint layer) {
+  const auto t = Clock::now();
+  const int size = shadow_size;
+  if (csg_shadow_size != size) {
+    csg_shadow_face = GlTexture::generate();
+    gl().ActiveTexture(GLenum(GL_TEXTURE0 + kCsgUnit));
+    gl().BindTexture(GL_TEXTURE_2D, csg_shadow_face);
+    gl().TexImage2D(GL_TEXTURE_2D, 0, GL_R32F, size, size, 0, GL_RED, GL_FLOAT, nullptr);
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    gl().TexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 0);
+    gl().ActiveTexture(GL_TEXTURE0);
+    csg_shadow_fbo = GlFramebuffer::generate();
+    gl().BindFramebuffer(GL_FRAMEBUFFER, csg_shadow_fbo);
+    gl().FramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, csg_shadow_face,
+                              0);
+    const GLenum colour_buffer = GL_COLOR_ATTACHMENT0;
+    gl().DrawBuffers(1, &colour_buffer);
+    if (gl().CheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+      return internal_error("csg shadow-face framebuffer incomplete");
+    csg_shadow_size = size;
+  }
+  const float none = std::numeric_limits<float>::max();  // what no triangle left (GL_MIN)
+  const GLfloat nothing[4] = {none, 0.0f, 0.0f, 0.0f};
+  const glm::dmat4 view_projection = glm::dmat4(projection) * glm::dmat4(glm::dmat3(rotation)) *
+                                     glm::translate(glm::dmat4(1.0), -glm::dvec3(light));
+  gl().PixelStorei(GL_PACK_ALIGNMENT, 4);
+  gl().PixelStorei(GL_UNPACK_ALIGNMENT, 4);
+  gl().Enable(GL_SCISSOR_TEST);
+  for (const DrawItem& d : upload.draws) {
+    if (!d.csg) continue;
+    const std::vector<Sphere> leaves = csg_leaves(d.csg);
+    // Per leaf: its box in GL's rows (from the bottom), and each half's distances there.
+    std::vector<PixelBox> boxes(leaves.size());
+    std::vector<std::vector<float>> halves(2 * leaves.size());
+    PixelBox all{size, size, 0, 0};
+    gl().BindFramebuffer(GL_FRAMEBUFFER, csg_shadow_fbo);
+    for (size_t k = 0; k < leaves.size(); ++k) {
+      const PixelBox top_down = leaf_box(leaves[k], view_projection, size, size);
+      PixelBox& box = boxes[k];
+      box = {top_down.x0, size - top_down.y1, top_down.x1, size - top_down.y0};
+      if (box.empty()) continue;
+      all = {std::min(all.x0, box.x0), std::min(all.y0, box.y0), std::max(all.x1, box.x1),
+             std::max(all.y1, box.y1)};
+      const int w = box.x1 - box.x0, h = box.y1 - box.y0;
+      gl().Scissor(box.x0, box.y0, w, h);
+      gl().Uniform3fv(shadow_csg_centre, 1, glm::value_ptr(leaves[k].center));
+      for (size_t half = 0; half < 2; ++half) {
+        gl().ClearBufferfv(GL_COLOR, 0, nothing);
+        gl().Uniform1i(shadow_csg_half, GLint(half + 1));
+        gl().DrawArrays(GL_TRIANGLES, d.first + GLint(3 * k * d.leaf_triangles),
+                        GLsizei(3 * d.leaf_triangles));
+        std::vector<float>& read = halves[2 * k + half];
+        read.resize(size_t(w) * size_t(h));
+        gl().ReadPixels(box.x0, box.y0, w, h, GL_RED, GL_FLOAT, read.data());
+        csg_counts.leaf_passes++;
+      }
+    }
+    if (all.empty()) continue;
+    // The face over the leaves' boxes, the solid's first boundary kept where nearer.
+    const int w = all.x1 - all.x0, h = all.y1 - all.y0;
+    std::vector<float> face(size_t(w) * size_t(h));
+    gl().BindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+    gl().ReadPixels(all.x0, all.y0, w, h, GL_RED, GL_FLOAT, face.data());
+    const double infinity = std::numeric_limits<double>::infinity();
+    std::vector<CsgInterval> intervals(leaves.size());
+    for (int y = all.y0; y < all.y1; ++y)
+      for (int x = all.x0; x < all.x1; ++x) {
+        bool seen = false;
+        for (size_t k = 0; k < leaves.size(); ++k) {
+          const PixelBox& box = boxes[k];
+          double distance[2] = {infinity, infinity};
+          if (x >= box.x0 && x < box.x1 && y >= box.y0 && y < box.y1)
+            for (size_t half = 0; half < 2; ++half) {
+              const float v = halves[2 * k + half][size_t(y - box.y0) * size_t(box.x1 - box.x0) +
+                                                   size_t(x - box.x0)];
+              if (v < none) distance[half] = double(v);
+            }
+          intervals[k] = pixel_interval(distance[0], distance[1], 0, 0);
+          seen = seen || intervals[k].hit;
+        }
+        CsgBoundary b;
+        if (!seen || !first_csg_boundary(d.csg, intervals.data(),
+                                         std::numeric_limits<double>::lowest(), infinity, b))
+          continue;
+        float& nearest = face[size_t(y - all.y0) * size_t(w) + size_t(x - all.x0)];
+        nearest = std::min(nearest, float(b.t));
+      }
+    gl().ActiveTexture(GLenum(GL_TEXTURE0 + kShadowUnit));
+    gl().BindTexture(GL_TEXTURE_2D_ARRAY, shadow_texture);
+    gl().TexSubImage3D(GL_TEXTURE_2D_ARRAY, 0, all.x0, all.y0, layer, w, h, 1, GL_RED, GL_FLOAT,
+                       face.data());
+    gl().ActiveTexture(GL_TEXTURE0);
+  }
+  gl().Disable(GL_SCISSOR_TEST);
+  gl().Uniform1i(shadow_csg_half, 0);
+  gl().BindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+  RVR_GL_CHECK("csg in a shadow face");
+  csg_counts.seconds += seconds_since(t);
   return ok_status();
 }
 
@@ -653,6 +773,8 @@ void GlRasterizer::Impl::for_each_object(F f) {
   f(query);
   for (GlTexture& texture : textures) f(texture);
   for (GlTexture& texture : csg_winners) f(texture);
+  f(csg_shadow_fbo);
+  f(csg_shadow_face);
   for (GlFramebuffer* fbo : {&scene_fbo, &cost_fbo, &msaa_fbo, &shadow_fbo}) f(*fbo);
   for (GlRenderbuffer* rb : {&depth_buffer, &msaa_colour, &msaa_depth}) f(*rb);
   for (GlRenderbuffer& target : targets) f(target);
@@ -674,6 +796,7 @@ void GlRasterizer::Impl::release() {
   textures.clear();
   texture_sources.clear();
   csg_winners.clear();
+  csg_shadow_size = 0;
   width = height = 0;
 }
 
@@ -1029,8 +1152,7 @@ Status GlRasterizer::Impl::scene_passes(const ScenePass& pass, int msaa, RenderO
     if (shadows.enabled && !reuse) {
       auto ts = Clock::now();
       use_depth_convention(false);
-      RVR_TRY(render_shadow_maps(samples, first, end, shadows.light_projection,
-                                 pass.upload.plain_vertices));
+      RVR_TRY(render_shadow_maps(samples, first, end, shadows.light_projection, pass.upload));
       gl().Finish();
       shadow_time += seconds_since(ts);
       shadow_maps_kept = batches == 1 && keep_shadow_maps;
@@ -1316,8 +1438,8 @@ Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
     // Last: its faces resize the targets.
     if (!mapped.empty() && options.cube_map_size > 0) RVR_TRY(add_cube_maps(pass, mapped, out));
   }
-  note_what_a_zbuffer_leaves_out(scene, options, *uploaded, mapped, left_out, out.warnings);
-  if (uploaded->csg_solids > 0) {  // over every view drawn: the camera's, mirrors', cube faces'
+  note_what_a_zbuffer_leaves_out(scene, options, mapped, left_out, out.warnings);
+  if (uploaded->csg_solids > 0) {  // over every view drawn, the shadow cubes' faces too
     out.stats["csg.objects"] = double(uploaded->csg_solids);
     out.stats["csg.leaf_passes"] = double(csg_counts.leaf_passes);
     out.stats["csg.pixels"] = double(csg_pixels);

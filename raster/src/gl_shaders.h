@@ -253,22 +253,40 @@ void main() {
 // and turned into the face's eye space; the fragment stores |P - L| (linear distance, exact in
 // float whatever the near plane) and the target keeps the minimum (GL_MIN blending), so no
 // depth buffer and no depth-precision trade-off is needed.
+// A CSG leaf's pass keeps the fragments of its triangles that face the light (u_csg_half 1) or
+// of those that face away (2), outward taken from the leaf's centre, as the scene program's
+// leaf passes do for the eye.
 inline constexpr const char* kShadowVertex = R"glsl(#version 330 core
 layout(location = 0) in vec3 a_position;
+layout(location = 2) in vec3 a_geometric_normal;
 uniform vec3 u_light;
 uniform mat3 u_rotation;
 uniform mat4 u_projection;
 out vec3 v_offset;
+flat out vec3 v_geometric_normal;
 void main() {
   v_offset = a_position - u_light;
+  v_geometric_normal = a_geometric_normal;
   gl_Position = u_projection * vec4(u_rotation * v_offset, 1.0);
 }
 )glsl";
 
 inline constexpr const char* kShadowFragment = R"glsl(#version 330 core
 in vec3 v_offset;
+flat in vec3 v_geometric_normal;
+uniform vec3 u_light;
+uniform int u_csg_half;
+uniform vec3 u_csg_centre;
 layout(location = 0) out float o_distance;
-void main() { o_distance = length(v_offset); }
+void main() {
+  if (u_csg_half != 0) {
+    vec3 outward = v_geometric_normal;
+    if (dot(outward, u_light + v_offset - u_csg_centre) < 0.0) outward = -outward;
+    bool faces_light = dot(outward, -v_offset) > 0.0;
+    if (faces_light != (u_csg_half == 1)) discard;
+  }
+  o_distance = length(v_offset);
+}
 )glsl";
 
 // The overdraw pass: every generated fragment adds 1 to its pixel (additive blending, no depth

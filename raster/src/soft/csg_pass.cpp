@@ -41,34 +41,6 @@ struct LeafLayer {
   }
 };
 
-// Where a leaf can show in a view of width x height pixels: the pixel box around the
-// projection of its sphere's bounding cube, a pixel wider on each side; the whole frame when a
-// corner lies behind the eye's plane (its projection is unbounded); empty off screen.
-struct PixelBox {
-  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-  bool empty() const { return x0 >= x1 || y0 >= y1; }
-};
-
-PixelBox leaf_box(const Sphere& leaf, const glm::dmat4& view_projection, int width, int height) {
-  double lo_x = INFINITY, lo_y = INFINITY, hi_x = -INFINITY, hi_y = -INFINITY;
-  for (int corner = 0; corner < 8; ++corner) {
-    const glm::dvec3 offset(corner & 1 ? 1.0 : -1.0, corner & 2 ? 1.0 : -1.0,
-                            corner & 4 ? 1.0 : -1.0);
-    const glm::dvec4 clip =
-        view_projection * glm::dvec4(glm::dvec3(leaf.center) + double(leaf.radius) * offset, 1.0);
-    if (!(clip.w > 0.0)) return {0, 0, width, height};
-    const double px = (clip.x / clip.w + 1.0) * 0.5 * width;
-    const double py = (1.0 - clip.y / clip.w) * 0.5 * height;
-    lo_x = std::min(lo_x, px);
-    hi_x = std::max(hi_x, px);
-    lo_y = std::min(lo_y, py);
-    hi_y = std::max(hi_y, py);
-  }
-  auto clamp_to = [](double v, int n) { return int(std::clamp(v, 0.0, double(n))); };
-  return {clamp_to(std::floor(lo_x) - 1.0, width), clamp_to(std::floor(lo_y) - 1.0, height),
-          clamp_to(std::ceil(hi_x) + 1.0, width), clamp_to(std::ceil(hi_y) + 1.0, height)};
-}
-
 // The view-projection that draws `box` of a width x height view into a target of the box's
 // size: clip space scaled and shifted so that the box's pixel centres are the target's, at whole
 // pixel offsets (the same centres the view samples).
