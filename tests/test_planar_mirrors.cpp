@@ -1,6 +1,7 @@
-// The z-buffers' planar mirrors (raster/src/planar_mirrors.h): a reflected view per mirror seen,
-// clipped at the mirror, composited by the shading equation, recursing to --max-depth. Held to
-// the tracer's reflection rays with primary visibility's tolerance.
+// The z-buffers' planar mirrors and ior-1 layers (raster/src/planar_mirrors.h): a reflected view
+// per mirror seen, clipped at the mirror, and a view without the layer per layer seen,
+// composited by the shading equation, recursing to --max-depth. Held to the tracer's reflection
+// and transmitted rays with primary visibility's tolerance.
 #include <gtest/gtest.h>
 #include <stdint.h>
 
@@ -197,6 +198,65 @@ TEST_P(PlanarMirrors, ReflectionsAreShadedFromTheReflectedEye) {
   const RenderOutput t = render("raytrace", scene, 5);
   EXPECT_LE(double(pixels_differing(z.buffers, t.buffers, 1e-3f)),
             (1.0 - kMinAgreement) * double(t.buffers.pixel_count()));
+}
+
+// The same scene with the left mirror a tinted pane of ior 1 (the tracer's transmitted ray goes
+// straight on: the over operator) and the right one both a mirror and such a pane: every pixel,
+// layers included, at every recursion limit, is the tracer's but on edge ties. A layer's view
+// leaves the layer out, so what it shows is the first surface beyond it, as the ray meets it.
+Scene two_layers() {
+  Scene scene = two_mirrors();
+  Material& left = scene.materials[scene.objects[kLeftMirror].material];
+  left.mirror = 0.0f;
+  left.transparency = 0.7f;
+  left.ior = 1.0f;
+  Material& right = scene.materials[scene.objects[kRightMirror].material];
+  right.mirror = 0.4f;
+  right.transparency = 0.35f;
+  right.ior = 1.0f;
+  return scene;
+}
+
+TEST_P(PlanarMirrors, TransparentLayersAreTheOverOperatorAtEveryDepth) {
+  const Scene scene = two_layers();
+  for (int max_depth : {0, 1, 2, 5}) {
+    const RenderOutput z = render(GetParam(), scene, max_depth);
+    const RenderOutput t = render("raytrace", scene, max_depth);
+    const Disagreement d = disagreement(z.buffers, t.buffers);
+    const std::string where = std::string(GetParam()) + " max_depth " + std::to_string(max_depth);
+    EXPECT_LE(double(d.differing), (1.0 - kMinAgreement) * double(t.buffers.pixel_count()))
+        << where;
+    EXPECT_EQ(d.away_from_edges, 0u) << where;
+    // A view behind each pane seen (and, through the right one's reflection, the left one's).
+    EXPECT_EQ(z.stats.count("layer.views") > 0, max_depth > 0) << where;
+    if (max_depth > 0) {
+      EXPECT_GE(z.stats.at("layer.views"), 2.0) << where;
+    }
+  }
+  // Without the views behind them the panes lose what they show.
+  const RenderOutput none = render(GetParam(), scene, 0);
+  const RenderOutput t = render("raytrace", scene, 5);
+  size_t pane_pixels = 0;
+  for (size_t i = 0; i < t.buffers.pixel_count(); ++i)
+    pane_pixels += t.buffers.object_id[i] == kLeftMirror || t.buffers.object_id[i] == kRightMirror;
+  EXPECT_GT(pixels_differing(none.buffers, t.buffers, 0.01f), pane_pixels / 2);
+}
+
+// A planar mirror whose transparency has another ior is not a layer: its transparency is left
+// out, said by name, and its mirror still reflected.
+TEST_P(PlanarMirrors, ARefractingPlanarMirrorIsNamedInAWarning) {
+  Scene scene = two_mirrors();
+  Material& left = scene.materials[scene.objects[kLeftMirror].material];
+  left.transparency = 0.2f;
+  left.ior = 1.5f;
+  const RenderOutput out = render(GetParam(), scene, 5);
+  bool named = false;
+  for (const std::string& w : out.warnings)
+    named |=
+        w.find("transparency not rendered on 1 planar mirror (left mirror)") != std::string::npos;
+  EXPECT_TRUE(named);
+  EXPECT_EQ(out.stats.count("layer.views"), 0u);
+  EXPECT_GT(out.stats.at("mirror.views"), 0.0);
 }
 
 // The mirrors' planes are found from their meshes; a curved mirror is said, by name, and drawn

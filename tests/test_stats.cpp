@@ -54,11 +54,12 @@ TEST(StatsTable, AZbufferCopyIsWhatItsNameIs) {
 
 // Every renderer and variant in every mode, on a scene with lights, mirrors and glass, on one
 // with several samples per pixel (the hybrids' accumulation passes) and on one with a flat
-// mirror (the z-buffers' reflected views) and on one with CSG solids: each stat reported is
-// declared, and each declared stat is reported by some renderer.
+// mirror (the z-buffers' reflected views), on one with CSG solids and on one with a pane of
+// ior 1 (the views behind layers): each stat reported is declared, and each declared stat is
+// reported by some renderer.
 TEST(StatsTable, EveryStatReportedIsDeclaredAndEveryDeclaredOneReported) {
   std::set<std::string> reported;
-  for (const char* scene_name : {"cornell", "dof", "discs", "csg"}) {
+  for (const char* scene_name : {"cornell", "dof", "discs", "csg", "glass"}) {
     Scene scene = make_builtin_scene(scene_name).value();
     scene.image.width = 32;
     scene.image.height = 24;

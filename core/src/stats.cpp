@@ -93,8 +93,15 @@ constexpr std::array kStats = {
     StatDeclaration{"mirror.pixels", kCount, "pixels", "z-buffers",
                     "mirror pixels given their reflection, summed over the views"},
     StatDeclaration{"mirror.pixels_at_limit", kCount, "pixels", "z-buffers",
-                    "mirror pixels seen at --max-depth reflections: their mirrored share "
-                    "dropped, as the tracer drops it"},
+                    "mirror and layer pixels seen at --max-depth reflections and transmissions: "
+                    "their mirrored and transmitted shares dropped, as the tracer drops them"},
+    // Planar transparent layers with ior 1 (full mode): the view drawn again without the layer.
+    StatDeclaration{"layer.views", kCount, "views", "z-buffers",
+                    "views drawn behind planar transparent layers of ior 1: one per layer seen, "
+                    "per level (full mode)"},
+    StatDeclaration{"layer.pixels", kCount, "pixels", "z-buffers",
+                    "layer pixels given what lies behind them by the over operator, summed over "
+                    "the views"},
     // Shadows drawn by the z-buffers (full mode).
     StatDeclaration{"shadow_map.maps", kCount, "maps", "raster",
                     "shadow cube maps drawn, one per light sample"},

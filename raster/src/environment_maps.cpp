@@ -183,11 +183,14 @@ std::vector<EnvironmentMapped> environment_mapped(const Scene& scene, const Prep
     const Material& material = *p.material;
     const bool is_planar = std::any_of(planar.begin(), planar.end(),
                                        [&](const PlanarMirror& m) { return m.object == i; });
-    const float mirror = is_planar ? 0.0f : material.mirror;
-    if (is_planar && material.transparency > 0.0f) {
-      left_out.push_back(object_label(scene, i));
+    // A planar object's mirror and ior-1 layer have views of their own (planar_mirrors.h); a
+    // planar mirror's transparency with another ior is left out.
+    if (is_planar) {
+      if (material.transparency > 0.0f && !transmits_straight(material))
+        left_out.push_back(object_label(scene, i));
       continue;
     }
+    const float mirror = material.mirror;
     if (!(mirror > 0.0f) && !(material.transparency > 0.0f)) continue;
     const Bounds b = bounds(*p.mesh);
     const glm::vec3 centre = 0.5f * (b.lo + b.hi);

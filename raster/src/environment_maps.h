@@ -42,9 +42,9 @@ struct EnvironmentMapped {
   float sphere_radius = 0.0f;
 };
 
-// The objects of `prepared` with a mirror share that no planar view answers (`planar`) or with a
-// transparency share, in object order. A transparent planar mirror is left out (its mirror has
-// views of its own) and named in `left_out`.
+// The objects of `prepared` with a mirror or transparency share that no planar view answers
+// (`planar`), in object order. A transparent planar mirror whose ior is not 1 is left out (its
+// mirror has views of its own, its transparency none) and named in `left_out`.
 std::vector<EnvironmentMapped> environment_mapped(const Scene& scene, const PreparedScene& prepared,
                                                   const std::vector<PlanarMirror>& planar,
                                                   std::vector<std::string>& left_out);

@@ -209,10 +209,14 @@ struct ScenePass {
   glm::vec3 eye;      // where the pass looks from: the camera's eye or a sample's lens point
   int width, height;  // the frame's size: the image's, or a cube map face's
   // A planar mirror's view (planar_mirrors.h): only what lies on the positive side of the world
-  // plane `keep` is drawn (when `clipped`), and not the mirror `hidden`.
+  // plane `keep` is drawn (when `clipped`), and not the objects `hidden` (the mirror it is seen
+  // in, the layers it is seen through, a cube map's object).
   bool clipped = false;
   glm::vec4 keep{0.0f, 0.0f, 0.0f, 1.0f};
-  uint32_t hidden = kNoId;
+  std::vector<uint32_t> hidden = {};
+  bool drawn(uint32_t object) const {
+    return std::find(hidden.begin(), hidden.end(), object) == hidden.end();
+  }
 };
 
 // Renderbuffer format of a z-buffer format.
@@ -983,7 +987,7 @@ void GlRasterizer::Impl::draw_scene(const ScenePass& pass, bool shade_pass, size
                                     size_t end, bool base) {
   use_scene_program(pass, shade_pass, first, end, base);
   for (const DrawItem& d : pass.upload.draws) {
-    if (d.object == pass.hidden) continue;
+    if (!pass.drawn(d.object)) continue;
     gl().Uniform1i(su.csg_masked, d.csg ? 1 : 0);
     if (d.csg) {
       gl().ActiveTexture(GLenum(GL_TEXTURE0 + kCsgUnit));
@@ -1034,7 +1038,7 @@ Status GlRasterizer::Impl::resolve_csg(const ScenePass& pass, GLenum nearer, GLf
   std::vector<uint32_t> facet;    // the triangle there, in the leaf
   std::vector<uint32_t> winners;  // per pixel
   for (const DrawItem& d : pass.upload.draws) {
-    if (!d.csg || d.object == pass.hidden) continue;
+    if (!d.csg || !pass.drawn(d.object)) continue;
     const std::vector<Sphere> leaves = csg_leaves(d.csg);
     depth.resize(2 * leaves.size() * n);
     facet.resize(2 * leaves.size() * n);
@@ -1505,7 +1509,7 @@ Status GlRasterizer::Impl::add_cube_maps(const ScenePass& camera,
                           : glm::mat4(face.projection);
     pass.eye = face.eye;
     pass.width = pass.height = face.size;
-    pass.hidden = face.hidden;
+    pass.hidden = {face.hidden};
     RenderOutput drawn;
     RVR_TRY(scene_passes(pass, 1, drawn));
     uint64_t passed = 0;

@@ -51,13 +51,20 @@ std::optional<glm::dvec4> flat_plane(const TriangleMesh& mesh) {
 
 }  // namespace
 
+bool transmits_straight(const Material& material) {
+  return material.transparency > 0.0f && material.ior == 1.0f;
+}
+
 std::vector<PlanarMirror> planar_mirrors(const PreparedScene& prepared) {
   std::vector<PlanarMirror> mirrors;
   for (size_t i = 0; i < prepared.objects.size(); ++i) {
     const PreparedObject& p = prepared.objects[i];
-    if (!p.mesh || !(p.material->mirror > 0.0f)) continue;
+    if (!p.mesh) continue;
+    const Material& material = *p.material;
+    const float layer = transmits_straight(material) ? material.transparency : 0.0f;
+    if (!(material.mirror > 0.0f) && !(layer > 0.0f)) continue;
     if (const std::optional<glm::dvec4> plane = flat_plane(*p.mesh))
-      mirrors.push_back({uint32_t(i), *plane, p.material->mirror});
+      mirrors.push_back({uint32_t(i), *plane, material.mirror, layer});
   }
   return mirrors;
 }
@@ -84,7 +91,17 @@ MirrorView reflected_view(const MirrorView& parent, const PlanarMirror& m) {
   child.eye = glm::vec3(r * glm::dvec4(glm::dvec3(parent.eye), 1.0));
   const double side = glm::dot(m.plane, glm::dvec4(glm::dvec3(parent.eye), 1.0));
   child.keep = side >= 0.0 ? m.plane : -m.plane;
-  child.hidden = m.object;
+  child.hidden = {m.object};
+  child.depth = parent.depth + 1;
+  return child;
+}
+
+// The view `parent` sees through layer m: the same view without m (what the transmitted ray,
+// going straight on, meets beyond it). Everything the parent sees at m's pixels lies beyond m,
+// so nothing needs clipping.
+MirrorView view_behind(const MirrorView& parent, const PlanarMirror& m) {
+  MirrorView child = parent;
+  child.hidden.push_back(m.object);
   child.depth = parent.depth + 1;
   return child;
 }
@@ -116,9 +133,28 @@ std::vector<std::vector<size_t>> pixels_per_mirror(const std::vector<PlanarMirro
   return seen_by;
 }
 
-// The recursion of add_planar_reflections over the pixels `px` of `view`. A reflected view's
-// frame is kept only at the pixels that see its mirror (what the view above needs), so a chain
-// of reflections holds one frame at a time however deep it goes.
+// The frame of `child` at the pixels `seen` (indices into `px`), drawn by `pass`.
+Expected<ViewPixels> child_pixels(const MirrorView& child, const MirrorViewPass& pass,
+                                  const ViewPixels& px, const std::vector<size_t>& seen) {
+  Expected<FrameBuffers> frame = pass(child);
+  if (!frame) return frame.error();
+  RVR_CHECK(frame->colour.size() == frame->pixel_count() &&
+                frame->object_id.size() == frame->pixel_count(),
+            "a child view has colour and ids at every pixel");
+  ViewPixels out;
+  for (size_t k : seen) {
+    const size_t p = px.pixel[k];
+    RVR_CHECK(p < frame->pixel_count(), "a child view has the frame's size");
+    out.pixel.push_back(p);
+    out.colour.push_back(frame->colour[p]);
+    out.id.push_back(frame->object_id[p]);
+  }
+  return out;
+}
+
+// The recursion of add_planar_reflections over the pixels `px` of `view`. A child view's frame is
+// kept only at the pixels that see its object (what the view above needs), so a chain of
+// reflections holds one frame at a time however deep it goes.
 Status reflect(const std::vector<PlanarMirror>& mirrors, int max_depth, const MirrorView& view,
                const MirrorViewPass& pass, ViewPixels& px, MirrorStats& stats) {
   const std::vector<std::vector<size_t>> seen_by = pixels_per_mirror(mirrors, px);
@@ -126,37 +162,41 @@ Status reflect(const std::vector<PlanarMirror>& mirrors, int max_depth, const Mi
     const PlanarMirror& m = mirrors[i];
     const std::vector<size_t>& seen = seen_by[i];
     if (seen.empty()) continue;
-    if (view.depth >= max_depth) {  // the tracer's recursion limit: the mirrored share dropped
-      for (size_t k : seen) px.colour[k] = (1.0f - m.mirror) * px.colour[k];
+    const float kept = 1.0f - m.mirror - m.transparency;  // the local share
+    if (view.depth >= max_depth) {  // the tracer's recursion limit: the shares dropped
+      for (size_t k : seen) px.colour[k] = kept * px.colour[k];
       stats.dropped += seen.size();
       continue;
     }
-    const MirrorView child = reflected_view(view, m);
-    ViewPixels reflected;
-    {
-      Expected<FrameBuffers> frame = pass(child);
-      if (!frame) return frame.error();
-      RVR_CHECK(frame->colour.size() == frame->pixel_count() &&
-                    frame->object_id.size() == frame->pixel_count(),
-                "a reflected view has colour and ids at every pixel");
-      for (size_t k : seen) {
-        const size_t p = px.pixel[k];
-        RVR_CHECK(p < frame->pixel_count(), "a reflected view has the frame's size");
-        reflected.pixel.push_back(p);
-        reflected.colour.push_back(frame->colour[p]);
-        reflected.id.push_back(frame->object_id[p]);
-      }
+    ViewPixels reflected, behind;
+    if (m.mirror > 0.0f) {
+      const MirrorView child = reflected_view(view, m);
+      RVR_TRY_ASSIGN(drawn, child_pixels(child, pass, px, seen));
+      reflected = std::move(*drawn);
+      ++stats.passes;
+      stats.deepest = std::max(stats.deepest, child.depth);
+      RVR_TRY(reflect(mirrors, max_depth, child, pass, reflected, stats));
+      stats.pixels += seen.size();
     }
-    ++stats.passes;
-    stats.deepest = std::max(stats.deepest, child.depth);
-    RVR_TRY(reflect(mirrors, max_depth, child, pass, reflected, stats));
-    // The tracer's sum: (1 - mirror - transparency) · local, plus mirror · reflected. The
-    // z-buffers leave transparency out (its share stays local), so the first term is (1 - mirror).
+    if (m.transparency > 0.0f) {
+      const MirrorView child = view_behind(view, m);
+      RVR_TRY_ASSIGN(drawn, child_pixels(child, pass, px, seen));
+      behind = std::move(*drawn);
+      ++stats.layer_passes;
+      stats.deepest = std::max(stats.deepest, child.depth);
+      RVR_TRY(reflect(mirrors, max_depth, child, pass, behind, stats));
+      stats.layer_pixels += seen.size();
+    }
+    // The tracer's sum: (1 - mirror - transparency) · local, plus mirror · reflected, plus
+    // transparency · what the straight transmitted ray meets. A planar mirror with another ior
+    // is not a layer: its transparency share stays local (the z-buffers leave it out).
     for (size_t j = 0; j < seen.size(); ++j) {
       glm::vec3& c = px.colour[seen[j]];
-      c = (1.0f - m.mirror) * c + m.mirror * reflected.colour[j];
+      glm::vec3 sum = kept * c;
+      if (m.mirror > 0.0f) sum += m.mirror * reflected.colour[j];
+      if (m.transparency > 0.0f) sum += m.transparency * behind.colour[j];
+      c = sum;
     }
-    stats.pixels += seen.size();
   }
   return ok_status();
 }
@@ -182,6 +222,9 @@ void record_mirror_stats(const MirrorStats& stats, double seconds, RenderOutput&
   out.stats["mirror.pixels"] = double(stats.pixels);
   out.stats["mirror.pixels_at_limit"] = double(stats.dropped);
   out.stats["time.mirrors"] = seconds;
+  if (stats.layer_passes == 0) return;
+  out.stats["layer.views"] = double(stats.layer_passes);
+  out.stats["layer.pixels"] = double(stats.layer_pixels);
 }
 
 }  // namespace rvr

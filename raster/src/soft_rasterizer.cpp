@@ -358,10 +358,11 @@ ViewFrame camera_frame(const RenderSetup& setup, const glm::dmat4& reflection) {
           setup.kept};
 }
 
-// `list` without object `hidden` (a mirror's view does not draw the mirror); ids stay the same.
-DrawList without_object(const DrawList& list, uint32_t hidden) {
+// `list` without the objects `hidden` (a mirror's view does not draw the mirror, nor a view
+// behind a layer the layer); ids stay the same.
+DrawList without_objects(const DrawList& list, const std::vector<uint32_t>& hidden) {
   std::vector<DrawObject> objects = list.objects;
-  objects[hidden].mesh = nullptr;
+  for (uint32_t object : hidden) objects[object].mesh = nullptr;
   return soft::make_draw_list(std::move(objects));
 }
 
@@ -379,7 +380,7 @@ Status draw_view(const RenderSetup& setup, const MirrorView& view, const ViewFra
   auto t = Clock::now();
   const auto t_visibility = t;
   std::optional<DrawList> own_list;
-  if (view.hidden != kNoId) own_list = without_object(setup.list, view.hidden);
+  if (!view.hidden.empty()) own_list = without_objects(setup.list, view.hidden);
   const DrawList& list = own_list ? *own_list : setup.list;
   const glm::dmat4& view_projection = frame.view_projection;
   // Textured and vertex-coloured objects (none: no per-pixel work at all).
@@ -487,7 +488,7 @@ Status add_cube_maps(const RenderSetup& setup, const std::vector<EnvironmentMapp
   const CubeFacePass pass = [&](const CubeFace& face) -> Expected<FrameBuffers> {
     MirrorView view;
     view.eye = face.eye;
-    view.hidden = face.hidden;
+    view.hidden = {face.hidden};
     const ViewFrame frame{
         face.projection * face.view, face.size, face.size, face.near, face.far, face_target};
     RenderOutput drawn_face;

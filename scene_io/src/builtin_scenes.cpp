@@ -354,8 +354,8 @@ Scene tessphere(size_t n) {
 
 // tessphere's sphere on a floor in front of a mirror, lit from above: in full mode the sphere's
 // shadow falls on the floor (shadow rays or shadow maps over its N triangles) and the mirror
-// shows it again (reflection rays traced into its N triangles), so the tracer pays for effects
-// the z-buffers draw only in part (shadow maps, no reflection).
+// shows it again (reflection rays traced into its N triangles; the z-buffers draw its N
+// triangles again into the mirror's reflected view).
 Scene effects(size_t n) {
   Scene s = base_scene("effects:" + std::to_string(n));
   uint32_t m = add_material(s, "sphere", {0.3f, 0.5f, 0.8f}, {0.5f, 0.5f, 0.5f}, 48.0f);
@@ -458,6 +458,8 @@ Scene dof() {
 }
 
 // A glass slab and a glass sphere in front of coloured quads: refraction bends their edges.
+// Between them and behind, a tinted pane of ior 1: its transmitted rays go straight on (the
+// over operator), so what it shows is the scene behind it, tinted.
 Scene glass() {
   Scene s = base_scene("glass");
   add_floor(s, {0.6f, 0.6f, 0.6f}, {0, 0, 0}, 6.0f);
@@ -483,6 +485,11 @@ Scene glass() {
   uint32_t g = uint32_t(s.materials.size() - 1);
   add_box(s, "slab", g, {-0.9f, 0.8f, 0.0f}, {0.6f, 0.7f, 0.15f});
   add_sphere(s, "glass ball", g, {0.9f, 0.6f, 0.2f}, 0.6f);
+  const uint32_t tint = add_material(s, "tinted pane", {0.3f, 0.55f, 0.8f});
+  s.materials[tint].transparency = 0.6f;
+  s.materials[tint].ior = 1.0f;
+  add_quad(s, "pane", tint, {-0.25f, 0.2f, -0.6f}, {0.25f, 0.2f, -0.6f}, {0.25f, 1.9f, -0.6f},
+           {-0.25f, 1.9f, -0.6f});
   look_at(s, {0.0f, 1.1f, 4.5f}, {0.0f, 0.8f, 0.0f}, 40.0f, 0.1f, 100.0f);
   s.ambient = {0.08f, 0.08f, 0.08f};
   add_point_light(s, {1.5f, 4.0f, 4.0f}, {30.0f, 30.0f, 30.0f});
@@ -554,7 +561,8 @@ std::vector<BuiltinSceneInfo> builtin_scenes() {
        "N small mirror balls on a floor between coloured walls (default 16): a z-buffer draws a "
        "cube map per ball"},
       {"dof", "spheres at several depths, thin lens focused on the middle one, 16 samples"},
-      {"glass", "a glass slab and a glass sphere in front of coloured quads"},
+      {"glass",
+       "a glass slab, a glass sphere and a tinted pane (ior 1) in front of coloured quads"},
       {"textured",
        "a checkerboard-textured floor to the horizon (every mip level) and a vertex-coloured "
        "triangle"},

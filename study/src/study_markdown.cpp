@@ -115,8 +115,11 @@ std::string full_mode_text(const StudyResult& r) {
       case ModelForm::ZBuffer:
         each.push_back(name +
                        " shadow maps (a cube of six per light sample, drawn over every "
-                       "triangle) and no reflection or refraction: where a family has a mirror "
-                       "(effects) its frame does less work than a tracer's");
+                       "triangle), a view drawn again per flat mirror and ior-1 layer seen and a "
+                       "cube map of six views per curved mirror or other transparent object: "
+                       "every triangle drawn once more per such view, where a tracer casts a ray "
+                       "per pixel of the effect (each technique's error against the tracer: "
+                       "bench/charts/effects.md)");
         break;
       case ModelForm::Tracer:
         each.push_back(name + " shadow rays and reflection and refraction rays");
