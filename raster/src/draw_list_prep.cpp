@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <glm/glm.hpp>
+#include <string>
 #include <utility>
 
 #include "rvr/core/check.h"

@@ -10,7 +10,6 @@
 #include <map>
 #include <memory>
 #include <optional>
-#include <type_traits>
 #include <utility>
 
 #include "pass_camera.h"

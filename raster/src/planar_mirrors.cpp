@@ -6,6 +6,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "rvr/core/check.h"
 #include "rvr/core/scene.h"
