@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "rvr/compare/effect_errors.h"
+#include "rvr/core/effect_answer.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
@@ -128,6 +129,67 @@ TEST(EffectErrors, TheMaskImageColoursEachEffectsPixels) {
     EXPECT_EQ(pixel(grey).y, pixel(grey).z);
     EXPECT_LT(pixel(grey).x, 0.6f);
   }
+}
+
+// A z-buffer's answers split each mask: the mirror's pixel and the glass's answered by cube
+// maps, a second mirror pixel (the background's, masked by a frame that sees the mirror there)
+// by screen-space reflections off screen. Each answer's error is its own pixels' alone; the
+// answers are read from the frame that holds them, a's before b's, and absent when neither does.
+TEST(EffectErrors, AnswersSplitEachMaskByTechnique) {
+  const Scene scene = four_objects();
+  const FrameBuffers a =
+      frame({glm::vec3(0.2f), glm::vec3(0.5f), glm::vec3(0.4f), glm::vec3(0.1f), glm::vec3(0.0f)});
+  FrameBuffers b = a;
+  b.colour[1].y += 0.3f;
+  b.colour[4].x += 0.6f;
+  FrameBuffers masks = a;
+  masks.object_id[4] = 1;
+  FrameBuffers answered = b;
+  answered.answer = {0, uint8_t(EffectAnswer::CubeMapReflection),
+                     uint8_t(EffectAnswer::CubeMapRefraction), 0,
+                     uint8_t(EffectAnswer::SsrOffScreen)};
+  EXPECT_EQ(answering_frame(a, answered), &answered);
+  EXPECT_EQ(answering_frame(answered, a), &answered);
+  EXPECT_EQ(answering_frame(a, b), nullptr);
+  const std::vector<EffectError> errors =
+      effect_errors(scene, RenderMode::Full, masks, a, answered);
+  const EffectError* reflection = find(errors, "reflection");
+  ASSERT_NE(reflection, nullptr);
+  EXPECT_EQ(reflection->pixels, 2u);
+  ASSERT_EQ(reflection->answers.size(), 2u);
+  EXPECT_EQ(reflection->answers[0].answer, "cube_map_reflection");
+  EXPECT_EQ(reflection->answers[0].pixels, 1u);
+  EXPECT_NEAR(reflection->answers[0].rmse, 0.3 / std::sqrt(3.0), 1e-6);
+  EXPECT_EQ(reflection->answers[1].answer, "ssr_off_screen");
+  EXPECT_NEAR(reflection->answers[1].rmse, 0.6 / std::sqrt(3.0), 1e-6);
+  EXPECT_NEAR(reflection->answers[1].max_abs, 0.6, 1e-6);
+  const EffectError* refraction = find(errors, "refraction");
+  ASSERT_NE(refraction, nullptr);
+  ASSERT_EQ(refraction->answers.size(), 1u);
+  EXPECT_EQ(refraction->answers[0].answer, "cube_map_refraction");
+  EXPECT_EQ(refraction->answers[0].psnr_db, std::numeric_limits<double>::infinity());
+  // The CSG solid's pixel: answered by nothing the z-buffer records.
+  const EffectError* csg = find(errors, "csg");
+  ASSERT_NE(csg, nullptr);
+  ASSERT_EQ(csg->answers.size(), 1u);
+  EXPECT_EQ(csg->answers[0].answer, "none");
+  // Without answers in either frame, no split.
+  for (const EffectError& e : effect_errors(scene, RenderMode::Full, masks, a, b))
+    EXPECT_TRUE(e.answers.empty()) << e.effect;
+  // answers.png: the answered pixels in their answer's colour, the others grey.
+  const Image img = answer_image(answered);
+  ASSERT_EQ(img.pixels.size(), 15u);
+  const auto pixel = [&](size_t i) {
+    return glm::vec3(img.pixels[3 * i], img.pixels[3 * i + 1], img.pixels[3 * i + 2]);
+  };
+  const auto colour = [](EffectAnswer k) {
+    const float* c = kAnswerColours[size_t(k)];
+    return glm::vec3(c[0], c[1], c[2]);
+  };
+  EXPECT_EQ(pixel(1), colour(EffectAnswer::CubeMapReflection));
+  EXPECT_EQ(pixel(4), colour(EffectAnswer::SsrOffScreen));
+  EXPECT_EQ(pixel(0).x, pixel(0).y);
+  EXPECT_EQ(pixel(3).y, pixel(3).z);
 }
 
 // Frames of another size than the mask's: nothing is measured rather than read out of range.

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "colour_edges.h"
+#include "rvr/core/effect_answer.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
@@ -178,6 +179,64 @@ TEST_P(EnvironmentMaps, RecursionLimitDropsTheShares) {
     EXPECT_EQ(a.differing, 0u) << GetParam() << " " << ball;
     EXPECT_EQ(z.stats.at("cube_map.faces"), 0.0) << GetParam() << " " << ball;
   }
+}
+
+// The answer AOV (rvr/core/effect_answer.h) names the technique at every pixel whose own
+// surface is the object, and nothing elsewhere: a mirror ball's map, a sheet's first interface
+// only, a glass ball's two interfaces, the recursion limit, no map at size 0.
+TEST_P(EnvironmentMaps, EachPixelOfTheObjectNamesItsAnswer) {
+  struct Case {
+    const char* shape;
+    const char* material;
+    int max_depth, map_size;
+    EffectAnswer answer;
+  };
+  for (const Case& c : {Case{kBallShape, kMirrorBall, 5, 64, EffectAnswer::CubeMapReflection},
+                        Case{kSheetShape, kGlass, 5, 64, EffectAnswer::FirstInterfaceOnly},
+                        Case{kBallShape, kGlass, 5, 64, EffectAnswer::CubeMapRefraction},
+                        Case{kBallShape, kMirrorBall, 0, 64, EffectAnswer::AtLimit},
+                        Case{kBallShape, kGlass, 5, 0, EffectAnswer::LeftOut}}) {
+    const Scene scene = load(box_scene(1e4, c.shape, c.material));
+    RenderOptions options;
+    options.mode = RenderMode::Full;
+    options.max_depth = c.max_depth;
+    options.cube_map_size = c.map_size;
+    const FrameBuffers fb = test::table_render(GetParam(), scene, options).buffers;
+    const std::string where = std::string(GetParam()) + " " + effect_answer_name(c.answer);
+    ASSERT_EQ(fb.answer.size(), fb.pixel_count()) << where;
+    size_t object = 0, wrong = 0;
+    for (size_t i = 0; i < fb.pixel_count(); ++i) {
+      const bool own = fb.object_id[i] == kBall;
+      object += own;
+      wrong += fb.answer[i] != uint8_t(own ? c.answer : EffectAnswer::None);
+    }
+    EXPECT_GT(object, fb.pixel_count() / 8) << where;
+    EXPECT_EQ(wrong, 0u) << where;
+  }
+}
+
+// Screen-space reflections: the mirror ball's pixel at the image centre faces the camera, so
+// its reflected ray comes straight back past the eye and leaves the view (off screen); every
+// ball pixel carries its march's outcome, as many of each as the ssr stats count.
+TEST_P(EnvironmentMaps, ScreenSpaceReflectionsNameEachMarchsOutcome) {
+  const Scene scene = load(box_scene(3.5, kBallShape, kMirrorBall));
+  RenderOptions options;
+  options.mode = RenderMode::Full;
+  options.zbuffer_reflection = ZBufferReflection::Ssr;
+  const RenderOutput out = test::table_render(GetParam(), scene, options);
+  const FrameBuffers& fb = out.buffers;
+  ASSERT_EQ(fb.answer.size(), fb.pixel_count());
+  EXPECT_EQ(fb.answer[fb.index(fb.width / 2, fb.height / 2)], uint8_t(EffectAnswer::SsrOffScreen))
+      << GetParam();
+  std::map<std::string, double> counted;
+  for (size_t i = 0; i < fb.pixel_count(); ++i)
+    if (fb.answer[i] != uint8_t(EffectAnswer::None))
+      counted[effect_answer_name(EffectAnswer(fb.answer[i]))] += 1.0;
+  EXPECT_EQ(counted["ssr_hit"], out.stats.at("ssr.hits")) << GetParam();
+  EXPECT_EQ(counted["ssr_background"], out.stats.at("ssr.background")) << GetParam();
+  EXPECT_EQ(counted["ssr_off_screen"], out.stats.at("ssr.off_screen")) << GetParam();
+  EXPECT_EQ(counted["ssr_hidden"], out.stats.at("ssr.hidden")) << GetParam();
+  EXPECT_GT(counted["ssr_hit"], 0.0) << GetParam();
 }
 
 // --cube-map-size 0: no map, the ball's local colour at full weight, said in a warning.

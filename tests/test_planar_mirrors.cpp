@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "colour_edges.h"
+#include "rvr/core/effect_answer.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/renderer.h"
@@ -154,6 +155,16 @@ TEST_P(PlanarMirrors, AgreeWithTheTracersReflectionRaysAtEveryDepth) {
     EXPECT_EQ(z.stats.at("mirror.depth"), double(std::min(max_depth, kLongestChain))) << where;
     EXPECT_EQ(z.stats.at("mirror.views") > 0, max_depth > 0) << where;
     EXPECT_EQ(z.stats.at("mirror.pixels_at_limit") > 0, max_depth < kLongestChain) << where;
+    // Every mirror pixel names the reflected view (the limit at depth 0), no other pixel any.
+    size_t wrong = 0;
+    for (size_t i = 0; i < a.pixel_count(); ++i) {
+      const bool mirror = a.object_id[i] == kLeftMirror || a.object_id[i] == kRightMirror;
+      const EffectAnswer want = !mirror          ? EffectAnswer::None
+                                : max_depth == 0 ? EffectAnswer::AtLimit
+                                                 : EffectAnswer::ReflectedView;
+      wrong += a.answer.size() == a.pixel_count() ? a.answer[i] != uint8_t(want) : 1;
+    }
+    EXPECT_EQ(wrong, 0u) << where;
   }
 }
 
@@ -227,6 +238,19 @@ TEST_P(PlanarMirrors, TransparentLayersAreTheOverOperatorAtEveryDepth) {
     EXPECT_LE(double(d.differing), (1.0 - kMinAgreement) * double(t.buffers.pixel_count()))
         << where;
     EXPECT_EQ(d.away_from_edges, 0u) << where;
+    // Each pane's own pixels name their answer: a layer's view (the right pane is also a
+    // mirror: its transmitted share names it), at depth 0 the limit; nothing elsewhere.
+    const FrameBuffers& fb = z.buffers;
+    ASSERT_EQ(fb.answer.size(), fb.pixel_count()) << where;
+    size_t wrong = 0;
+    for (size_t i = 0; i < fb.pixel_count(); ++i) {
+      const bool pane = fb.object_id[i] == kLeftMirror || fb.object_id[i] == kRightMirror;
+      const EffectAnswer want = !pane            ? EffectAnswer::None
+                                : max_depth == 0 ? EffectAnswer::AtLimit
+                                                 : EffectAnswer::LayerView;
+      wrong += fb.answer[i] != uint8_t(want);
+    }
+    EXPECT_EQ(wrong, 0u) << where;
     // A view behind each pane seen (and, through the right one's reflection, the left one's).
     EXPECT_EQ(z.stats.count("layer.views") > 0, max_depth > 0) << where;
     if (max_depth > 0) {

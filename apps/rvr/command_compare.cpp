@@ -52,10 +52,14 @@ void print_pair(const ReportPair& p, const std::string& name_a, const std::strin
   if (m.lod.pixels > 0)
     std::printf("  texture lod       |a - b| mean %.3g  p99 %.3g levels over %zu pixels\n",
                 m.lod.mean_abs, m.lod.p99_abs, m.lod.pixels);
-  for (const EffectError& e : m.effects)
+  for (const EffectError& e : m.effects) {
     std::printf("  %-17s rmse %.4g  psnr %.2f dB  max %.4g  over %zu pixels (%s's mask)\n",
                 e.effect.c_str(), e.rmse, e.psnr_db, e.max_abs, e.pixels,
                 m.effects_mask_from.c_str());
+    for (const AnswerError& s : e.answers)
+      std::printf("    %-21s psnr %.2f dB  max %.4g  over %zu pixels (%s's answer)\n",
+                  s.answer.c_str(), s.psnr_db, s.max_abs, s.pixels, m.answers_from.c_str());
+  }
 }
 
 // The exit status the thresholds give: 1 when a pair's id agreement is below
@@ -134,6 +138,8 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
     check(write_image(a.out_dir + "/" + rp.file("mismatch_classes"), p.mismatch_classes, false));
     if (!p.metrics.effects.empty())
       check(write_image(a.out_dir + "/" + rp.file("effects"), p.effects, false));
+    if (!p.metrics.answers_from.empty())
+      check(write_image(a.out_dir + "/" + rp.file("answers"), p.answers, false));
   }
   check(write_text_file(a.out_dir + "/metrics.json", metrics_json(report)));
   check(write_text_file(a.out_dir + "/report.html", take(report_html(report))));
@@ -159,6 +165,7 @@ int run_compare(const CompareArgs& a, const std::string& command_line) {
     std::printf("%s,%s,%s,%s,", p.file("diff").c_str(), p.file("depth_diff").c_str(),
                 p.file("id_mismatch").c_str(), p.file("mismatch_classes").c_str());
     if (!p.metrics.effects.empty()) std::printf("%s,", p.file("effects").c_str());
+    if (!p.metrics.answers_from.empty()) std::printf("%s,", p.file("answers").c_str());
   }
   std::printf("metrics.json,report.html}\n");
   return verdict(a, report.pairs, keys);

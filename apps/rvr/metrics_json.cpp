@@ -95,13 +95,26 @@ ordered_json pair_metrics(const ComparisonMetrics& m) {
                   {"p99_abs", number(m.lod.p99_abs)}};
   if (!m.effects.empty()) {
     ordered_json by_effect = ordered_json::array();
-    for (const EffectError& e : m.effects)
-      by_effect.push_back({{"effect", e.effect},
-                           {"pixels", e.pixels},
-                           {"rmse", number(e.rmse)},
-                           {"psnr_db", psnr_number(e.psnr_db)},
-                           {"max_abs", number(e.max_abs)}});
+    for (const EffectError& e : m.effects) {
+      ordered_json entry = {{"effect", e.effect},
+                            {"pixels", e.pixels},
+                            {"rmse", number(e.rmse)},
+                            {"psnr_db", psnr_number(e.psnr_db)},
+                            {"max_abs", number(e.max_abs)}};
+      if (!m.answers_from.empty()) {
+        ordered_json answers = ordered_json::array();
+        for (const AnswerError& s : e.answers)
+          answers.push_back({{"answer", s.answer},
+                             {"pixels", s.pixels},
+                             {"rmse", number(s.rmse)},
+                             {"psnr_db", psnr_number(s.psnr_db)},
+                             {"max_abs", number(s.max_abs)}});
+        entry["answers"] = answers;
+      }
+      by_effect.push_back(entry);
+    }
     doc["effects"] = {{"mask_from", m.effects_mask_from}, {"by_effect", by_effect}};
+    if (!m.answers_from.empty()) doc["effects"]["answers_from"] = m.answers_from;
   }
   return doc;
 }
@@ -112,6 +125,7 @@ ordered_json pair_files(const ReportPair& p) {
                         {"id_mismatch", p.file("id_mismatch")},
                         {"mismatch_classes", p.file("mismatch_classes")}};
   if (!p.metrics.effects.empty()) files["effects"] = p.file("effects");
+  if (!p.metrics.answers_from.empty()) files["answers"] = p.file("answers");
   return files;
 }
 

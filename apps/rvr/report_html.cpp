@@ -25,6 +25,7 @@
 #include "rvr/compare/compare.h"
 #include "rvr/compare/effect_errors.h"
 #include "rvr/compare/mismatch_classes.h"
+#include "rvr/core/effect_answer.h"
 #include "rvr/core/expected.h"
 #include "rvr/core/stats.h"
 #include "rvr/present/html_escape.h"
@@ -209,8 +210,22 @@ struct ReportImages {
   std::vector<std::string> renders, costs;    // per renderer; a cost URI is empty without a file
   std::string diff, id_mismatch, depth_diff;  // of the first pair
   std::string effects;                        // of the first pair; empty when no effect acts
+  std::string answers;                        // of answers_pair; empty without one
   std::vector<std::string> classes;           // per pair
 };
+
+// The pair whose z-buffer answers the report shows: the first whose masks come from the other
+// renderer (a tracer's or a hybrid's frame: the z-buffer against the rays), else the first with
+// answers at all; nullptr when none has them.
+const ReportPair* answers_pair(const std::vector<ReportPair>& pairs) {
+  const ReportPair* any = nullptr;
+  for (const ReportPair& p : pairs) {
+    if (p.metrics.answers_from.empty()) continue;
+    if (p.metrics.answers_from != p.metrics.effects_mask_from) return &p;
+    if (!any) any = &p;
+  }
+  return any;
+}
 
 // Reads every image first, so that a missing file fails before any HTML is built.
 Expected<ReportImages> embed_images(const ReportInput& input,
@@ -238,6 +253,10 @@ Expected<ReportImages> embed_images(const ReportInput& input,
   if (!first.metrics.effects.empty()) {
     RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, first.file("effects")));
     images.effects = std::move(uri.value());
+  }
+  if (const ReportPair* p = answers_pair(pairs)) {
+    RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, p->file("answers")));
+    images.answers = std::move(uri.value());
   }
   for (const ReportPair& p : pairs) {
     RVR_TRY_ASSIGN(uri, data_uri(input.out_dir, p.file("mismatch_classes")));
@@ -396,6 +415,39 @@ std::string effect_masks(const ReportPair& first, const ReportImages& images) {
       << "</span>";
   }
   h << "</figcaption></figure>\n</div>\n";
+  return h.str();
+}
+
+// How the z-buffer answered each effect (answers.png of answers_pair) with its legend, and the
+// error of each answer inside each effect's mask: where each approximation's known failure
+// lies. Nothing without answers.
+std::string effect_answers(const std::vector<ReportPair>& pairs, const ReportImages& images) {
+  const ReportPair* p = answers_pair(pairs);
+  if (!p || images.answers.empty()) return "";
+  const ComparisonMetrics& m = p->metrics;
+  std::ostringstream h;
+  h << "<h2>How the z-buffer answered them</h2>\n<div class=\"grid\">\n<figure><img src=\""
+    << images.answers << "\" alt=\"z-buffer answers\"><figcaption><b>"
+    << escape_html(p->file("answers")) << "</b>: the technique " << escape_html(m.answers_from)
+    << " answered each pixel's effect with, over a dimmed grey version of its frame:";
+  std::vector<bool> shown(kEffectAnswers, false);
+  for (const EffectError& e : m.effects)
+    for (const AnswerError& a : e.answers)
+      for (size_t k = 1; k < kEffectAnswers; ++k)
+        if (a.answer == effect_answer_name(EffectAnswer(k))) shown[k] = true;
+  for (size_t k = 1; k < kEffectAnswers; ++k)
+    if (shown[k])
+      h << "<span class=\"key\">" << swatch(kAnswerColours[k])
+        << effect_answer_name(EffectAnswer(k)) << "</span>";
+  h << "</figcaption></figure>\n</div>\n<table>\n<tr><th>effect</th><th>answer</th>"
+       "<th>pixels</th><th>PSNR</th><th>max</th></tr>\n";
+  for (const EffectError& e : m.effects)
+    for (const AnswerError& a : e.answers)
+      h << "<tr><td>" << e.effect << "</td><td>" << escape_html(a.answer) << "</td><td>" << a.pixels
+        << "</td><td>"
+        << (std::isinf(a.psnr_db) ? std::string("&infin;") : fmt("%.2f dB", a.psnr_db))
+        << "</td><td>" << fmt("%.4g", a.max_abs) << "</td></tr>\n";
+  h << "</table>\n";
   return h.str();
 }
 
@@ -602,7 +654,8 @@ Expected<std::string> report_html(const ReportInput& input) {
     h << present::page_start(title, present::PageWidth::Wide) << summary(input, title, first)
       << warnings(input) << renders(input, *images, name_a, name_b)
       << differences(input, first, *images, name_a, name_b) << effect_masks(first, *images)
-      << work_per_pixel(input, *images) << metrics_table(metric_rows(first.metrics))
+      << effect_answers(pairs, *images) << work_per_pixel(input, *images)
+      << metrics_table(metric_rows(first.metrics))
       << outlier_table(first.metrics.depth, name_a, name_b)
       << other_pairs(pairs, names, images->classes) << timings(input) << all_statistics(input)
       << page_end(input);

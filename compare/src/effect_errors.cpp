@@ -6,8 +6,10 @@
 #include <initializer_list>
 #include <iterator>
 #include <limits>
+#include <memory>
 
 #include "dimmed_backdrop.h"
+#include "rvr/core/effect_answer.h"
 
 namespace rvr {
 
@@ -41,7 +43,33 @@ std::vector<uint8_t> effect_bits(const Scene& scene, RenderMode mode,
   return bits;
 }
 
+// A colour error summed over pixels, then finished into rmse and PSNR.
+struct ErrorSum {
+  size_t pixels = 0;
+  double sq = 0.0, max_abs = 0.0;
+  void add(const FrameBuffers& a, const FrameBuffers& b, size_t i) {
+    ++pixels;
+    for (int c = 0; c < 3; ++c) {
+      double d = std::fabs(double(a.colour[i][c]) - double(b.colour[i][c]));
+      if (std::isnan(d)) d = 1.0;  // as the whole image's colour error counts a NaN
+      sq += d * d;
+      max_abs = std::max(max_abs, d);
+    }
+  }
+  double rmse() const { return pixels > 0 ? std::sqrt(sq / (3.0 * double(pixels))) : 0.0; }
+  double psnr_db() const {
+    const double r = rmse();
+    return r > 0.0 ? 20.0 * std::log10(1.0 / r) : std::numeric_limits<double>::infinity();
+  }
+};
+
 }  // namespace
+
+const FrameBuffers* answering_frame(const FrameBuffers& a, const FrameBuffers& b) {
+  if (!a.answer.empty() && a.answer.size() == a.pixel_count()) return &a;
+  if (!b.answer.empty() && b.answer.size() == b.pixel_count()) return &b;
+  return nullptr;
+}
 
 std::vector<EffectError> effect_errors(const Scene& scene, RenderMode mode,
                                        const FrameBuffers& mask_from, const FrameBuffers& a,
@@ -49,25 +77,31 @@ std::vector<EffectError> effect_errors(const Scene& scene, RenderMode mode,
   const size_t n = mask_from.pixel_count();
   if (mask_from.object_id.size() != n || a.colour.size() != n || b.colour.size() != n) return {};
   const std::vector<uint8_t> bits = effect_bits(scene, mode, mask_from);
+  const FrameBuffers* answered = answering_frame(a, b);
+  if (answered && answered->pixel_count() != n) answered = nullptr;
   std::vector<EffectError> errors;
   for (size_t k = 0; k < std::size(kEffectKeys); ++k) {
-    EffectError e;
-    e.effect = kEffectKeys[k].name;
-    double sq = 0.0;
+    ErrorSum all;
+    std::vector<ErrorSum> by_answer(kEffectAnswers);
     for (size_t i = 0; i < n; ++i) {
       if (!(bits[i] & (1u << k))) continue;
-      ++e.pixels;
-      for (int c = 0; c < 3; ++c) {
-        double d = std::fabs(double(a.colour[i][c]) - double(b.colour[i][c]));
-        if (std::isnan(d)) d = 1.0;  // as the whole image's colour error counts a NaN
-        sq += d * d;
-        e.max_abs = std::max(e.max_abs, d);
-      }
+      all.add(a, b, i);
+      if (answered)
+        by_answer[std::min<size_t>(answered->answer[i], kEffectAnswers - 1)].add(a, b, i);
     }
-    if (e.pixels == 0) continue;
-    e.rmse = std::sqrt(sq / (3.0 * double(e.pixels)));
-    e.psnr_db =
-        e.rmse > 0.0 ? 20.0 * std::log10(1.0 / e.rmse) : std::numeric_limits<double>::infinity();
+    if (all.pixels == 0) continue;
+    EffectError e;
+    e.effect = kEffectKeys[k].name;
+    e.pixels = all.pixels;
+    e.rmse = all.rmse();
+    e.psnr_db = all.psnr_db();
+    e.max_abs = all.max_abs;
+    for (size_t c = 0; c < kEffectAnswers; ++c) {
+      const ErrorSum& s = by_answer[c];
+      if (s.pixels == 0) continue;
+      e.answers.push_back(
+          {effect_answer_name(EffectAnswer(c)), s.pixels, s.rmse(), s.psnr_db(), s.max_abs});
+    }
     errors.push_back(e);
   }
   return errors;
@@ -93,6 +127,28 @@ Image effect_mask_image(const Scene& scene, RenderMode mode, const FrameBuffers&
       continue;
     }
     p[0] = p[1] = p[2] = dimmed_grey(mask_from, i);
+  }
+  return img;
+}
+
+static_assert(std::size(kAnswerColours) == kEffectAnswers, "a colour per answer");
+
+Image answer_image(const FrameBuffers& answered) {
+  Image img;
+  img.width = answered.width;
+  img.height = answered.height;
+  img.channels = 3;
+  img.channel_names = {"R", "G", "B"};
+  const size_t n = answered.pixel_count();
+  img.pixels.assign(n * 3, 0.0f);
+  for (size_t i = 0; i < n; ++i) {
+    float* p = &img.pixels[3 * i];
+    const size_t answer = i < answered.answer.size() ? answered.answer[i] : 0;
+    if (answer > 0 && answer < kEffectAnswers) {
+      std::copy(kAnswerColours[answer], kAnswerColours[answer] + 3, p);
+      continue;
+    }
+    p[0] = p[1] = p[2] = dimmed_grey(answered, i);
   }
   return img;
 }

@@ -14,6 +14,7 @@
 
 #include "pass_camera.h"
 #include "rvr/core/check.h"
+#include "rvr/core/effect_answer.h"
 #include "rvr/core/shapes/sphere.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "screen_space_reflections.h"
@@ -167,6 +168,21 @@ std::vector<std::vector<size_t>> pixels_per_object(const std::vector<Environment
   return seen;
 }
 
+// The answer a screen-space reflection's outcome gives its pixel.
+EffectAnswer ssr_answer(SsrOutcome outcome) {
+  switch (outcome) {
+    case SsrOutcome::Hit:
+      return EffectAnswer::SsrHit;
+    case SsrOutcome::Background:
+      return EffectAnswer::SsrBackground;
+    case SsrOutcome::OffScreen:
+      return EffectAnswer::SsrOffScreen;
+    case SsrOutcome::Hidden:
+      return EffectAnswer::SsrHidden;
+  }
+  return EffectAnswer::None;
+}
+
 }  // namespace
 
 std::vector<EnvironmentMapped> environment_mapped(const Scene& scene, const PreparedScene& prepared,
@@ -228,7 +244,10 @@ Status add_environment_maps(const Scene& scene, const RenderOptions& options,
     if (seen[i].empty()) continue;
     const float kept = 1.0f - m.mirror - m.transparency;  // the local share
     if (options.max_depth < 1) {  // the tracer's recursion limit: the shares dropped
-      for (size_t p : seen[i]) fb.colour[p] = kept * fb.colour[p];
+      for (size_t p : seen[i]) {
+        fb.colour[p] = kept * fb.colour[p];
+        set_answer(fb, p, EffectAnswer::AtLimit);
+      }
       stats.dropped += seen[i].size();
       continue;
     }
@@ -255,10 +274,16 @@ Status add_environment_maps(const Scene& scene, const RenderOptions& options,
           shown = scene.image.background;
         ++stats.ssr[size_t(outcome)];
         c += m.mirror * shown;
+        set_answer(fb, p, ssr_answer(outcome));
       } else if (m.mirror > 0.0f) {
         c += m.mirror * map->lookup(r);
         ++stats.reflected;
+        set_answer(fb, p, EffectAnswer::CubeMapReflection);
       }
+      // A pixel with both shares is classed by its transmitted one.
+      if (m.transparency > 0.0f)
+        set_answer(fb, p,
+                   m.sphere ? EffectAnswer::CubeMapRefraction : EffectAnswer::FirstInterfaceOnly);
       if (m.transparency > 0.0f) {
         ++stats.refracted;
         const std::optional<glm::dvec3> t = transmitted(d, n, 1.0 / double(m.ior));
@@ -284,6 +309,11 @@ Status add_environment_maps(const Scene& scene, const RenderOptions& options,
     }
   }
   return ok_status();
+}
+
+void mark_left_out(const std::vector<EnvironmentMapped>& mapped, FrameBuffers& fb) {
+  for (const std::vector<size_t>& pixels : pixels_per_object(mapped, fb))
+    for (size_t p : pixels) set_answer(fb, p, EffectAnswer::LeftOut);
 }
 
 int cube_face_shadow_map_size(const RenderOptions& options) {

@@ -91,6 +91,10 @@ Status add_environment_maps(const Scene& scene, const RenderOptions& options,
 
 // The shadow-map resolution of a cube map's faces: the map's own (a face texel and a shadow texel
 // then span the same angle), never finer than the camera's shadow maps and at least 16.
+// Marks the pixels of `mapped`'s objects as left out (EffectAnswer::LeftOut): with no cube map
+// (--cube-map-size 0) they keep the local colour at full weight.
+void mark_left_out(const std::vector<EnvironmentMapped>& mapped, FrameBuffers& fb);
+
 int cube_face_shadow_map_size(const RenderOptions& options);
 
 // The stats of a render's cube maps (cube_map.faces, cube_map.reflected_pixels,

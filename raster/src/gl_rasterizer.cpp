@@ -1441,6 +1441,7 @@ Expected<RenderOutput> GlRasterizer::Impl::render_pass(const Scene& scene,
     mapped = environment_mapped(scene, uploaded->prepared, mirrors, left_out);
     // Last: its faces resize the targets.
     if (!mapped.empty() && options.cube_map_size > 0) RVR_TRY(add_cube_maps(pass, mapped, out));
+    if (!mapped.empty() && options.cube_map_size == 0) mark_left_out(mapped, out.buffers);
   }
   note_what_a_zbuffer_leaves_out(scene, options, mapped, left_out, out.warnings);
   if (uploaded->csg_solids > 0) {  // over every view drawn, the shadow cubes' faces too

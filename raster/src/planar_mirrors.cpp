@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "rvr/core/check.h"
+#include "rvr/core/effect_answer.h"
 #include "rvr/core/scene.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 
@@ -212,6 +213,14 @@ Status add_planar_reflections(const std::vector<PlanarMirror>& mirrors, int max_
   for (size_t p = 0; p < px.pixel.size(); ++p) px.pixel[p] = p;
   px.colour.assign(fb.colour.begin(), fb.colour.end());
   px.id.assign(fb.object_id.begin(), fb.object_id.end());
+  // What answers each pixel that sees a planar mirror or layer (its shares drop at the limit).
+  const std::vector<std::vector<size_t>> seen_by = pixels_per_mirror(mirrors, px);
+  for (size_t i = 0; i < mirrors.size(); ++i) {
+    const EffectAnswer answer = view.depth >= max_depth          ? EffectAnswer::AtLimit
+                                : mirrors[i].transparency > 0.0f ? EffectAnswer::LayerView
+                                                                 : EffectAnswer::ReflectedView;
+    for (size_t k : seen_by[i]) set_answer(fb, px.pixel[k], answer);
+  }
   RVR_TRY(reflect(mirrors, max_depth, view, pass, px, stats));
   std::copy(px.colour.begin(), px.colour.end(), fb.colour.begin());
   return ok_status();

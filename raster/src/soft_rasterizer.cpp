@@ -549,6 +549,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
     if (!mirrors.empty()) RVR_TRY(add_mirrors(setup, mirrors, camera, out));
     mapped = environment_mapped(scene, *prepared, mirrors, left_out);
     if (!mapped.empty() && options.cube_map_size > 0) RVR_TRY(add_cube_maps(setup, mapped, out));
+    if (!mapped.empty() && options.cube_map_size == 0) mark_left_out(mapped, out.buffers);
   }
   out.info["hiz"] = options.hiz ? "on" : "off";
   note_what_is_left_out(scene, options, mapped, left_out, out.warnings);

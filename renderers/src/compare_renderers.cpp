@@ -82,6 +82,11 @@ ComparedPair compare_pair(const Scene& scene, const CompareResult& result, size_
   const FrameBuffers& masks = p.metrics.effects_mask_from == ra.name ? a : b;
   p.metrics.effects = effect_errors(scene, compare.mode, masks, a, b);
   if (!p.metrics.effects.empty()) p.effects = effect_mask_image(scene, compare.mode, masks);
+  const FrameBuffers* answered = answering_frame(a, b);
+  if (answered && !p.metrics.effects.empty()) {
+    p.metrics.answers_from = answered == &a ? ra.name : rb.name;
+    p.answers = answer_image(*answered);
+  }
   p.diff = diff_heat_map(ra.image, rb.image, compare.heat_map_scale);
   p.id_mismatch = id_mismatch_image(a, b);
   p.depth_diff = depth_diff_image(a, b, compare.depth_diff_scale);

@@ -97,6 +97,9 @@ struct ComparisonMetrics {
   // `effects_mask_from` (one of the two renderers' names); set by compare_renderers.
   std::vector<EffectError> effects;
   std::string effects_mask_from;
+  // The renderer of the pair whose z-buffer answers (FrameBuffers::answer) split each effect's
+  // mask (EffectError::answers); "" when neither frame holds answers. Set by compare_renderers.
+  std::string answers_from;
 };
 
 LodMetrics lod_metrics(const FrameBuffers& a, const FrameBuffers& b);

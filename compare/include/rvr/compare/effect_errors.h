@@ -15,6 +15,16 @@
 
 namespace rvr {
 
+// The colour error over the pixels of one effect's mask that one z-buffer technique answered
+// (EffectAnswer, rvr/core/effect_answer.h): where each approximation's known failure lies.
+struct AnswerError {
+  std::string answer;  // effect_answer_name: "cube_map_reflection", "ssr_off_screen", ...
+  size_t pixels = 0;
+  double rmse = 0.0;
+  double psnr_db = 0.0;  // +inf when identical
+  double max_abs = 0.0;
+};
+
 // The colour error (linear RGB, peak 1, as ComparisonMetrics::colour) over the pixels one
 // effect touches.
 struct EffectError {
@@ -23,6 +33,9 @@ struct EffectError {
   double rmse = 0.0;
   double psnr_db = 0.0;  // +inf when identical
   double max_abs = 0.0;
+  // When a or b holds a z-buffer's answers (FrameBuffers::answer, a's first): the mask split by
+  // answer, in EffectAnswer's order, answers no pixel of the mask has left out. Empty else.
+  std::vector<AnswerError> answers;
 };
 
 // The effects `mask_from` shows (a frame of the scene: the tracer's, whose primary surfaces the
@@ -38,6 +51,29 @@ struct EffectError {
 std::vector<EffectError> effect_errors(const Scene& scene, RenderMode mode,
                                        const FrameBuffers& mask_from, const FrameBuffers& a,
                                        const FrameBuffers& b);
+
+// The frame of a and b that holds a z-buffer's answers (a's first), or nullptr.
+const FrameBuffers* answering_frame(const FrameBuffers& a, const FrameBuffers& b);
+
+// answers.png: each pixel of `answered` where a technique answered an effect in its answer's
+// colour (kAnswerColours), over a dimmed grey version of its colour elsewhere.
+Image answer_image(const FrameBuffers& answered);
+
+// The colours answers.png shows each EffectAnswer in (display-referred), in its order.
+inline constexpr float kAnswerColours[][3] = {
+    {0.0f, 0.0f, 0.0f},  // none: not drawn
+    {0.2f, 0.5f, 1.0f},  // reflected_view
+    {0.3f, 0.9f, 0.9f},  // layer_view
+    {1.0f, 0.6f, 0.1f},  // cube_map_reflection
+    {0.9f, 0.9f, 0.2f},  // cube_map_refraction
+    {1.0f, 0.2f, 0.2f},  // first_interface_only
+    {0.3f, 0.9f, 0.3f},  // ssr_hit
+    {1.0f, 0.2f, 1.0f},  // ssr_off_screen
+    {0.6f, 0.2f, 0.9f},  // ssr_hidden
+    {0.6f, 0.6f, 0.6f},  // ssr_background
+    {1.0f, 1.0f, 1.0f},  // left_out
+    {0.5f, 0.3f, 0.1f},  // at_limit
+};
 
 // The effects in effect_errors' order, their names and the colours effects.png shows them in.
 struct EffectKey {

@@ -60,6 +60,9 @@ struct FrameBuffers {
   // The texture level of detail the renderer sampled at the visible surface, NaN where that is
   // not textured; empty (reset and allocate empty it) unless the scene has a textured object.
   PixelVector<float> lod;
+  // How a z-buffer answered the effect at each pixel (EffectAnswer, rvr/core/effect_answer.h);
+  // empty unless a z-buffer answered some effect (full mode). The tracers leave it empty.
+  PixelVector<uint8_t> answer;
 
   // Sizes every buffer and fills it with the background values.
   void reset(int w, int h, const glm::vec3& background);
@@ -94,6 +97,7 @@ inline void FrameBuffers::reset(int w, int h, const glm::vec3& background) {
   normal.assign(n, glm::vec3(0.0f));
   cost.assign(n, 0.0f);
   lod.clear();
+  answer.clear();
 }
 
 inline void FrameBuffers::allocate(int w, int h) {
@@ -114,6 +118,7 @@ inline void FrameBuffers::allocate(int w, int h) {
     v->resize(n);
   }
   lod.clear();
+  answer.clear();
 }
 
 // The one colour transform after shading, the same for every renderer: linear colour times

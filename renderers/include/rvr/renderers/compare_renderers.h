@@ -58,6 +58,7 @@ struct ComparedPair {
   Image depth_diff;        // relative depth difference
   Image mismatch_classes;  // mismatched pixels coloured by class over grey
   Image effects;           // the effect masks (effect_mask_image); empty when none acts
+  Image answers;           // the z-buffer's answers (answer_image); empty without answers_from
 };
 
 // A renderer whose image shows a surface in fewer than this fraction of its pixels is warned
