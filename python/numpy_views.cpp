@@ -29,5 +29,7 @@ template py::array_t<float> view(std::shared_ptr<const void>, const float*, size
                                  const std::vector<py::ssize_t>&);
 template py::array_t<int32_t> view(std::shared_ptr<const void>, const int32_t*, size_t,
                                    const std::vector<py::ssize_t>&);
+template py::array_t<uint8_t> view(std::shared_ptr<const void>, const uint8_t*, size_t,
+                                   const std::vector<py::ssize_t>&);
 
 }  // namespace rvr::python

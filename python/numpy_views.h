@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <stddef.h>
+#include <stdint.h>
 
 #include <memory>
 #include <vector>
@@ -21,6 +22,8 @@ pybind11::array_t<T> view(std::shared_ptr<const void> owner, const T* data, size
 extern template pybind11::array_t<float> view(std::shared_ptr<const void>, const float*, size_t,
                                               const std::vector<pybind11::ssize_t>&);
 extern template pybind11::array_t<int32_t> view(std::shared_ptr<const void>, const int32_t*, size_t,
+                                                const std::vector<pybind11::ssize_t>&);
+extern template pybind11::array_t<uint8_t> view(std::shared_ptr<const void>, const uint8_t*, size_t,
                                                 const std::vector<pybind11::ssize_t>&);
 
 }  // namespace rvr::python

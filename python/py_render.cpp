@@ -108,6 +108,17 @@ py::array_t<float> lod(const PyRender& r) {
   return view(std::shared_ptr<const void>(nan), nan->data(), nan->size(), shape(r));
 }
 
+// How a z-buffer answered each pixel's effect; a render that answered none (a tracer's, or not
+// full mode) keeps an empty buffer, which reads as 0 (none) everywhere.
+py::array_t<uint8_t> answer(const PyRender& r) {
+  const FrameBuffers& fb = r.result->output.buffers;
+  if (fb.answer.size() == fb.pixel_count())
+    return view(std::shared_ptr<const void>(r.result), fb.answer.data(), fb.answer.size(),
+                shape(r));
+  auto none = std::make_shared<const std::vector<uint8_t>>(fb.pixel_count(), uint8_t(0));
+  return view(std::shared_ptr<const void>(none), none->data(), none->size(), shape(r));
+}
+
 // Writes as `rvr render -o PATH --aov AOVS` does.
 void save(const PyRender& r, const py::object& where, const py::object& aovs) {
   const std::string path = path_of("path", where);
@@ -181,6 +192,7 @@ void bind_render_class(py::module_& m) {
           },
           docs::Render_cost)
       .def_property_readonly("lod", &lod, docs::Render_lod)
+      .def_property_readonly("answer", &answer, docs::Render_answer)
       .def_property_readonly(
           "stats", [](const PyRender& r) { return json_loads(r.result->stats_json); },
           docs::Render_stats)

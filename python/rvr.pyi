@@ -158,6 +158,14 @@ class Render:
         `--aov lod` writes), NaN where the surface is not textured."""
 
     @property
+    def answer(self) -> npt.NDArray[np.uint8]:
+        """H x W uint8: how a z-buffer answered the effect at each pixel in full mode, the
+        answers compare splits each effect's error by, in this order from 0: none,
+        reflected_view, layer_view, cube_map_reflection, cube_map_refraction,
+        first_interface_only, ssr_hit, ssr_off_screen, ssr_hidden, ssr_background, left_out,
+        at_limit. 0 everywhere for a tracer's render, or outside full mode."""
+
+    @property
     def stats(self) -> dict[str, Any]:
         """The document `rvr render --stats` writes, as a dict."""
 

@@ -168,3 +168,22 @@ def test_a_mesh_from_arrays_is_the_model_file_of_it(run_cli, tmp_path):
     assert np.array_equal(red.object_id, r.object_id)
     seen = r.object_id == 0
     assert (red.color[seen][:, 1:] == 0).all() and (red.color[seen][:, 0] > 0).any()
+
+
+def test_answer_names_each_z_buffer_technique(tmp_path):
+    # Render.answer: on builtin:glass in full mode a z-buffer answers the pane (ior 1) by the view
+    # behind it (2), the slab by a cube map bent at its first interface only (5), the ball by a
+    # cube map through both interfaces (4), and nothing elsewhere (0); a tracer answers nothing.
+    scene = rvr.Scene("builtin:glass", width=64, height=48)
+    scene.save(tmp_path / "glass.json")
+    names = [o["name"] for o in json.loads((tmp_path / "glass.json").read_text())["objects"]]
+    want = {names.index("pane"): 2, names.index("slab"): 5, names.index("glass ball"): 4}
+    r = rvr.render(scene, "softraster", mode="full", cube_map_size=16)
+    assert r.answer.shape == (48, 64) and r.answer.dtype == np.uint8
+    expected = np.zeros((48, 64), dtype=np.uint8)
+    for index, code in want.items():
+        expected[r.object_id == index] = code
+    assert (r.answer == expected).all()
+    assert set(np.unique(r.answer)) == {0, 2, 4, 5}
+    traced = rvr.render(scene, "raytrace", mode="full")
+    assert not traced.answer.any()
