@@ -128,6 +128,26 @@ Disagreement disagreement(const FrameBuffers& a, const FrameBuffers& b) {
   return d;
 }
 
+// The z-buffer's frame `z` is the tracer's `t` but on edge ties: primary visibility's tolerance.
+void expect_the_tracers_image(const FrameBuffers& z, const FrameBuffers& t,
+                              const std::string& where) {
+  const Disagreement d = disagreement(z, t);
+  EXPECT_LE(double(d.differing), (1.0 - kMinAgreement) * double(t.pixel_count())) << where;
+  EXPECT_EQ(d.away_from_edges, 0u) << where;
+}
+
+// The pixels of `fb` whose answer is not `on_them` where its own surface is one of the two
+// mirrors, or not none elsewhere (every pixel when fb has no answers).
+size_t wrong_answers(const FrameBuffers& fb, EffectAnswer on_them) {
+  if (fb.answer.size() != fb.pixel_count()) return fb.pixel_count();
+  size_t wrong = 0;
+  for (size_t i = 0; i < fb.pixel_count(); ++i) {
+    const bool mirror = fb.object_id[i] == kLeftMirror || fb.object_id[i] == kRightMirror;
+    wrong += fb.answer[i] != uint8_t(mirror ? on_them : EffectAnswer::None);
+  }
+  return wrong;
+}
+
 class PlanarMirrors : public ::testing::TestWithParam<const char*> {};
 
 // Every pixel, mirror pixels included, at every recursion limit: the z-buffer's colour is the
@@ -145,26 +165,18 @@ TEST_P(PlanarMirrors, AgreeWithTheTracersReflectionRaysAtEveryDepth) {
     size_t mirror_pixels = 0;
     for (size_t i = 0; i < b.pixel_count(); ++i)
       mirror_pixels += b.object_id[i] == kLeftMirror || b.object_id[i] == kRightMirror;
-    const Disagreement d = disagreement(a, b);
     const std::string where = std::string(GetParam()) + " max_depth " + std::to_string(max_depth);
     // Something to agree on: both mirrors fill a fifth of the frame.
     EXPECT_GT(mirror_pixels, a.pixel_count() / 5) << where;
-    EXPECT_LE(double(d.differing), (1.0 - kMinAgreement) * double(a.pixel_count())) << where;
-    EXPECT_EQ(d.away_from_edges, 0u) << where;
+    expect_the_tracers_image(a, b, where);
     // The views drawn: none at depth 0, and the two mirrors see each other to the limit.
     EXPECT_EQ(z.stats.at("mirror.depth"), double(std::min(max_depth, kLongestChain))) << where;
     EXPECT_EQ(z.stats.at("mirror.views") > 0, max_depth > 0) << where;
     EXPECT_EQ(z.stats.at("mirror.pixels_at_limit") > 0, max_depth < kLongestChain) << where;
     // Every mirror pixel names the reflected view (the limit at depth 0), no other pixel any.
-    size_t wrong = 0;
-    for (size_t i = 0; i < a.pixel_count(); ++i) {
-      const bool mirror = a.object_id[i] == kLeftMirror || a.object_id[i] == kRightMirror;
-      const EffectAnswer want = !mirror          ? EffectAnswer::None
-                                : max_depth == 0 ? EffectAnswer::AtLimit
-                                                 : EffectAnswer::ReflectedView;
-      wrong += a.answer.size() == a.pixel_count() ? a.answer[i] != uint8_t(want) : 1;
-    }
-    EXPECT_EQ(wrong, 0u) << where;
+    EXPECT_EQ(
+        wrong_answers(a, max_depth == 0 ? EffectAnswer::AtLimit : EffectAnswer::ReflectedView), 0u)
+        << where;
   }
 }
 
@@ -180,11 +192,8 @@ TEST_P(PlanarMirrors, FacingMirrorsRecurseToTheLimit) {
   for (int max_depth : {3, 6}) {
     const RenderOutput z = render(GetParam(), scene, max_depth);
     const RenderOutput t = render("raytrace", scene, max_depth);
-    const Disagreement d = disagreement(z.buffers, t.buffers);
     const std::string where = std::string(GetParam()) + " max_depth " + std::to_string(max_depth);
-    EXPECT_LE(double(d.differing), (1.0 - kMinAgreement) * double(t.buffers.pixel_count()))
-        << where;
-    EXPECT_EQ(d.away_from_edges, 0u) << where;
+    expect_the_tracers_image(z.buffers, t.buffers, where);
     EXPECT_EQ(z.stats.at("mirror.depth"), double(max_depth)) << where;
     EXPECT_GT(z.stats.at("mirror.pixels_at_limit"), 0.0) << where;
   }
@@ -233,24 +242,14 @@ TEST_P(PlanarMirrors, TransparentLayersAreTheOverOperatorAtEveryDepth) {
   for (int max_depth : {0, 1, 2, 5}) {
     const RenderOutput z = render(GetParam(), scene, max_depth);
     const RenderOutput t = render("raytrace", scene, max_depth);
-    const Disagreement d = disagreement(z.buffers, t.buffers);
     const std::string where = std::string(GetParam()) + " max_depth " + std::to_string(max_depth);
-    EXPECT_LE(double(d.differing), (1.0 - kMinAgreement) * double(t.buffers.pixel_count()))
-        << where;
-    EXPECT_EQ(d.away_from_edges, 0u) << where;
+    expect_the_tracers_image(z.buffers, t.buffers, where);
     // Each pane's own pixels name their answer: a layer's view (the right pane is also a
     // mirror: its transmitted share names it), at depth 0 the limit; nothing elsewhere.
-    const FrameBuffers& fb = z.buffers;
-    ASSERT_EQ(fb.answer.size(), fb.pixel_count()) << where;
-    size_t wrong = 0;
-    for (size_t i = 0; i < fb.pixel_count(); ++i) {
-      const bool pane = fb.object_id[i] == kLeftMirror || fb.object_id[i] == kRightMirror;
-      const EffectAnswer want = !pane            ? EffectAnswer::None
-                                : max_depth == 0 ? EffectAnswer::AtLimit
-                                                 : EffectAnswer::LayerView;
-      wrong += fb.answer[i] != uint8_t(want);
-    }
-    EXPECT_EQ(wrong, 0u) << where;
+    EXPECT_EQ(
+        wrong_answers(z.buffers, max_depth == 0 ? EffectAnswer::AtLimit : EffectAnswer::LayerView),
+        0u)
+        << where;
     // A view behind each pane seen (and, through the right one's reflection, the left one's).
     EXPECT_EQ(z.stats.count("layer.views") > 0, max_depth > 0) << where;
     if (max_depth > 0) {

@@ -108,49 +108,23 @@ std::vector<EffectError> effect_errors(const Scene& scene, RenderMode mode,
 }
 
 Image effect_mask_image(const Scene& scene, RenderMode mode, const FrameBuffers& mask_from) {
-  Image img;
-  img.width = mask_from.width;
-  img.height = mask_from.height;
-  img.channels = 3;
-  img.channel_names = {"R", "G", "B"};
-  const size_t n = mask_from.pixel_count();
-  img.pixels.assign(n * 3, 0.0f);
   const std::vector<uint8_t> bits = effect_bits(scene, mode, mask_from);
-  for (size_t i = 0; i < n && i < bits.size(); ++i) {
-    float* p = &img.pixels[3 * i];
+  return overlay_on_dimmed(mask_from, [&](size_t i) -> const float* {
+    if (i >= bits.size()) return nullptr;
     // The lens last: it touches every pixel, and the others would not show through it.
-    int shown = -1;
     for (int k : {0, 1, 3, 2})
-      if (shown < 0 && (bits[i] & (1u << k))) shown = k;
-    if (shown >= 0) {
-      std::copy(kEffectKeys[shown].rgb, kEffectKeys[shown].rgb + 3, p);
-      continue;
-    }
-    p[0] = p[1] = p[2] = dimmed_grey(mask_from, i);
-  }
-  return img;
+      if (bits[i] & (1u << k)) return kEffectKeys[k].rgb;
+    return nullptr;
+  });
 }
 
 static_assert(std::size(kAnswerColours) == kEffectAnswers, "a colour per answer");
 
 Image answer_image(const FrameBuffers& answered) {
-  Image img;
-  img.width = answered.width;
-  img.height = answered.height;
-  img.channels = 3;
-  img.channel_names = {"R", "G", "B"};
-  const size_t n = answered.pixel_count();
-  img.pixels.assign(n * 3, 0.0f);
-  for (size_t i = 0; i < n; ++i) {
-    float* p = &img.pixels[3 * i];
+  return overlay_on_dimmed(answered, [&](size_t i) -> const float* {
     const size_t answer = i < answered.answer.size() ? answered.answer[i] : 0;
-    if (answer > 0 && answer < kEffectAnswers) {
-      std::copy(kAnswerColours[answer], kAnswerColours[answer] + 3, p);
-      continue;
-    }
-    p[0] = p[1] = p[2] = dimmed_grey(answered, i);
-  }
-  return img;
+    return answer > 0 && answer < kEffectAnswers ? kAnswerColours[answer] : nullptr;
+  });
 }
 
 }  // namespace rvr

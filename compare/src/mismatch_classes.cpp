@@ -343,24 +343,10 @@ std::vector<MismatchClass> classify_mismatches(const FrameBuffers& a, const Fram
 }
 
 Image mismatch_class_image(const FrameBuffers& a, const std::vector<MismatchClass>& classes) {
-  Image img;
-  img.width = a.width;
-  img.height = a.height;
-  img.channels = 3;
-  img.channel_names = {"R", "G", "B"};
-  const size_t n = a.pixel_count();
-  img.pixels.assign(n * 3, 0.0f);
-  for (size_t i = 0; i < n; ++i) {
-    float* p = &img.pixels[3 * i];
+  return overlay_on_dimmed(a, [&](size_t i) -> const float* {
     const MismatchClass c = i < classes.size() ? classes[i] : MismatchClass::Coverage;
-    if (c != MismatchClass::None) {
-      const auto& rgb = kMismatchClassColours[size_t(c)];
-      std::copy(rgb.begin(), rgb.end(), p);
-      continue;
-    }
-    p[0] = p[1] = p[2] = dimmed_grey(a, i);
-  }
-  return img;
+    return c != MismatchClass::None ? kMismatchClassColours[size_t(c)].data() : nullptr;
+  });
 }
 
 }  // namespace rvr

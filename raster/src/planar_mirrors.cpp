@@ -170,23 +170,22 @@ Status reflect(const std::vector<PlanarMirror>& mirrors, int max_depth, const Mi
       stats.dropped += seen.size();
       continue;
     }
+    // A child view at the pixels `seen`, drawn, with its own mirrors and layers composited.
+    const auto drawn_child = [&](const MirrorView& child, ViewPixels& into) -> Status {
+      RVR_TRY_ASSIGN(drawn, child_pixels(child, pass, px, seen));
+      into = std::move(*drawn);
+      stats.deepest = std::max(stats.deepest, child.depth);
+      return reflect(mirrors, max_depth, child, pass, into, stats);
+    };
     ViewPixels reflected, behind;
     if (m.mirror > 0.0f) {
-      const MirrorView child = reflected_view(view, m);
-      RVR_TRY_ASSIGN(drawn, child_pixels(child, pass, px, seen));
-      reflected = std::move(*drawn);
+      RVR_TRY(drawn_child(reflected_view(view, m), reflected));
       ++stats.passes;
-      stats.deepest = std::max(stats.deepest, child.depth);
-      RVR_TRY(reflect(mirrors, max_depth, child, pass, reflected, stats));
       stats.pixels += seen.size();
     }
     if (m.transparency > 0.0f) {
-      const MirrorView child = view_behind(view, m);
-      RVR_TRY_ASSIGN(drawn, child_pixels(child, pass, px, seen));
-      behind = std::move(*drawn);
+      RVR_TRY(drawn_child(view_behind(view, m), behind));
       ++stats.layer_passes;
-      stats.deepest = std::max(stats.deepest, child.depth);
-      RVR_TRY(reflect(mirrors, max_depth, child, pass, behind, stats));
       stats.layer_pixels += seen.size();
     }
     // The tracer's sum: (1 - mirror - transparency) · local, plus mirror · reflected, plus
