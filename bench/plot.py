@@ -158,7 +158,7 @@ def effect_rows(rows):
 
 # Registration order (the JSON's is the random interleaving's): cheapest effect first.
 EFFECT_ORDER = (["primary", "hard_shadows", "area_light_4x4"] + [f"mirror_depth_{d}" for d in range(1, 6)]
-                + ["planar_mirror", "curved_mirror", "glass", "dof_16", "csg"])
+                + ["planar_mirror", "curved_mirror", "glass", "clear_pane", "dof_16", "csg"])
 
 
 def effect_rank(effect):

@@ -304,6 +304,23 @@ void effect_scene(const std::string& effect, Scene& scene, RenderOptions& option
   } else if (effect == "glass") {
     for (Material& m : scene.materials)
       if (m.name == "glass") m.transparency = 0.9f;
+  } else if (effect == "clear_pane") {
+    // A tinted pane of ior 1 standing in front of both balls: the tracer's transmitted rays go
+    // straight on, the z-buffers draw the view again without it (the over operator).
+    Material tint;
+    tint.name = "tinted pane";
+    tint.diffuse = {0.3f, 0.55f, 0.8f};
+    tint.transparency = 0.6f;
+    tint.ior = 1.0f;
+    scene.materials.push_back(tint);
+    Object pane;
+    pane.name = "pane";
+    pane.type = ObjectType::Triangles;
+    pane.material = uint32_t(scene.materials.size() - 1);
+    pane.mesh.positions = {
+        {4.0f, 0.0f, 1.5f}, {1.5f, 0.0f, 1.5f}, {1.5f, 3.0f, 1.5f}, {4.0f, 3.0f, 1.5f}};
+    pane.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+    scene.objects.push_back(std::move(pane));
   } else if (effect == "csg") {
     // The mirror ball, matt, with a ball of 0.7 its radius cut out of its front: a CSG
     // difference the z-buffers draw leaf by leaf.
@@ -451,12 +468,14 @@ void add_error_counters(benchmark::State& state, const Scene& scene, const Rende
 // the tracer's are. The split of its time: zbuffer_ms (visibility passes) and trace_ms (hits
 // rebuilt, shading, rays); its error against the tracer (add_error_counters).
 void BM_EffectsWith(benchmark::State& state, const std::string& renderer_name,
-                    const std::string& effect, Supersampling supersampling, ZBufferDof dof) {
+                    const std::string& effect, Supersampling supersampling, ZBufferDof dof,
+                    ZBufferReflection reflection) {
   Scene scene;
   RenderOptions options;
   effect_scene(effect, scene, options);
   options.supersampling = supersampling;
   options.zbuffer_dof = dof;
+  options.zbuffer_reflection = reflection;
   std::unique_ptr<Renderer> renderer = make_renderer(renderer_name).value();
   RenderOutput out = renderer->render(scene, options).value();
   PhaseTimes phases;
@@ -776,14 +795,16 @@ void register_frame_sweep(const FrameSweep& sweep) {
 }
 
 // The z-buffers' own answers to the effects they render, by technique: primary visibility,
-// shadow maps, a flat mirror by reflected views, a curved mirror and glass by cube maps, a
-// CSG solid by its leaves' intervals, and depth of field by the accumulation
+// shadow maps, a flat mirror by reflected views, a curved mirror by a cube map or screen-space
+// reflections, glass by a cube map, a clear pane of ior 1 by the view behind it, a CSG solid
+// by its leaves' intervals, and depth of field by the accumulation
 // buffer (raster also by MSAA: a pinhole) or a blur.
 void register_zbuffer_effects() {
   struct ZBufferEffect {
     std::string renderer, effect, technique;
     Supersampling supersampling = Supersampling::Accumulation;
     ZBufferDof dof = ZBufferDof::Accumulation;
+    ZBufferReflection reflection = ZBufferReflection::CubeMap;
   };
   for (const std::string z : {"raster", "softraster"}) {
     std::vector<ZBufferEffect> cases = {
@@ -792,7 +813,10 @@ void register_zbuffer_effects() {
         {z, "area_light_4x4", "shadow_maps"},
         {z, "planar_mirror", "reflected_views"},
         {z, "curved_mirror", "cube_map"},
+        {z, "curved_mirror", "ssr", Supersampling::Accumulation, ZBufferDof::Accumulation,
+         ZBufferReflection::Ssr},
         {z, "glass", "cube_map"},
+        {z, "clear_pane", "layer_views"},
         {z, "dof_16", "accumulation"},
         {z, "csg", "leaf_intervals"},
         {z, "dof_16", "blur", Supersampling::Accumulation, ZBufferDof::Blur}};
@@ -800,7 +824,7 @@ void register_zbuffer_effects() {
     for (const ZBufferEffect& c : cases)
       benchmark::RegisterBenchmark(
           bench_name({"BM_Effects", c.renderer, c.effect, c.technique}).c_str(), BM_EffectsWith,
-          c.renderer, c.effect, c.supersampling, c.dof)
+          c.renderer, c.effect, c.supersampling, c.dof, c.reflection)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
   }
@@ -821,14 +845,15 @@ void register_all() {
             ->UseRealTime();
   for (std::string e : {"primary", "hard_shadows", "area_light_4x4", "mirror_depth_1",
                         "mirror_depth_2", "mirror_depth_3", "mirror_depth_4", "mirror_depth_5",
-                        "planar_mirror", "curved_mirror", "glass", "csg", "dof_16"}) {
+                        "planar_mirror", "curved_mirror", "glass", "clear_pane", "csg", "dof_16"}) {
     benchmark::RegisterBenchmark(("BM_Effects/" + e).c_str(), BM_Effects, e)
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
     // Beside the tracer's: the hybrids (GL's z-buffer, softraster's) on the same frames.
     for (std::string h : {"hybrid", "hybrid_soft"})
       benchmark::RegisterBenchmark(bench_name({"BM_Effects", h, e}).c_str(), BM_EffectsWith, h, e,
-                                   Supersampling::Accumulation, ZBufferDof::Accumulation)
+                                   Supersampling::Accumulation, ZBufferDof::Accumulation,
+                                   ZBufferReflection::CubeMap)
           ->Unit(benchmark::kMillisecond)
           ->UseRealTime();
   }
