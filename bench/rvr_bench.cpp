@@ -62,6 +62,7 @@
 #include "rvr/core/scene.h"
 #include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/sphere.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/texture.h"
 #include "rvr/image_codec/image_io.h"
 #include "rvr/raytrace/bvh.h"
