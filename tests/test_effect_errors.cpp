@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "rvr/compare/compare.h"
 #include "rvr/compare/effect_errors.h"
 #include "rvr/core/effect_answer.h"
 #include "rvr/core/framebuffers.h"
@@ -190,6 +191,40 @@ TEST(EffectErrors, AnswersSplitEachMaskByTechnique) {
   EXPECT_EQ(pixel(4), colour(EffectAnswer::SsrOffScreen));
   EXPECT_EQ(pixel(0).x, pixel(0).y);
   EXPECT_EQ(pixel(3).y, pixel(3).z);
+}
+
+// The mask's SSIM is the mean of the whole image's SSIM map over the mask: a 40x10 frame whose
+// right half is the mirror, b changed only in its last ten columns, so the matt left half (its
+// window reaches 5 columns) keeps SSIM 1 exactly and the whole image's mean (compare_buffers)
+// is (20·10·1 + 200·mask SSIM) / 400. Identical frames give 1.
+TEST(EffectErrors, TheMaskSsimIsTheImagesSsimMapAveragedOverTheMask) {
+  Scene scene = four_objects();
+  scene.image.width = 40;
+  scene.image.height = 10;
+  FrameBuffers a;
+  a.reset(40, 10, glm::vec3(0.0f));
+  for (int y = 0; y < 10; ++y)
+    for (int x = 0; x < 40; ++x) {
+      const size_t i = a.index(x, y);
+      a.object_id[i] = x < 20 ? 0u : 1u;
+      a.primitive_id[i] = 0u;
+      a.depth[i] = 1.0f;
+      a.colour[i] = glm::vec3(0.2f + 0.015f * float(x), 0.4f, 0.3f + 0.02f * float(y));
+    }
+  FrameBuffers b = a;
+  for (int y = 0; y < 10; ++y)
+    for (int x = 30; x < 40; ++x)
+      b.colour[size_t(y) * 40 + size_t(x)] = glm::vec3((x + y) % 2 == 0 ? 0.9f : 0.1f);
+  const std::vector<EffectError> errors = effect_errors(scene, RenderMode::Full, a, a, b);
+  const EffectError* reflection = find(errors, "reflection");
+  ASSERT_NE(reflection, nullptr);
+  EXPECT_EQ(reflection->pixels, 200u);
+  EXPECT_LT(reflection->ssim, 0.9);
+  const double whole = compare_buffers(a, b).colour.ssim;
+  EXPECT_NEAR(reflection->ssim, (400.0 * whole - 200.0) / 200.0, 1e-9);
+  const EffectError* same = find(effect_errors(scene, RenderMode::Full, a, a, a), "reflection");
+  ASSERT_NE(same, nullptr);
+  EXPECT_EQ(same->ssim, 1.0);
 }
 
 // Frames of another size than the mask's: nothing is measured rather than read out of range.

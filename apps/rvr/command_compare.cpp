@@ -53,12 +53,13 @@ void print_pair(const ReportPair& p, const std::string& name_a, const std::strin
     std::printf("  texture lod       |a - b| mean %.3g  p99 %.3g levels over %zu pixels\n",
                 m.lod.mean_abs, m.lod.p99_abs, m.lod.pixels);
   for (const EffectError& e : m.effects) {
-    std::printf("  %-17s rmse %.4g  psnr %.2f dB  max %.4g  over %zu pixels (%s's mask)\n",
-                e.effect.c_str(), e.rmse, e.psnr_db, e.max_abs, e.pixels,
-                m.effects_mask_from.c_str());
+    std::printf(
+        "  %-17s rmse %.4g  psnr %.2f dB  max %.4g  ssim %.4f  over %zu pixels (%s's mask)\n",
+        e.effect.c_str(), e.rmse, e.psnr_db, e.max_abs, e.ssim, e.pixels,
+        m.effects_mask_from.c_str());
     for (const AnswerError& s : e.answers)
-      std::printf("    %-21s psnr %.2f dB  max %.4g  over %zu pixels (%s's answer)\n",
-                  s.answer.c_str(), s.psnr_db, s.max_abs, s.pixels, m.answers_from.c_str());
+      std::printf("    %-21s psnr %.2f dB  max %.4g  ssim %.4f  over %zu pixels (%s's answer)\n",
+                  s.answer.c_str(), s.psnr_db, s.max_abs, s.ssim, s.pixels, m.answers_from.c_str());
   }
 }
 

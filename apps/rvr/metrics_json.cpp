@@ -96,11 +96,9 @@ ordered_json pair_metrics(const ComparisonMetrics& m) {
   if (!m.effects.empty()) {
     ordered_json by_effect = ordered_json::array();
     for (const EffectError& e : m.effects) {
-      ordered_json entry = {{"effect", e.effect},
-                            {"pixels", e.pixels},
-                            {"rmse", number(e.rmse)},
-                            {"psnr_db", psnr_number(e.psnr_db)},
-                            {"max_abs", number(e.max_abs)}};
+      ordered_json entry = {{"effect", e.effect},           {"pixels", e.pixels},
+                            {"rmse", number(e.rmse)},       {"psnr_db", psnr_number(e.psnr_db)},
+                            {"max_abs", number(e.max_abs)}, {"ssim", number(e.ssim)}};
       if (!m.answers_from.empty()) {
         ordered_json answers = ordered_json::array();
         for (const AnswerError& s : e.answers)
@@ -108,7 +106,8 @@ ordered_json pair_metrics(const ComparisonMetrics& m) {
                              {"pixels", s.pixels},
                              {"rmse", number(s.rmse)},
                              {"psnr_db", psnr_number(s.psnr_db)},
-                             {"max_abs", number(s.max_abs)}});
+                             {"max_abs", number(s.max_abs)},
+                             {"ssim", number(s.ssim)}});
         entry["answers"] = answers;
       }
       by_effect.push_back(entry);

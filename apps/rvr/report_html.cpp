@@ -412,7 +412,7 @@ std::string effect_masks(const ReportPair& first, const ReportImages& images) {
     h << "<span class=\"key\">" << swatch(key.rgb) << key.name << ": " << error->pixels
       << " pixels, PSNR "
       << (std::isinf(error->psnr_db) ? std::string("&infin;") : fmt("%.2f dB", error->psnr_db))
-      << "</span>";
+      << ", SSIM " << fmt("%.4f", error->ssim) << "</span>";
   }
   h << "</figcaption></figure>\n</div>\n";
   return h.str();
@@ -440,13 +440,14 @@ std::string effect_answers(const std::vector<ReportPair>& pairs, const ReportIma
       h << "<span class=\"key\">" << swatch(kAnswerColours[k])
         << effect_answer_name(EffectAnswer(k)) << "</span>";
   h << "</figcaption></figure>\n</div>\n<table>\n<tr><th>effect</th><th>answer</th>"
-       "<th>pixels</th><th>PSNR</th><th>max</th></tr>\n";
+       "<th>pixels</th><th>PSNR</th><th>max</th><th>SSIM</th></tr>\n";
   for (const EffectError& e : m.effects)
     for (const AnswerError& a : e.answers)
       h << "<tr><td>" << e.effect << "</td><td>" << escape_html(a.answer) << "</td><td>" << a.pixels
         << "</td><td>"
         << (std::isinf(a.psnr_db) ? std::string("&infin;") : fmt("%.2f dB", a.psnr_db))
-        << "</td><td>" << fmt("%.4g", a.max_abs) << "</td></tr>\n";
+        << "</td><td>" << fmt("%.4g", a.max_abs) << "</td><td>" << fmt("%.4f", a.ssim)
+        << "</td></tr>\n";
   h << "</table>\n";
   return h.str();
 }

@@ -3,7 +3,6 @@
 #include "rvr/compare/compare.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -24,6 +23,7 @@
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/srgb.h"
 #include "rvr/core/tessellate.h"
+#include "ssim.h"
 
 namespace rvr {
 
@@ -56,77 +56,6 @@ double relative_depth_error(double da, double db) {
   if (!std::isfinite(da) || !std::isfinite(db)) return 1.0;
   double denom = std::max(std::fabs(da), std::fabs(db));
   return denom > 0 ? std::fabs(da - db) / denom : 0.0;
-}
-
-float luminance(const glm::vec3& c) {
-  auto cl = [](float v) { return v > 0.0f ? std::min(v, 1.0f) : 0.0f; };  // NaN -> 0
-  return 0.2126f * cl(c.r) + 0.7152f * cl(c.g) + 0.0722f * cl(c.b);
-}
-
-// Mean SSIM of two luminance images: 11x11 Gaussian window (sigma 1.5), C1 = 0.01^2,
-// C2 = 0.03^2, one value per pixel, averaged. Near the borders (and in images smaller than the
-// window) the window is cut to the image and renormalised, so every pixel has a value.
-double mean_ssim(const std::vector<float>& ya, const std::vector<float>& yb, int w, int h) {
-  if (w <= 0 || h <= 0) return 1.0;
-  RVR_CHECK(ya.size() == size_t(w) * size_t(h) && yb.size() == ya.size(),
-            "one luminance per pixel of the ", w, "x", h, " image: ", ya.size(), " and ",
-            yb.size());
-  constexpr int R = 5;
-  std::array<double, 2 * R + 1> g{};
-  for (int k = -R; k <= R; ++k) g[k + R] = std::exp(-double(k * k) / (2.0 * 1.5 * 1.5));
-
-  // Horizontal pass of the five moments (a, b, a^2, b^2, ab) of one row, into a ring of 11 rows.
-  constexpr int kMoments = 5;
-  const int ring = 2 * R + 1;
-  std::vector<double> hbuf(size_t(ring) * kMoments * w);
-  auto hrow = [&](int y) -> double* { return &hbuf[size_t(y % ring) * kMoments * w]; };
-  auto horizontal = [&](int y) {
-    double* out = hrow(y);
-    const float* ra = &ya[size_t(y) * w];
-    const float* rb = &yb[size_t(y) * w];
-    for (int x = 0; x < w; ++x) {
-      double s[kMoments] = {0, 0, 0, 0, 0}, wsum = 0;
-      int k0 = std::max(-R, -x), k1 = std::min(R, w - 1 - x);
-      for (int k = k0; k <= k1; ++k) {
-        double wt = g[k + R], a = ra[x + k], b = rb[x + k];
-        wsum += wt;
-        s[0] += wt * a;
-        s[1] += wt * b;
-        s[2] += wt * a * a;
-        s[3] += wt * b * b;
-        s[4] += wt * a * b;
-      }
-      for (int m = 0; m < kMoments; ++m) out[size_t(m) * w + x] = s[m] / wsum;
-    }
-  };
-
-  const double C1 = 0.01 * 0.01, C2 = 0.03 * 0.03;
-  double total = 0.0;
-  int done = 0;  // rows [0, done) have been filtered horizontally
-  std::vector<double> s(size_t(kMoments) * w);
-  for (int y = 0; y < h; ++y) {
-    while (done < std::min(h, y + R + 1)) horizontal(done++);
-    std::fill(s.begin(), s.end(), 0.0);
-    int k0 = std::max(-R, -y), k1 = std::min(R, h - 1 - y);
-    double wsum = 0;
-    for (int k = k0; k <= k1; ++k) {
-      double wt = g[k + R];
-      wsum += wt;
-      const double* row = hrow(y + k);
-      for (size_t i = 0; i < s.size(); ++i) s[i] += wt * row[i];
-    }
-    double row_total = 0.0;
-    for (int x = 0; x < w; ++x) {
-      double ma = s[x] / wsum, mb = s[size_t(w) + x] / wsum;
-      double va = std::max(0.0, s[2 * size_t(w) + x] / wsum - ma * ma);
-      double vb = std::max(0.0, s[3 * size_t(w) + x] / wsum - mb * mb);
-      double cov = s[4 * size_t(w) + x] / wsum - ma * mb;
-      row_total +=
-          ((2 * ma * mb + C1) * (2 * cov + C2)) / ((ma * ma + mb * mb + C1) * (va + vb + C2));
-    }
-    total += row_total;
-  }
-  return total / (double(w) * h);
 }
 
 double psnr_of(double rmse) {
@@ -413,7 +342,7 @@ ComparisonMetrics compare_buffers(const FrameBuffers& a, const FrameBuffers& b,
   m.colour.rmse = std::sqrt(sq / (3.0 * double(n)));
   m.colour.psnr_db = psnr_of(m.colour.rmse);
   m.colour.max_abs = max_abs;
-  m.colour.ssim = mean_ssim(ya, yb, w, h);
+  m.colour.ssim = mean_ssim(ssim_map(ya, yb, w, h), w);
   return m;
 }
 

@@ -10,6 +10,7 @@
 
 #include "dimmed_backdrop.h"
 #include "rvr/core/effect_answer.h"
+#include "ssim.h"
 
 namespace rvr {
 
@@ -43,12 +44,14 @@ std::vector<uint8_t> effect_bits(const Scene& scene, RenderMode mode,
   return bits;
 }
 
-// A colour error summed over pixels, then finished into rmse and PSNR.
+// A colour error summed over pixels, then finished into rmse, PSNR and mean SSIM.
 struct ErrorSum {
   size_t pixels = 0;
-  double sq = 0.0, max_abs = 0.0;
-  void add(const FrameBuffers& a, const FrameBuffers& b, size_t i) {
+  double sq = 0.0, max_abs = 0.0, ssim = 0.0;
+  void add(const FrameBuffers& a, const FrameBuffers& b, const std::vector<double>& ssim_at,
+           size_t i) {
     ++pixels;
+    ssim += ssim_at[i];
     for (int c = 0; c < 3; ++c) {
       double d = std::fabs(double(a.colour[i][c]) - double(b.colour[i][c]));
       if (std::isnan(d)) d = 1.0;  // as the whole image's colour error counts a NaN
@@ -61,7 +64,19 @@ struct ErrorSum {
     const double r = rmse();
     return r > 0.0 ? 20.0 * std::log10(1.0 / r) : std::numeric_limits<double>::infinity();
   }
+  double mean_ssim() const { return pixels > 0 ? ssim / double(pixels) : 1.0; }
 };
+
+// The SSIM map of a's and b's luminance (ssim.h).
+std::vector<double> luminance_ssim(const FrameBuffers& a, const FrameBuffers& b) {
+  const size_t n = a.pixel_count();
+  std::vector<float> ya(n), yb(n);
+  for (size_t i = 0; i < n; ++i) {
+    ya[i] = luminance(a.colour[i]);
+    yb[i] = luminance(b.colour[i]);
+  }
+  return ssim_map(ya, yb, a.width, a.height);
+}
 
 }  // namespace
 
@@ -79,15 +94,21 @@ std::vector<EffectError> effect_errors(const Scene& scene, RenderMode mode,
   const std::vector<uint8_t> bits = effect_bits(scene, mode, mask_from);
   const FrameBuffers* answered = answering_frame(a, b);
   if (answered && answered->pixel_count() != n) answered = nullptr;
+  const bool any = std::any_of(bits.begin(), bits.end(), [](uint8_t b) { return b != 0; });
+  // The SSIM window needs both frames laid out as the mask's.
+  if (!any || a.width != mask_from.width || b.width != mask_from.width || a.pixel_count() != n ||
+      b.pixel_count() != n)
+    return {};
+  const std::vector<double> ssim_at = luminance_ssim(a, b);
   std::vector<EffectError> errors;
   for (size_t k = 0; k < std::size(kEffectKeys); ++k) {
     ErrorSum all;
     std::vector<ErrorSum> by_answer(kEffectAnswers);
     for (size_t i = 0; i < n; ++i) {
       if (!(bits[i] & (1u << k))) continue;
-      all.add(a, b, i);
+      all.add(a, b, ssim_at, i);
       if (answered)
-        by_answer[std::min<size_t>(answered->answer[i], kEffectAnswers - 1)].add(a, b, i);
+        by_answer[std::min<size_t>(answered->answer[i], kEffectAnswers - 1)].add(a, b, ssim_at, i);
     }
     if (all.pixels == 0) continue;
     EffectError e;
@@ -96,6 +117,7 @@ std::vector<EffectError> effect_errors(const Scene& scene, RenderMode mode,
     e.rmse = all.rmse();
     e.psnr_db = all.psnr_db();
     e.max_abs = all.max_abs;
+    e.ssim = all.mean_ssim();
     for (size_t c = 0; c < kEffectAnswers; ++c) {
       const ErrorSum& s = by_answer[c];
       if (s.pixels == 0) continue;

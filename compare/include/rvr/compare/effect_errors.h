@@ -23,6 +23,7 @@ struct AnswerError {
   double rmse = 0.0;
   double psnr_db = 0.0;  // +inf when identical
   double max_abs = 0.0;
+  double ssim = 1.0;  // the mean of the whole image's SSIM map over these pixels
 };
 
 // The colour error (linear RGB, peak 1, as ComparisonMetrics::colour) over the pixels one
@@ -33,6 +34,10 @@ struct EffectError {
   double rmse = 0.0;
   double psnr_db = 0.0;  // +inf when identical
   double max_abs = 0.0;
+  // The mean over the mask of the whole image's SSIM map (ComparisonMetrics::colour.ssim is
+  // its mean over every pixel): the perceptual error where the effect acts, with its context
+  // (the window reaches 5 pixels past the mask).
+  double ssim = 1.0;
   // When a or b holds a z-buffer's answers (FrameBuffers::answer, a's first): the mask split by
   // answer, in EffectAnswer's order, answers no pixel of the mask has left out. Empty else.
   std::vector<AnswerError> answers;
