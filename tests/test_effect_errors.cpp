@@ -222,6 +222,21 @@ TEST(EffectErrors, TheMaskSsimIsTheImagesSsimMapAveragedOverTheMask) {
   EXPECT_LT(reflection->ssim, 0.9);
   const double whole = compare_buffers(a, b).colour.ssim;
   EXPECT_NEAR(reflection->ssim, (400.0 * whole - 200.0) / 200.0, 1e-9);
+  // Split by answers (the mirror's columns 20-29 one, 30-39 another): each part's mean, and
+  // together the mask's.
+  FrameBuffers answered = b;
+  answered.answer.assign(answered.pixel_count(), 0);
+  for (int y = 0; y < 10; ++y)
+    for (int x = 20; x < 40; ++x)
+      answered.answer[answered.index(x, y)] =
+          uint8_t(x < 30 ? EffectAnswer::ReflectedView : EffectAnswer::CubeMapReflection);
+  const EffectError* split =
+      find(effect_errors(scene, RenderMode::Full, a, a, answered), "reflection");
+  ASSERT_NE(split, nullptr);
+  ASSERT_EQ(split->answers.size(), 2u);
+  EXPECT_NEAR(split->answers[0].ssim + split->answers[1].ssim, 2.0 * reflection->ssim, 1e-9);
+  EXPECT_LT(split->answers[1].ssim, split->answers[0].ssim);
+  EXPECT_LT(split->answers[0].ssim, 1.0);
   const EffectError* same = find(effect_errors(scene, RenderMode::Full, a, a, a), "reflection");
   ASSERT_NE(same, nullptr);
   EXPECT_EQ(same->ssim, 1.0);

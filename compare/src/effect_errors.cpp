@@ -121,8 +121,8 @@ std::vector<EffectError> effect_errors(const Scene& scene, RenderMode mode,
     for (size_t c = 0; c < kEffectAnswers; ++c) {
       const ErrorSum& s = by_answer[c];
       if (s.pixels == 0) continue;
-      e.answers.push_back(
-          {effect_answer_name(EffectAnswer(c)), s.pixels, s.rmse(), s.psnr_db(), s.max_abs});
+      e.answers.push_back({effect_answer_name(EffectAnswer(c)), s.pixels, s.rmse(), s.psnr_db(),
+                           s.max_abs, s.mean_ssim()});
     }
     errors.push_back(e);
   }
