@@ -50,6 +50,7 @@ std::string first_difference(const FrameBuffers& a, const FrameBuffers& b) {
   if (!same_bytes(a.normal, b.normal)) return "normal";
   if (!same_bytes(a.colour, b.colour)) return "colour";
   if (!same_bytes(a.cost, b.cost)) return "cost";
+  if (!same_bytes(a.answer, b.answer)) return "answer";
   return "";
 }
 
