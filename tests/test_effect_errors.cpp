@@ -230,14 +230,16 @@ TEST(EffectErrors, TheMaskSsimIsTheImagesSsimMapAveragedOverTheMask) {
     for (int x = 20; x < 40; ++x)
       answered.answer[answered.index(x, y)] =
           uint8_t(x < 30 ? EffectAnswer::ReflectedView : EffectAnswer::CubeMapReflection);
-  const EffectError* split =
-      find(effect_errors(scene, RenderMode::Full, a, a, answered), "reflection");
+  const std::vector<EffectError> split_errors =
+      effect_errors(scene, RenderMode::Full, a, a, answered);
+  const EffectError* split = find(split_errors, "reflection");
   ASSERT_NE(split, nullptr);
   ASSERT_EQ(split->answers.size(), 2u);
   EXPECT_NEAR(split->answers[0].ssim + split->answers[1].ssim, 2.0 * reflection->ssim, 1e-9);
   EXPECT_LT(split->answers[1].ssim, split->answers[0].ssim);
   EXPECT_LT(split->answers[0].ssim, 1.0);
-  const EffectError* same = find(effect_errors(scene, RenderMode::Full, a, a, a), "reflection");
+  const std::vector<EffectError> same_errors = effect_errors(scene, RenderMode::Full, a, a, a);
+  const EffectError* same = find(same_errors, "reflection");
   ASSERT_NE(same, nullptr);
   EXPECT_EQ(same->ssim, 1.0);
 }
