@@ -132,6 +132,9 @@ py::object compare(const PyRender& a, const PyRender& b, bool allow_different) {
                           "compares them anyway)");
   }
   CompareOptions options;
+  // Which effects act, and so which masks the metrics' effects hold (ra.mode == rb.mode unless
+  // allow_different).
+  options.mode = ra.mode;
   // As compare_renderers sets them for the command line: the geometry the mismatch classes
   // and depth-outlier causes are judged on (only when both renders drew spheres alike).
   if (ra.spheres == rb.spheres && ra.sphere_segments == rb.sphere_segments) {

@@ -661,6 +661,41 @@ TEST(StudyMarkdown, NumbersInPowersOfTen) {
   EXPECT_EQ(format_number(0.5), "0.5");
 }
 
+// Full mode: per renderer, family and effect, the range of the error over the points and its
+// worst point; nothing when no point holds effect errors.
+TEST(StudyMarkdown, EachTechniquesErrorIsItsRangeOverThePointsAndItsWorstPoint) {
+  StudyResult r;
+  r.scenes = {"effects"};
+  r.axes["effects"] = "triangles";
+  r.renderers = {"softraster", "raytrace"};
+  r.mode = "full";
+  EXPECT_TRUE(technique_error_sentences(r).empty());
+  const double kInf = std::numeric_limits<double>::infinity();
+  // PSNR, SSIM and pixels at three N: the worst PSNR at the middle one.
+  const double psnr[] = {30, 20, 25}, ssim[] = {0.9, 0.8, 0.85}, pixels[] = {100, 200, 150};
+  for (int k = 0; k < 3; ++k) {
+    Measurement m;
+    m.renderer = "softraster";
+    m.scene = "effects";
+    m.n = 1000.0 * (k + 1);
+    m.width = 64;
+    m.height = 48;
+    m.effect_errors = {{"reflection", pixels[k], 0.1, psnr[k], ssim[k]}, {"csg", 10, 0, kInf, 1}};
+    r.points.push_back(m);
+    m.renderer = "raytrace";
+    m.effect_errors.clear();
+    r.points.push_back(m);
+  }
+  EXPECT_EQ(technique_error_sentences(r),
+            (std::vector<std::string>{
+                "softraster on effects, reflection: PSNR 20 to 30 dB, SSIM 0.8 to 0.9 in a mask "
+                "of 100 to 200 pixels, over 3 points; worst at 2000 triangles, 64×48.",
+                "softraster on effects, csg: PSNR ∞ dB, SSIM 1 in a mask of 10 pixels, over 3 "
+                "points; worst at 1000 triangles, 64×48."}));
+  EXPECT_NE(study_markdown(r).find("## Each technique's error"), std::string::npos);
+  EXPECT_NE(study_html(r).find("<h2>Each technique's error</h2>"), std::string::npos);
+}
+
 namespace {
 
 // A concluded study of softraster and raytrace on two scenes: "synthetic", where the curves
@@ -982,6 +1017,8 @@ TEST(StudyJsonRead, RoundTripsEveryFieldConcludeNeeds) {
   r.points[5].runs[1].busy = true;
   r.points[5].runs[1].reference_ratio = 1.6;
   r.points[6].runs[0].phases["zbuffer"] = {1, 2, 3, 4, 5};
+  const double kInf = std::numeric_limits<double>::infinity();
+  r.points[4].effect_errors = {{"reflection", 162, 0.015, 36.5, 0.996}, {"csg", 7, 0, kInf, 1}};
   conclude(r, {r.bootstrap_replicates, r.seed});
   StudyResult back = read_back(r);
   EXPECT_EQ(back.scenes, r.scenes);
@@ -1024,6 +1061,14 @@ TEST(StudyJsonRead, RoundTripsEveryFieldConcludeNeeds) {
     EXPECT_EQ(a.width, b.width);
     EXPECT_EQ(a.height, b.height);
     EXPECT_EQ(a.counters, b.counters);
+    ASSERT_EQ(a.effect_errors.size(), b.effect_errors.size());
+    for (size_t k = 0; k < a.effect_errors.size(); ++k) {
+      EXPECT_EQ(a.effect_errors[k].effect, b.effect_errors[k].effect);
+      EXPECT_EQ(a.effect_errors[k].pixels, b.effect_errors[k].pixels);
+      EXPECT_EQ(a.effect_errors[k].rmse, b.effect_errors[k].rmse);
+      EXPECT_EQ(a.effect_errors[k].psnr_db, b.effect_errors[k].psnr_db);  // +inf too
+      EXPECT_EQ(a.effect_errors[k].ssim, b.effect_errors[k].ssim);
+    }
     ASSERT_EQ(a.runs.size(), b.runs.size());
     for (size_t k = 0; k < a.runs.size(); ++k) {
       EXPECT_EQ(a.runs[k].session, b.runs[k].session);

@@ -11,10 +11,12 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <initializer_list>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -25,6 +27,7 @@
 
 #include "commands.h"
 #include "rvr/core/expected.h"
+#include "rvr/study/measurement.h"
 #include "rvr/study/memory_estimate.h"
 #include "rvr/study/renderer_frames.h"
 #include "rvr/study/sweep_plan.h"
@@ -52,6 +55,30 @@ Error error_of(const json& reply) {
 json family_json(const study::Family& f) {
   return {{"name", f.name}, {"axis", f.axis},     {"low", f.low},
           {"high", f.high}, {"points", f.points}, {"source", f.source}};
+}
+
+// A renderer's effect errors at one point, as the worker sends them (an identical frame's
+// infinite PSNR as null).
+json effect_errors_json(const std::vector<study::PointEffectError>& errors) {
+  json out = json::array();
+  for (const study::PointEffectError& e : errors)
+    out.push_back({{"effect", e.effect},
+                   {"pixels", e.pixels},
+                   {"rmse", e.rmse},
+                   {"psnr_db", std::isfinite(e.psnr_db) ? json(e.psnr_db) : json(nullptr)},
+                   {"ssim", e.ssim}});
+  return out;
+}
+
+std::vector<study::PointEffectError> effect_errors_of(const json& j) {
+  std::vector<study::PointEffectError> out;
+  for (const json& e : j)
+    out.push_back({e.at("effect").get<std::string>(), e.at("pixels").get<double>(),
+                   e.at("rmse").get<double>(),
+                   e.at("psnr_db").is_null() ? std::numeric_limits<double>::infinity()
+                                             : e.at("psnr_db").get<double>(),
+                   e.at("ssim").get<double>()});
+  return out;
 }
 
 study::Family family_of(const json& j) {
@@ -162,6 +189,8 @@ class ProcessFrames : public study::FrameSource {
     pixels_ = prepared.at("pixels").get<double>();
     prepare_ = prepared.at("prepare_seconds").get<std::vector<double>>();
     counters_ = prepared.at("counters").get<std::vector<std::map<std::string, double>>>();
+    for (const json& errors : prepared.at("effect_errors"))
+      effect_errors_.push_back(effect_errors_of(errors));
   }
   ProcessFrames(const ProcessFrames&) = delete;
   ProcessFrames& operator=(const ProcessFrames&) = delete;
@@ -172,6 +201,9 @@ class ProcessFrames : public study::FrameSource {
   double prepare_seconds(size_t index) const override { return prepare_.at(index); }
   std::map<std::string, double> counters(size_t index) const override {
     return counters_.at(index);
+  }
+  std::vector<study::PointEffectError> effect_errors(size_t index) const override {
+    return effect_errors_.at(index);
   }
   Expected<study::FrameTime> time_frame(size_t index) override {
     RVR_TRY_ASSIGN(reply, worker_->call({{"op", "frame"}, {"id", id_}, {"renderer", index}}));
@@ -187,6 +219,7 @@ class ProcessFrames : public study::FrameSource {
   double axis_ = 0, pixels_ = 0;
   std::vector<double> prepare_;
   std::vector<std::map<std::string, double>> counters_;
+  std::vector<std::vector<study::PointEffectError>> effect_errors_;
 };
 
 class ProcessSession : public study::Session {
@@ -228,15 +261,17 @@ json answer(const json& request, const std::vector<std::string>& renderers, Rend
         study::prepare_frames(renderers, mode, family_of(request.at("family")),
                               request.at("n").get<size_t>(), request.at("width").get<int>());
     if (!frames) return error_json(frames.error());
-    json prepare = json::array(), counters = json::array();
+    json prepare = json::array(), counters = json::array(), effect_errors = json::array();
     for (size_t i = 0; i < renderers.size(); ++i) {
       prepare.push_back((*frames)->prepare_seconds(i));
       counters.push_back((*frames)->counters(i));
+      effect_errors.push_back(effect_errors_json((*frames)->effect_errors(i)));
     }
     json out = {{"axis", (*frames)->axis_value()},
                 {"pixels", (*frames)->pixels()},
                 {"prepare_seconds", prepare},
-                {"counters", counters}};
+                {"counters", counters},
+                {"effect_errors", effect_errors}};
     prepared[id] = std::move(*frames);
     return out;
   }

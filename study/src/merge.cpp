@@ -116,6 +116,7 @@ class PointPool {
         pooled.runs.back().session += offset;
       }
       if (pooled.counters.empty()) pooled.counters = m.counters;
+      if (pooled.effect_errors.empty()) pooled.effect_errors = m.effect_errors;
     }
     return ok_status();
   }

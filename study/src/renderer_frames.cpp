@@ -1,6 +1,7 @@
 // FrameSource over the renderer table (see renderer_frames.h).
 #include "rvr/study/renderer_frames.h"
 
+#include <algorithm>
 #include <chrono>
 #include <initializer_list>
 #include <map>
@@ -8,6 +9,8 @@
 #include <utility>
 #include <variant>
 
+#include "rvr/compare/effect_errors.h"
+#include "rvr/core/framebuffers.h"
 #include "rvr/core/scene.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/renderers/prepared_renderer.h"
@@ -30,11 +33,16 @@ double axis_value_of(const Scene& scene, const Family& family, size_t n) {
   return triangles;
 }
 
+// The tracer whose frame each renderer's effect errors are measured against.
+constexpr const char* kEffectReference = "raytrace";
+
 class RendererFrames : public FrameSource {
  public:
   RendererFrames(std::unique_ptr<Scene> scene, double axis)
       : scene_(std::move(scene)), axis_(axis) {}
 
+  // Renderer `name` prepared and its first frame rendered; in full mode that frame is kept
+  // until measure_effect_errors.
   Status add(const std::string& name, const RenderOptions& options) {
     RVR_TRY_ASSIGN(choice, find_renderer_choice(name));
     const auto start = std::chrono::steady_clock::now();
@@ -48,7 +56,26 @@ class RendererFrames : public FrameSource {
     for (const auto& [stat, value] : first->stats)
       if (is_work_counter(stat)) work[stat] = value;
     counters_.push_back(std::move(work));
+    names_.push_back(name);
+    if (options.mode == RenderMode::Full) first_frames_.push_back(std::move(first->buffers));
     return ok_status();
+  }
+
+  // Each renderer's error in each effect's mask against the reference tracer's first frame
+  // (when the study holds it); the first frames are released.
+  void measure_effect_errors(RenderMode mode) {
+    effect_errors_.assign(names_.size(), {});
+    auto ref = std::find(names_.begin(), names_.end(), kEffectReference);
+    if (mode == RenderMode::Full && ref != names_.end()) {
+      const FrameBuffers& reference = first_frames_.at(size_t(ref - names_.begin()));
+      for (size_t i = 0; i < names_.size(); ++i) {
+        if (names_[i] == kEffectReference) continue;
+        for (const EffectError& e :
+             rvr::effect_errors(*scene_, mode, reference, reference, first_frames_[i]))
+          effect_errors_[i].push_back({e.effect, double(e.pixels), e.rmse, e.psnr_db, e.ssim});
+      }
+    }
+    first_frames_.clear();
   }
 
   double axis_value() const override { return axis_; }
@@ -56,6 +83,10 @@ class RendererFrames : public FrameSource {
   double prepare_seconds(size_t index) const override { return prepare_seconds_.at(index); }
   std::map<std::string, double> counters(size_t index) const override {
     return counters_.at(index);
+  }
+
+  std::vector<PointEffectError> effect_errors(size_t index) const override {
+    return effect_errors_.at(index);
   }
 
   Expected<FrameTime> time_frame(size_t index) override {
@@ -76,6 +107,9 @@ class RendererFrames : public FrameSource {
   std::vector<std::unique_ptr<PreparedRenderer>> prepared_;
   std::vector<double> prepare_seconds_;
   std::vector<std::map<std::string, double>> counters_;
+  std::vector<std::string> names_;
+  std::vector<FrameBuffers> first_frames_;  // full mode, until measure_effect_errors
+  std::vector<std::vector<PointEffectError>> effect_errors_;
 };
 
 class InProcessSession : public Session {
@@ -127,6 +161,7 @@ Expected<std::unique_ptr<FrameSource>> prepare_frames(const std::vector<std::str
   RenderOptions options;
   options.mode = mode;
   for (const std::string& name : renderers) RVR_TRY(frames->add(name, options));
+  frames->measure_effect_errors(mode);
   return std::unique_ptr<FrameSource>(std::move(frames));
 }
 

@@ -318,6 +318,7 @@ Status Sweep::measure_run(const Family& family, size_t n, int width, OpenSession
       m.width = width;
       m.height = width * 3 / 4;
       m.counters = (*frames)->counters(i);
+      m.effect_errors = (*frames)->effect_errors(i);
       list.push_back(std::move(m));
     }
     list[it->second + i].runs.push_back(std::move(runs[i]));

@@ -407,6 +407,18 @@ std::string machine_html(const StudyResult& r) {
   return o + "</dl>\n";
 }
 
+// Full mode: each renderer's error against raytrace in each effect's mask.
+std::string technique_error_html(const StudyResult& r) {
+  const std::vector<std::string> sentences = technique_error_sentences(r);
+  if (sentences.empty()) return "";
+  std::string o =
+      "<h2>Each technique's error</h2>\n<p>Each renderer's frame of every point against "
+      "raytrace's, in the mask of the pixels each effect touches (from the tracer's "
+      "ray tree). Exact, not sampled.</p>\n<ul class=\"technique-error\">";
+  for (const std::string& s : sentences) o += "<li>" + html_with_powers(s) + "</li>";
+  return o + "</ul>\n";
+}
+
 }  // namespace
 
 std::string study_html(const StudyResult& r) {
@@ -416,6 +428,7 @@ std::string study_html(const StudyResult& r) {
   std::string o = present::page_start("rvr study: " + scenes, present::PageWidth::Reading);
   o += header_html(r);
   for (size_t i = 0; i < r.scenes.size(); ++i) o += scene_section(r, i, colours);
+  o += technique_error_html(r);
   o += counted_work_html(r);
   o += machine_html(r);
   return o + present::page_end();

@@ -356,24 +356,37 @@ json runs_json(const Measurement& m) {
   return out;
 }
 
+json effect_errors_json(const std::vector<PointEffectError>& errors) {
+  json out = json::array();
+  for (const PointEffectError& e : errors)
+    out.push_back({{"effect", e.effect},
+                   {"pixels", e.pixels},
+                   {"rmse", number(e.rmse)},
+                   {"psnr_db", number(e.psnr_db)},
+                   {"ssim", number(e.ssim)}});
+  return out;
+}
+
 json points_json(const std::vector<Measurement>& points) {
   json out = json::array();
   for (const Measurement& m : points) {
     json counters = json::object();
     for (const auto& [name, value] : m.counters) counters[name] = number(value);
-    out.push_back({{"renderer", m.renderer},
-                   {"scene", m.scene},
-                   {"scene_n", m.scene_n},
-                   {"n", m.n},
-                   {"width", m.width},
-                   {"height", m.height},
-                   {"pixels", m.pixels},
-                   {"counters", counters},
-                   {"runs", runs_json(m)},
-                   {"seconds", number(typical_seconds(m))},
-                   {"median", number(median_seconds(m))},
-                   {"relative_mad", number(relative_mad(m))},
-                   {"busy", m.busy()}});
+    json point = {{"renderer", m.renderer},
+                  {"scene", m.scene},
+                  {"scene_n", m.scene_n},
+                  {"n", m.n},
+                  {"width", m.width},
+                  {"height", m.height},
+                  {"pixels", m.pixels},
+                  {"counters", counters},
+                  {"runs", runs_json(m)},
+                  {"seconds", number(typical_seconds(m))},
+                  {"median", number(median_seconds(m))},
+                  {"relative_mad", number(relative_mad(m))},
+                  {"busy", m.busy()}};
+    if (!m.effect_errors.empty()) point["effect_errors"] = effect_errors_json(m.effect_errors);
+    out.push_back(std::move(point));
   }
   return out;
 }

@@ -173,7 +173,8 @@ const std::vector<std::string> kCountedWorkKeys = {"work_models", "count_scaling
 const std::vector<std::string> kBuildAndMemoryKeys = {"builds", "scene_changes", "memory"};
 const std::vector<std::string> kPointKeys = {
     "renderer", "scene", "scene_n", "n",      "width",        "height", "pixels",
-    "counters", "runs",  "seconds", "median", "relative_mad", "busy"};
+    "counters", "runs",  "seconds", "median", "relative_mad", "busy",   "effect_errors"};
+const std::vector<std::string> kEffectErrorKeys = {"effect", "pixels", "rmse", "psnr_db", "ssim"};
 const std::vector<std::string> kRunKeys = {"session", "prepare_seconds", "seconds", "order",
                                            "phases",  "reference_ratio", "busy"};
 const std::vector<std::string> kSystemKeys = {"at",         "known", "cpus", "load",
@@ -370,6 +371,21 @@ Run read_run(const json& v, const std::string& path, const StudyResult& r) {
   return run;
 }
 
+// An identical frame's PSNR, infinite, is written as null.
+PointEffectError read_effect_error(const json& v, const std::string& path) {
+  Fields f(v, path, kEffectErrorKeys);
+  PointEffectError e;
+  e.effect = f.string("effect");
+  e.pixels = f.number("pixels", 1);
+  e.rmse = f.number("rmse", 0);
+  e.psnr_db = f.at("psnr_db").is_null()
+                  ? std::numeric_limits<double>::infinity()
+                  : f.number("psnr_db", -std::numeric_limits<double>::infinity());
+  e.ssim = f.number("ssim", -1);
+  if (e.ssim > 1) fail(f.path("ssim"), fmt::format("must be <= 1, got {}", e.ssim));
+  return e;
+}
+
 Measurement read_point(const json& v, const std::string& path, const StudyResult& r) {
   Fields p(v, path, kPointKeys);
   Measurement m;
@@ -387,6 +403,12 @@ Measurement read_point(const json& v, const std::string& path, const StudyResult
   for (const auto& item : p.object("counters").items())
     m.counters[item.key()] =
         Fields::number_at(item.value(), p.path("counters") + "." + item.key(), 0);
+  if (p.has("effect_errors")) {
+    const json& errors = p.array("effect_errors");
+    for (size_t k = 0; k < errors.size(); ++k)
+      m.effect_errors.push_back(
+          read_effect_error(errors[k], index_path(p.path("effect_errors"), k)));
+  }
   const json& runs = p.array("runs");
   if (runs.empty()) fail(p.path("runs"), "must hold at least one run");
   for (size_t k = 0; k < runs.size(); ++k) {

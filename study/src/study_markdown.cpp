@@ -6,7 +6,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <string>
+#include <tuple>
 #include <vector>
 
 #include "counted_work_text.h"
@@ -118,8 +121,9 @@ std::string full_mode_text(const StudyResult& r) {
                        "triangle), a view drawn again per flat mirror and ior-1 layer seen and a "
                        "cube map of six views per curved mirror or other transparent object: "
                        "every triangle drawn once more per such view, where a tracer casts a ray "
-                       "per pixel of the effect (each technique's error against the tracer: "
-                       "bench/charts/effects.md)");
+                       "per pixel of the effect (each technique's error against raytrace at "
+                       "each point: 'Each technique's error' below, when the study holds "
+                       "raytrace; each technique's cost: bench/charts/effects.md)");
         break;
       case ModelForm::Tracer:
         each.push_back(name + " shadow rays and reflection and refraction rays");
@@ -298,6 +302,55 @@ std::string format_number(double v) {
   return fmt::format("{:.1f}×10^{}", m, e);
 }
 
+std::vector<std::string> technique_error_sentences(const StudyResult& r) {
+  struct Range {
+    double worst_psnr = std::numeric_limits<double>::infinity(), best_psnr = -1;
+    double worst_ssim = 1, best_ssim = -1, min_pixels = 0, max_pixels = 0;
+    const Measurement* worst = nullptr;
+    size_t points = 0;
+  };
+  // In the study's orders of renderers and families, effects in effect_errors' order.
+  const std::vector<std::string> effect_order = {"reflection", "refraction", "lens", "csg"};
+  std::map<std::tuple<size_t, size_t, size_t>, Range> ranges;
+  for (const Measurement& m : r.points) {
+    const size_t renderer =
+        size_t(std::find(r.renderers.begin(), r.renderers.end(), m.renderer) - r.renderers.begin());
+    const size_t scene =
+        size_t(std::find(r.scenes.begin(), r.scenes.end(), m.scene) - r.scenes.begin());
+    for (const PointEffectError& e : m.effect_errors) {
+      const size_t effect = size_t(std::find(effect_order.begin(), effect_order.end(), e.effect) -
+                                   effect_order.begin());
+      Range& g = ranges[{renderer, scene, effect}];
+      if (g.points == 0 || e.psnr_db < g.worst_psnr) {
+        g.worst_psnr = e.psnr_db;
+        g.worst = &m;
+      }
+      g.best_psnr = std::max(g.best_psnr, e.psnr_db);
+      g.worst_ssim = std::min(g.worst_ssim, e.ssim);
+      g.best_ssim = std::max(g.best_ssim, e.ssim);
+      g.min_pixels = g.points == 0 ? e.pixels : std::min(g.min_pixels, e.pixels);
+      g.max_pixels = std::max(g.max_pixels, e.pixels);
+      ++g.points;
+    }
+  }
+  auto span = [](double lo, double hi) {
+    return lo == hi ? format_number(lo) : format_number(lo) + " to " + format_number(hi);
+  };
+  std::vector<std::string> out;
+  for (const auto& [key, g] : ranges) {
+    const auto& [renderer, scene, effect] = key;
+    out.push_back(fmt::format(
+        "{} on {}, {}: PSNR {} dB, SSIM {} in a mask of {} pixels, over {} point{}; worst at {} "
+        "{}, {}×{}.",
+        r.renderers.at(renderer), r.scenes.at(scene),
+        effect < effect_order.size() ? effect_order[effect] : "other",
+        span(g.worst_psnr, g.best_psnr), span(g.worst_ssim, g.best_ssim),
+        span(g.min_pixels, g.max_pixels), g.points, g.points == 1 ? "" : "s",
+        format_number(g.worst->n), r.axes.at(g.worst->scene), g.worst->width, g.worst->height));
+  }
+  return out;
+}
+
 std::string study_markdown(const StudyResult& r) {
   std::string text = header(r);
   text += section("Where the pixel-major loop overtakes the triangle-major one",
@@ -317,6 +370,12 @@ std::string study_markdown(const StudyResult& r) {
                   "grid, measured in fresh sessions.",
                   checks);
   text += section("The hybrids' split", "", split_sentences(r));
+  text += section("Each technique's error",
+                  "Full mode: each renderer's frame of every point against raytrace's, in the "
+                  "mask of the pixels each effect touches (read from the tracer's ray tree, as "
+                  "rvr compare's by_effect). The error is exact, not sampled: the same in every "
+                  "run.",
+                  technique_error_sentences(r));
   text += section("Building per scene",
                   "What each renderer builds before its first frame, timed in every run; a scene "
                   "that changes every k frames costs t_frame + t_prepare / k a frame.",

@@ -36,3 +36,44 @@ def test_study_bad_input_is_the_command_lines(run_cli, tmp_path):
     with pytest.raises(rvr.BadInput) as caught:
         rvr.study(["builtin:nonesuch"], width=32, budget=2)
     assert str(caught.value) == expected
+
+
+def test_full_mode_measures_each_technique_against_the_tracer(run_cli, tmp_path):
+    # In full mode each renderer's first frame of a point is compared with raytrace's in each
+    # effect's mask: the same numbers whether the point was prepared in a worker process (the
+    # command line) or in this one, and the same as rvr.compare of the two renders made here.
+    args = ["builtin:effects", "--mode", "full", "--width", "32", "--budget", "6",
+            "--repetitions", "3", "-q", "-o", str(tmp_path)]
+    run_cli("study", *args)
+    by_process = json.loads((tmp_path / "study.json").read_text())["points"]
+    in_process = rvr.study(["builtin:effects"], mode="full", width=32, budget=6, repetitions=3)
+    assert by_process and in_process["points"]
+    for points in (by_process, in_process["points"]):
+        for p in points:
+            if p["renderer"] == "raytrace":
+                assert "effect_errors" not in p
+            else:
+                # builtin:effects' flat mirror is seen at every N.
+                assert [e["effect"] for e in p["effect_errors"]][:1] == ["reflection"], p
+    # The hybrid traces what its z-buffer cannot answer: identical to the tracer (PSNR null).
+    assert all(e["psnr_db"] is None for p in by_process if p["renderer"] == "hybrid_soft"
+               for e in p["effect_errors"])
+    key = lambda p: (p["renderer"], p["scene_n"], p["width"])
+    here = {key(p): p for p in in_process["points"]}
+    shared = [p for p in by_process if key(p) in here]
+    assert shared, "no point measured by both studies"
+    for p in shared:
+        assert p.get("effect_errors") == here[key(p)].get("effect_errors"), key(p)
+    # Independently: the point's renders here, compared as rvr compare compares them.
+    p = next(p for p in by_process if p["renderer"] == "softraster")
+    scene = rvr.Scene(f"builtin:effects:{int(p['scene_n'])}", width=p["width"],
+                      height=p["height"])
+    metrics = rvr.compare(rvr.render(scene, "raytrace", mode="full"),
+                          rvr.render(scene, "softraster", mode="full"))
+    expected = [{k: e[k] for k in ("effect", "pixels", "rmse", "psnr_db", "ssim")}
+                for e in metrics["effects"]["by_effect"]]
+    assert p["effect_errors"] == expected
+    # rvr.compare splits each effect's mask by the z-buffer's answers, as the command does.
+    assert metrics["effects"]["answers_from"] == "softraster"
+    reflection = metrics["effects"]["by_effect"][0]
+    assert [a["answer"] for a in reflection["answers"]] == ["reflected_view"]

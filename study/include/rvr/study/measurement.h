@@ -29,6 +29,17 @@ struct Run {
   bool busy = false;  // reference_ratio over kBusyRatio, or the system probe saw other work
 };
 
+// The colour error of a renderer's frame where one effect acts, against the tracer's frame of
+// the same point (compare's effect_errors: the mask from the tracer's ray tree). Exact and
+// machine-independent, like the counters: the same in every run.
+struct PointEffectError {
+  std::string effect;  // "reflection", "refraction", "lens", "csg"
+  double pixels = 0;   // the effect's mask
+  double rmse = 0;
+  double psnr_db = 0;  // +inf when identical
+  double ssim = 1;     // the mean of the SSIM map over the mask
+};
+
 struct Measurement {
   std::string renderer;  // "softraster"
   std::string scene;     // the family: "tessphere"
@@ -41,6 +52,10 @@ struct Measurement {
   // memory): "triangles.setup", "fragments.generated", "rays.primary", "bvh.nodes_visited", ...
   // Exact and machine-independent: the same in every run.
   std::map<std::string, double> counters;
+  // In full mode, when the study holds raytrace: the error of this renderer's frame in each
+  // effect's mask against raytrace's frame of the point (empty for raytrace itself, and for
+  // effects no pixel of the point shows).
+  std::vector<PointEffectError> effect_errors;
 
   // Every run measured while the machine was busy with something else.
   bool busy() const;

@@ -28,6 +28,7 @@
 
 #include "rvr/core/expected.h"
 #include "rvr/core/renderer.h"
+#include "rvr/study/measurement.h"
 #include "rvr/study/memory_estimate.h"
 #include "rvr/study/study.h"
 #include "rvr/study/sweep_plan.h"
@@ -74,6 +75,9 @@ class FrameSource {
   virtual double prepare_seconds(size_t index) const = 0;
   // Renderer `index`'s own count of the work of one frame (measurement.h).
   virtual std::map<std::string, double> counters(size_t index) const = 0;
+  // In full mode with raytrace among the renderers: renderer `index`'s error in each effect's
+  // mask against raytrace's frame of this scene (Measurement::effect_errors). Empty else.
+  virtual std::vector<PointEffectError> effect_errors(size_t /*index*/) const { return {}; }
   // One frame of renderer `index`.
   virtual Expected<FrameTime> time_frame(size_t index) = 0;
 };

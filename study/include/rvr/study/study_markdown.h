@@ -32,6 +32,11 @@ std::string method_text(const StudyResult& r);
 // crossover, a dominance, a tie or why nothing is concluded.
 std::vector<std::string> headline_sentences(const StudyResult& r);
 
+// In full mode, per renderer, family and effect: the range of its error in the effect's mask
+// against raytrace's frame over the sweep's points (Measurement::effect_errors), its worst
+// point named. Empty when no point holds such errors.
+std::vector<std::string> technique_error_sentences(const StudyResult& r);
+
 // "a = 1.2 ms (95%: 0.9 – 1.5)" (ns for the per-pixel, per-triangle and per-ray terms); empty
 // for a coefficient that is not identifiable.
 std::string coefficient_text(const Coefficient& c);
