@@ -17,6 +17,7 @@
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/scene_loader.h"
 #include "rvr/study/grid_of_copies.h"
+#include "rvr/study/measurement.h"
 
 namespace rvr::study {
 namespace {

@@ -10,12 +10,14 @@
 #include <map>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "counted_work_text.h"
 #include "rvr/study/bootstrap.h"
 #include "rvr/study/conclusions.h"
 #include "rvr/study/cost_model.h"
+#include "rvr/study/measurement.h"
 #include "rvr/study/memory_estimate.h"
 #include "rvr/study/scene_changes.h"
 #include "rvr/study/system_probe.h"
