@@ -294,6 +294,36 @@ TEST(TextureLod, VisibilityModeWritesTheShadingPassesLodWhenAsked) {
   }
 }
 
+// The hybrids' z-buffer pass in softraster: with visibility_ids_only it writes the ids and
+// levels of detail visibility mode writes without it, to the bit, and no other buffer.
+TEST(TextureLod, SoftrasterIdsOnlyWritesTheSameIdsAndLodAndNothingElse) {
+  Expected<Scene> cornell = make_builtin_scene("cornell");
+  ASSERT_TRUE(cornell.ok());
+  for (const Scene& s : {grazing_plane(160, 120), *cornell}) {
+    SoftRasterizer soft;
+    RenderOptions options;
+    options.mode = RenderMode::Visibility;
+    options.visibility_lod = true;
+    Expected<RenderOutput> all = soft.render(s, options);
+    options.visibility_ids_only = true;
+    Expected<RenderOutput> ids = soft.render(s, options);
+    ASSERT_TRUE(all.ok() && ids.ok());
+    const FrameBuffers &a = all->buffers, &b = ids->buffers;
+    EXPECT_EQ(b.width, a.width);
+    EXPECT_EQ(b.height, a.height);
+    ASSERT_EQ(b.object_id.size(), a.pixel_count());
+    EXPECT_TRUE(std::equal(a.object_id.begin(), a.object_id.end(), b.object_id.begin()));
+    EXPECT_TRUE(std::equal(a.primitive_id.begin(), a.primitive_id.end(), b.primitive_id.begin()));
+    ASSERT_EQ(b.lod.size(), a.lod.size());
+    for (size_t i = 0; i < a.lod.size(); ++i)
+      ASSERT_TRUE(a.lod[i] == b.lod[i] || (std::isnan(a.lod[i]) && std::isnan(b.lod[i]))) << i;
+    EXPECT_TRUE(b.depth.empty() && b.colour.empty() && b.normal.empty() && b.cost.empty());
+    size_t covered = 0;
+    for (uint32_t id : b.object_id) covered += id != kNoId;
+    EXPECT_GT(covered, a.pixel_count() / 4);
+  }
+}
+
 // A mesh whose texture coordinates or colours do not match its positions is bad input to both
 // z-buffers, not a read past the end.
 TEST(TextureLod, MismatchedUvsOrColoursAreBadInput) {

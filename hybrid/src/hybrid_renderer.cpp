@@ -71,6 +71,9 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   visibility_options.cost_aov = false;  // the cost AOV is the tracer's
   // Primary hits take the z-buffer's level of detail (its own screen-space derivatives).
   visibility_options.visibility_lod = true;
+  // Only the ids are read (ZBufferHits rebuilds each hit from them): softraster writes no other
+  // buffer.
+  visibility_options.visibility_ids_only = true;
   auto t_zbuffer = Clock::now();
   Expected<RenderOutput> zbuffer = rasterizer_->render(scene, visibility_options);
   const double zbuffer_seconds = seconds_since(t_zbuffer);

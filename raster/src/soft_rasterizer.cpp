@@ -416,7 +416,8 @@ Status draw_view(const RenderSetup& setup, const MirrorView& view, const ViewFra
     t = Clock::now();
     if (progress) progress->begin("readback", uint64_t(w) * uint64_t(h), "pixels");
     soft::write_visibility(list, target, scene.image.background, options.cost_aov,
-                           surfaces ? &*surfaces : nullptr, arena, progress, fb);
+                           options.visibility_ids_only, surfaces ? &*surfaces : nullptr, arena,
+                           progress, fb);
     out.stats["time.readback"] = seconds_since(t);
     return ok_status();
   }

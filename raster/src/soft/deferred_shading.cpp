@@ -61,6 +61,17 @@ void allocate_frame(int w, int h, FrameBuffers& fb) {
   ask_for_huge_pages(fb.cost);
 }
 
+// The ids alone, sized and left undefined (every pixel is written); every other buffer empty.
+void allocate_ids(int w, int h, FrameBuffers& fb) {
+  fb.allocate(0, 0);
+  fb.width = w;
+  fb.height = h;
+  fb.object_id.resize(fb.pixel_count());
+  fb.primitive_id.resize(fb.pixel_count());
+  ask_for_huge_pages(fb.object_id);
+  ask_for_huge_pages(fb.primitive_id);
+}
+
 // What visibility leaves per pixel, a row at a time: depth, object and primitive id, cost.
 // The one writer of those buffers for both passes (shading and visibility only).
 class VisibilityRows {
@@ -76,8 +87,7 @@ class VisibilityRows {
   // Row y of fb's depth, object id, primitive id and cost (0 without the cost AOV). The
   // target's "nothing covers it" id is the frame buffers' background id.
   void write(int y, FrameBuffers& fb) const {
-    static_assert(kNoId == 0xFFFFFFFFu);
-    const int width = target_.width();  // a local: stores through uint32_t* could alias a member
+    const int width = target_.width();  // a local: stores through float* could alias a member
     const size_t row = fb.index(0, y);
     if (cost_)
       target_.cost_row(y, fb.cost.data() + row);
@@ -85,16 +95,25 @@ class VisibilityRows {
       std::fill_n(fb.cost.data() + row, size_t(width), 0.0f);
     // One buffer at a time.
     const uint32_t* __restrict row_object = target_.objects() + row;
-    const uint32_t* __restrict row_primitive = target_.primitives() + row;
     const double* __restrict row_depth = target_.depths() + row;
     float* __restrict depth_out = fb.depth.data() + row;
-    uint32_t* __restrict primitive_out = fb.primitive_id.data() + row;
-    std::memcpy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
     // Loads before the selection, so that these loops vectorize (branch-free).
     for (int k = 0; k < width; ++k) {
       const float depth = float(row_depth[k]);
       depth_out[k] = row_object[k] == kNoId ? std::numeric_limits<float>::infinity() : depth;
     }
+    write_ids(y, fb);
+  }
+
+  // Row y of fb's object and primitive ids alone.
+  void write_ids(int y, FrameBuffers& fb) const {
+    static_assert(kNoId == 0xFFFFFFFFu);
+    const int width = target_.width();  // a local: stores through uint32_t* could alias a member
+    const size_t row = fb.index(0, y);
+    const uint32_t* __restrict row_object = target_.objects() + row;
+    const uint32_t* __restrict row_primitive = target_.primitives() + row;
+    uint32_t* __restrict primitive_out = fb.primitive_id.data() + row;
+    std::memcpy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
     if (every_primitive_id_) {
       for (int k = 0; k < width; ++k) {
         const uint32_t primitive = row_primitive[k];
@@ -307,10 +326,13 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
 }
 
 void write_visibility(const DrawList& list, const DepthTarget& target, const glm::vec3& background,
-                      bool cost, const SurfaceColours* surfaces, tbb::task_arena& arena,
-                      ProgressSink* progress, FrameBuffers& fb) {
+                      bool cost, bool ids_only, const SurfaceColours* surfaces,
+                      tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb) {
   const int w = target.width(), h = target.height();
-  allocate_frame(w, h, fb);  // every pixel is written below
+  if (ids_only)
+    allocate_ids(w, h, fb);
+  else
+    allocate_frame(w, h, fb);  // every pixel is written below
   const VisibilityRows visibility(list, target, cost);
   if (surfaces && surfaces->textured())
     fb.lod.assign(fb.pixel_count(), std::numeric_limits<float>::quiet_NaN());
@@ -318,10 +340,14 @@ void write_visibility(const DrawList& list, const DepthTarget& target, const glm
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
       for (int y = r.begin(); y != r.end(); ++y) {
         const size_t row = fb.index(0, y);
-        visibility.write(y, fb);
-        fill_vec3(fb.colour.data() + row, size_t(w), background);
-        std::memset(static_cast<void*>(fb.normal.data() + row), 0,
-                    size_t(w) * sizeof(glm::vec3));  // +0.0f is all zero bits
+        if (ids_only) {
+          visibility.write_ids(y, fb);
+        } else {
+          visibility.write(y, fb);
+          fill_vec3(fb.colour.data() + row, size_t(w), background);
+          std::memset(static_cast<void*>(fb.normal.data() + row), 0,
+                      size_t(w) * sizeof(glm::vec3));  // +0.0f is all zero bits
+        }
         if (fb.lod.empty()) continue;
         PlanesCache planes;
         for (int x = 0; x < w; ++x) {

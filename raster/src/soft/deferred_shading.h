@@ -44,10 +44,11 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
 
 // Visibility mode: sizes fb to the target and writes every pixel of every buffer without
 // shading: depth, object and primitive id and cost (0 everywhere when !cost) as shade_pixels
-// writes them, colour the background, normal 0.
+// writes them, colour the background, normal 0; with ids_only, the ids alone, the other
+// buffers left empty.
 // `surfaces` not null and some object textured: fb.lod too (the hybrids' primary hits).
 void write_visibility(const DrawList& list, const DepthTarget& target, const glm::vec3& background,
-                      bool cost, const SurfaceColours* surfaces, tbb::task_arena& arena,
-                      ProgressSink* progress, FrameBuffers& fb);
+                      bool cost, bool ids_only, const SurfaceColours* surfaces,
+                      tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb);
 
 }  // namespace rvr::soft

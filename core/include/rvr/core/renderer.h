@@ -84,6 +84,10 @@ struct RenderOptions {
   // Z-buffers in visibility mode: also write FrameBuffers::lod (their level of detail of each
   // textured pixel), which the hybrids' primary hits then sample at.
   bool visibility_lod = false;
+  // softraster in visibility mode: write object_id and primitive_id only (and lod with
+  // visibility_lod), leaving depth, colour, normal and cost empty: the hybrids' z-buffer pass,
+  // whose tracer rebuilds every hit from the ids. raster reads its buffers back as before.
+  bool visibility_ids_only = false;
   // softraster: hierarchical z (each 8x8 block's farthest depth rejects triangles behind it).
   bool hiz = true;
   // Cost AOV: false: the caller does not read the cost AOV, which is then 0 everywhere (the
