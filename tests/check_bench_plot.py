@@ -8,6 +8,9 @@
    panel (three panels wide).
 2. An older run without BM_Visibility rows or phase counters, as repetitions' medians: every
    chart is still written, each with its old layout (one row; two panels).
+3. The first run with a second one whose kernels were forced (RVR_ISA) and whose tracer is 1.5
+   times slower: targets.md gives each target from each run, side by side, with the ratios the
+   synthetic times make.
 
 Usage: check_bench_plot.py --plot bench/plot.py [--work-dir DIR]
 Exits 1 with one line per failure.
@@ -121,6 +124,37 @@ def check_run(plot, work, new):
                 f"{'no' if new else 'a'} z-buffer share panel")
 
 
+def check_forced(plot, work):
+    label = "forced run"
+    first, forced = synthetic_run(True), synthetic_run(True)
+    first["context"]["rvr_kernel"] = "avx512 (chosen from the CPU)"
+    forced["context"]["rvr_kernel"] = "avx2 (forced by RVR_ISA)"
+    for b in forced["benchmarks"]:
+        if b["name"].startswith("BM_Frame/raytrace/"):
+            b["real_time"] *= 1.5
+    paths = []
+    for name, run in [("first", first), ("forced", forced)]:
+        paths.append(work / f"{name}.json")
+        paths[-1].write_text(json.dumps(run))
+    out = work / "forced_run"
+    result = subprocess.run([sys.executable, str(plot), str(paths[0]), str(out), str(paths[1])],
+                            capture_output=True, text=True, timeout=100)
+    if result.returncode != 0:
+        failure(f"{label}: plot.py exited {result.returncode}: {result.stderr.strip()[-800:]}")
+        return
+    table = (out / "targets.md").read_text() if (out / "targets.md").is_file() else ""
+    # At N = 100 the synthetic times are 20.02 (softraster), 60.06 (raytrace; 90.09 forced) and
+    # 80.08 ms (hybrid_soft).
+    for want in ["| target | avx512 (chosen from the CPU) | wanted | met | avx2 (forced by RVR_ISA) | wanted | met |",
+                 "| BM_Frame tessphere/100/1024: raytrace time / softraster time (the per-pixel fixed cost) "
+                 "| 3 | <= 1.5 | no | 4.5 | <= 1.5 | no |",
+                 "| BM_Frame tessphere/100/1024: hybrid_soft time / raytrace time | 1.33 | <= 0.8 | no "
+                 "| 0.889 | <= 0.8 | no |",
+                 "not run (`bench/whole_process.sh`)"]:
+        if want not in table:
+            failure(f"{label}: targets.md has no line {want!r}:\n{table}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--plot", required=True, type=Path)
@@ -133,6 +167,7 @@ def main():
         work = Path(tempfile.mkdtemp(prefix="check_bench_plot_"))
     for new in (True, False):
         check_run(args.plot, work, new)
+    check_forced(args.plot, work)
     if FAILURES:
         sys.exit(1)
     print(f"check_bench_plot: every chart written, panels as the rows say ({work})")

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <glm/glm.hpp>
 #include <limits>
@@ -127,13 +128,32 @@ void EmbreeScene::occluded(const RTCOccludedFunctionNArguments* args) {
   }
 }
 
+namespace {
+
+// Embree's device configuration: when RVR_ISA forces our kernels to an instruction set, Embree
+// is held to the same one (its max_isa), so that a forced comparison races equals. Unset, each
+// chooses from the CPU.
+std::string device_config(const char* extra) {
+  std::string config = extra;
+  const char* forced = std::getenv("RVR_ISA");
+  const std::string isa = forced ? forced : "";
+  const char* embree_isa = isa == "sse"      ? "sse4.2"
+                           : isa == "avx2"   ? "avx2"
+                           : isa == "avx512" ? "avx512"
+                                             : nullptr;
+  if (embree_isa) config += std::string(config.empty() ? "" : ",") + "max_isa=" + embree_isa;
+  return config;
+}
+
+}  // namespace
+
 EmbreeScene* EmbreeScene::create(const EmbreeSceneInput& input, std::string& error) {
   auto backend = std::make_unique<EmbreeScene>();
   backend->user = input.user;
   backend->analytic_bounds = input.analytic_bounds;
   backend->hit_analytic = input.hit_analytic;
   backend->analytic_count = input.analytic_count;
-  backend->device = rtcNewDevice(nullptr);
+  backend->device = rtcNewDevice(device_config("").c_str());
   if (!backend->device) {
     error = "Embree: cannot create a device (error " +
             std::to_string(int(rtcGetDeviceError(nullptr))) + ")";
@@ -285,7 +305,7 @@ const char* kernel_isa() {
     if (!capture) return std::string("unknown");
     int saved = ::dup(1);
     ::dup2(::fileno(capture), 1);
-    RTCDevice device = rtcNewDevice("verbose=1");
+    RTCDevice device = rtcNewDevice(device_config("verbose=1").c_str());
     std::fflush(stdout);
     ::dup2(saved, 1);
     ::close(saved);
