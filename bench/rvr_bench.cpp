@@ -525,18 +525,23 @@ struct TraceAnswer {
 
 // Embree's answers for one scene and set of rays, computed once: the reference every other
 // accelerator's answers are checked against.
-const std::vector<TraceAnswer>& embree_answers(const std::string& key, const Scene& scene,
-                                               const std::vector<Ray>& rays) {
+// Embree's answers, or null with `error` set when Embree cannot trace here (no plugin).
+const std::vector<TraceAnswer>* embree_answers(const std::string& key, const Scene& scene,
+                                               const std::vector<Ray>& rays, std::string& error) {
   static std::mutex mutex;
   static std::map<std::string, std::vector<TraceAnswer>> cache;
   std::lock_guard<std::mutex> lock(mutex);
   auto& slot = cache[key];
   if (slot.empty()) {
     TraceGeometry embree(scene, SphereMode::Analytic, 64, AccelKind::Embree);
+    if (!embree.error().empty()) {
+      error = "Embree cannot trace: " + embree.error();
+      return nullptr;
+    }
     slot.resize(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) slot[i].hit = embree.closest(rays[i], slot[i].h);
   }
-  return slot;
+  return &slot;
 }
 
 // Checks that `answers` are Embree's, ray for ray: the same primitive (or the same miss) and t
@@ -613,6 +618,10 @@ void BM_Trace(benchmark::State& state, const std::string& accel, const std::stri
   TraceGeometry geometry(scene, SphereMode::Analytic, 64, accel_kind(accel),
                          TriangleTest::MollerTrumbore, std::nullopt,
                          accel == "embree_medium" ? EmbreeQuality::Medium : EmbreeQuality::High);
+  if (!geometry.error().empty()) {  // e.g. Embree without its plugin: nothing to measure
+    state.SkipWithError(geometry.error().c_str());
+    return;
+  }
   std::vector<Ray> rays = make_rays(scene, rays_kind);
   tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
 
@@ -621,8 +630,14 @@ void BM_Trace(benchmark::State& state, const std::string& accel, const std::stri
   for (size_t i = 0; i < rays.size(); ++i)
     answers[i].hit = geometry.closest(rays[i], answers[i].h, counters);
   if (accel_kind(accel) != AccelKind::Embree) {
-    TraceCheck check = check_against_embree(answers, embree_answers(name + rays_kind, scene, rays),
-                                            geometry, rays);
+    std::string embree_error;
+    const std::vector<TraceAnswer>* embree =
+        embree_answers(name + rays_kind, scene, rays, embree_error);
+    if (!embree) {
+      state.SkipWithError(embree_error.c_str());
+      return;
+    }
+    TraceCheck check = check_against_embree(answers, *embree, geometry, rays);
     // Edge cases are rare: a ray must pass within 1e-4 of an edge (in barycentrics).
     if (check.wrong > 0 ||
         check.edge + check.crossing + check.ill_conditioned > rays.size() / 1000) {
@@ -683,6 +698,10 @@ void BM_TracePacket(benchmark::State& state, const std::string& accel,
   std::string name = scene_name + ":" + std::to_string(state.range(0));
   const Scene& scene = builtin(name);
   TraceGeometry geometry(scene, SphereMode::Analytic, 64, accel_kind(accel));
+  if (!geometry.error().empty()) {
+    state.SkipWithError(geometry.error().c_str());
+    return;
+  }
   std::vector<std::vector<int>> ray_index;
   std::vector<RayPacket> tiles = make_tiles(scene, ray_index);
   std::vector<Ray> rays = make_rays(scene, "primary");
@@ -703,8 +722,14 @@ void BM_TracePacket(benchmark::State& state, const std::string& accel,
       total.primitive_tests += counters[size_t(k)].primitive_tests;
     }
   }
-  TraceCheck check =
-      check_against_embree(answers, embree_answers(name + "primary", scene, rays), geometry, rays);
+  std::string embree_error;
+  const std::vector<TraceAnswer>* embree =
+      embree_answers(name + "primary", scene, rays, embree_error);
+  if (!embree) {
+    state.SkipWithError(embree_error.c_str());
+    return;
+  }
+  TraceCheck check = check_against_embree(answers, *embree, geometry, rays);
   if (check.wrong > 0 || check.edge + check.crossing + check.ill_conditioned > rays.size() / 1000) {
     std::string error = "packet answers differ from Embree's single-ray ones on " +
                         std::to_string(check.wrong) + " rays (first: ray " +
@@ -744,6 +769,10 @@ void BM_Build(benchmark::State& state, const std::string& accel) {
     TraceGeometry g(scene, SphereMode::Analytic, 64, accel_kind(accel),
                     TriangleTest::MollerTrumbore, std::nullopt,
                     accel == "embree_medium" ? EmbreeQuality::Medium : EmbreeQuality::High);
+    if (!g.error().empty()) {
+      state.SkipWithError(g.error().c_str());
+      break;
+    }
     if (accel == "bvh") {
       nodes = double(g.wide_bvh().stats().nodes);
       sah = g.wide_bvh().stats().binary_sah_cost;

@@ -365,6 +365,14 @@ struct Packet8 {
   Vec3f o;
   unsigned valid;
   KernelRay ray[8];  // the same rays one by one: edge rechecks, single-ray fallback
+  // The packet as one interval ray (Boulos et al. 2006), for culling a node's children that no
+  // lane can enter (cull_children): when every lane's direction has the same sign on each axis,
+  // each reciprocal lies in [rdir_lo, rdir_hi] and the near plane of a box on axis a is bounds
+  // row near_row[a] for every lane; margin_hi is the largest lane margin.
+  bool coherent = false;
+  float rdir_lo[3], rdir_hi[3];
+  int near_row[3], far_row[3];
+  float margin_hi;
 };
 
 struct PacketBest8 {
@@ -482,6 +490,49 @@ inline void intersect_triangle8(const TriangleBlock& b, unsigned j, const Packet
   }
 }
 
+// The largest lane of a.
+inline float max_lane(V8 a) {
+  a = max(a, swap_lanes<4>(a));
+  a = max(a, swap_lanes<2>(a));
+  a = max(a, swap_lanes<1>(a));
+  alignas(32) float x[8];
+  store(x, a);
+  return x[0];
+}
+
+// The children of `node` (bit i: child slot i) that no lane of `active` can enter, found for all
+// eight slots at once with the packet's interval ray. A lane enters a child when the per-lane
+// test of traverse_packet passes: t0 - margin <= (t1 + margin) * kWiden, with t0 the largest
+// entry over the axes (and tmin) and t1 the smallest exit (and the lane's best t). Over the
+// packet, each axis's entry (b - o) / d is at least the smaller of (b - o) * rdir_lo and
+// (b - o) * rdir_hi (it is linear in the reciprocal), each exit at most the larger, and every
+// best t at most the largest: a child whose largest entry bound exceeds its smallest exit bound,
+// after margins wider than every rounding of either test (2^-18 of the planes' and origin's
+// magnitudes, against the per-lane test's few ulps), has no lane that enters it. Slots whose
+// bounds are infinite (empty) give NaN and are never culled here.
+inline unsigned cull_children(const WideNode& node, const Packet8& p, unsigned active,
+                              const PacketBest8& best) {
+  const V8 slack = V8::splat(1.0f / 262144.0f);
+  V8 entry = p.tmin;  // the same in every lane
+  V8 exit =
+      V8::splat(max_lane(select(M8::from_bits(active), best.t, V8::splat(-__builtin_inff()))));
+  for (int a = 0; a < 3; ++a) {
+    const V8 o = V8::splat(p.o[a]);
+    const V8 lo = V8::splat(p.rdir_lo[a]), hi = V8::splat(p.rdir_hi[a]);
+    const V8 r = max(abs(lo), abs(hi));
+    const V8 bn = V8::load(node.bounds[p.near_row[a]]), bf = V8::load(node.bounds[p.far_row[a]]);
+    const V8 dn = bn - o, df = bf - o;
+    const V8 near_lo = min(dn * lo, dn * hi) - (abs(bn) + abs(o)) * r * slack;
+    const V8 far_hi = max(df * lo, df * hi) + (abs(bf) + abs(o)) * r * slack;
+    entry = max(near_lo, entry);
+    exit = min(far_hi, exit);
+  }
+  const V8 margin = V8::splat(p.margin_hi);
+  const V8 lane_hi = (exit + margin) * V8::splat(kWiden);
+  const V8 bound = lane_hi + abs(lane_hi) * slack;
+  return movemask(entry - margin > bound);
+}
+
 template <bool kCount>
 void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best,
                      KernelCounters* counters) {
@@ -506,11 +557,13 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
       if (kCount) nodes = nodes + masked(M8::from_bits(active), V8::splat(1.0f));
       const WideNode& node = bvh.nodes[ref];
       const M8 act = M8::from_bits(active);
+      const unsigned culled = p.coherent ? cull_children(node, p, active, best) : 0u;
       uint32_t refs[kWideBvhWidth];
       float keys[kWideBvhWidth];
       alignas(32) float nears[kWideBvhWidth][8];
       int n = 0;
       for (int i = 0; i < kWideBvhWidth && node.child[i] != kEmptyTree; ++i) {
+        if ((culled >> i) & 1u) continue;
         V8 tn[3], tf[3];
         for (int a = 0; a < 3; ++a) {
           V8 t_lo = mul_sub(V8::splat(node.bounds[2 * a][i]), p.rdir[a], p.org_rdir[a]);
@@ -589,6 +642,16 @@ bool make_packet8(const RayPacket& packet, int first, Packet8& p) {
   }
   p.margin = margin;
   p.tmin = V8::splat(packet.tmin);
+  p.coherent = true;
+  for (int a = 0; a < 3; ++a) {
+    const unsigned negative = movemask(p.rdir[a] < V8::splat(0.0f));
+    p.coherent = p.coherent && (negative == 0u || negative == 0xFFu);
+    p.rdir_lo[a] = -max_lane(-p.rdir[a]);
+    p.rdir_hi[a] = max_lane(p.rdir[a]);
+    p.near_row[a] = 2 * a + (negative ? 1 : 0);
+    p.far_row[a] = 2 * a + (negative ? 0 : 1);
+  }
+  p.margin_hi = max_lane(margin);
   for (int l = 0; l < 8; ++l) {
     for (int a = 0; a < 3; ++a) {
       p.ray[l].origin[a] = packet.origin[a];
