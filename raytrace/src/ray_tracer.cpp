@@ -209,6 +209,7 @@ class FrameTracer {
     size_t batch_pixel[kPacketRays];
     bool mixed = false;  // the batch's pixels have more than one material
     uint32_t batch_material = 0;
+    geometry_.fetch_surface_data(hits, packet.count, mode == RenderMode::Visibility);
     const int y1 = y0 + packet.count / w;
     for (int y = y0, k = 0; y < y1; ++y)
       for (int x = x0; x < x0 + w; ++x, ++k) {  // ray k is pixel (x, y)

@@ -7,6 +7,7 @@
 
 #include "embree_backend.h"
 #include "rvr/core/check.h"
+#include "rvr/core/prefetch.h"
 #include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/shape_geometry.h"
 #include "rvr/raytrace/traversal_kernels.h"
@@ -457,6 +458,32 @@ TriangleSurfaceData TraceGeometry::triangle_surface_data(uint32_t p) const {
     for (int c = 0; c < 3; ++c) d.normal[c] = &mesh->normals[v[c]];
   }
   return d;
+}
+
+void TraceGeometry::fetch_surface_data(const HitRecord* hits, int n, bool ids_only) const {
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  auto each_triangle = [&](auto&& fetch) {
+    for (int k = 0; k < n; ++k)
+      if (hits[k].primitive < n_triangles && (k == 0 || hits[k].primitive != hits[k - 1].primitive))
+        fetch(hits[k].primitive);
+  };
+  each_triangle([&](uint32_t p) {
+    prefetch(&triangles_[p]);
+    prefetch(&triangle_object_[p]);
+    prefetch(&triangle_id_[p]);
+    prefetch(&triangle_in_mesh_[p]);
+  });
+  if (ids_only) return;
+  each_triangle([&](uint32_t p) {
+    const TriangleMesh* mesh = object_mesh_[triangle_object_[p]];
+    if (mesh->smooth()) prefetch(&mesh->triangles[triangle_in_mesh_[p]]);
+  });
+  each_triangle([&](uint32_t p) {
+    const TriangleMesh* mesh = object_mesh_[triangle_object_[p]];
+    if (!mesh->smooth()) return;
+    const glm::uvec3& v = mesh->triangles[triangle_in_mesh_[p]];
+    for (int c = 0; c < 3; ++c) prefetch(&mesh->normals[v[c]]);
+  });
 }
 
 bool TraceGeometry::intersect_named(const Ray& ray, uint32_t object, uint32_t primitive,

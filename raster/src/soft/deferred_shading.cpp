@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "rvr/core/check.h"
+#include "rvr/core/prefetch.h"
 #include "rvr/core/shade_batch.h"
 #include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/surface_colour.h"
@@ -180,6 +181,7 @@ class RowShader {
     const uint32_t* object_of = frame_.target.objects();
     const size_t row = frame_.fb.index(0, y);
     frame_.visibility.write(y, frame_.fb);
+    for (int x = 0; x < std::min(w, kVerticesAhead); ++x) fetch_triangle(row + size_t(x));
     int x = 0;
     while (x < w) {
       if (object_of[row + size_t(x)] == kNoId) {
@@ -189,6 +191,8 @@ class RowShader {
         x = end;
         continue;
       }
+      if (x + kTriangleAhead < w) fetch_triangle(row + size_t(x + kTriangleAhead));
+      if (x + kVerticesAhead < w) fetch_vertices(row + size_t(x + kVerticesAhead));
       add_pixel(row + size_t(x), x, y);
       ++x;
     }
@@ -220,6 +224,34 @@ class RowShader {
     fill_vec3(frame_.fb.colour.data() + o, n, frame_.settings.background);
     std::memset(static_cast<void*>(frame_.fb.normal.data() + o), 0,
                 n * sizeof(glm::vec3));  // +0.0f is all zero bits
+  }
+
+  // Shading a pixel reads its triangle's vertex indices, then its vertices (and vertex
+  // normals): two dependent loads, both misses where neighbouring pixels show unrelated
+  // triangles of a large mesh (a soup). They are fetched ahead along the row, so that the
+  // misses of several pixels overlap instead of stalling one by one: pixel x + kTriangleAhead's
+  // vertex indices, and pixel x + kVerticesAhead's vertices (its indices have arrived by then).
+  // A pixel showing its left neighbour's triangle is skipped (put_triangle keeps that one).
+  static constexpr int kTriangleAhead = 16, kVerticesAhead = 8;
+  bool shows_new_triangle(size_t o) const {
+    const uint32_t* object = frame_.target.objects();
+    const uint32_t* primitive = frame_.target.primitives();
+    return object[o] != kNoId && (o % size_t(frame_.target.width()) == 0 ||
+                                  object[o] != object[o - 1] || primitive[o] != primitive[o - 1]);
+  }
+  void fetch_triangle(size_t o) const {
+    if (!shows_new_triangle(o)) return;
+    const TriangleMesh& mesh = *frame_.objects[frame_.target.objects()[o]].mesh;
+    prefetch(&mesh.triangles[frame_.target.primitives()[o]]);
+  }
+  void fetch_vertices(size_t o) const {
+    if (!shows_new_triangle(o)) return;
+    const ObjectShading& s = frame_.objects[frame_.target.objects()[o]];
+    const glm::uvec3& tri = s.mesh->triangles[frame_.target.primitives()[o]];
+    for (int c = 0; c < 3; ++c) {
+      prefetch(&s.mesh->positions[tri[c]]);
+      if (s.smooth) prefetch(&s.mesh->normals[tri[c]]);
+    }
   }
 
   // The covered pixel o (at x, y) into the next slot: barycentrics, material, triangle.

@@ -112,6 +112,11 @@ class TraceGeometry {
   // surface()'s inputs for triangle p (a unified index below triangle_count()), for the shading
   // kernels, which compute the same surface from them.
   TriangleSurfaceData triangle_surface_data(uint32_t p) const;
+  // Asks the cache ahead for what triangle_surface_data (ids_only: hit_ids) reads of the
+  // triangles hits[0, n) hit: its arrays' entries, then the mesh's vertex indices, then its
+  // vertex normals (each level's addresses come from the one before). A block's misses overlap
+  // instead of stalling one hit at a time; nothing is computed or changed.
+  void fetch_surface_data(const HitRecord* hits, int n, bool ids_only) const;
 
   // The hit of `ray` with one thing a visibility buffer named, by the same intersection code as
   // closest(): for a mesh object triangle `primitive` of it; for a sphere or square the object
