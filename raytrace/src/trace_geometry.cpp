@@ -461,6 +461,7 @@ TriangleSurfaceData TraceGeometry::triangle_surface_data(uint32_t p) const {
 }
 
 void TraceGeometry::fetch_surface_data(const HitRecord* hits, int n, bool ids_only) const {
+  if (triangles_.size() < kFetchAheadTriangles) return;
   const uint32_t n_triangles = uint32_t(triangles_.size());
   auto each_triangle = [&](auto&& fetch) {
     for (int k = 0; k < n; ++k)

@@ -161,6 +161,7 @@ struct FrameShading {
   const ShadeLights& lights;
   glm::vec3 eye;
   FrameBuffers& fb;
+  bool fetch_ahead;  // enough triangles that their data lies beyond the caches (prefetch.h)
 };
 
 // Shades rows of one range: each covered pixel gathered into a batch of kShadeBatch slots
@@ -181,7 +182,9 @@ class RowShader {
     const uint32_t* object_of = frame_.target.objects();
     const size_t row = frame_.fb.index(0, y);
     frame_.visibility.write(y, frame_.fb);
-    for (int x = 0; x < std::min(w, kVerticesAhead); ++x) fetch_triangle(row + size_t(x));
+    const bool ahead = frame_.fetch_ahead;
+    if (ahead)
+      for (int x = 0; x < std::min(w, kVerticesAhead); ++x) fetch_triangle(row + size_t(x));
     int x = 0;
     while (x < w) {
       if (object_of[row + size_t(x)] == kNoId) {
@@ -191,8 +194,8 @@ class RowShader {
         x = end;
         continue;
       }
-      if (x + kTriangleAhead < w) fetch_triangle(row + size_t(x + kTriangleAhead));
-      if (x + kVerticesAhead < w) fetch_vertices(row + size_t(x + kVerticesAhead));
+      if (ahead && x + kTriangleAhead < w) fetch_triangle(row + size_t(x + kTriangleAhead));
+      if (ahead && x + kVerticesAhead < w) fetch_vertices(row + size_t(x + kVerticesAhead));
       add_pixel(row + size_t(x), x, y);
       ++x;
     }
@@ -342,8 +345,9 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
   // The light samples as the kernel reads them (none: the colour is the base).
   const bool lit = settings.colour == ShadedColour::Local && settings.samples;
   const ShadeLightArrays light_arrays(lit ? *settings.samples : std::vector<LightSample>{});
-  const FrameShading frame{
-      target, settings, kernels, visibility, objects, light_arrays.lights(), settings.eye, fb};
+  const FrameShading frame{target,       settings, kernels,
+                           visibility,   objects,  light_arrays.lights(),
+                           settings.eye, fb,       list.triangles() >= kFetchAheadTriangles};
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, target.height()),
                       [&](const tbb::blocked_range<int>& r) {

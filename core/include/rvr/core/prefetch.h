@@ -2,7 +2,14 @@
 // miss, so that the misses of a batch overlap instead of stalling one at a time.
 #pragma once
 
+#include <cstddef>
+
 namespace rvr {
+
+// Below this many triangles a scene's per-triangle shading data (vertex indices, vertices,
+// normals, the tracer's precomputed edges: about 100 bytes a triangle) stays in a core's L2
+// cache, and fetching it ahead would be work for nothing; both loop orders skip it there alike.
+constexpr size_t kFetchAheadTriangles = size_t(1) << 14;
 
 // An asm statement rather than __builtin_prefetch: GCC 12 deletes a builtin prefetch whose loop
 // does nothing else but test a condition (the shape of a fetch-ahead pass over a batch), and the
