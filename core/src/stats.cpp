@@ -167,6 +167,10 @@ constexpr std::array kStats = {
                     "(silhouettes, edges)"},
     StatDeclaration{"hybrid.csg_pixels", kCount, "pixels", "hybrids",
                     "pixels a CSG object won, intersected besides the z-buffer's hit"},
+    StatDeclaration{"hybrid.approximated_pixels", kCount, "samples", "hybrids",
+                    "samples of the accumulation passes whose rebuilt hit a nearer analytic "
+                    "sphere or CSG solid replaced (a sphere's rim outside its polygon), "
+                    "intersected besides the z-buffer's hit"},
     StatDeclaration{"hybrid.background", kCount, "pixels", "hybrids",
                     "empty pixels left as background without a ray: rays.primary + "
                     "hybrid.background is the pixel count"},

@@ -9,13 +9,15 @@
 namespace rvr {
 
 // X(field, stat): pixels whose hit was rebuilt from the z-buffer's ids, traced instead (missed
-// or empty), and won by a CSG object; of those traced, the ones whose named primitive the ray
+// or empty), and won by a CSG object; samples whose rebuilt hit a shape the z-buffer draws
+// approximately won (sample passes); of those traced, the ones whose named primitive the ray
 // missed (silhouettes, edges); empty pixels left as background without a ray.
-#define RVR_HYBRID_COUNTS(X)                   \
-  X(rebuilt, "hybrid.rebuilt")                 \
-  X(fallback_traced, "hybrid.fallback_traced") \
-  X(fallback_missed, "hybrid.fallback_missed") \
-  X(csg_pixels, "hybrid.csg_pixels")           \
+#define RVR_HYBRID_COUNTS(X)                           \
+  X(rebuilt, "hybrid.rebuilt")                         \
+  X(fallback_traced, "hybrid.fallback_traced")         \
+  X(fallback_missed, "hybrid.fallback_missed")         \
+  X(csg_pixels, "hybrid.csg_pixels")                   \
+  X(approximated_pixels, "hybrid.approximated_pixels") \
   X(background, "hybrid.background")
 
 struct HybridCounters {

@@ -72,6 +72,15 @@ bool ZBufferHits::csg_wins(const Ray& ray, HitRecord& hit, TraversalCounters& wo
   return true;
 }
 
+bool ZBufferHits::approximated_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const {
+  HitRecord shape;
+  if (!geometry_.closest_approximated(ray, shape, work) ||
+      !(shape.t < hit.t || (shape.t == hit.t && shape.primitive < hit.primitive)))
+    return false;
+  hit = shape;
+  return true;
+}
+
 void ZBufferHits::centre_hits(CentreBlock& block) const {
   HybridCounters& counters = counters_.local();
   const RayPacket& packet = block.packet;
@@ -172,6 +181,16 @@ void ZBufferHits::sample_hits(SampleBlock& block) const {
       if (block.given[j]) block.given_lod[j] = visible_.lod[i];
       if (rebuilt) {
         counters.rebuilt++;
+        // A sample's ray is jittered in its pixel and leaves from its lens point: the centre
+        // rays' screen bounds of the shapes the z-buffer draws approximately do not bound where
+        // it meets them. Every rebuilt hit is checked against those shapes instead (a sphere's
+        // rim outside its inscribed polygon, in front of what the z-buffer drew there); the
+        // nearer wins, as closest() would have it. No triangle lies nearer: the one the z-buffer
+        // drew is the nearest, and an approximated shape's polygon lies inside the shape.
+        if (geometry_.has_approximated() && approximated_wins(ray, hit, block.work)) {
+          block.given[j] = false;
+          counters.approximated_pixels++;
+        }
         if (geometry_.has_csg() && csg_wins(ray, hit, block.work)) {
           block.given[j] = false;
           counters.csg_pixels++;

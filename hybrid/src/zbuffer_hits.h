@@ -43,6 +43,8 @@ class ZBufferHits : public PrimaryHitSource {
   // Whether the hit a CSG object gives `ray` is nearer than `hit` (ties by primitive index, as
   // closest() breaks them); if so `hit` becomes it.
   bool csg_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const;
+  // The same for the shapes the z-buffer draws approximately (sample passes: see sample_hits).
+  bool approximated_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const;
 
   const Scene& scene_;
   const TraceGeometry& geometry_;

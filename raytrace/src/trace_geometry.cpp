@@ -68,9 +68,12 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
     });
   }
 
-  for (size_t k = 0; k < analytic_.size(); ++k)
+  for (size_t k = 0; k < analytic_.size(); ++k) {
     if (std::holds_alternative<CsgSolid::Traced>(analytic_[k].shape))
       csg_primitives_.push_back(uint32_t(triangles_.size() + k));
+    if (!triangle_form_exact(analytic_[k]))
+      approximated_primitives_.push_back(uint32_t(triangles_.size() + k));
+  }
 
   if (accel_ == AccelKind::Embree) {
     embree_.reset(make_embree_backend(*this, error_.message));
@@ -125,6 +128,11 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
 
 TraceGeometry::~TraceGeometry() = default;
 
+bool TraceGeometry::triangle_form_exact(const Analytic& a) {
+  return std::visit(
+      [](const auto& shape) { return std::decay_t<decltype(shape)>::kTriangleFormExact; }, a.shape);
+}
+
 Aabb TraceGeometry::analytic_bounds(const Analytic& a) {
   std::vector<BoundingBall> balls;
   std::visit([&](const auto& shape) { shape.bounding_balls(balls); }, a.shape);
@@ -138,12 +146,9 @@ Aabb TraceGeometry::analytic_bounds(const Analytic& a) {
 
 std::vector<Aabb> TraceGeometry::approximated_bounds() const {
   std::vector<Aabb> bounds;
-  for (const Analytic& a : analytic_) {
-    const bool exact = std::visit(
-        [](const auto& shape) { return std::decay_t<decltype(shape)>::kTriangleFormExact; },
-        a.shape);
-    if (!exact) bounds.push_back(analytic_bounds(a));
-  }
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  for (uint32_t p : approximated_primitives_)
+    bounds.push_back(analytic_bounds(analytic_[p - n_triangles]));
   return bounds;
 }
 
@@ -599,9 +604,19 @@ void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32
 }
 
 bool TraceGeometry::closest_csg(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
+  return closest_among(csg_primitives_, ray, hit, counters);
+}
+
+bool TraceGeometry::closest_approximated(const Ray& ray, HitRecord& hit,
+                                         TraversalCounters& counters) const {
+  return closest_among(approximated_primitives_, ray, hit, counters);
+}
+
+bool TraceGeometry::closest_among(const std::vector<uint32_t>& primitives, const Ray& ray,
+                                  HitRecord& hit, TraversalCounters& counters) const {
   const uint32_t n_triangles = uint32_t(triangles_.size());
   bool found = false;
-  for (uint32_t p : csg_primitives_) {
+  for (uint32_t p : primitives) {
     HitRecord h;
     counters.primitive_tests++;
     if (!hit_analytic(analytic_[p - n_triangles], ray, found ? tie_limit(hit.t) : ray.tmax, h))

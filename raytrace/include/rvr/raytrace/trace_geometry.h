@@ -140,6 +140,11 @@ class TraceGeometry {
   bool has_csg() const { return !csg_primitives_.empty(); }
   // Closest hit among the CSG objects only, with closest()'s tie rule.
   bool closest_csg(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
+  // True when the scene holds shapes a z-buffer draws approximately or not at all (those of
+  // approximated_bounds).
+  bool has_approximated() const { return !approximated_primitives_.empty(); }
+  // Closest hit among those shapes only, with closest()'s tie rule.
+  bool closest_approximated(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
 
   size_t primitive_count() const { return triangles_.size() + analytic_.size(); }
   size_t triangle_count() const { return triangles_.size(); }
@@ -166,6 +171,9 @@ class TraceGeometry {
 
   template <class TriangleTestFn, bool kAnyHit>
   bool query(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
+  // Closest hit among the analytic shapes `primitives` (unified indices), closest()'s tie rule.
+  bool closest_among(const std::vector<uint32_t>& primitives, const Ray& ray, HitRecord& hit,
+                     TraversalCounters& counters) const;
   template <bool kAnyHit>
   bool query_analytic(const Ray& ray, float t_max, HitRecord& hit,
                       TraversalCounters* counters) const;
@@ -175,6 +183,8 @@ class TraceGeometry {
   bool occluded_wide(const Ray& ray, TraversalCounters* counters) const;
   bool hit_analytic(const Analytic& a, const Ray& ray, float t_max, HitRecord& hit) const;
   static Aabb analytic_bounds(const Analytic& a);
+  // Whether the shape's triangle form, which a z-buffer draws, is exactly it (a square).
+  static bool triangle_form_exact(const Analytic& a);
   friend struct EmbreeBackend;
   friend bool embree_closest(const EmbreeBackend&, const Ray&, HitRecord&);
   friend void embree_closest_packet(const EmbreeBackend&, const RayPacket&, HitRecord*);
@@ -191,10 +201,11 @@ class TraceGeometry {
   std::vector<const TriangleMesh*> object_mesh_;                   // per object, or null
   std::vector<std::unique_ptr<const TriangleMesh>> owned_meshes_;  // tessellated spheres
   std::vector<uint32_t> object_material_;
-  std::vector<uint32_t> object_first_triangle_;  // unified index of each object's triangle 0
-  std::vector<uint32_t> object_analytic_;        // index into analytic_, or kNoPrimitive
-  std::vector<uint32_t> csg_primitives_;         // unified indices of the CSG objects
-  std::vector<uint8_t> object_names_triangles_;  // 1: its ids name triangles (not a sphere's)
+  std::vector<uint32_t> object_first_triangle_;    // unified index of each object's triangle 0
+  std::vector<uint32_t> object_analytic_;          // index into analytic_, or kNoPrimitive
+  std::vector<uint32_t> csg_primitives_;           // unified indices of the CSG objects
+  std::vector<uint32_t> approximated_primitives_;  // ... of approximated_bounds' shapes
+  std::vector<uint8_t> object_names_triangles_;    // 1: its ids name triangles (not a sphere's)
   // bvh2: leaf slots of bvh_ hold a primitive index and, for triangles, a copy in leaf order for
   // locality. bvh: bvh_ is over analytic_ only (slot -> analytic index), wide_ over triangles_.
   Bvh bvh_;
