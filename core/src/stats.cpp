@@ -166,11 +166,13 @@ constexpr std::array kStats = {
                     "of those traced, the ones whose named primitive the ray missed "
                     "(silhouettes, edges)"},
     StatDeclaration{"hybrid.csg_pixels", kCount, "pixels", "hybrids",
-                    "pixels a CSG object won, intersected besides the z-buffer's hit"},
-    StatDeclaration{"hybrid.approximated_pixels", kCount, "samples", "hybrids",
-                    "samples of the accumulation passes whose rebuilt hit a nearer analytic "
-                    "sphere or CSG solid replaced (a sphere's rim outside its polygon), "
-                    "intersected besides the z-buffer's hit"},
+                    "pixels (and samples) where a CSG object is seen, intersected besides the "
+                    "z-buffer's hit"},
+    StatDeclaration{"hybrid.approximated_pixels", kCount, "pixels", "hybrids",
+                    "pixels (and samples) whose hit is a shape the z-buffer draws approximately "
+                    "(an analytic sphere, disc or CSG solid), intersected besides the z-buffer's "
+                    "hit: nearer than it (a sphere's rim outside its polygon) or where it drew "
+                    "nothing"},
     StatDeclaration{"hybrid.background", kCount, "pixels", "hybrids",
                     "empty pixels left as background without a ray: rays.primary + "
                     "hybrid.background is the pixel count"},

@@ -31,7 +31,7 @@ HybridCounters ZBufferHits::counters() const {
 
 // No pixel of the block can show anything to the tracer: the z-buffer covered none of them nor
 // of their neighbours, and none lies where a shape it draws approximately or not at all may
-// appear (may_hide_a_surface for the whole block at once).
+// appear (centre_hits' tests for the whole block at once).
 bool ZBufferHits::only_background(int x0, int y0, int x1, int y1) const {
   const size_t width = size_t(visible_.width);
   if (!approximated_.empty())
@@ -51,12 +51,10 @@ bool ZBufferHits::only_background(int x0, int y0, int x1, int y1) const {
   return true;
 }
 
-// Whether the tracer may see a surface at empty pixel (x, y): next to a pixel the z-buffer
-// covered (a silhouette or shared edge may fall either way at a centre), or where a shape it
-// draws approximately or not at all may appear.
-bool ZBufferHits::may_hide_a_surface(int x, int y) const {
+// Whether empty pixel (x, y) lies next to a pixel the z-buffer covered: a silhouette or shared
+// edge may fall either way at its centre, so the tracer may see any surface there.
+bool ZBufferHits::next_to_drawn(int x, int y) const {
   const size_t width = size_t(visible_.width);
-  if (approximated_at(size_t(y) * width + size_t(x))) return true;
   for (int ny = std::max(y - 1, 0); ny <= std::min(y + 1, visible_.height - 1); ++ny)
     for (int nx = std::max(x - 1, 0); nx <= std::min(x + 1, visible_.width - 1); ++nx)
       if (visible_.object_id[size_t(ny) * width + size_t(nx)] != kNoId) return true;
@@ -79,6 +77,11 @@ bool ZBufferHits::approximated_wins(const Ray& ray, HitRecord& hit, TraversalCou
     return false;
   hit = shape;
   return true;
+}
+
+bool ZBufferHits::csg_hit(const HitRecord& hit) const {
+  return hit.primitive != kNoPrimitive &&
+         scene_.objects[geometry_.hit_ids(hit).first].type == ObjectType::Csg;
 }
 
 void ZBufferHits::centre_hits(CentreBlock& block) const {
@@ -104,34 +107,46 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
       approximate[k] = approximated_at(i);
       hits[k] = HitRecord{};
       work[k] = TraversalCounters{};
-      traced[k] = !drawn[k] && may_hide_a_surface(x, y);
-      // Otherwise background to the z-buffer, away from every edge it drew and from every
-      // shape it could not draw exactly: background to the tracer too, without a ray.
-      if (!drawn[k] && !traced[k]) background++;
+      traced[k] = !drawn[k] && next_to_drawn(x, y);
+      // Otherwise, empty, background to the z-buffer away from every edge it drew: background
+      // to the tracer too, without a ray, unless a shape the z-buffer draws approximately may
+      // appear there (below).
+      if (!drawn[k] && !traced[k] && !approximate[k]) background++;
     }
   geometry_.intersect_named_packet(packet, object, primitive, drawn, hits, rebuilt, work);
   for (int k = 0; k < n; ++k) {
     if (!drawn[k]) {
       n_traced += traced[k];
+      // Empty, away from every edge, where a shape the z-buffer draws approximately or not at
+      // all may appear: no triangle lies under the centre, so the nearest of those shapes is
+      // the hit, or the background.
+      if (!traced[k] && approximate[k]) {
+        counters.fallback_traced++;
+        counters.approximated_pixels +=
+            geometry_.closest_approximated(PrimaryRays::ray_of(packet, k), hits[k], work[k]);
+      }
       continue;
     }
-    if (!rebuilt[k] || approximate[k]) {
+    if (!rebuilt[k]) {
       // The z-buffer's polygon covers the centre where the exact surface does not
-      // (silhouettes, shared edges), or the centre lies where a shape it draws approximately
-      // may cover what it drew (a sphere's inscribed polygon misses the rim in front of the
-      // surface it shows there): the tracer decides, below.
+      // (silhouettes, shared edges): the tracer decides, below.
       traced[k] = true;
       n_traced++;
-      counters.fallback_missed += !rebuilt[k];
+      counters.fallback_missed++;
       continue;
     }
     counters.rebuilt++;
     // A hit rebuilt from the z-buffer samples its texture at the z-buffer's level.
     block.given[k] = !visible_.lod.empty();
-    if (geometry_.has_csg() && csg_wins(PrimaryRays::ray_of(packet, k), hits[k], work[k])) {
+    const Ray ray = PrimaryRays::ray_of(packet, k);
+    // Where a shape the z-buffer draws approximately may appear, that shape may lie in front
+    // of what it drew (a sphere's rim outside its inscribed polygon): checked as sample_hits
+    // checks every sample.
+    if (approximate[k] && approximated_wins(ray, hits[k], work[k])) {
       block.given[k] = false;
-      counters.csg_pixels++;
+      counters.approximated_pixels++;
     }
+    if (geometry_.has_csg() && csg_wins(ray, hits[k], work[k])) block.given[k] = false;
   }
   counters.fallback_traced += uint64_t(n_traced);
   if (n_traced >= kPacketFallbacks) {
@@ -157,10 +172,7 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
     }
   }
   if (geometry_.has_csg())
-    for (int k = 0; k < n; ++k)
-      if (traced[k] && hits[k].primitive != kNoPrimitive &&
-          scene_.objects[geometry_.hit_ids(hits[k]).first].type == ObjectType::Csg)
-        counters.csg_pixels++;
+    for (int k = 0; k < n; ++k) counters.csg_pixels += csg_hit(hits[k]);
   counters.background += background;
   block.rays = uint64_t(n) - background;
 }
@@ -191,15 +203,13 @@ void ZBufferHits::sample_hits(SampleBlock& block) const {
           block.given[j] = false;
           counters.approximated_pixels++;
         }
-        if (geometry_.has_csg() && csg_wins(ray, hit, block.work)) {
-          block.given[j] = false;
-          counters.csg_pixels++;
-        }
+        if (geometry_.has_csg() && csg_wins(ray, hit, block.work)) block.given[j] = false;
       } else {
         counters.fallback_traced++;
         counters.fallback_missed += visible_.object_id[i] != kNoId && !approximated_at(i);
         if (!geometry_.closest(ray, hit, block.work)) hit = HitRecord{};
       }
+      if (geometry_.has_csg()) counters.csg_pixels += csg_hit(hit);
     }
 }
 

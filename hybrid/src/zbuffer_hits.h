@@ -1,8 +1,8 @@
 // The hybrid's primary hits: each pixel's hit rebuilt from the one primitive the z-buffer's
 // visibility buffer names there, traced where the z-buffer cannot answer (empty pixels next to
-// what it drew or where it draws only approximately, named primitives the exact ray misses), and
-// background without a ray everywhere else. No z-buffer draws CSG: the CSG objects are
-// intersected besides for every rebuilt pixel, the nearer hit kept.
+// what it drew, named primitives the exact ray misses), and background without a ray everywhere
+// else. The shapes a z-buffer draws approximately or not at all (analytic spheres and discs,
+// CSG solids) are intersected besides where they may appear, the nearer hit kept.
 #pragma once
 
 #include <stddef.h>
@@ -25,7 +25,9 @@ class ZBufferHits : public PrimaryHitSource {
  public:
   // `approximated`: 1 at the pixels where a shape the z-buffer draws approximately may appear
   // (approximated_pixels), row-major; empty: none. There the z-buffer may show nothing, or a
-  // surface behind the shape, where the tracer sees the shape: those pixels are traced.
+  // surface behind the shape, where the tracer sees the shape: those shapes are intersected
+  // besides the z-buffer's hit there. A sample pass (sample_hits) needs none: its rays are
+  // checked against those shapes wherever the z-buffer's hit is rebuilt.
   ZBufferHits(const Scene& scene, const TraceGeometry& geometry, const PrimaryVisibility& visible,
               std::span<const uint8_t> approximated = {});
 
@@ -37,7 +39,7 @@ class ZBufferHits : public PrimaryHitSource {
   HybridCounters counters() const;
 
  private:
-  bool may_hide_a_surface(int x, int y) const;
+  bool next_to_drawn(int x, int y) const;
   // Pixel i lies where a shape the z-buffer draws approximately may appear.
   bool approximated_at(size_t i) const { return !approximated_.empty() && approximated_[i]; }
   // Whether the hit a CSG object gives `ray` is nearer than `hit` (ties by primitive index, as
@@ -45,6 +47,8 @@ class ZBufferHits : public PrimaryHitSource {
   bool csg_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const;
   // The same for the shapes the z-buffer draws approximately (sample passes: see sample_hits).
   bool approximated_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const;
+  // Whether `hit` is on a CSG object.
+  bool csg_hit(const HitRecord& hit) const;
 
   const Scene& scene_;
   const TraceGeometry& geometry_;
