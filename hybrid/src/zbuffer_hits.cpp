@@ -17,6 +17,14 @@ namespace {
 // A block with at least this many pixels to trace traces them as one packet.
 constexpr int kPacketFallbacks = 8;
 
+// Whether `other` is nearer than `hit` by closest()'s rule (a tie goes to the lower primitive
+// index); if so `hit` becomes it.
+bool take_if_nearer(const HitRecord& other, HitRecord& hit) {
+  if (!(other.t < hit.t || (other.t == hit.t && other.primitive < hit.primitive))) return false;
+  hit = other;
+  return true;
+}
+
 }  // namespace
 
 ZBufferHits::ZBufferHits(const Scene& scene, const TraceGeometry& geometry,
@@ -63,20 +71,12 @@ bool ZBufferHits::next_to_drawn(int x, int y) const {
 
 bool ZBufferHits::csg_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const {
   HitRecord csg;
-  if (!geometry_.closest_csg(ray, csg, work) ||
-      !(csg.t < hit.t || (csg.t == hit.t && csg.primitive < hit.primitive)))
-    return false;
-  hit = csg;
-  return true;
+  return geometry_.closest_csg(ray, csg, work) && take_if_nearer(csg, hit);
 }
 
 bool ZBufferHits::approximated_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const {
   HitRecord shape;
-  if (!geometry_.closest_approximated(ray, shape, work) ||
-      !(shape.t < hit.t || (shape.t == hit.t && shape.primitive < hit.primitive)))
-    return false;
-  hit = shape;
-  return true;
+  return geometry_.closest_approximated(ray, shape, work) && take_if_nearer(shape, hit);
 }
 
 bool ZBufferHits::csg_hit(const HitRecord& hit) const {
