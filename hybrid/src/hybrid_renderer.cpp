@@ -74,6 +74,10 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   // Only the ids are read (ZBufferHits rebuilds each hit from them): softraster writes no other
   // buffer.
   visibility_options.visibility_ids_only = true;
+  // The shapes the z-buffer would draw as polygons inside them (spheres, discs) or combine from
+  // their leaves (CSG) are not drawn: ZBufferHits intersects them wherever they may appear, so
+  // their polygons would only hide the surfaces behind them and cost a pass of triangles.
+  visibility_options.zbuffer_left_out = geometry.approximated_objects();
   auto t_zbuffer = Clock::now();
   Expected<RenderOutput> zbuffer = rasterizer_->render(scene, visibility_options);
   const double zbuffer_seconds = seconds_since(t_zbuffer);

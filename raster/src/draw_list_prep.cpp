@@ -8,6 +8,7 @@
 #include <glm/glm.hpp>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "rvr/core/check.h"
 #include "rvr/core/shapes.h"
@@ -65,17 +66,23 @@ Status check_mesh(const TriangleMesh& m, const std::string& name) {
 
 }  // namespace
 
-Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
-                                        int sphere_segments) {
+Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres, int sphere_segments,
+                                        std::span<const uint32_t> left_out) {
   PreparedScene prepared;
   prepared.fallback = std::make_unique<const Material>(default_material());
   prepared.objects.resize(scene.objects.size());
+  std::vector<uint8_t> drawn(scene.objects.size(), 1);
+  for (uint32_t object : left_out) {
+    RVR_CHECK(object < drawn.size(), "an object left out of the z-buffer is a scene object");
+    drawn[object] = 0;
+  }
   const TessellationOptions tessellation{sphere_segments, spheres == SphereMode::Mesh};
   for (size_t i = 0; i < scene.objects.size(); ++i) {
     const Object& o = scene.objects[i];
     PreparedObject& p = prepared.objects[i];
     RVR_TRY_ASSIGN(material, object_material(scene, o, *prepared.fallback));
     p.material = *material;
+    if (!drawn[i]) continue;
     if (o.type == ObjectType::Csg) {
       auto leaves = std::make_unique<TriangleMesh>(csg_leaf_meshes(o.csg.get(), sphere_segments));
       p.mesh = leaves.get();

@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "rvr/core/expected.h"
@@ -44,9 +45,11 @@ struct PreparedScene {
 };
 
 // Every object of `scene` prepared, spheres tessellated with `sphere_segments` and named as
-// `spheres` says. Bad input: a material index out of range, or a mesh whose normals, texture
-// coordinates or vertex colours do not match its positions, or whose triangles index past them.
-Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres,
-                                        int sphere_segments);
+// `spheres` says; the objects `left_out` (scene indices) get their material only, no mesh, so
+// nothing is drawn for them and the others keep their ids. Bad input: a material index out of
+// range, or a mesh whose normals, texture coordinates or vertex colours do not match its positions,
+// or whose triangles index past them.
+Expected<PreparedScene> prepare_objects(const Scene& scene, SphereMode spheres, int sphere_segments,
+                                        std::span<const uint32_t> left_out = {});
 
 }  // namespace rvr

@@ -813,7 +813,8 @@ Expected<SceneUpload> GlRasterizer::Impl::upload(const Scene& scene, const Rende
   bool varies = false;
   for (const Object& o : scene.objects) varies = varies || varies_in_colour(scene, o);
   if (varies) RVR_TRY(upload_textures(scene));
-  RVR_TRY_ASSIGN(prepared, prepare_objects(scene, options.spheres, options.sphere_segments));
+  RVR_TRY_ASSIGN(prepared, prepare_objects(scene, options.spheres, options.sphere_segments,
+                                           options.zbuffer_left_out));
   up.prepared = std::move(*prepared);
   // The CSG solids after every other object: the shadow maps draw the vertices before them.
   std::vector<size_t> order;

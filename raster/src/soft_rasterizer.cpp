@@ -522,7 +522,8 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
 
   // Setup: the objects' meshes and materials (the tessellations live until shading ends).
   const auto t = Clock::now();
-  RVR_TRY_ASSIGN(prepared, prepare_objects(scene, options.spheres, options.sphere_segments));
+  RVR_TRY_ASSIGN(prepared, prepare_objects(scene, options.spheres, options.sphere_segments,
+                                           options.zbuffer_left_out));
   const SceneDraws draws = scene_draws(*prepared);
   const bool shade = options.mode != RenderMode::Visibility;
   const std::vector<LightSample> samples =

@@ -1,5 +1,6 @@
 #include "rvr/raytrace/trace_geometry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <type_traits>
 #include <utility>
@@ -150,6 +151,15 @@ std::vector<Aabb> TraceGeometry::approximated_bounds() const {
   for (uint32_t p : approximated_primitives_)
     bounds.push_back(analytic_bounds(analytic_[p - n_triangles]));
   return bounds;
+}
+
+std::vector<uint32_t> TraceGeometry::approximated_objects() const {
+  std::vector<uint32_t> objects;
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  for (uint32_t p : approximated_primitives_) objects.push_back(analytic_[p - n_triangles].object);
+  std::sort(objects.begin(), objects.end());
+  objects.erase(std::unique(objects.begin(), objects.end()), objects.end());
+  return objects;
 }
 
 int TraceGeometry::embree_packet_width() const {

@@ -88,6 +88,11 @@ struct RenderOptions {
   // visibility_lod), leaving depth, colour, normal and cost empty: the hybrids' z-buffer pass,
   // whose tracer rebuilds every hit from the ids. raster reads its buffers back as before.
   bool visibility_ids_only = false;
+  // Z-buffers: scene objects (indices into Scene::objects) left out of every view they draw; the
+  // others keep their ids. The hybrids leave out the shapes their tracer intersects wherever
+  // those may appear (TraceGeometry::closest_approximated), which the z-buffer would only draw
+  // as polygons inside them.
+  std::vector<uint32_t> zbuffer_left_out;
   // softraster: hierarchical z (each 8x8 block's farthest depth rejects triangles behind it).
   bool hiz = true;
   // Cost AOV: false: the caller does not read the cost AOV, which is then 0 everywhere (the

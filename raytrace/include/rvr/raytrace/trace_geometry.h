@@ -128,6 +128,8 @@ class TraceGeometry {
   // Bounds of the shapes a z-buffer draws only approximately or not at all: analytic spheres
   // (their tessellation lies inside the exact silhouette) and CSG solids.
   std::vector<Aabb> approximated_bounds() const;
+  // The scene objects those shapes are, ascending.
+  std::vector<uint32_t> approximated_objects() const;
   // intersect_named for the rays of a packet at once: for each ray k with wanted[k], the
   // object[k] and primitive[k] a visibility buffer named; found[k] and hits[k] as
   // intersect_named gives them, counters[k] its tests. With the wide BVH's kernels, the rays
