@@ -437,5 +437,45 @@ TEST(SoftRasterizer, DrawsCsgObjectsLeafByLeafWithoutWarnings) {
   EXPECT_EQ(r.name(), "softraster");
 }
 
+// RenderOptions::zbuffer_left_out (the hybrids' z-buffer pass): both z-buffers draw the scene as
+// if the objects left out had no triangles, and every other object keeps its id. The expected ids
+// come from the same scene with those objects emptied (a mesh with no triangles, same index);
+// each left-out object is seen in the full render first, so leaving out nothing fails.
+TEST(ZBufferLeftOut, DrawsTheSceneAsIfTheObjectsHadNoTriangles) {
+  for (const char* scene_name : {"cornell", "csg"}) {
+    Scene scene = make_builtin_scene(scene_name).value();
+    scene.image.width = 160;
+    scene.image.height = 120;
+    std::vector<uint32_t> left_out;
+    Scene emptied = scene;
+    for (uint32_t i = 0; i < scene.objects.size(); ++i) {
+      const ObjectType type = scene.objects[i].type;
+      if (type != ObjectType::Sphere && type != ObjectType::Disc && type != ObjectType::Csg)
+        continue;
+      left_out.push_back(i);
+      emptied.objects[i] = Object{};
+      emptied.objects[i].name = scene.objects[i].name;
+      emptied.objects[i].material = scene.objects[i].material;
+    }
+    ASSERT_FALSE(left_out.empty()) << scene_name;
+    for (const char* renderer_name : {"raster", "softraster"}) {
+      SCOPED_TRACE(std::string(renderer_name) + " " + scene_name);
+      std::unique_ptr<Renderer> renderer = make_renderer(renderer_name).value();
+      RenderOptions options;
+      options.mode = RenderMode::Visibility;
+      const FrameBuffers all = renderer->render(scene, options).value().buffers;
+      for (uint32_t object : left_out)
+        EXPECT_NE(std::count(all.object_id.begin(), all.object_id.end(), object), 0)
+            << "object " << object << " is seen when drawn";
+      const FrameBuffers expected = renderer->render(emptied, options).value().buffers;
+      options.zbuffer_left_out = left_out;
+      const FrameBuffers got = renderer->render(scene, options).value().buffers;
+      EXPECT_TRUE(test::same_bytes(got.object_id, expected.object_id));
+      EXPECT_TRUE(test::same_bytes(got.primitive_id, expected.primitive_id));
+      EXPECT_TRUE(test::same_bytes(got.depth, expected.depth));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rvr

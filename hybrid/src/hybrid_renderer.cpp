@@ -154,8 +154,8 @@ Expected<RenderOutput> HybridRenderer::render(const Scene& scene, const RenderOp
   for (const Object& obj : scene.objects) csg += obj.type == ObjectType::Csg;
   if (csg > 0)
     o.warnings.push_back("csg objects (" + std::to_string(csg) +
-                         "): the tracer intersects them for every pixel, whatever the z-buffer "
-                         "drew there");
+                         "): the tracer intersects them wherever they may appear, "
+                         "the z-buffer does not draw them");
   return out;
 }
 

@@ -69,11 +69,6 @@ bool ZBufferHits::next_to_drawn(int x, int y) const {
   return false;
 }
 
-bool ZBufferHits::csg_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const {
-  HitRecord csg;
-  return geometry_.closest_csg(ray, csg, work) && take_if_nearer(csg, hit);
-}
-
 bool ZBufferHits::approximated_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const {
   HitRecord shape;
   return geometry_.closest_approximated(ray, shape, work) && take_if_nearer(shape, hit);
@@ -146,7 +141,6 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
       block.given[k] = false;
       counters.approximated_pixels++;
     }
-    if (geometry_.has_csg() && csg_wins(ray, hits[k], work[k])) block.given[k] = false;
   }
   counters.fallback_traced += uint64_t(n_traced);
   if (n_traced >= kPacketFallbacks) {
@@ -203,7 +197,15 @@ void ZBufferHits::sample_hits(SampleBlock& block) const {
           block.given[j] = false;
           counters.approximated_pixels++;
         }
-        if (geometry_.has_csg() && csg_wins(ray, hit, block.work)) block.given[j] = false;
+      } else if (visible_.object_id[i] == kNoId && !next_to_drawn(x, y)) {
+        // Empty away from every edge the pass drew: the pass was drawn through this sample's
+        // place and lens point, so no triangle lies on its ray, as for an empty centre (see
+        // centre_hits). Only the shapes the z-buffer draws approximately or not at all may.
+        // (Its ray was made and is counted as primary: hybrid.background stays the centre's.)
+        if (geometry_.has_approximated()) {
+          counters.fallback_traced++;
+          counters.approximated_pixels += geometry_.closest_approximated(ray, hit, block.work);
+        }
       } else {
         counters.fallback_traced++;
         counters.fallback_missed += visible_.object_id[i] != kNoId && !approximated_at(i);

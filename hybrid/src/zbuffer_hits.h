@@ -23,11 +23,11 @@ namespace rvr {
 
 class ZBufferHits : public PrimaryHitSource {
  public:
-  // `approximated`: 1 at the pixels where a shape the z-buffer draws approximately may appear
-  // (approximated_pixels), row-major; empty: none. There the z-buffer may show nothing, or a
-  // surface behind the shape, where the tracer sees the shape: those shapes are intersected
-  // besides the z-buffer's hit there. A sample pass (sample_hits) needs none: its rays are
-  // checked against those shapes wherever the z-buffer's hit is rebuilt.
+  // `approximated`: 1 at the pixels where a shape the z-buffer draws approximately or not at all
+  // may appear (approximated_pixels), row-major; empty: none. There the z-buffer may show
+  // nothing, or a surface behind the shape, where the tracer sees the shape: those shapes are
+  // intersected besides the z-buffer's hit there. A sample pass (sample_hits) needs none: its
+  // rays are checked against those shapes wherever the z-buffer's hit is rebuilt.
   ZBufferHits(const Scene& scene, const TraceGeometry& geometry, const PrimaryVisibility& visible,
               std::span<const uint8_t> approximated = {});
 
@@ -42,10 +42,9 @@ class ZBufferHits : public PrimaryHitSource {
   bool next_to_drawn(int x, int y) const;
   // Pixel i lies where a shape the z-buffer draws approximately may appear.
   bool approximated_at(size_t i) const { return !approximated_.empty() && approximated_[i]; }
-  // Whether the hit a CSG object gives `ray` is nearer than `hit` (ties by primitive index, as
-  // closest() breaks them); if so `hit` becomes it.
-  bool csg_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const;
-  // The same for the shapes the z-buffer draws approximately (sample passes: see sample_hits).
+  // Whether the hit a shape the z-buffer draws approximately or not at all (spheres, discs, CSG
+  // solids) gives `ray` is nearer than `hit` (ties by primitive index, as closest() breaks them);
+  // if so `hit` becomes it.
   bool approximated_wins(const Ray& ray, HitRecord& hit, TraversalCounters& work) const;
   // Whether `hit` is on a CSG object.
   bool csg_hit(const HitRecord& hit) const;

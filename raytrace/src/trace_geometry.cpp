@@ -613,10 +613,6 @@ void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32
   }
 }
 
-bool TraceGeometry::closest_csg(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const {
-  return closest_among(csg_primitives_, ray, hit, counters);
-}
-
 bool TraceGeometry::closest_approximated(const Ray& ray, HitRecord& hit,
                                          TraversalCounters& counters) const {
   return closest_among(approximated_primitives_, ray, hit, counters);

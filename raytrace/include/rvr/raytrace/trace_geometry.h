@@ -140,8 +140,6 @@ class TraceGeometry {
                               bool* found, TraversalCounters* counters) const;
   // True when the scene holds CSG objects (which no z-buffer draws).
   bool has_csg() const { return !csg_primitives_.empty(); }
-  // Closest hit among the CSG objects only, with closest()'s tie rule.
-  bool closest_csg(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
   // True when the scene holds shapes a z-buffer draws approximately or not at all (those of
   // approximated_bounds).
   bool has_approximated() const { return !approximated_primitives_.empty(); }
