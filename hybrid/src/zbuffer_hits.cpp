@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rvr/core/framebuffers.h"
+#include "rvr/core/prefetch.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
 
@@ -79,6 +80,22 @@ bool ZBufferHits::csg_hit(const HitRecord& hit) const {
          scene_.objects[geometry_.hit_ids(hit).first].type == ObjectType::Csg;
 }
 
+// The ids of the block to the right of `block` (the next a tile's thread asks for, as wide): asked
+// of the cache ahead, since a visibility buffer is larger than a core's L2 cache and its rows lie a
+// frame's width apart, which the hardware prefetchers do not follow from one row to the next.
+void ZBufferHits::fetch_next_block(const CentreBlock& block) const {
+  const int x0 = block.x1, x1 = std::min(block.x1 + (block.x1 - block.x0), visible_.width);
+  if (x0 >= x1) return;
+  for (int y = block.y0; y < block.y1; ++y) {
+    const size_t i0 = size_t(y) * size_t(visible_.width) + size_t(x0);
+    const size_t i1 = i0 + size_t(x1 - x0 - 1);
+    for (const uint32_t* ids : {visible_.object_id.data(), visible_.primitive_id.data()}) {
+      prefetch(ids + i0);
+      prefetch(ids + i1);
+    }
+  }
+}
+
 void ZBufferHits::centre_hits(CentreBlock& block) const {
   HybridCounters& counters = counters_.local();
   const RayPacket& packet = block.packet;
@@ -108,6 +125,7 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
       // appear there (below).
       if (!drawn[k] && !traced[k] && !approximate[k]) background++;
     }
+  fetch_next_block(block);
   geometry_.intersect_named_packet(packet, object, primitive, drawn, hits, rebuilt, work);
   for (int k = 0; k < n; ++k) {
     if (!drawn[k]) {
