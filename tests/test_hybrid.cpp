@@ -157,8 +157,14 @@ TEST_P(HybridFullMode, IsTheTracersImageButOnEdges) {
   EXPECT_EQ(mixed.stats.at("hybrid.rebuilt") + mixed.stats.at("hybrid.fallback_traced") +
                 mixed.stats.at("hybrid.background"),
             passes * double(a.pixel_count()));
+  // The tracer's camera rays (the centre's and every sample's) and the centre pixels it culled
+  // outside the scene's screen bounds make the pixel count per pass, as the hybrid's rays and
+  // its background do.
+  EXPECT_EQ(traced.stats.at("rays.primary") + traced.stats.at("rays.primary_culled"),
+            passes * double(a.pixel_count()));
+  EXPECT_EQ(mixed.stats.at("rays.primary_culled"), 0.0);
   EXPECT_EQ(mixed.stats.at("rays.primary") + mixed.stats.at("hybrid.background"),
-            traced.stats.at("rays.primary"));
+            passes * double(a.pixel_count()));
   EXPECT_GT(mixed.stats.at("time.zbuffer"), 0.0);
   EXPECT_GT(mixed.stats.at("time.trace"), 0.0);
   EXPECT_EQ(mixed.stats.at("rays.shadow") > 0, traced.stats.at("rays.shadow") > 0);
@@ -221,7 +227,7 @@ TEST(Hybrid, SupersamplesComeFromZBufferPassesThroughTheirLensPoints) {
     const double samples = double(out.buffers.pixel_count()) * double(spp + 1);
     EXPECT_EQ(out.stats.at("hybrid.zbuffer_passes"), double(spp + 1)) << hybrid;
     EXPECT_EQ(out.stats.at("rays.primary") + out.stats.at("hybrid.background"),
-              traced.stats.at("rays.primary"))
+              traced.stats.at("rays.primary") + traced.stats.at("rays.primary_culled"))
         << hybrid;
     // Measured: 1 of 208,896 samples (a silhouette); a pass through the wrong camera misses
     // on every out-of-focus edge, thousands of samples at this size.

@@ -131,6 +131,10 @@ constexpr std::array kStats = {
                     "reflection rays traced"},
     StatDeclaration{"rays.refraction", kCount, "rays", "tracers, hybrids",
                     "refraction rays traced"},
+    StatDeclaration{"rays.primary_culled", kCount, "pixels", "tracers, hybrids",
+                    "pixels outside the scene's screen bounds, background without a camera ray: "
+                    "rays.primary + rays.primary_culled is the pixel count (hybrids: 0, see "
+                    "hybrid.background)"},
     StatDeclaration{"bvh.nodes_visited", kCount, "nodes", "tracers but embree, hybrids",
                     "BVH nodes visited by every ray: child boxes tested"},
     StatDeclaration{"primitive_tests", kCount, "tests", "tracers but embree, hybrids",
@@ -169,10 +173,10 @@ constexpr std::array kStats = {
                     "pixels (and samples) where a CSG object is seen, intersected besides the "
                     "z-buffer's hit"},
     StatDeclaration{"hybrid.approximated_pixels", kCount, "pixels", "hybrids",
-                    "pixels (and samples) whose hit is a shape the z-buffer draws approximately "
-                    "(an analytic sphere, disc or CSG solid), intersected besides the z-buffer's "
-                    "hit: nearer than it (a sphere's rim outside its polygon) or where it drew "
-                    "nothing"},
+                    "pixels (and samples) whose hit is a shape the z-buffer would draw only "
+                    "approximately (an analytic sphere, disc or CSG solid: the hybrids leave them "
+                    "out of its pass), intersected besides the z-buffer's hit: in front of what it "
+                    "drew, or where it drew nothing"},
     StatDeclaration{"hybrid.background", kCount, "pixels", "hybrids",
                     "empty pixels left as background without a ray: rays.primary + "
                     "hybrid.background is the pixel count"},

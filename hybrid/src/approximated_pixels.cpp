@@ -4,7 +4,7 @@
 
 #include "rvr/core/camera.h"
 #include "rvr/raytrace/bvh.h"
-#include "screen_bounds.h"
+#include "rvr/raytrace/screen_bounds.h"
 
 namespace rvr {
 

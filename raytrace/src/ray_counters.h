@@ -21,7 +21,8 @@ enum class ReportedIn { EveryFrame, OwnTraversal };
   X(primary, "rays.primary", EveryFrame)       \
   X(shadow, "rays.shadow", EveryFrame)         \
   X(reflection, "rays.reflection", EveryFrame) \
-  X(refraction, "rays.refraction", EveryFrame)
+  X(refraction, "rays.refraction", EveryFrame) \
+  X(primary_culled, "rays.primary_culled", EveryFrame)
 
 // X(field, stat, reported in) for the counts of TraversalCounters (bvh.h), which the traversal
 // kernels fill.

@@ -39,6 +39,7 @@
 #include "rvr/raytrace/intersect.h"
 #include "rvr/raytrace/primary_hit_source.h"
 #include "rvr/raytrace/primary_rays.h"
+#include "rvr/raytrace/screen_bounds.h"
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
@@ -106,7 +107,8 @@ class FrameTracer {
         thin_lens_(options.mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f),
         kernels_(kernels),
         light_arrays_(lights_),
-        primary_footprint_(rvr::primary_footprint(frame_)) {
+        primary_footprint_(rvr::primary_footprint(frame_)),
+        scene_rect_(screen_bounds(frame_, scene.camera.near, geometry.bounds())) {
     materials_.reserve(scene.materials.size());
     for (const Material& m : scene.materials)
       materials_.push_back(shade_material(m, scene.ambient));
@@ -151,7 +153,14 @@ class FrameTracer {
 
   // The pixels [x0, x1) x [y0, y1) of one tile (at most kPacketSide on a side): their centre
   // rays traced together as one packet, then finished (finish_block).
+  // A block outside the scene's screen bounds gets no rays: every pixel is background.
   void render_block(int x0, int y0, int x1, int y1, TileOutput& out, RayCounters& counters) const {
+    if (x1 <= scene_rect_.x0 || x0 >= scene_rect_.x1 || y1 <= scene_rect_.y0 ||
+        y0 >= scene_rect_.y1) {
+      write_background(x0, y0, x1, y1, out);
+      counters.primary_culled += uint64_t(x1 - x0) * uint64_t(y1 - y0);
+      return;
+    }
     const RayPacket packet = rays_.packet(x0, y0, x1 - x0, y1 - y0);
     HitRecord hits[kPacketRays];
     TraversalCounters work[kPacketRays];
@@ -164,11 +173,7 @@ class FrameTracer {
   void render_block_from(int x0, int y0, int x1, int y1, const PrimaryHitSource& source,
                          TileOutput& out, RayCounters& counters) const {
     if (source.only_background(x0, y0, x1, y1)) {
-      for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x) {
-          out.set_background(out.index(x, y), scene_.image.background);
-          if (textured_) out.lod[out.index(x, y)] = kNoLod;
-        }
+      write_background(x0, y0, x1, y1, out);
       return;
     }
     const RayPacket packet = rays_.packet(x0, y0, x1 - x0, y1 - y0);
@@ -184,6 +189,14 @@ class FrameTracer {
   }
 
  private:
+  void write_background(int x0, int y0, int x1, int y1, TileOutput& out) const {
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) {
+        out.set_background(out.index(x, y), scene_.image.background);
+        if (textured_) out.lod[out.index(x, y)] = kNoLod;
+      }
+  }
+
   static void add_traversal(RayCounters& counters, const TraversalCounters& work) {
     counters.traversal.nodes_visited += work.nodes_visited;
     counters.traversal.primitive_tests += work.primitive_tests;
@@ -510,6 +523,8 @@ class FrameTracer {
   bool varies_ = false;
   bool textured_ = false;  // a texture to sample: rays carry footprints, the lod AOV is written
   RayFootprint primary_footprint_;
+  // The pixels whose centre rays may meet anything (screen_bounds of the scene's bounds).
+  PixelRect scene_rect_;
 };
 
 }  // namespace

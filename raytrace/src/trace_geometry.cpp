@@ -41,6 +41,7 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
       const glm::uvec3& t = mesh.triangles[i];
       triangles_.push_back(
           precompute_triangle(mesh.positions[t.x], mesh.positions[t.y], mesh.positions[t.z]));
+      for (int c = 0; c < 3; ++c) bounds_.grow(mesh.positions[t[c]]);
       triangle_object_.push_back(object);
       triangle_id_.push_back(uint32_t(i));
       triangle_in_mesh_.push_back(uint32_t(i));
@@ -70,6 +71,7 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
   }
 
   for (size_t k = 0; k < analytic_.size(); ++k) {
+    bounds_.grow(analytic_bounds(analytic_[k]));
     if (std::holds_alternative<CsgSolid::Traced>(analytic_[k].shape))
       csg_primitives_.push_back(uint32_t(triangles_.size() + k));
     if (!triangle_form_exact(analytic_[k]))

@@ -146,6 +146,8 @@ class TraceGeometry {
   // Closest hit among those shapes only, with closest()'s tie rule.
   bool closest_approximated(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
 
+  // The bounds of every primitive the tracer intersects (empty: none).
+  const Aabb& bounds() const { return bounds_; }
   size_t primitive_count() const { return triangles_.size() + analytic_.size(); }
   size_t triangle_count() const { return triangles_.size(); }
   // Triangle p (a unified primitive index below triangle_count()).
@@ -201,9 +203,10 @@ class TraceGeometry {
   std::vector<const TriangleMesh*> object_mesh_;                   // per object, or null
   std::vector<std::unique_ptr<const TriangleMesh>> owned_meshes_;  // tessellated spheres
   std::vector<uint32_t> object_material_;
-  std::vector<uint32_t> object_first_triangle_;    // unified index of each object's triangle 0
-  std::vector<uint32_t> object_analytic_;          // index into analytic_, or kNoPrimitive
-  std::vector<uint32_t> csg_primitives_;           // unified indices of the CSG objects
+  std::vector<uint32_t> object_first_triangle_;  // unified index of each object's triangle 0
+  std::vector<uint32_t> object_analytic_;        // index into analytic_, or kNoPrimitive
+  std::vector<uint32_t> csg_primitives_;         // unified indices of the CSG objects
+  Aabb bounds_;
   std::vector<uint32_t> approximated_primitives_;  // ... of approximated_bounds' shapes
   std::vector<uint8_t> object_names_triangles_;    // 1: its ids name triangles (not a sphere's)
   // bvh2: leaf slots of bvh_ hold a primitive index and, for triangles, a copy in leaf order for

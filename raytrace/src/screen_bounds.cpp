@@ -1,4 +1,4 @@
-#include "screen_bounds.h"
+#include "rvr/raytrace/screen_bounds.h"
 
 #include <algorithm>
 #include <cmath>
