@@ -133,8 +133,8 @@ constexpr std::array kStats = {
                     "refraction rays traced"},
     StatDeclaration{"rays.primary_culled", kCount, "pixels", "tracers, hybrids",
                     "pixels outside the scene's screen bounds, background without a camera ray: "
-                    "rays.primary + rays.primary_culled is the pixel count (hybrids: 0, see "
-                    "hybrid.background)"},
+                    "rays.primary + rays.primary_culled (+ hybrid.background in the hybrids) is "
+                    "the pixel count"},
     StatDeclaration{"bvh.nodes_visited", kCount, "nodes", "tracers but embree, hybrids",
                     "BVH nodes visited by every ray: child boxes tested"},
     StatDeclaration{"primitive_tests", kCount, "tests", "tracers but embree, hybrids",
@@ -178,8 +178,9 @@ constexpr std::array kStats = {
                     "out of its pass), intersected besides the z-buffer's hit: in front of what it "
                     "drew, or where it drew nothing"},
     StatDeclaration{"hybrid.background", kCount, "pixels", "hybrids",
-                    "empty pixels left as background without a ray: rays.primary + "
-                    "hybrid.background is the pixel count"},
+                    "empty pixels left as background without a ray, inside the scene's screen "
+                    "bounds: rays.primary + hybrid.background + rays.primary_culled is the pixel "
+                    "count"},
     StatDeclaration{"hybrid.zbuffer_passes", kCount, "passes", "hybrids",
                     "z-buffer passes drawn: 1, or 1 + one per sample of an accumulation buffer"},
     // Phase times.

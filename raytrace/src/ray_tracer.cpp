@@ -155,12 +155,7 @@ class FrameTracer {
   // rays traced together as one packet, then finished (finish_block).
   // A block outside the scene's screen bounds gets no rays: every pixel is background.
   void render_block(int x0, int y0, int x1, int y1, TileOutput& out, RayCounters& counters) const {
-    if (x1 <= scene_rect_.x0 || x0 >= scene_rect_.x1 || y1 <= scene_rect_.y0 ||
-        y0 >= scene_rect_.y1) {
-      write_background(x0, y0, x1, y1, out);
-      counters.primary_culled += uint64_t(x1 - x0) * uint64_t(y1 - y0);
-      return;
-    }
+    if (culled(x0, y0, x1, y1, out, counters)) return;
     const RayPacket packet = rays_.packet(x0, y0, x1 - x0, y1 - y0);
     HitRecord hits[kPacketRays];
     TraversalCounters work[kPacketRays];
@@ -172,6 +167,7 @@ class FrameTracer {
   // The same pixels with their primary hits from `source`.
   void render_block_from(int x0, int y0, int x1, int y1, const PrimaryHitSource& source,
                          TileOutput& out, RayCounters& counters) const {
+    if (culled(x0, y0, x1, y1, out, counters)) return;
     if (source.only_background(x0, y0, x1, y1)) {
       write_background(x0, y0, x1, y1, out);
       return;
@@ -189,6 +185,16 @@ class FrameTracer {
   }
 
  private:
+  // Whether the block lies outside the scene's screen bounds: if so its pixels are written as
+  // background and counted as culled.
+  bool culled(int x0, int y0, int x1, int y1, TileOutput& out, RayCounters& counters) const {
+    if (x1 > scene_rect_.x0 && x0 < scene_rect_.x1 && y1 > scene_rect_.y0 && y0 < scene_rect_.y1)
+      return false;
+    write_background(x0, y0, x1, y1, out);
+    counters.primary_culled += uint64_t(x1 - x0) * uint64_t(y1 - y0);
+    return true;
+  }
+
   void write_background(int x0, int y0, int x1, int y1, TileOutput& out) const {
     for (int y = y0; y < y1; ++y)
       for (int x = x0; x < x1; ++x) {
