@@ -2,10 +2,10 @@
 // thread counts, agreement with the GL rasterizer and the ray tracer, and the cost AOV.
 #include <gtest/gtest.h>
 #include <stddef.h>
-#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <functional>
 #include <glm/glm.hpp>
 #include <initializer_list>

@@ -1,9 +1,9 @@
 #include "rvr/hybrid/hybrid_renderer.h"
 
 #include <stddef.h>
-#include <stdint.h>
 
 #include <chrono>
+#include <cstdint>
 #include <glm/glm.hpp>
 #include <map>
 #include <optional>

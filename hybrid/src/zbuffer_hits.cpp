@@ -3,6 +3,7 @@
 #include <stddef.h>
 
 #include <algorithm>
+#include <initializer_list>
 #include <memory>
 #include <utility>
 #include <vector>

@@ -5,6 +5,7 @@
 #include <stddef.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <glm/glm.hpp>
 #include <string>
 #include <utility>
