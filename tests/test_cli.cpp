@@ -894,11 +894,13 @@ bool catches(pid_t pid, int signal_number) {
   return false;
 }
 
-// Waits (up to the process time limit) until `pid` catches SIGINT; false if it exited first.
-bool wait_until_catching_sigint(pid_t pid) {
+// Waits (up to the process time limit) until `pid` catches `signal_number`; false if it exited
+// first. Each signal's handler is installed on its own, so a test of one signal waits for that
+// one (a process preempted between two installations catches SIGINT but not yet SIGTERM).
+bool wait_until_catching(pid_t pid, int signal_number) {
   auto start = std::chrono::steady_clock::now();
   while (std::chrono::steady_clock::now() - start < std::chrono::seconds(RVR_PROCESS_TIMEOUT)) {
-    if (catches(pid, SIGINT)) return true;
+    if (catches(pid, signal_number)) return true;
     if (::waitpid(pid, nullptr, WNOHANG) == pid) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
@@ -940,7 +942,7 @@ TEST_F(Cli, CtrlCWhileRenderingStopsPromptlyAndLeavesNoFile) {
                          "1024", "--height", "768", "-o", (dir_ / "long.png").string()});
   ASSERT_GE(pid, 0);
   ReapOnExit reap{pid};
-  ASSERT_TRUE(wait_until_catching_sigint(pid));
+  ASSERT_TRUE(wait_until_catching(pid, SIGINT));
   Interrupted r = interrupt_and_wait(pid);
   EXPECT_EQ(r.status, 130);
   // The handler exits at once; the bound allows for a loaded machine.
@@ -957,8 +959,7 @@ TEST_F(Cli, SigtermAndSighupStopWithTheirExitStatusAndLeaveNoFile) {
                            "1024", "--height", "768", "-o", (dir_ / "long.png").string()});
     ASSERT_GE(pid, 0);
     ReapOnExit reap{pid};
-    ASSERT_TRUE(wait_until_catching_sigint(pid));
-    ASSERT_TRUE(catches(pid, signal_number));
+    ASSERT_TRUE(wait_until_catching(pid, signal_number));
     ASSERT_EQ(::kill(pid, signal_number), 0);
     int raw = 0;
     ASSERT_EQ(::waitpid(pid, &raw, 0), pid);
@@ -1185,7 +1186,7 @@ TEST_F(Cli, CtrlCDuringAStudyWritesThePartialStudy) {
                         err);
   ASSERT_GE(pid, 0);
   ReapOnExit reap{pid};
-  ASSERT_TRUE(wait_until_catching_sigint(pid));
+  ASSERT_TRUE(wait_until_catching(pid, SIGINT));
   std::this_thread::sleep_for(std::chrono::seconds(3));  // the first points take milliseconds
   Interrupted r = interrupt_and_wait(pid);
   std::string message = slurp(err);

@@ -241,6 +241,26 @@ TEST(Hybrid, SupersamplesComeFromZBufferPassesThroughTheirLensPoints) {
   }
 }
 
+// Spheres far out of focus, nothing behind them: their blur reaches beyond the screen bounds of
+// the centre rays, where the tracer's lens samples still meet them, so the tracer's blocks
+// outside those bounds must still trace their samples. The hybrids' sample passes are drawn
+// through the lens points and never culled: their image is the independent answer. (Planted:
+// culling those blocks gives 40.96 dB.)
+TEST(Hybrid, DefocusedBlurReachesPastTheCentreRaysScreenBounds) {
+  Scene scene = small_scene("dof");
+  std::vector<Object> spheres;
+  for (const Object& o : scene.objects)
+    if (o.type == ObjectType::Sphere) spheres.push_back(o);
+  ASSERT_FALSE(spheres.empty());
+  scene.objects = spheres;
+  scene.camera.aperture_radius *= 4.0f;
+  scene.camera.focus_distance *= 0.25f;
+  RenderOutput traced = render_full("raytrace", scene);
+  RenderOutput hybrid = render_full("hybrid_soft", scene);
+  ComparisonMetrics m = compare_buffers(hybrid.buffers, traced.buffers);
+  EXPECT_GE(m.colour.psnr_db, 60.0);
+}
+
 // With several samples per pixel each sample's ray is jittered in its pixel and leaves from its
 // lens point, so the centre rays' screen bounds of a sphere do not bound where a sample meets
 // it: a hit rebuilt behind a sphere's rim (outside the inscribed polygon the z-buffer drew) must

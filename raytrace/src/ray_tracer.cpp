@@ -186,8 +186,12 @@ class FrameTracer {
 
  private:
   // Whether the block lies outside the scene's screen bounds: if so its pixels are written as
-  // background and counted as culled.
+  // background and counted as culled. A frame whose samples leave from lens points is never culled:
+  // those rays may meet what no centre ray can (the blur around a defocused object). Samples
+  // jittered in their pixels stay within the bounds' margin. A hybrid's frame takes its samples
+  // from its own passes.
   bool culled(int x0, int y0, int x1, int y1, TileOutput& out, RayCounters& counters) const {
+    if (thin_lens_ && scene_.image.samples_per_pixel > 1 && !centre_only_) return false;
     if (x1 > scene_rect_.x0 && x0 < scene_rect_.x1 && y1 > scene_rect_.y0 && y0 < scene_rect_.y1)
       return false;
     write_background(x0, y0, x1, y1, out);
