@@ -12,6 +12,7 @@
 #include <assimp/Importer.hpp>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <glm/glm.hpp>

@@ -1,10 +1,10 @@
 // Shadow maps (raster) against shadow rays (tracer) on the Cornell box: whether each pixel is
 // lit, partly lit or shadowed by the area light must agree almost everywhere.
 #include <gtest/gtest.h>
-#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <glm/glm.hpp>
 #include <initializer_list>

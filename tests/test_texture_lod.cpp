@@ -4,10 +4,10 @@
 // nothing of the renderers' camera or texture code), against softraster's and GL's lod AOV.
 // And builtin:textured in both z-buffers: the same visibility, close colours.
 #include <gtest/gtest.h>
-#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <glm/glm.hpp>
 #include <initializer_list>
