@@ -402,21 +402,39 @@ namespace {
 // preparing (1 µs a triangle) and the system probe advance. Frames started while the clock is
 // in [busy_from, busy_to) take twice as long: something else is running; with `load` every
 // frame does, by a factor that varies from round to round (a constant load the probe sees).
+constexpr double kNever = std::numeric_limits<double>::infinity();
+
 struct SimulatedMachine {
   double clock = 0;
   Rng rng{1};
   double busy_from = 0, busy_to = 0;
   bool load = false;
   double frame_noise = 0.03;
+  // The first frame started at or after stall_at takes stall_seconds more: a step far longer
+  // than any before it.
+  double stall_at = kNever, stall_seconds = 0;
+  // The study's budget clock (Session::stop_steps_when_out_of_time): a step that would end past
+  // it ends there with ErrorKind::OutOfTime, as a killed worker's does. Unset, or with
+  // `ignore_budget`, steps end when they end.
+  std::function<double()> seconds_left;
+  bool ignore_budget = false;
   double slowdown() const { return (clock >= busy_from && clock < busy_to) ? 2.0 : 1.0; }
+  // Advances the clock by a step of `seconds`, or to the budget's end: false then.
+  bool step(double seconds) {
+    const double left = seconds_left && !ignore_budget ? seconds_left() : kNever;
+    if (seconds >= left) {
+      clock += std::max(left, 0.0);
+      return false;
+    }
+    clock += seconds;
+    return true;
+  }
 };
 
 class SimulatedFrames : public FrameSource {
  public:
   SimulatedFrames(double n, int width, SimulatedMachine& machine)
-      : n_(n), pixels_(double(width) * double(width * 3 / 4)), machine_(machine) {
-    machine_.clock += 1e-6 * n;
-  }
+      : n_(n), pixels_(double(width) * double(width * 3 / 4)), machine_(machine) {}
   double axis_value() const override { return n_; }
   double pixels() const override { return pixels_; }
   double prepare_seconds(size_t index) const override { return index == 0 ? 0.0 : 1e-6 * n_; }
@@ -430,7 +448,11 @@ class SimulatedFrames : public FrameSource {
     // its effect: contention slows a memory-bound frame more than another.
     if (machine_.load) t *= index == 0 ? load_ : load_ * std::exp(0.1 * machine_.rng.normal());
     if (machine_.load && index == 0) load_ = 1.5 + machine_.rng.uniform();
-    machine_.clock += t;
+    if (machine_.clock >= machine_.stall_at) {
+      t += machine_.stall_seconds;
+      machine_.stall_at = kNever;
+    }
+    if (!machine_.step(t)) return out_of_time_error("stopped at the budget's end");
     FrameTime out;
     out.seconds = t;
     return out;
@@ -447,7 +469,11 @@ class SimulatedSession : public Session {
   explicit SimulatedSession(SimulatedMachine& machine) : machine_(machine) {}
   std::string kind() const override { return "process"; }
   Expected<std::unique_ptr<FrameSource>> prepare(const Family&, size_t n, int width) override {
+    if (!machine_.step(1e-6 * double(n))) return out_of_time_error("stopped at the budget's end");
     return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, machine_));
+  }
+  void stop_steps_when_out_of_time(std::function<double()> seconds_left) override {
+    machine_.seconds_left = std::move(seconds_left);
   }
 
  private:
@@ -590,15 +616,14 @@ TEST(StudyRun, ABusyMachineStillGetsAnAnswer) {
   EXPECT_TRUE(noted(*b, "fitted to times measured while the machine was busy"));
 }
 
-// The budget is a limit: whatever it is, no frame starts after it (a frame started before may
-// end after it: here under 0.4 s), and a budget too small for anything says so and concludes
-// nothing, without an empty heading.
+// The budget is a limit: whatever it is, the measuring ends within it, and a budget too small
+// for anything says so and concludes nothing, without an empty heading.
 TEST(StudyRun, TheBudgetIsALimitThatHolds) {
   for (double budget : {1.0, 3.0, 12.0, 40.0}) {
     SimulatedStudy study(5, budget, 50);
     Expected<StudyResult> r = run_study(study.request, study.hooks);
     ASSERT_TRUE(r.ok()) << r.error().message;
-    EXPECT_LE(r->elapsed_seconds, budget + 0.4) << "budget " << budget;
+    EXPECT_LE(r->elapsed_seconds, budget * (1 + 1e-12)) << "budget " << budget;
   }
   SimulatedStudy tiny(5, 1.0, 50);
   Expected<StudyResult> r = run_study(tiny.request, tiny.hooks);
@@ -614,6 +639,46 @@ TEST(StudyRun, TheBudgetIsALimitThatHolds) {
   }
   const std::string html = study_html(*r);
   EXPECT_NE(html.find(r->no_conclusion.substr(0, 40)), std::string::npos);
+}
+
+// A frame far longer than any before it, started late in the sweep and in the prediction checks'
+// last second: the session stops it at the budget's end, its run is dropped and said to be, and
+// the study concludes from the runs before. Without the stop (ignore_budget) the measuring ends
+// late.
+TEST(StudyRun, AStepStillRunningAtTheBudgetsEndIsStopped) {
+  const double budget = 600;
+  SimulatedStudy undisturbed(4, budget, 100);
+  Expected<StudyResult> u = run_study(undisturbed.request, undisturbed.hooks);
+  ASSERT_TRUE(u.ok()) << u.error().message;
+  ASSERT_FALSE(u->check_points.empty());
+  const double end = u->elapsed_seconds;
+  struct Case {
+    double stall_at;
+    const char* note;
+  };
+  for (Case c : {Case{0.5 * end, "ran out during the sweep"},
+                 Case{end - 0.5, "ran out during the prediction checks"}}) {
+    SimulatedStudy study(4, budget, 100);
+    study.machine.stall_at = c.stall_at;
+    study.machine.stall_seconds = budget;
+    Expected<StudyResult> r = run_study(study.request, study.hooks);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_LE(r->elapsed_seconds, budget * (1 + 1e-12)) << c.note;
+    EXPECT_GE(r->elapsed_seconds, budget * (1 - 1e-12)) << c.note;
+    EXPECT_TRUE(noted(*r, c.note)) << c.note;
+    expect_one_run_per_session(*r);
+    for (const Measurement& m : r->points)
+      for (const study::Run& run : m.runs) EXPECT_EQ(run.seconds.size(), 5u);
+    EXPECT_FALSE(r->points.empty());
+
+    SimulatedStudy late(4, budget, 100);
+    late.machine.stall_at = c.stall_at;
+    late.machine.stall_seconds = budget;
+    late.machine.ignore_budget = true;
+    Expected<StudyResult> l = run_study(late.request, late.hooks);
+    ASSERT_TRUE(l.ok()) << l.error().message;
+    EXPECT_GT(l->elapsed_seconds, budget + 1) << c.note << ": the plant is inert";
+  }
 }
 
 TEST(StudyRun, RefusesBadInputBeforeAnyWork) {

@@ -200,7 +200,7 @@ int run(int argc, char** argv) {
   if (info_cmd->parsed()) return run_info(info_gl);
   if (study_cmd->parsed()) return run_study(study, join_args(argc, argv));
   if (study_worker_cmd->parsed())
-    return run_study_worker(study_worker.renderers, study_worker.mode);
+    return run_study_worker(study_worker.renderers, parse_mode(study_worker.mode));
   return 2;
 }
 

@@ -2,6 +2,7 @@
 #include "study_processes.h"
 
 #include <fmt/format.h>
+#include <poll.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/prctl.h>
@@ -9,11 +10,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <initializer_list>
 #include <iostream>
 #include <limits>
@@ -25,7 +28,6 @@
 #include <thread>
 #include <utility>
 
-#include "commands.h"
 #include "rvr/core/expected.h"
 #include "rvr/study/measurement.h"
 #include "rvr/study/memory_estimate.h"
@@ -127,16 +129,25 @@ class Worker {
   // Closing the socket ends the worker's loop; one that does not end is killed.
   ~Worker() {
     ::close(fd_);
-    for (int k = 0; k < 200; ++k) {
+    if (reaped_) return;
+    for (int k = 0; k < 200 && !killed_; ++k) {
       if (waitpid(pid_, nullptr, WNOHANG) == pid_) return;
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
-    ::kill(pid_, SIGKILL);
+    if (!killed_) ::kill(pid_, SIGKILL);
     waitpid(pid_, nullptr, 0);
   }
 
-  // Sends one request and reads its one-line reply.
+  // The clock a reply is awaited against (Session::stop_steps_when_out_of_time).
+  void stop_when_out_of_time(std::function<double()> seconds_left) {
+    seconds_left_ = std::move(seconds_left);
+  }
+
+  // Sends one request and reads its one-line reply. A reply still awaited when seconds_left_
+  // reads <= 0 is given up: the worker is killed, stopping the preparation or frame it runs,
+  // and this call and every one after fail with ErrorKind::OutOfTime.
   Expected<json> call(const json& request) {
+    if (killed_) return out_of_time();
     const std::string line = request.dump() + "\n";
     for (size_t sent = 0; sent < line.size();) {
       const ssize_t k = ::send(fd_, line.data() + sent, line.size() - sent, MSG_NOSIGNAL);
@@ -150,6 +161,11 @@ class Worker {
         reply = buffer_.substr(0, end);
         buffer_.erase(0, end + 1);
         break;
+      }
+      if (!reply_in_time()) {
+        ::kill(pid_, SIGKILL);
+        killed_ = true;
+        return out_of_time();
       }
       char chunk[4096];
       const ssize_t k = ::recv(fd_, chunk, sizeof chunk, 0);
@@ -165,12 +181,32 @@ class Worker {
   }
 
  private:
+  // Waits until the socket has something to read (or an error recv will tell), or until
+  // seconds_left_ reads <= 0: false then. Without a clock: true at once (recv waits).
+  bool reply_in_time() const {
+    if (!seconds_left_) return true;
+    while (true) {
+      const double left = seconds_left_();
+      if (!(left > 0)) return false;
+      pollfd ready{fd_, POLLIN, 0};
+      const int r = ::poll(&ready, 1, int(std::ceil(std::min(left, 60.0) * 1000)));
+      if (r > 0 || (r < 0 && errno != EINTR)) return true;
+    }
+  }
+
+  Error out_of_time() const {
+    return out_of_time_error(
+        fmt::format("study: the worker process {} was stopped at the budget's end", pid_));
+  }
+
   Error lost(const char* doing) {
     int status = 0;
     std::string how = "it closed the connection";
-    if (waitpid(pid_, &status, WNOHANG) == pid_)
+    if (waitpid(pid_, &status, WNOHANG) == pid_) {
+      reaped_ = true;
       how = WIFSIGNALED(status) ? fmt::format("it was killed by signal {}", WTERMSIG(status))
                                 : fmt::format("it exited with status {}", WEXITSTATUS(status));
+    }
     return internal_error(
         fmt::format("study: lost the worker process {} while {}: {}", pid_, doing, how));
   }
@@ -178,6 +214,9 @@ class Worker {
   pid_t pid_;
   int fd_;
   std::string buffer_;
+  std::function<double()> seconds_left_;  // null: replies are awaited however long they take
+  bool killed_ = false;                   // stopped at the budget's end
+  bool reaped_ = false;                   // its exit status collected
 };
 
 // A scene prepared in a worker: what the worker said of it, and its frames timed there.
@@ -226,6 +265,9 @@ class ProcessSession : public study::Session {
  public:
   explicit ProcessSession(std::shared_ptr<Worker> worker) : worker_(std::move(worker)) {}
   std::string kind() const override { return "process"; }
+  void stop_steps_when_out_of_time(std::function<double()> seconds_left) override {
+    worker_->stop_when_out_of_time(std::move(seconds_left));
+  }
   Expected<std::unique_ptr<study::FrameSource>> prepare(const study::Family& family, size_t n,
                                                         int width) override {
     const int id = next_id_++;
@@ -319,12 +361,11 @@ study::ProbeMemory process_memory_probes(const std::string& executable,
   };
 }
 
-int run_study_worker(const std::vector<std::string>& renderers, const std::string& mode_name) {
+int run_study_worker(const std::vector<std::string>& renderers, RenderMode mode) {
   // Ctrl-C reaches the whole process group: the parent decides what stops. A worker whose
   // parent dies goes with it.
   ::signal(SIGINT, SIG_IGN);
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  const RenderMode mode = parse_mode(mode_name);
   std::map<int, std::unique_ptr<study::FrameSource>> prepared;
   std::string line;
   while (std::getline(std::cin, line)) {

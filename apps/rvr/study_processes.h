@@ -23,7 +23,7 @@ study::ProbeMemory process_memory_probes(const std::string& executable,
                                          RenderMode mode);
 
 // The worker's loop: requests from stdin until it closes, answers on stdout. Exit status 0.
-int run_study_worker(const std::vector<std::string>& renderers, const std::string& mode);
+int run_study_worker(const std::vector<std::string>& renderers, RenderMode mode);
 
 // The path of the running executable (/proc/self/exe), for starting workers of the same build.
 std::string own_executable();

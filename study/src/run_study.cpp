@@ -131,7 +131,8 @@ class Sweep {
   void exclude(double seconds) { excluded_ += seconds; }
   bool cancelled() const { return hooks_.cancelled && hooks_.cancelled(); }
   // The budget is a limit: no frame, preparation or session is started that would end past it,
-  // were it as long as the longest such step so far (the run in progress is dropped).
+  // were it as long as the longest such step so far; a step still running at its end is
+  // stopped by its session (Session::stop_steps_when_out_of_time) and its run dropped.
   bool out_of_time() const { return elapsed() + longest_step_ > request_.budget_seconds; }
   // f(), a frame, a preparation or a session's opening, its duration kept as the longest step
   // when it is.
@@ -143,6 +144,15 @@ class Sweep {
     return result;
   }
   bool stopped() const { return cancelled() || out_of_time(); }
+  // A step stopped at the budget's end ends the measuring as running out of time between steps
+  // does: the run it belonged to was never added. Other errors pass.
+  Status unless_out_of_time(Status s) {
+    if (s || s.error().kind != ErrorKind::OutOfTime) return s;
+    step_stopped_ = true;
+    return ok_status();
+  }
+  // Whether a step was stopped at the budget's end.
+  bool step_stopped() const { return step_stopped_; }
   SystemSnapshot probe() const {
     SystemSnapshot s = hooks_.probe(kProbeWindow);
     s.at = elapsed();
@@ -184,6 +194,7 @@ class Sweep {
   Rng rng_;
   double start_ = 0, excluded_ = 0;
   double longest_step_ = 0;  // seconds of the longest step so far (timed_step)
+  bool step_stopped_ = false;
   std::map<std::string, FamilyState> families_;
   FamilyState* f_ = nullptr;  // the family being measured
   size_t plan_size_ = 0;      // of the families swept so far
@@ -201,6 +212,7 @@ Expected<OpenSession> Sweep::open_new_session(const Family& family) {
   open.other_work = shows_other_work(info.system);
   RVR_TRY_ASSIGN(session, hooks_.start_session());
   open.session = std::move(*session);
+  open.session->stop_steps_when_out_of_time([this] { return request_.budget_seconds - elapsed(); });
   info.kind = open.session->kind();
   open.index = int(result_.sessions.size());
   result_.sessions.push_back(info);
@@ -658,7 +670,7 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
     double left = sweep_budget - sweep.elapsed();
     double share_end = sweep.elapsed() + left / double(request.scenes.size() - i);
     if (sweep.stopped()) continue;
-    RVR_TRY(sweep.run_family(family, share_end));
+    RVR_TRY(sweep.unless_out_of_time(sweep.run_family(family, share_end)));
   }
   if (sweep.cancelled()) {
     result.interrupted = true;
@@ -674,9 +686,16 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
   const double before_fits = sweep.elapsed();
   conclude(result, boot);
   sweep.exclude(sweep.elapsed() - before_fits);
+  double measured = sweep.elapsed();
   if (!result.interrupted && checks && !sweep.stopped() && !result.crossovers.empty()) {
-    RVR_TRY(sweep.measure_checks(families));
-    // Checks cut short are evaluated from the points they measured.
+    RVR_TRY(sweep.unless_out_of_time(sweep.measure_checks(families)));
+    if (sweep.step_stopped())
+      result.notes.push_back(fmt::format(
+          "the budget of {:.0f} s ran out during the prediction checks: the run being measured "
+          "was stopped and dropped",
+          request.budget_seconds));
+    // Checks cut short are evaluated from the points they measured; not in the budget.
+    measured = sweep.elapsed();
     evaluate_checks(result, CompareOptions{boot, request.noise_threshold});
     if (sweep.cancelled()) {
       result.interrupted = true;
@@ -685,7 +704,7 @@ Expected<StudyResult> run_study(const StudyRequest& request, const StudyHooks& h
           "before the interruption are given");
     }
   }
-  result.elapsed_seconds = sweep.elapsed();
+  result.elapsed_seconds = measured;
   result.system_after = sweep.probe();
   return result;
 }

@@ -9,7 +9,9 @@ namespace rvr {
 
 // Exit status the CLI uses for an error (see docs/cli.md). Cancelled: the work was asked to stop
 // part way (ProgressSink::cancel) and returned no result; 130 is a shell's status for Ctrl-C.
-enum class ErrorKind { BadInput = 2, Internal = 3, Cancelled = 130 };
+// OutOfTime: a step was stopped at the end of the time it was given (the study's budget, which
+// catches it: a command never exits with it); 124 is timeout(1)'s status.
+enum class ErrorKind { BadInput = 2, Internal = 3, OutOfTime = 124, Cancelled = 130 };
 
 struct Error {
   // Without the "error: " prefix, e.g. "scenes/bad.json: objects[3].radius: must be > 0, got -1".
@@ -25,6 +27,9 @@ inline Error internal_error(std::string message) {
 }
 inline Error cancelled_error() {
   return Error{"cancelled", ErrorKind::Cancelled};
+}
+inline Error out_of_time_error(std::string message) {
+  return Error{std::move(message), ErrorKind::OutOfTime};
 }
 
 // A value or an Error (std::expected is C++23).

@@ -92,6 +92,13 @@ class Session {
   // `width` × width·3/4 pixels.
   virtual Expected<std::unique_ptr<FrameSource>> prepare(const Family& family, size_t n,
                                                          int width) = 0;
+  // The budget's clock, read while the session prepares or times a frame: once `seconds_left`
+  // returns <= 0 the step is stopped and fails with ErrorKind::OutOfTime (a process session
+  // kills its worker; the session is of no use after). A session that cannot stop a step
+  // ignores it: the step ends when it ends.
+  virtual void stop_steps_when_out_of_time(std::function<double()> seconds_left) {
+    (void)seconds_left;
+  }
 };
 
 using StartSession = std::function<Expected<std::unique_ptr<Session>>()>;
