@@ -623,7 +623,7 @@ TEST(StudyRun, TheBudgetIsALimitThatHolds) {
     SimulatedStudy study(5, budget, 50);
     Expected<StudyResult> r = run_study(study.request, study.hooks);
     ASSERT_TRUE(r.ok()) << r.error().message;
-    EXPECT_LE(r->elapsed_seconds, budget * (1 + 1e-12)) << "budget " << budget;
+    EXPECT_LE(r->elapsed_seconds, budget) << "budget " << budget;
   }
   SimulatedStudy tiny(5, 1.0, 50);
   Expected<StudyResult> r = run_study(tiny.request, tiny.hooks);
@@ -663,8 +663,9 @@ TEST(StudyRun, AStepStillRunningAtTheBudgetsEndIsStopped) {
     study.machine.stall_seconds = budget;
     Expected<StudyResult> r = run_study(study.request, study.hooks);
     ASSERT_TRUE(r.ok()) << r.error().message;
-    EXPECT_LE(r->elapsed_seconds, budget * (1 + 1e-12)) << c.note;
-    EXPECT_GE(r->elapsed_seconds, budget * (1 - 1e-12)) << c.note;
+    // Stopped 10 ms before the end, the time stopping a worker may take.
+    EXPECT_LE(r->elapsed_seconds, budget) << c.note;
+    EXPECT_GE(r->elapsed_seconds, budget - 0.011) << c.note;
     EXPECT_TRUE(noted(*r, c.note)) << c.note;
     expect_one_run_per_session(*r);
     for (const Measurement& m : r->points)

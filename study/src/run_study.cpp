@@ -38,6 +38,9 @@ constexpr double kCheckShare = 0.15;
 constexpr double kReferenceSeconds = 10e-3;
 // How long the system probe waits (idle) to see what else uses the CPUs.
 constexpr double kProbeWindow = 0.2;
+// A step still running this long before the budget's end is stopped, so that stopping it (a
+// worker killed, its run dropped) ends within the budget.
+constexpr double kStoppingSeconds = 0.01;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 Status validate(const StudyRequest& r) {
@@ -212,7 +215,8 @@ Expected<OpenSession> Sweep::open_new_session(const Family& family) {
   open.other_work = shows_other_work(info.system);
   RVR_TRY_ASSIGN(session, hooks_.start_session());
   open.session = std::move(*session);
-  open.session->stop_steps_when_out_of_time([this] { return request_.budget_seconds - elapsed(); });
+  open.session->stop_steps_when_out_of_time(
+      [this] { return request_.budget_seconds - kStoppingSeconds - elapsed(); });
   info.kind = open.session->kind();
   open.index = int(result_.sessions.size());
   result_.sessions.push_back(info);
