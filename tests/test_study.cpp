@@ -472,8 +472,8 @@ class SimulatedSession : public Session {
     if (!machine_.step(1e-6 * double(n))) return out_of_time_error("stopped at the budget's end");
     return std::unique_ptr<FrameSource>(new SimulatedFrames(double(n), width, machine_));
   }
-  void stop_steps_when_out_of_time(std::function<double()> seconds_left) override {
-    machine_.seconds_left = std::move(seconds_left);
+  void stop_steps_when_out_of_time(const std::function<double()>& seconds_left) override {
+    machine_.seconds_left = seconds_left;
   }
 
  private:

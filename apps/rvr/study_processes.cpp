@@ -270,8 +270,8 @@ class ProcessSession : public study::Session {
  public:
   explicit ProcessSession(std::shared_ptr<Worker> worker) : worker_(std::move(worker)) {}
   std::string kind() const override { return "process"; }
-  void stop_steps_when_out_of_time(std::function<double()> seconds_left) override {
-    worker_->stop_when_out_of_time(std::move(seconds_left));
+  void stop_steps_when_out_of_time(const std::function<double()>& seconds_left) override {
+    worker_->stop_when_out_of_time(seconds_left);
   }
   Expected<std::unique_ptr<study::FrameSource>> prepare(const study::Family& family, size_t n,
                                                         int width) override {

@@ -96,9 +96,7 @@ class Session {
   // returns <= 0 the step is stopped and fails with ErrorKind::OutOfTime (a process session
   // kills its worker; the session is of no use after). A session that cannot stop a step
   // ignores it: the step ends when it ends.
-  virtual void stop_steps_when_out_of_time(std::function<double()> seconds_left) {
-    (void)seconds_left;
-  }
+  virtual void stop_steps_when_out_of_time(const std::function<double()>& /*seconds_left*/) {}
 };
 
 using StartSession = std::function<Expected<std::unique_ptr<Session>>()>;
