@@ -485,9 +485,12 @@ TEST(Bvh, CountsFewerTestsThanBruteForce) {
 // Packets of primary rays (one origin, up to 64 directions) find exactly the hits single rays
 // find, lane by lane, with every kernel and with Embree's rtcIntersect8/16; the per-ray counters
 // add up to some work for every ray. Tiles are full or partial, aim at the scene or past it, and
-// include directions with zero components (the robust single-ray path).
+// include directions with zero components (the robust single-ray path). The analytic shapes'
+// tree is walked by the packet too: "spheres" and "mirror_balls" have enough spheres for inner
+// nodes, where a ray that wrongly leaves the packet's walk loses its hit.
 TEST(Packets, SameHitsAsSingleRays) {
-  for (Scene scene : {mixed_scene(), builtin("tessphere:5000"), builtin("cornell")}) {
+  for (Scene scene : {mixed_scene(), builtin("tessphere:5000"), builtin("cornell"),
+                      builtin("spheres"), builtin("mirror_balls:100")}) {
     TraceGeometry brute(scene, SphereMode::Analytic, 24, AccelKind::None);
     std::vector<Accelerated> accels = accelerated(scene, SphereMode::Analytic);
     accels.push_back({"embree", std::make_unique<TraceGeometry>(scene, SphereMode::Analytic, 24,

@@ -11,6 +11,7 @@
 #include "rvr/core/prefetch.h"
 #include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/shape_geometry.h"
+#include "rvr/raytrace/bvh_packet.h"
 #include "rvr/raytrace/traversal_kernels.h"
 
 namespace rvr {
@@ -394,10 +395,50 @@ void TraceGeometry::closest_packet(const RayPacket& packet, HitRecord* hits,
       counters[i].nodes_visited += kc[i].nodes;
       counters[i].primitive_tests += kc[i].tests;
     }
-    if (!analytic_.empty())
-      query_analytic<false>(ray(i), found ? h.t : packet.tmax, h,
-                            counters ? &counters[i] : nullptr);
   }
+  if (!analytic_.empty()) closest_analytic_packet(packet, hits, counters);
+}
+
+// query_analytic<false> for every ray of the packet, the analytic shapes' tree walked once for
+// the packet: the rays' limits start at their triangle hits (a triangle wins a tie, having the
+// lower index), and a shape's hit replaces the ray's hit when nearer.
+void TraceGeometry::closest_analytic_packet(const RayPacket& packet, HitRecord* hits,
+                                            TraversalCounters* counters) const {
+  static_assert(kPacketRays <= PacketBoxData::kMaxRays, "a packet's rays fit one bit mask");
+  if (bvh_.empty()) return;
+  const float* const dir[3] = {packet.dir[0], packet.dir[1], packet.dir[2]};
+  const PacketBoxData rays(packet.origin, dir, packet.count, packet.tmin);
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  float t_max[PacketBoxData::kMaxRays];
+  for (int k = 0; k < PacketBoxData::kMaxRays; ++k)
+    t_max[k] = k < packet.count && hits[k].primitive != kNoPrimitive ? hits[k].t : packet.tmax;
+  uint64_t found = 0;  // rays with an analytic hit so far
+  auto leaf = [&](uint32_t first, uint32_t count, uint64_t entered) {
+    for (uint64_t m = entered; m != 0; m &= m - 1) {
+      const int k = __builtin_ctzll(m);
+      const uint64_t bit = uint64_t(1) << k;
+      const Ray ray{{packet.origin[0], packet.origin[1], packet.origin[2]},
+                    {dir[0][k], dir[1][k], dir[2][k]},
+                    packet.tmin,
+                    packet.tmax};
+      for (uint32_t s = first; s < first + count; ++s) {
+        const uint32_t p = n_triangles + slot_primitive_[s];
+        const float t = t_max[k];
+        HitRecord h;
+        if (!hit_analytic(analytic_[slot_primitive_[s]], ray, found & bit ? tie_limit(t) : t, h))
+          continue;
+        if ((found & bit) && !nearer(h.t, p, t, hits[k].primitive)) continue;
+        hits[k] = h;
+        hits[k].primitive = p;
+        t_max[k] = h.t;
+        found |= bit;
+      }
+    }
+  };
+  if (counters)
+    traverse_packet<true>(bvh_, rays, t_max, leaf, counters);
+  else
+    traverse_packet<false>(bvh_, rays, t_max, leaf, nullptr);
 }
 
 bool TraceGeometry::occluded(const Ray& ray, TraversalCounters& counters) const {

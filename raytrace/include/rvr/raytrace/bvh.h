@@ -141,6 +141,8 @@ class Bvh {
 
 // Slab test against a node box with precomputed reciprocal direction.
 struct RayBoxData {
+  // Widen the exit a little (pbrt's 1 + 2*gamma(3)) so rounding never loses a hit.
+  static constexpr float kExitWiden = 1.0000004f;
   glm::vec3 origin, inv_dir;
   int neg[3];
   explicit RayBoxData(const Ray& ray) : origin(ray.origin), inv_dir(1.0f / ray.dir) {
@@ -157,10 +159,8 @@ struct RayBoxData {
     float ty1 = ((*b[1 - neg[1]]).y - origin.y) * inv_dir.y;
     float tz0 = ((*b[neg[2]]).z - origin.z) * inv_dir.z;
     float tz1 = ((*b[1 - neg[2]]).z - origin.z) * inv_dir.z;
-    // Widen the exit a little (pbrt's 1 + 2*gamma(3)) so rounding never loses a hit.
-    constexpr float kWiden = 1.0000004f;
     float t0 = std::max(std::max(std::max(t_min, tx0), ty0), tz0);
-    float t1 = std::min(std::min(std::min(t_max, tx1), ty1), tz1) * kWiden;
+    float t1 = std::min(std::min(std::min(t_max, tx1), ty1), tz1) * kExitWiden;
     return t0 <= t1;
   }
 };

@@ -179,6 +179,9 @@ class TraceGeometry {
   template <bool kAnyHit>
   bool query_analytic(const Ray& ray, float t_max, HitRecord& hit,
                       TraversalCounters* counters) const;
+  // The analytic shapes' part of closest_packet: hits[k] holds ray k's triangle hit, if any.
+  void closest_analytic_packet(const RayPacket& packet, HitRecord* hits,
+                               TraversalCounters* counters) const;
   template <bool kCount>
   bool closest_wide(const Ray& ray, HitRecord& hit, TraversalCounters* counters) const;
   template <bool kCount>
