@@ -19,3 +19,17 @@ def run_cli(rvr_binary):
         return subprocess.run([rvr_binary, *args], capture_output=True, text=True, timeout=300)
 
     return run
+
+
+@pytest.fixture(scope="session")
+def study_budget():
+    """The budget in seconds to give a study that must measure some point: `seconds` times
+    RVR_TEST_BUDGET_SCALE (4 under the sanitizers, whose frames run several times slower: the
+    command line stops a worker still busy at the budget's end and drops its run, and a study in
+    this process starts no step that would end past it)."""
+    scale = float(os.environ.get("RVR_TEST_BUDGET_SCALE", "1"))
+
+    def budget(seconds):
+        return seconds * scale
+
+    return budget
