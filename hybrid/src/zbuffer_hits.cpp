@@ -128,7 +128,17 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
     }
   fetch_next_block(block);
   geometry_.intersect_named_packet(packet, object, primitive, drawn, hits, rebuilt, work);
+  // Where a shape the z-buffer draws approximately or not at all may appear, the nearest of
+  // those shapes, for the block's rays at once: asked of the empty pixels away from every edge,
+  // and of the rebuilt ones.
+  uint64_t ask_shapes = 0;
+  for (int k = 0; k < n; ++k)
+    if (approximate[k] && (drawn[k] ? rebuilt[k] : !traced[k])) ask_shapes |= uint64_t(1) << k;
+  HitRecord shape[kPacketRays];
+  const uint64_t shape_found =
+      ask_shapes ? geometry_.closest_approximated_packet(packet, ask_shapes, shape, work) : 0;
   for (int k = 0; k < n; ++k) {
+    const bool has_shape = (shape_found >> k) & 1;
     if (!drawn[k]) {
       n_traced += traced[k];
       // Empty, away from every edge, where a shape the z-buffer draws approximately or not at
@@ -136,8 +146,8 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
       // the hit, or the background.
       if (!traced[k] && approximate[k]) {
         counters.fallback_traced++;
-        counters.approximated_pixels +=
-            geometry_.closest_approximated(PrimaryRays::ray_of(packet, k), hits[k], work[k]);
+        counters.approximated_pixels += has_shape;
+        if (has_shape) hits[k] = shape[k];
       }
       continue;
     }
@@ -152,11 +162,10 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
     counters.rebuilt++;
     // A hit rebuilt from the z-buffer samples its texture at the z-buffer's level.
     block.given[k] = !visible_.lod.empty();
-    const Ray ray = PrimaryRays::ray_of(packet, k);
     // Where a shape the z-buffer draws approximately may appear, that shape may lie in front
     // of what it drew (a sphere's rim outside its inscribed polygon): checked as sample_hits
     // checks every sample.
-    if (approximate[k] && approximated_wins(ray, hits[k], work[k])) {
+    if (has_shape && take_if_nearer(shape[k], hits[k])) {
       block.given[k] = false;
       counters.approximated_pixels++;
     }

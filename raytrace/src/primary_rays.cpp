@@ -42,15 +42,6 @@ RayPacket PrimaryRays::packet(int x0, int y0, int w, int h) const {
   return packet;
 }
 
-Ray PrimaryRays::ray_of(const RayPacket& packet, int k) {
-  Ray r;
-  r.origin = {packet.origin[0], packet.origin[1], packet.origin[2]};
-  r.dir = {packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]};
-  r.tmin = packet.tmin;
-  r.tmax = packet.tmax;
-  return r;
-}
-
 Ray PrimaryRays::ray(int x, int y) const {
   Ray r;
   r.origin = frame_.eye;

@@ -12,6 +12,7 @@
 #include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/shape_geometry.h"
 #include "rvr/raytrace/bvh_packet.h"
+#include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/traversal_kernels.h"
 
 namespace rvr {
@@ -31,13 +32,13 @@ TraceGeometry::TraceGeometry(const Scene& scene, SphereMode spheres, int sphere_
 
   object_first_triangle_.assign(n_objects, 0);
   object_analytic_.assign(n_objects, kNoPrimitive);
-  object_names_triangles_.assign(n_objects, 0);
+  object_triangle_count_.assign(n_objects, 0);
   // Every triangle the tracer sees is named by its index in its mesh (a tessellated sphere's
   // facets too, as the z-buffers name them under SphereMode::Mesh).
   auto add_mesh = [&](uint32_t object, const TriangleMesh& mesh) {
     object_mesh_[object] = &mesh;
     object_first_triangle_[object] = uint32_t(triangles_.size());
-    object_names_triangles_[object] = 1;
+    object_triangle_count_[object] = uint32_t(mesh.triangles.size());
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
       const glm::uvec3& t = mesh.triangles[i];
       triangles_.push_back(
@@ -174,6 +175,20 @@ size_t TraceGeometry::acceleration_bytes() const {
          slot_primitive_.size() * sizeof(uint32_t) +
          slot_triangles_.size() * sizeof(TrianglePrecomputed);
 }
+
+namespace {
+
+// A hit of an analytic shape as closest() reports it, as primitive p.
+HitRecord shape_hit_record(const ShapeHit& h, uint32_t p) {
+  HitRecord hit;
+  hit.t = h.t;
+  hit.csg_leaf = h.part;
+  hit.csg_flip = h.flip;
+  hit.primitive = p;
+  return hit;
+}
+
+}  // namespace
 
 bool TraceGeometry::hit_analytic(const Analytic& a, const Ray& ray, float t_max,
                                  HitRecord& hit) const {
@@ -399,6 +414,32 @@ void TraceGeometry::closest_packet(const RayPacket& packet, HitRecord* hits,
   if (!analytic_.empty()) closest_analytic_packet(packet, hits, counters);
 }
 
+// Shape `a` for the rays of bit mask `rays`, each limited by its t_max[k] and, once it has an
+// analytic hit (bit k of `found`), by closest()'s tie rule against it; a nearer hit replaces
+// hits[k] and lowers t_max[k]. The shape's kind is dispatched once for all the rays, and each ray
+// meets the shapes in the order of the calls, as a single ray's query would.
+void TraceGeometry::nearest_shape_hits(const RayPacket& packet, uint64_t rays, uint32_t a,
+                                       float* t_max, uint64_t& found, HitRecord* hits) const {
+  const uint32_t p = uint32_t(triangles_.size()) + a;
+  std::visit(
+      [&](const auto& shape) {
+        for (uint64_t m = rays; m != 0; m &= m - 1) {
+          const int k = __builtin_ctzll(m);
+          const uint64_t bit = uint64_t(1) << k;
+          const float t = t_max[k];
+          Ray ray = PrimaryRays::ray_of(packet, k);
+          ray.tmax = found & bit ? tie_limit(t) : t;
+          ShapeHit h;
+          if (!shape.intersect(ray, h)) continue;
+          if ((found & bit) && !nearer(h.t, p, t, hits[k].primitive)) continue;
+          hits[k] = shape_hit_record(h, p);
+          t_max[k] = h.t;
+          found |= bit;
+        }
+      },
+      analytic_[a].shape);
+}
+
 // query_analytic<false> for every ray of the packet, the analytic shapes' tree walked once for
 // the packet: the rays' limits start at their triangle hits (a triangle wins a tie, having the
 // lower index), and a shape's hit replaces the ray's hit when nearer.
@@ -408,32 +449,13 @@ void TraceGeometry::closest_analytic_packet(const RayPacket& packet, HitRecord* 
   if (bvh_.empty()) return;
   const float* const dir[3] = {packet.dir[0], packet.dir[1], packet.dir[2]};
   const PacketBoxData rays(packet.origin, dir, packet.count, packet.tmin);
-  const uint32_t n_triangles = uint32_t(triangles_.size());
   float t_max[PacketBoxData::kMaxRays];
   for (int k = 0; k < PacketBoxData::kMaxRays; ++k)
     t_max[k] = k < packet.count && hits[k].primitive != kNoPrimitive ? hits[k].t : packet.tmax;
   uint64_t found = 0;  // rays with an analytic hit so far
   auto leaf = [&](uint32_t first, uint32_t count, uint64_t entered) {
-    for (uint64_t m = entered; m != 0; m &= m - 1) {
-      const int k = __builtin_ctzll(m);
-      const uint64_t bit = uint64_t(1) << k;
-      const Ray ray{{packet.origin[0], packet.origin[1], packet.origin[2]},
-                    {dir[0][k], dir[1][k], dir[2][k]},
-                    packet.tmin,
-                    packet.tmax};
-      for (uint32_t s = first; s < first + count; ++s) {
-        const uint32_t p = n_triangles + slot_primitive_[s];
-        const float t = t_max[k];
-        HitRecord h;
-        if (!hit_analytic(analytic_[slot_primitive_[s]], ray, found & bit ? tie_limit(t) : t, h))
-          continue;
-        if ((found & bit) && !nearer(h.t, p, t, hits[k].primitive)) continue;
-        hits[k] = h;
-        hits[k].primitive = p;
-        t_max[k] = h.t;
-        found |= bit;
-      }
-    }
+    for (uint32_t s = first; s < first + count; ++s)
+      nearest_shape_hits(packet, entered, slot_primitive_[s], t_max, found, hits);
   };
   if (counters)
     traverse_packet<true>(bvh_, rays, t_max, leaf, counters);
@@ -556,37 +578,45 @@ bool TraceGeometry::intersect_named(const Ray& ray, uint32_t object, uint32_t pr
     hit.primitive = n_triangles + a;
     return true;
   }
-  const TriangleMesh* mesh = object_mesh_[object];
-  if (!mesh) return false;
-  // A mesh names its triangle; a tessellated sphere reports 0, so all of its triangles are tried.
-  uint32_t first = object_first_triangle_[object];
-  uint32_t count = uint32_t(mesh->triangles.size());
-  const bool named = object_names_triangles_[object] != 0;
-  uint32_t begin = first, end = first + count;
-  if (named) {
-    if (primitive >= count) return false;
-    begin = first + primitive;
-    end = begin + 1;
+  // A mesh's ids name its triangle (0 triangles: an object without a mesh).
+  if (primitive >= object_triangle_count_[object]) return false;
+  const uint32_t p = object_first_triangle_[object] + primitive;
+  TriangleHit th;
+  counters.primitive_tests++;
+  const bool ok = triangle_test_ == TriangleTest::Chapter
+                      ? intersect_triangle_chapter(ray, triangles_[p], th)
+                      : intersect_triangle_mt(ray, triangles_[p], th);
+  if (!ok) return false;
+  hit.t = th.t;
+  hit.u = th.u;
+  hit.v = th.v;
+  hit.primitive = p;
+  return true;
+}
+
+// intersect_named for the rays of `rays` (bit k: ray k), each naming an object traced
+// analytically: shape by shape, its kind dispatched once for the rays that name it.
+void TraceGeometry::intersect_named_shapes(const RayPacket& packet, const uint32_t* object,
+                                           uint64_t rays, HitRecord* hits, bool* found,
+                                           TraversalCounters* counters) const {
+  const uint32_t n_triangles = uint32_t(triangles_.size());
+  while (rays != 0) {
+    const uint32_t a = object_analytic_[object[__builtin_ctzll(rays)]];
+    std::visit(
+        [&](const auto& shape) {
+          for (uint64_t m = rays; m != 0; m &= m - 1) {
+            const int k = __builtin_ctzll(m);
+            if (object_analytic_[object[k]] != a) continue;
+            rays &= ~(uint64_t(1) << k);
+            counters[k].primitive_tests++;
+            hits[k] = HitRecord{};
+            ShapeHit h;
+            found[k] = shape.intersect(PrimaryRays::ray_of(packet, k), h);
+            if (found[k]) hits[k] = shape_hit_record(h, n_triangles + a);
+          }
+        },
+        analytic_[a].shape);
   }
-  bool found = false;
-  for (uint32_t p = begin; p < end; ++p) {
-    Ray r = ray;
-    // As query(): after the first hit, a tie at the same t is kept by the lower index.
-    if (found) r.tmax = tie_limit(hit.t);
-    TriangleHit th;
-    counters.primitive_tests++;
-    bool ok = triangle_test_ == TriangleTest::Chapter
-                  ? intersect_triangle_chapter(r, triangles_[p], th)
-                  : intersect_triangle_mt(r, triangles_[p], th);
-    if (!ok || (found && !nearer(th.t, p, hit.t, hit.primitive))) continue;
-    hit = HitRecord{};
-    hit.t = th.t;
-    hit.u = th.u;
-    hit.v = th.v;
-    hit.primitive = p;
-    found = true;
-  }
-  return found;
 }
 
 void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32_t* object,
@@ -603,17 +633,19 @@ void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32
   NamedTriangles named;
   int lane_ray[kPacketRays];
   uint32_t lane_triangle[kPacketRays];
+  uint64_t analytic_rays = 0;  // the rays naming a shape traced analytically
   for (int k = 0; k < packet.count; ++k) {
     found[k] = false;
     if (!wanted[k]) continue;
     const uint32_t o = object[k];
-    // One named triangle of a mesh (not a tessellated sphere's, whose ids name none).
-    const bool one_triangle = simd && o < object_analytic_.size() &&
-                              object_analytic_[o] == kNoPrimitive && object_mesh_[o] &&
-                              object_names_triangles_[o] &&
-                              primitive[k] < object_mesh_[o]->triangles.size();
+    // One named triangle of a mesh, read from flat per-object tables (no pointer to follow).
+    const bool one_triangle =
+        simd && o < object_triangle_count_.size() && primitive[k] < object_triangle_count_[o];
     if (!one_triangle) {
-      found[k] = intersect_named(ray_of(k), o, primitive[k], hits[k], counters[k]);
+      if (o < object_analytic_.size() && object_analytic_[o] != kNoPrimitive)
+        analytic_rays |= uint64_t(1) << k;  // below, shape by shape
+      else
+        found[k] = intersect_named(ray_of(k), o, primitive[k], hits[k], counters[k]);
       continue;
     }
     const int lane = named.count++;
@@ -628,6 +660,7 @@ void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32
       named.e2[a][lane] = tri.e2[a];
     }
   }
+  intersect_named_shapes(packet, object, analytic_rays, hits, found, counters);
   if (named.count == 0) return;
   for (int lane = named.count; lane % 8 != 0; ++lane)  // the kernel's last group: repeat a lane
     for (int a = 0; a < 3; ++a) {
@@ -659,6 +692,21 @@ void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32
 bool TraceGeometry::closest_approximated(const Ray& ray, HitRecord& hit,
                                          TraversalCounters& counters) const {
   return closest_among(approximated_primitives_, ray, hit, counters);
+}
+
+uint64_t TraceGeometry::closest_approximated_packet(const RayPacket& packet, uint64_t rays,
+                                                    HitRecord* hits,
+                                                    TraversalCounters* counters) const {
+  float t_max[kPacketRays];
+  for (uint64_t m = rays; m != 0; m &= m - 1) {
+    const int k = __builtin_ctzll(m);
+    t_max[k] = packet.tmax;
+    counters[k].primitive_tests += approximated_primitives_.size();
+  }
+  uint64_t found = 0;
+  for (uint32_t p : approximated_primitives_)
+    nearest_shape_hits(packet, rays, p - uint32_t(triangles_.size()), t_max, found, hits);
+  return found;
 }
 
 bool TraceGeometry::closest_among(const std::vector<uint32_t>& primitives, const Ray& ray,

@@ -24,7 +24,12 @@ class PrimaryRays {
   // The centre rays of pixels [x0, x0 + w) x [y0, y0 + h), row by row (w * h <= kPacketRays).
   RayPacket packet(int x0, int y0, int w, int h) const;
   // Ray k of a packet as a single ray.
-  static Ray ray_of(const RayPacket& packet, int k);
+  static Ray ray_of(const RayPacket& packet, int k) {
+    return Ray{{packet.origin[0], packet.origin[1], packet.origin[2]},
+               {packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]},
+               packet.tmin,
+               packet.tmax};
+  }
   // The centre ray of pixel (x, y).
   Ray ray(int x, int y) const;
 

@@ -119,9 +119,10 @@ class TraceGeometry {
   void fetch_surface_data(const HitRecord* hits, int n, bool ids_only) const;
 
   // The hit of `ray` with one thing a visibility buffer named, by the same intersection code as
-  // closest(): for a mesh object triangle `primitive` of it; for a sphere or square the object
-  // (a sphere traced as its tessellation: the nearest of its triangles, since a z-buffer does
-  // not report which). False when the ray misses it in (tmin, tmax) or the ids name nothing.
+  // closest(): for an object traced as triangles (a mesh, or a shape traced as its
+  // tessellation, whose facets the z-buffers name alike) triangle `primitive` of it; for a shape
+  // traced analytically the object. False when the ray misses it in (tmin, tmax) or the ids name
+  // nothing.
   // counters.primitive_tests counts the tests made.
   bool intersect_named(const Ray& ray, uint32_t object, uint32_t primitive, HitRecord& hit,
                        TraversalCounters& counters) const;
@@ -145,6 +146,11 @@ class TraceGeometry {
   bool has_approximated() const { return !approximated_primitives_.empty(); }
   // Closest hit among those shapes only, with closest()'s tie rule.
   bool closest_approximated(const Ray& ray, HitRecord& hit, TraversalCounters& counters) const;
+  // closest_approximated for the rays of a packet in bit mask `rays` (ray k: bit k) at once, the
+  // same hits: hits[k] is set where ray k meets one of those shapes (the bits returned) and left
+  // as it was where it meets none; counters[k] counts its tests.
+  uint64_t closest_approximated_packet(const RayPacket& packet, uint64_t rays, HitRecord* hits,
+                                       TraversalCounters* counters) const;
 
   // The bounds of every primitive the tracer intersects (empty: none).
   const Aabb& bounds() const { return bounds_; }
@@ -179,6 +185,11 @@ class TraceGeometry {
   template <bool kAnyHit>
   bool query_analytic(const Ray& ray, float t_max, HitRecord& hit,
                       TraversalCounters* counters) const;
+  // intersect_named_packet's rays (bit k of `rays`: ray k) that name a shape traced analytically.
+  void intersect_named_shapes(const RayPacket& packet, const uint32_t* object, uint64_t rays,
+                              HitRecord* hits, bool* found, TraversalCounters* counters) const;
+  void nearest_shape_hits(const RayPacket& packet, uint64_t rays, uint32_t analytic, float* t_max,
+                          uint64_t& found, HitRecord* hits) const;
   // The analytic shapes' part of closest_packet: hits[k] holds ray k's triangle hit, if any.
   void closest_analytic_packet(const RayPacket& packet, HitRecord* hits,
                                TraversalCounters* counters) const;
@@ -211,7 +222,7 @@ class TraceGeometry {
   std::vector<uint32_t> csg_primitives_;         // unified indices of the CSG objects
   Aabb bounds_;
   std::vector<uint32_t> approximated_primitives_;  // ... of approximated_bounds' shapes
-  std::vector<uint8_t> object_names_triangles_;    // 1: its ids name triangles (not a sphere's)
+  std::vector<uint32_t> object_triangle_count_;    // triangles in its mesh (0: none)
   // bvh2: leaf slots of bvh_ hold a primitive index and, for triangles, a copy in leaf order for
   // locality. bvh: bvh_ is over analytic_ only (slot -> analytic index), wide_ over triangles_.
   Bvh bvh_;
