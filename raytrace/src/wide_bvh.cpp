@@ -10,6 +10,7 @@
 
 #include "rvr/core/check.h"
 #include "rvr/core/ray.h"
+#include "rvr/raytrace/wide_node_quantize.h"
 
 namespace rvr {
 namespace {
@@ -60,15 +61,12 @@ class Collapser {
               "an inner node's index must not look like a leaf reference: ", index);
     nodes_.push_back(empty_node());
     stats_.child_slots += size_t(n);
+    Aabb boxes[kWideBvhWidth];
+    for (int i = 0; i < n; ++i) boxes[i] = box_of(binary_[children[i]]);
+    quantize_children(boxes, n, nodes_[index]);
     for (int i = 0; i < n; ++i) {
-      Aabb box = box_of(binary_[children[i]]);
       uint32_t ref = collapse(children[i], depth + 1);
-      WideNode& w = nodes_[index];  // after the recursion: push_back may have moved it
-      for (int a = 0; a < 3; ++a) {
-        w.bounds[2 * a][i] = box.lo[a];
-        w.bounds[2 * a + 1][i] = box.hi[a];
-      }
-      w.child[i] = ref;
+      nodes_[index].child[i] = ref;  // after the recursion: push_back may have moved the node
     }
     return index;
   }
@@ -80,14 +78,8 @@ class Collapser {
   static Aabb box_of(const BvhNode& n) { return Aabb{n.lo, n.hi}; }
 
   static WideNode empty_node() {
-    WideNode w;
-    for (int i = 0; i < kWideBvhWidth; ++i) {
-      for (int a = 0; a < 3; ++a) {
-        w.bounds[2 * a][i] = INFINITY;
-        w.bounds[2 * a + 1][i] = -INFINITY;
-      }
-      w.child[i] = kEmptyTree;
-    }
+    WideNode w{};
+    for (int i = 0; i < kWideBvhWidth; ++i) w.child[i] = kEmptyTree;
     return w;
   }
 
@@ -157,8 +149,13 @@ Expected<WideBvh> WideBvh::build(const std::vector<TrianglePrecomputed>& triangl
   w.stats_.binary_seconds = binary.stats().seconds;
   w.stats_.binary_sah_cost = binary.stats().sah_cost;
 
+  // The blocks exactly (so they are never copied, by growth or by shrink_to_fit); the nodes
+  // roughly (each has two to eight children).
+  size_t blocks = 0;
+  for (const BvhNode& node : binary.nodes())
+    blocks += (size_t(node.count) + kTriangleBlock - 1) / kTriangleBlock;
   w.nodes_.reserve(binary.stats().nodes / 4 + 1);
-  w.blocks_.reserve(triangles.size() / 2 + 1);
+  w.blocks_.reserve(blocks);
   Collapser collapser(binary, triangles, w.nodes_, w.blocks_, w.stats_);
   w.root_ = collapser.collapse(0, 0);
   RVR_CHECK(w.stats_.max_depth < 64,
@@ -170,8 +167,9 @@ Expected<WideBvh> WideBvh::build(const std::vector<TrianglePrecomputed>& triangl
   RVR_CHECK(w.nodes_.size() + w.stats_.leaves - 1 == w.stats_.child_slots,
             "every node but the root fills one child slot: ", w.nodes_.size(), " nodes, ",
             w.stats_.leaves, " leaves, ", w.stats_.child_slots, " slots");
+  RVR_CHECK(w.blocks_.size() == blocks, "the leaves fill the blocks counted: ", w.blocks_.size(),
+            " of ", blocks);
   w.nodes_.shrink_to_fit();
-  w.blocks_.shrink_to_fit();
   w.stats_.nodes = w.nodes_.size();
   w.stats_.blocks = w.blocks_.size();
   w.stats_.seconds =
