@@ -10,7 +10,6 @@
 
 #include "rvr/core/check.h"
 #include "rvr/core/ray.h"
-#include "rvr/raytrace/wide_node_quantize.h"
 
 namespace rvr {
 namespace {
@@ -61,12 +60,15 @@ class Collapser {
               "an inner node's index must not look like a leaf reference: ", index);
     nodes_.push_back(empty_node());
     stats_.child_slots += size_t(n);
-    Aabb boxes[kWideBvhWidth];
-    for (int i = 0; i < n; ++i) boxes[i] = box_of(binary_[children[i]]);
-    quantize_children(boxes, n, nodes_[index]);
     for (int i = 0; i < n; ++i) {
+      Aabb box = box_of(binary_[children[i]]);
       uint32_t ref = collapse(children[i], depth + 1);
-      nodes_[index].child[i] = ref;  // after the recursion: push_back may have moved the node
+      WideNode& w = nodes_[index];  // after the recursion: push_back may have moved it
+      for (int a = 0; a < 3; ++a) {
+        w.bounds[2 * a][i] = box.lo[a];
+        w.bounds[2 * a + 1][i] = box.hi[a];
+      }
+      w.child[i] = ref;
     }
     return index;
   }
@@ -78,8 +80,14 @@ class Collapser {
   static Aabb box_of(const BvhNode& n) { return Aabb{n.lo, n.hi}; }
 
   static WideNode empty_node() {
-    WideNode w{};
-    for (int i = 0; i < kWideBvhWidth; ++i) w.child[i] = kEmptyTree;
+    WideNode w;
+    for (int i = 0; i < kWideBvhWidth; ++i) {
+      for (int a = 0; a < 3; ++a) {
+        w.bounds[2 * a][i] = INFINITY;
+        w.bounds[2 * a + 1][i] = -INFINITY;
+      }
+      w.child[i] = kEmptyTree;
+    }
     return w;
   }
 

@@ -3,8 +3,6 @@
 // computation: each unit evaluates the operations on sixteen lanes of inputs.
 #pragma once
 
-#include <cstdint>
-
 namespace rvr {
 
 constexpr int kProbeLanes = 16;
@@ -13,7 +11,6 @@ struct Vec3vProbeInput {
   alignas(64) float a[3][kProbeLanes];
   alignas(64) float b[3][kProbeLanes];
   alignas(64) float s[kProbeLanes];  // the scalar factor and divisor
-  uint8_t bytes[kProbeLanes];        // for vfloat8::load_u8
 };
 
 // Lane k of every result from lane k of the inputs; select takes a where a.x < b.x.
@@ -29,7 +26,6 @@ struct Vec3vProbeOutput {
   alignas(64) float selected[3][kProbeLanes];
   alignas(64) float dot[kProbeLanes];
   alignas(64) float length_squared[kProbeLanes];
-  alignas(64) float from_bytes[kProbeLanes];  // vfloat8::load_u8 of the bytes, any width
 };
 
 // The vector types Vec3v is instantiated with: float (one lane at a time; no normalize or

@@ -73,8 +73,6 @@ void run_width(const Vec3vProbeInput& in, Vec3vProbeOutput& out) {
 }
 
 void run(ProbeWidth width, const Vec3vProbeInput& in, Vec3vProbeOutput& out) {
-  for (int i = 0; i < kProbeLanes; i += 8)
-    store(out.from_bytes + i, vfloat8::load_u8(in.bytes + i));
   switch (width) {
     case ProbeWidth::Scalar:
       return run_width<float>(in, out);

@@ -45,22 +45,6 @@ inline unsigned lowest_bit(unsigned m) {
   return unsigned(__builtin_ctz(m));
 }
 
-// --------------------------------------------------------------------- a node's child boxes
-
-// The step of an axis from its biased exponent: 2^(e - 127), a normal float.
-inline float quantization_step(uint8_t e) {
-  return __builtin_bit_cast(float, uint32_t(e) << 23);
-}
-
-// Row `row` of a node's child planes for its eight slots (WideNode's row order): origin +
-// q * step, the float the builder checked against the child's box (q * step is exact, so the
-// sum is the only rounding, with or without a fused multiply-add).
-inline V8 plane_row(const WideNode& n, int row) {
-  const int a = row >> 1;
-  return V8::splat(n.origin[a]) +
-         V8::load_u8(n.q[row]) * V8::splat(quantization_step(n.scale_exp[a]));
-}
-
 // ----------------------------------------------------------------------- ray against boxes
 
 // Exit distances are widened by this factor (pbrt's 1 + 2 gamma(3), with room): rounding in the
@@ -107,19 +91,17 @@ struct RayBox {
     }
   }
 
-  // Bit i set when child i is entered in [t_min, t_max]; near[i] its entry distance. Empty
-  // slots are never entered.
+  // Bit i set when child i is entered in [t_min, t_max]; near[i] its entry distance.
   template <bool kRobust>
   unsigned intersect(const WideNode& n, V8 t_min, V8 t_max, V8& near) const {
     V8 tn[3], tf[3];
     for (int a = 0; a < 3; ++a) {
-      const V8 bn = plane_row(n, near_row[a]), bf = plane_row(n, far_row[a]);
       if (kRobust) {
-        tn[a] = (bn - origin[a]) * rdir[a];
-        tf[a] = (bf - origin[a]) * rdir[a];
+        tn[a] = (V8::load(n.bounds[near_row[a]]) - origin[a]) * rdir[a];
+        tf[a] = (V8::load(n.bounds[far_row[a]]) - origin[a]) * rdir[a];
       } else {
-        tn[a] = mul_sub(bn, rdir[a], near_offset[a]);
-        tf[a] = mul_sub(bf, rdir[a], far_offset[a]);
+        tn[a] = mul_sub(V8::load(n.bounds[near_row[a]]), rdir[a], near_offset[a]);
+        tf[a] = mul_sub(V8::load(n.bounds[far_row[a]]), rdir[a], far_offset[a]);
       }
     }
     // max / min return their second operand when either is NaN (MAXPS / MINPS): the
@@ -127,7 +109,7 @@ struct RayBox {
     V8 t0 = max(tn[2], max(tn[1], max(tn[0], t_min)));
     V8 t1 = min(tf[2], min(tf[1], min(tf[0], t_max)));
     near = t0;
-    return le_bits(t0, t1 * V8::splat(kWiden)) & n.valid;
+    return le_bits(t0, t1 * V8::splat(kWiden));
   }
 };
 
@@ -385,8 +367,8 @@ struct Packet8 {
   KernelRay ray[8];  // the same rays one by one: edge rechecks, single-ray fallback
   // The packet as one interval ray (Boulos et al. 2006), for culling a node's children that no
   // lane can enter (cull_children): when every lane's direction has the same sign on each axis,
-  // each reciprocal lies in [rdir_lo, rdir_hi] and the near plane of a box on axis a is plane
-  // row near_row[a] (plane_row) for every lane; margin_hi is the largest lane margin.
+  // each reciprocal lies in [rdir_lo, rdir_hi] and the near plane of a box on axis a is bounds
+  // row near_row[a] for every lane; margin_hi is the largest lane margin.
   bool coherent = false;
   float rdir_lo[3], rdir_hi[3];
   int near_row[3], far_row[3];
@@ -527,8 +509,8 @@ inline float max_lane(V8 a) {
 // best t at most the largest: a child whose largest entry bound exceeds its smallest exit bound,
 // after margins wider than every rounding of either test (2^-18 of the planes' and origin's
 // magnitudes, against the per-lane test's few ulps), has no lane that enters it. Slots whose
-// `rows` are the node's planes (plane_row); empty slots are left to the caller.
-inline unsigned cull_children(const V8 (&rows)[6], const Packet8& p, unsigned active,
+// bounds are infinite (empty) give NaN and are never culled here.
+inline unsigned cull_children(const WideNode& node, const Packet8& p, unsigned active,
                               const PacketBest8& best) {
   const V8 slack = V8::splat(1.0f / 262144.0f);
   V8 entry = p.tmin;  // the same in every lane
@@ -538,7 +520,7 @@ inline unsigned cull_children(const V8 (&rows)[6], const Packet8& p, unsigned ac
     const V8 o = V8::splat(p.o[a]);
     const V8 lo = V8::splat(p.rdir_lo[a]), hi = V8::splat(p.rdir_hi[a]);
     const V8 r = max(abs(lo), abs(hi));
-    const V8 bn = rows[p.near_row[a]], bf = rows[p.far_row[a]];
+    const V8 bn = V8::load(node.bounds[p.near_row[a]]), bf = V8::load(node.bounds[p.far_row[a]]);
     const V8 dn = bn - o, df = bf - o;
     const V8 near_lo = min(dn * lo, dn * hi) - (abs(bn) + abs(o)) * r * slack;
     const V8 far_hi = max(df * lo, df * hi) + (abs(bf) + abs(o)) * r * slack;
@@ -575,13 +557,7 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
       if (kCount) nodes = nodes + masked(M8::from_bits(active), V8::splat(1.0f));
       const WideNode& node = bvh.nodes[ref];
       const M8 act = M8::from_bits(active);
-      V8 rows[6];
-      alignas(32) float planes[6][kWideBvhWidth];
-      for (int r = 0; r < 6; ++r) {
-        rows[r] = plane_row(node, r);
-        store(planes[r], rows[r]);
-      }
-      const unsigned culled = p.coherent ? cull_children(rows, p, active, best) : 0u;
+      const unsigned culled = p.coherent ? cull_children(node, p, active, best) : 0u;
       uint32_t refs[kWideBvhWidth];
       float keys[kWideBvhWidth];
       alignas(32) float nears[kWideBvhWidth][8];
@@ -590,8 +566,8 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
         if ((culled >> i) & 1u) continue;
         V8 tn[3], tf[3];
         for (int a = 0; a < 3; ++a) {
-          V8 t_lo = mul_sub(V8::splat(planes[2 * a][i]), p.rdir[a], p.org_rdir[a]);
-          V8 t_hi = mul_sub(V8::splat(planes[2 * a + 1][i]), p.rdir[a], p.org_rdir[a]);
+          V8 t_lo = mul_sub(V8::splat(node.bounds[2 * a][i]), p.rdir[a], p.org_rdir[a]);
+          V8 t_hi = mul_sub(V8::splat(node.bounds[2 * a + 1][i]), p.rdir[a], p.org_rdir[a]);
           tn[a] = min(t_lo, t_hi);
           tf[a] = max(t_lo, t_hi);
         }

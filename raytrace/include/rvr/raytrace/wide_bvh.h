@@ -1,8 +1,8 @@
 // The wide BVH ("bvh", the default): the binned-SAH binary tree collapsed into 8-wide nodes by
 // opening, at every node, the child of largest surface area until eight children are gathered
-// (as Embree's builders do), child boxes quantized to a byte per plane (wide_node_quantize.h),
-// with leaves of 1..8 triangles stored in 4-wide SoA blocks. Built here in baseline code; traversed
-// by the SIMD kernels of the instruction set chosen at run time (simd_kernels.h).
+// (as Embree's builders do), with leaves of 1..8 triangles stored in 4-wide SoA blocks. Built
+// here in baseline code; traversed by the SIMD kernels of the instruction set chosen at run time
+// (simd_kernels.h).
 #pragma once
 
 #include <stddef.h>

@@ -12,24 +12,15 @@ constexpr int kWideBvhWidth = 8;   // children per node
 constexpr int kTriangleBlock = 4;  // triangles per SoA leaf block
 constexpr int kMaxLeafTriangles = 8;
 
-// Eight child boxes, quantized (Ylitie et al. 2017; Embree's compressed BVH8): per axis the
-// node's lower corner `origin` and a step 2^(scale_exp - 127), and per child and plane the number
-// of steps from the origin, so a plane is origin + q * step. The steps are powers of two and q
-// has at most 8 bits, so q * step is exact and a plane is the same float whether computed with
-// or without a fused multiply-add, in every kernel. The builder rounds lower planes down and
-// upper planes up (checked on the dequantized floats): every box contains its child's subtree.
-// Rows of q are lower x, upper x, lower y, upper y, lower z, upper z, so the near and far planes
-// of an axis are rows 2a + s and 2a + 1 - s, with s the sign bit of the ray's direction. Slots
-// hold children from the first one on; `valid` has bit i set when slot i holds one (an empty
-// slot's q and child are meaningless but for child = kEmptyTree).
+// Eight child boxes in SoA, tested against a ray with one SIMD slab test (two halves with SSE).
+// Rows are lower x, upper x, lower y, upper y, lower z, upper z, so the near and far planes of
+// an axis are rows 2a + s and 2a + 1 - s, with s the sign bit of the ray's direction. An empty
+// slot has lower = +inf, upper = -inf: no ray ever enters it.
 struct alignas(32) WideNode {
-  float origin[3];
-  uint8_t scale_exp[3];  // biased exponent of the step, 1..254: steps are normal floats
-  uint8_t valid;
-  uint8_t q[6][kWideBvhWidth];
+  float bounds[6][kWideBvhWidth];
   uint32_t child[kWideBvhWidth];
 };
-static_assert(sizeof(WideNode) == 96, "wide nodes are 3 cache half-lines");
+static_assert(sizeof(WideNode) == 224, "wide nodes are 7 cache half-lines");
 
 // Child references: an inner node's index, or a leaf of 1..8 triangles in consecutive blocks.
 constexpr uint32_t kLeafFlag = 0x80000000u;

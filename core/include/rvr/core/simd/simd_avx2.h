@@ -37,11 +37,6 @@ struct vfloat8 {
   __m256 v;
   static vfloat8 load(const float* p) { return {_mm256_load_ps(p)}; }  // 32-byte aligned
   static vfloat8 loadu(const float* p) { return {_mm256_loadu_ps(p)}; }
-  // Eight unsigned bytes (any alignment) as floats, exactly.
-  static vfloat8 load_u8(const uint8_t* p) {
-    const __m128i b = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p));
-    return {_mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(b))};
-  }
   static vfloat8 splat(float x) { return {_mm256_set1_ps(x)}; }
   static vfloat8 zero() { return {_mm256_setzero_ps()}; }
 };

@@ -30,14 +30,6 @@ struct vfloat8 {
   vfloat4 lo, hi;
   static vfloat8 load(const float* p) { return {vfloat4::load(p), vfloat4::load(p + 4)}; }
   static vfloat8 loadu(const float* p) { return {vfloat4::loadu(p), vfloat4::loadu(p + 4)}; }
-  // Eight unsigned bytes (any alignment) as floats, exactly (SSE2: zero-extended by unpacking).
-  static vfloat8 load_u8(const uint8_t* p) {
-    const __m128i zero = _mm_setzero_si128();
-    const __m128i b = _mm_loadl_epi64(reinterpret_cast<const __m128i*>(p));
-    const __m128i w = _mm_unpacklo_epi8(b, zero);
-    return {{_mm_cvtepi32_ps(_mm_unpacklo_epi16(w, zero))},
-            {_mm_cvtepi32_ps(_mm_unpackhi_epi16(w, zero))}};
-  }
   static vfloat8 splat(float x) { return {vfloat4::splat(x), vfloat4::splat(x)}; }
   static vfloat8 zero() { return {vfloat4::zero(), vfloat4::zero()}; }
 };
