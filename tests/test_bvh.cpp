@@ -303,6 +303,125 @@ TEST(Bvh, AxisParallelRaysStartingOnANodeFace) {
   EXPECT_GT(checked, 100);
 }
 
+// The binary builder against the binned SAH written out plainly, per node: an inner node above
+// the median depth splits its primitives at the split of least cost over the 16 centroid bins
+// of every axis (its left child holds exactly the primitives of bins up to the split), and a
+// leaf that could split is no costlier than that split. Costs as the wide BVH builds with them:
+// traversal 1, leaves counted in blocks of 4, at most 8 primitives a leaf.
+TEST(Bvh, EveryNodeTakesTheLeastCostBinnedSplit) {
+  constexpr int kBins = 16;
+  constexpr size_t kMedianDepth = 32;
+  constexpr uint32_t kBlock = 4, kMaxLeaf = 8;
+  constexpr float kTraversal = 1.0f;
+  auto tests = [&](uint32_t n) { return float((n + kBlock - 1) / kBlock); };
+  for (const char* name : {"soup:3000", "tessphere:3000"}) {
+    Scene scene = builtin(name);
+    TraceGeometry g(scene, SphereMode::Analytic, 1, AccelKind::Bvh2);
+    std::vector<Aabb> prims(g.triangle_count());
+    for (size_t i = 0; i < prims.size(); ++i) {
+      const TrianglePrecomputed& t = g.triangle(uint32_t(i));
+      prims[i].grow(t.v0);
+      prims[i].grow(t.v0 + t.e1);
+      prims[i].grow(t.v0 + t.e2);
+    }
+    BvhBuildOptions options;
+    options.max_leaf_size = int(kMaxLeaf);
+    options.leaf_block = int(kBlock);
+    options.traversal_cost = kTraversal;
+    const Bvh bvh = Bvh::build(prims, options);
+    const std::vector<uint32_t>& order = bvh.primitive_order();
+    int inner_checked = 0, leaves_checked = 0;
+    // The node's primitive range [begin, end), checking its split on the way.
+    std::function<std::pair<uint32_t, uint32_t>(uint32_t, size_t)> walk = [&](uint32_t index,
+                                                                              size_t depth) {
+      const BvhNode& node = bvh.nodes()[index];
+      if (node.count > 0) {
+        EXPECT_LE(node.count, kMaxLeaf);
+        return std::pair<uint32_t, uint32_t>{node.offset, node.offset + node.count};
+      }
+      auto [begin, mid] = walk(index + 1, depth + 1);
+      auto [mid2, end] = walk(node.offset, depth + 1);
+      EXPECT_EQ(mid, mid2) << name << " node " << index;
+      (void)mid2;
+      return std::pair<uint32_t, uint32_t>{begin, end};
+    };
+    // The least-cost binned split of primitives order[begin, end): axis (-1: none), bin, cost.
+    struct Best {
+      int axis = -1, bin = 0;
+      float cost = INFINITY;
+    };
+    auto best_split = [&](uint32_t begin, uint32_t end, std::vector<int>(&bin_of)[3]) {
+      Aabb box, centroids;
+      for (uint32_t k = begin; k < end; ++k) {
+        const Aabb& b = prims[order[k]];
+        box.grow(b);
+        centroids.grow(b.lo + b.hi);
+      }
+      Best best;
+      const float inv_area = 1.0f / std::max(box.surface_area(), 1e-30f);
+      for (int a = 0; a < 3; ++a) {
+        bin_of[a].assign(end - begin, 0);
+        const float extent = centroids.hi[a] - centroids.lo[a];
+        if (!(extent > 0.0f)) continue;
+        const float scale = float(kBins) / extent;
+        Aabb bin_box[kBins];
+        uint32_t count[kBins] = {};
+        for (uint32_t k = begin; k < end; ++k) {
+          const Aabb& b = prims[order[k]];
+          const int bin = std::min(kBins - 1, int(((b.lo + b.hi)[a] - centroids.lo[a]) * scale));
+          bin_of[a][k - begin] = bin;
+          count[bin]++;
+          bin_box[bin].grow(b);
+        }
+        for (int split = 0; split < kBins - 1; ++split) {
+          Aabb left, right;
+          uint32_t n_left = 0, n_right = 0;
+          for (int bin = 0; bin <= split; ++bin) left.grow(bin_box[bin]), n_left += count[bin];
+          for (int bin = split + 1; bin < kBins; ++bin)
+            right.grow(bin_box[bin]), n_right += count[bin];
+          if (n_left == 0 || n_right == 0) continue;
+          const float cost = kTraversal + inv_area * (left.surface_area() * tests(n_left) +
+                                                      right.surface_area() * tests(n_right));
+          if (cost < best.cost) best = {a, split, cost};
+        }
+      }
+      return best;
+    };
+    std::function<void(uint32_t, size_t)> check = [&](uint32_t index, size_t depth) {
+      const BvhNode& node = bvh.nodes()[index];
+      std::vector<int> bin_of[3];
+      if (node.count > 0) {
+        if (node.count > 1 && depth < kMedianDepth) {
+          const Best best = best_split(node.offset, node.offset + node.count, bin_of);
+          EXPECT_FALSE(best.cost < tests(node.count))
+              << name << " leaf " << index << " of " << node.count << " has a cheaper split";
+          ++leaves_checked;
+        }
+        return;
+      }
+      const auto [begin, mid] = walk(index + 1, depth + 1);
+      const auto [mid2, end] = walk(node.offset, depth + 1);
+      (void)mid2;
+      if (depth < kMedianDepth) {
+        const Best best = best_split(begin, end, bin_of);
+        EXPECT_EQ(int(node.axis), best.axis) << name << " node " << index;
+        if (best.axis >= 0) {
+          int wrong = 0;
+          for (uint32_t k = begin; k < end; ++k)
+            wrong += (bin_of[best.axis][k - begin] <= best.bin) != (k < mid);
+          EXPECT_EQ(wrong, 0) << name << " node " << index << ": primitives on the wrong side";
+        }
+        ++inner_checked;
+      }
+      check(index + 1, depth + 1);
+      check(node.offset, depth + 1);
+    };
+    check(0, 0);
+    EXPECT_GT(inner_checked, 300) << name;
+    EXPECT_GT(leaves_checked, 100) << name;
+  }
+}
+
 TEST(Bvh, BinaryTreeIsSane) {
   Scene s = builtin("soup:20000");
   TraceGeometry g(s, SphereMode::Analytic, 24, AccelKind::Bvh2);

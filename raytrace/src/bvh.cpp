@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <utility>
@@ -62,13 +64,51 @@ struct Split {
   float cost = INFINITY;
 };
 
-void bounds_of(const PrimRef* first, const PrimRef* last, Aabb& box, Aabb& centroids) {
-  box = Aabb();
-  centroids = Aabb();
-  for (const PrimRef* r = first; r != last; ++r) {
-    box.grow(Aabb{r->lo, r->hi});
-    centroids.grow(r->centroid2());
+// Four floats as one value of the compiler's generic vectors (GCC and Clang vector extensions):
+// baseline code, so plain SSE2 on every x86-64; + - * < ?: and & work lane by lane.
+typedef float Row4 __attribute__((vector_size(16)));
+typedef int32_t Int4 __attribute__((vector_size(16)));
+
+// A PrimRef's two rows of four lanes: lo with the bits of id, hi with those of pad.
+void rows_of(const PrimRef& r, Row4& lo, Row4& hi) {
+  static_assert(sizeof(PrimRef) == 2 * sizeof(Row4), "a PrimRef is two rows of four lanes");
+  std::memcpy(&lo, &r, sizeof lo);
+  std::memcpy(&hi, reinterpret_cast<const char*>(&r) + sizeof lo, sizeof hi);
+}
+
+// Twice the centroid (lo + hi, as centroid2) in lanes x, y, z; lane 3 is 0 (the id's bits are
+// cleared first: added as floats they could be denormals, which some CPUs add slowly).
+Row4 centroid2_row(Row4 lo, Row4 hi) {
+  const Int4 xyz = {-1, -1, -1, 0};
+  return Row4(Int4(lo) & xyz) + Row4(Int4(hi) & xyz);
+}
+
+// A box as two rows of four lanes (x, y, z and one never read), grown by a PrimRef's rows with
+// one vector min and one vector max. Its fourth lanes only take min and max of the bits of id and
+// pad, no arithmetic.
+struct Box4 {
+  Row4 lo = {INFINITY, INFINITY, INFINITY, INFINITY};
+  Row4 hi = {-INFINITY, -INFINITY, -INFINITY, -INFINITY};
+  void grow(Row4 ref_lo, Row4 ref_hi) {
+    lo = ref_lo < lo ? ref_lo : lo;
+    hi = ref_hi > hi ? ref_hi : hi;
   }
+  void grow(Row4 point) { grow(point, point); }
+  void grow(const Box4& b) { grow(b.lo, b.hi); }
+  Aabb aabb() const { return Aabb{{lo[0], lo[1], lo[2]}, {hi[0], hi[1], hi[2]}}; }
+  float surface_area() const { return aabb().surface_area(); }
+};
+
+void bounds_of(const PrimRef* first, const PrimRef* last, Aabb& box, Aabb& centroids) {
+  Box4 b, c;
+  for (const PrimRef* r = first; r != last; ++r) {
+    Row4 lo, hi;
+    rows_of(*r, lo, hi);
+    b.grow(lo, hi);
+    c.grow(centroid2_row(lo, hi));
+  }
+  box = b.aabb();
+  centroids = c.aabb();
 }
 
 // The SAH's costs: a node visit against `block` primitives tested at a time in a leaf.
@@ -96,19 +136,26 @@ Split find_binned_split(const PrimRef* first, const PrimRef* last, const BuildTa
                         const SahCosts& costs) {
   const Aabb& centroid_box = task.centroid_box;
   const glm::vec3 extent = centroid_box.hi - centroid_box.lo;
-  Aabb bin_box[3][kBins];
+  Box4 bin_box[3][kBins];
   uint32_t bin_count[3][kBins] = {};
-  float scale[3];
-  for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0.0f ? float(kBins) / extent[a] : 0.0f;
+  Row4 scale = {0.0f, 0.0f, 0.0f, 0.0f};
+  const Row4 origin = {centroid_box.lo[0], centroid_box.lo[1], centroid_box.lo[2], 0.0f};
+  int axes = 0, axis[3];
+  for (int a = 0; a < 3; ++a) {
+    scale[a] = extent[a] > 0.0f ? float(kBins) / extent[a] : 0.0f;
+    if (extent[a] > 0.0f) axis[axes++] = a;
+  }
   for (const PrimRef* r = first; r != last; ++r) {
-    glm::vec3 c = r->centroid2();
-    Aabb prim{r->lo, r->hi};
-    for (int a = 0; a < 3; ++a) {
-      if (extent[a] <= 0.0f) continue;
-      int b = std::min(kBins - 1, int((c[a] - centroid_box.lo[a]) * scale[a]));
+    Row4 lo, hi;
+    rows_of(*r, lo, hi);
+    // The bin on every axis at once: (c - origin) * scale truncated, as goes_left does per axis.
+    const Int4 bins = __builtin_convertvector((centroid2_row(lo, hi) - origin) * scale, Int4);
+    for (int k = 0; k < axes; ++k) {
+      const int a = axis[k];
+      const int b = std::min(kBins - 1, int(bins[a]));
       RVR_DCHECK(b >= 0, "centroid below its node's centroid bounds: bin ", b);
       bin_count[a][b]++;
-      bin_box[a][b].grow(prim);
+      bin_box[a][b].grow(lo, hi);
     }
   }
   Split best;
@@ -117,7 +164,7 @@ Split find_binned_split(const PrimRef* first, const PrimRef* last, const BuildTa
     if (extent[a] <= 0.0f) continue;
     float right_area[kBins];
     uint32_t right_count[kBins];
-    Aabb acc;
+    Box4 acc;
     uint32_t cnt = 0;
     for (int b = kBins - 1; b > 0; --b) {
       acc.grow(bin_box[a][b]);
@@ -125,7 +172,7 @@ Split find_binned_split(const PrimRef* first, const PrimRef* last, const BuildTa
       right_area[b] = acc.surface_area();
       right_count[b] = cnt;
     }
-    acc = Aabb();
+    acc = Box4();
     cnt = 0;
     for (int b = 0; b < kBins - 1; ++b) {
       acc.grow(bin_box[a][b]);
@@ -161,21 +208,24 @@ Partition partition_at_bin(std::vector<PrimRef>& refs, const BuildTask& task, co
   };
   PrimRef* i = refs.data() + task.begin;
   PrimRef* j = refs.data() + task.end;
+  Box4 left_box, left_centroids, right_box, right_centroids;
+  auto add = [](const PrimRef& r, Box4& box, Box4& centroids) {
+    Row4 lo, hi;
+    rows_of(r, lo, hi);
+    box.grow(lo, hi);
+    centroids.grow(centroid2_row(lo, hi));
+  };
   for (;;) {
-    while (i < j && goes_left(*i)) {
-      p.left_box.grow(Aabb{i->lo, i->hi});
-      p.left_centroids.grow(i->centroid2());
-      ++i;
-    }
-    while (i < j && !goes_left(*(j - 1))) {
-      --j;
-      p.right_box.grow(Aabb{j->lo, j->hi});
-      p.right_centroids.grow(j->centroid2());
-    }
+    while (i < j && goes_left(*i)) add(*i++, left_box, left_centroids);
+    while (i < j && !goes_left(*(j - 1))) add(*--j, right_box, right_centroids);
     if (i >= j) break;
     std::swap(*i, *(j - 1));
   }
   p.mid = uint32_t(i - refs.data());
+  p.left_box = left_box.aabb();
+  p.left_centroids = left_centroids.aabb();
+  p.right_box = right_box.aabb();
+  p.right_centroids = right_centroids.aabb();
   return p;
 }
 
