@@ -140,18 +140,15 @@ Split find_binned_split(const PrimRef* first, const PrimRef* last, const BuildTa
   uint32_t bin_count[3][kBins] = {};
   Row4 scale = {0.0f, 0.0f, 0.0f, 0.0f};
   const Row4 origin = {centroid_box.lo[0], centroid_box.lo[1], centroid_box.lo[2], 0.0f};
-  int axes = 0, axis[3];
-  for (int a = 0; a < 3; ++a) {
-    scale[a] = extent[a] > 0.0f ? float(kBins) / extent[a] : 0.0f;
-    if (extent[a] > 0.0f) axis[axes++] = a;
-  }
+  for (int a = 0; a < 3; ++a) scale[a] = extent[a] > 0.0f ? float(kBins) / extent[a] : 0.0f;
+  // Every axis is binned, unrolled: one without extent has scale 0 and puts everything in bin 0,
+  // and the sweep below skips it.
   for (const PrimRef* r = first; r != last; ++r) {
     Row4 lo, hi;
     rows_of(*r, lo, hi);
     // The bin on every axis at once: (c - origin) * scale truncated, as goes_left does per axis.
     const Int4 bins = __builtin_convertvector((centroid2_row(lo, hi) - origin) * scale, Int4);
-    for (int k = 0; k < axes; ++k) {
-      const int a = axis[k];
+    for (int a = 0; a < 3; ++a) {
       const int b = std::min(kBins - 1, int(bins[a]));
       RVR_DCHECK(b >= 0, "centroid below its node's centroid bounds: bin ", b);
       bin_count[a][b]++;
