@@ -16,6 +16,7 @@
 #include <random>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "rvr/core/expected.h"
@@ -313,7 +314,9 @@ TEST(Bvh, EveryNodeTakesTheLeastCostBinnedSplit) {
   constexpr size_t kMedianDepth = 32;
   constexpr uint32_t kBlock = 4, kMaxLeaf = 8;
   constexpr float kTraversal = 1.0f;
-  auto tests = [&](uint32_t n) { return float((n + kBlock - 1) / kBlock); };
+  auto tests = [&](uint32_t n) {              // whole blocks: the division rounds up
+    return float((n + kBlock - 1) / kBlock);  // NOLINT(bugprone-integer-division)
+  };
   for (const char* name : {"soup:3000", "tessphere:3000"}) {
     Scene scene = builtin(name);
     TraceGeometry g(scene, SphereMode::Analytic, 1, AccelKind::Bvh2);
