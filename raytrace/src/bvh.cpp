@@ -40,8 +40,7 @@ constexpr size_t kMedianDepth = 32;
 
 // A primitive's bounds and index, partitioned in place as the tree is built (as Embree's
 // PrimRef): every pass over a node's primitives reads memory in order, where an index array into
-// the input would jump around it at every level. They live in a TraversalVector, on huge pages
-// from 2 MiB: at 10^6 primitives that is 16 page faults instead of 8,000.
+// the input would jump around it at every level.
 struct PrimRef {  // 32 bytes
   glm::vec3 lo;
   uint32_t id;
@@ -123,8 +122,8 @@ struct SahCosts {
   float leaf(uint32_t n) const { return kIntersectCost * tests(n); }
 };
 
-TraversalVector<PrimRef> prim_refs(const std::vector<Aabb>& bounds) {
-  TraversalVector<PrimRef> refs(bounds.size());
+std::vector<PrimRef> prim_refs(const std::vector<Aabb>& bounds) {
+  std::vector<PrimRef> refs(bounds.size());
   for (uint32_t i = 0; i < uint32_t(bounds.size()); ++i)
     refs[i] = {bounds[i].lo, i, bounds[i].hi, 0};
   return refs;
@@ -195,7 +194,7 @@ struct Partition {
 
 // Hoare partition at the split's bin that also gathers each side's bounds, so the children need
 // no pass of their own.
-Partition partition_at_bin(TraversalVector<PrimRef>& refs, const BuildTask& task, const Split& split) {
+Partition partition_at_bin(std::vector<PrimRef>& refs, const BuildTask& task, const Split& split) {
   Partition p;
   p.axis = split.axis;
   const glm::vec3 extent = task.centroid_box.hi - task.centroid_box.lo;
@@ -229,7 +228,7 @@ Partition partition_at_bin(TraversalVector<PrimRef>& refs, const BuildTask& task
 
 // No useful SAH split (all centroids equal, or too deep): the object median along the axis of
 // widest centroid extent.
-Partition partition_at_median(TraversalVector<PrimRef>& refs, const BuildTask& task) {
+Partition partition_at_median(std::vector<PrimRef>& refs, const BuildTask& task) {
   Partition p;
   const glm::vec3 extent = task.centroid_box.hi - task.centroid_box.lo;
   p.axis = int(std::max_element(&extent[0], &extent[0] + 3) - &extent[0]);
@@ -277,7 +276,7 @@ Bvh Bvh::build(const std::vector<Aabb>& bounds, const BvhBuildOptions& options) 
   bvh.stats_.primitives = n;
   if (n == 0) return bvh;
 
-  TraversalVector<PrimRef> refs = prim_refs(bounds);
+  std::vector<PrimRef> refs = prim_refs(bounds);
   bvh.nodes_.reserve(size_t(n) / 2 + 1);
   std::vector<BuildTask> tasks;
   {
