@@ -2,10 +2,10 @@
 // every SIMD kernel this CPU can run, and the binary one. Ties at equal t go to the lowest
 // primitive index in all three, so hits agree to the bit, primitive included.
 #include <gtest/gtest.h>
-#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <functional>
