@@ -22,14 +22,19 @@ def run_cli(rvr_binary):
 
 
 @pytest.fixture(scope="session")
-def study_budget():
+def budget_scale():
+    """RVR_TEST_BUDGET_SCALE: 4 under the sanitizers, whose frames run several times slower, so
+    any wall-time bound a test sets on rendering work is this many times longer there."""
+    return float(os.environ.get("RVR_TEST_BUDGET_SCALE", "1"))
+
+
+@pytest.fixture(scope="session")
+def study_budget(budget_scale):
     """The budget in seconds to give a study that must measure some point: `seconds` times
-    RVR_TEST_BUDGET_SCALE (4 under the sanitizers, whose frames run several times slower: the
-    command line stops a worker still busy at the budget's end and drops its run, and a study in
-    this process starts no step that would end past it)."""
-    scale = float(os.environ.get("RVR_TEST_BUDGET_SCALE", "1"))
+    budget_scale (the command line stops a worker still busy at the budget's end and drops its
+    run, and a study in this process starts no step that would end past it)."""
 
     def budget(seconds):
-        return seconds * scale
+        return seconds * budget_scale
 
     return budget
