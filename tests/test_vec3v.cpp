@@ -1,11 +1,13 @@
 // Vec3v, the SIMD layer's 3-vectors of vectors (rvr/core/simd/vec3v.h), in every instruction set
 // this CPU runs and at every vector width the kernels use, against glm's vec3, the scalar code
-// the kernels mirror: every lane of every operation bit for bit, on random vectors whose
+// the kernels mirror (and the vectors' own lane operations against their scalar forms): every
+// lane of every operation bit for bit, on random vectors whose
 // components span many magnitudes (so that a different association of a sum or a different
 // order of a difference changes the bits).
 #include <gtest/gtest.h>
 #include <stdint.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <glm/glm.hpp>
@@ -29,6 +31,8 @@ const char* to_string(ProbeWidth width) {
       return "vfloat4";
     case ProbeWidth::Eight:
       return "vfloat8";
+    case ProbeWidth::Sixteen:
+      return "vfloat16";
     case ProbeWidth::Native:
       return "vfloatx";
   }
@@ -89,6 +93,16 @@ TEST(Vec3v, EveryLaneIsTheScalarOperationInEveryIsaAndWidth) {
         const Vec3vProbeInput in = random_input(rng);
         Vec3vProbeOutput out{};
         probe.run(width, in, out);
+        float max_x = in.a[0][0];
+        unsigned less_bits = 0;
+        for (int k = 0; k < kProbeLanes; ++k) {
+          max_x = std::max(max_x, in.a[0][k]);
+          less_bits |= unsigned(in.a[0][k] < in.b[0][k]) << k;
+        }
+        if (width != ProbeWidth::Scalar) {
+          EXPECT_EQ(out.less_bits, less_bits) << check.where;
+        }
+        if (width == ProbeWidth::Sixteen) check.same("reduce_max", 0, out.max_x, max_x);
         for (int k = 0; k < kProbeLanes; ++k) {
           const glm::vec3 a = lane(in.a, k), b = lane(in.b, k);
           const float s = in.s[k];
@@ -104,12 +118,15 @@ TEST(Vec3v, EveryLaneIsTheScalarOperationInEveryIsaAndWidth) {
           if (width == ProbeWidth::Scalar) continue;  // vector operations only
           check.same("normalize", k, out.normalized, glm::normalize(a));
           check.same("select", k, out.selected, a.x < b.x ? a : b);
+          check.same("abs", k, out.abs_x[k], std::fabs(a.x));
+          check.same("a ^ signbits(b)", k, out.sign_flipped_x[k], std::signbit(b.x) ? -a.x : a.x);
+          check.same("masked", k, out.masked_x[k], a.x < b.x ? a.x : 0.0f);
         }
       }
       ++tested;
     }
   }
-  EXPECT_GE(tested, 4);  // SSE runs on every x86-64
+  EXPECT_GE(tested, 5);  // SSE runs on every x86-64
 }
 
 }  // namespace

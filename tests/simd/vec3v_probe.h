@@ -1,6 +1,8 @@
 // Vec3v (rvr/core/simd/vec3v.h) compiled in one unit per instruction set, like the kernels, so
 // that test_vec3v can hold every operation of every ISA and vector width to the scalar
-// computation: each unit evaluates the operations on sixteen lanes of inputs.
+// computation: each unit evaluates the operations on sixteen lanes of inputs. With them, the
+// lane operations of the vectors themselves that the packet kernels use (abs, sign bits, masks
+// and their bits, the largest lane).
 #pragma once
 
 namespace rvr {
@@ -26,14 +28,22 @@ struct Vec3vProbeOutput {
   alignas(64) float selected[3][kProbeLanes];
   alignas(64) float dot[kProbeLanes];
   alignas(64) float length_squared[kProbeLanes];
+  // Vector widths only: abs(a.x); a.x ^ signbits(b.x); masked(from_bits(movemask(a.x < b.x)),
+  // a.x); bit k of less_bits is lane k of a.x < b.x.
+  alignas(64) float abs_x[kProbeLanes];
+  alignas(64) float sign_flipped_x[kProbeLanes];
+  alignas(64) float masked_x[kProbeLanes];
+  unsigned less_bits;
+  float max_x;  // 16 lanes only: reduce_max(a.x)
 };
 
 // The vector types Vec3v is instantiated with: float (one lane at a time; no normalize or
-// select, which the kernels use on vectors only), vfloat4,
-// vfloat8 and the ISA's native vfloatx.
-enum class ProbeWidth { Scalar, Four, Eight, Native };
+// select, which the kernels use on vectors only), vfloat4, vfloat8, vfloat16 (the packets'
+// width, in every ISA) and the ISA's native vfloatx.
+enum class ProbeWidth { Scalar, Four, Eight, Sixteen, Native };
 inline constexpr ProbeWidth kAllProbeWidths[] = {ProbeWidth::Scalar, ProbeWidth::Four,
-                                                 ProbeWidth::Eight, ProbeWidth::Native};
+                                                 ProbeWidth::Eight, ProbeWidth::Sixteen,
+                                                 ProbeWidth::Native};
 
 struct Vec3vProbe {
   const char* isa;

@@ -53,6 +53,7 @@ void store1(float (&row)[kProbeLanes], int i, V a) {
 template <class V>
 void run_width(const Vec3vProbeInput& in, Vec3vProbeOutput& out) {
   constexpr int kLanes = int(sizeof(V) / sizeof(float));
+  out.less_bits = 0;
   for (int i = 0; i < kProbeLanes; i += kLanes) {
     const Vec3v<V> a = load3<V>(in.a, i), b = load3<V>(in.b, i);
     const V s = load1<V>(in.s, i);
@@ -66,7 +67,14 @@ void run_width(const Vec3vProbeInput& in, Vec3vProbeOutput& out) {
     if constexpr (!std::is_same_v<V, float>) {  // vector operations only
       store3(out.normalized, i, normalize(a));
       store3(out.selected, i, select(a.x < b.x, a, b));
+      using M = decltype(a.x < b.x);
+      const unsigned less = movemask(a.x < b.x);
+      out.less_bits |= less << i;
+      store(out.abs_x + i, abs(a.x));
+      store(out.sign_flipped_x + i, a.x ^ signbits(b.x));
+      store(out.masked_x + i, masked(M::from_bits(less), a.x));
     }
+    if constexpr (std::is_same_v<V, vfloat16>) out.max_x = reduce_max(a.x);
     store1(out.dot, i, dot(a, b));
     store1(out.length_squared, i, length_squared(a));
   }
@@ -80,6 +88,8 @@ void run(ProbeWidth width, const Vec3vProbeInput& in, Vec3vProbeOutput& out) {
       return run_width<vfloat4>(in, out);
     case ProbeWidth::Eight:
       return run_width<vfloat8>(in, out);
+    case ProbeWidth::Sixteen:
+      return run_width<vfloat16>(in, out);
     case ProbeWidth::Native:
       return run_width<vfloatx>(in, out);
   }

@@ -351,20 +351,37 @@ bool occluded_counted(const WideBvhView& bvh, const KernelRay& ray, KernelCounte
   return trace<true, true>(bvh, ray, nullptr, &counters);
 }
 
-// ---------------------------------------------------------------------- packets of 8 rays
+// --------------------------------------------------------------------- packets of 16 rays
 
-// Eight rays from one origin in the lanes of V8s. A node's children are tested one at a time
-// against all eight (both planes per axis, then min/max, so each lane may point its own way);
-// each lane keeps its own nearest hit, found with the same triangle arithmetic as a single ray,
-// so every lane ends with exactly the hit a single ray would find.
-struct Packet8 {
-  Vec3vf8 d;
-  V8 rdir[3], org_rdir[3];
-  V8 margin;  // per lane, absolute: covers the rounding of org * rdir (as RayBox's margins)
-  V8 tmin;
+// A packet is kPacketLanes = 16 rays from one origin in the lanes of PVs, in every ISA (native in
+// AVX-512 units, two 8-lane halves in AVX2 and SSE ones): a ray's work counts (the cost AOV,
+// bvh.nodes_visited) depend on the rays it went with, so the width is the same everywhere.
+// Sixteen lanes are two rows of a tile's 8 x 8 rays, as with Embree's rtcIntersect16.
+using PV = vfloat16;
+using PM = vboolf16;
+using PI = vint16;  // primitive indices
+using Vec3vP = Vec3v<PV>;
+constexpr int kPacketLanes = 16;
+constexpr unsigned kAllLanes = (1u << kPacketLanes) - 1u;
+static_assert(kPacketRays % kPacketLanes == 0, "a tile is whole packets");
+
+inline PV mul_sub(PV a, PV b, PV c) {  // as mul_sub of V8s
+  return a * b - c;
+}
+
+// A node's children are tested one at a time against all the lanes (both planes per axis, then
+// min/max, so each lane may point its own way); each lane keeps its own nearest hit, found with the
+// same triangle arithmetic as a single ray, so every lane ends with exactly the hit a single ray
+// would find.
+struct Packet {
+  Vec3vP d;
+  PV rdir[3], org_rdir[3];
+  PV margin;  // per lane, absolute: covers the rounding of org * rdir (as RayBox's margins)
+  PV tmin;
+  float tmin1;  // tmin, the same in every lane
   Vec3f o;
   unsigned valid;
-  KernelRay ray[8];  // the same rays one by one: edge rechecks, single-ray fallback
+  KernelRay ray[kPacketLanes];  // the same rays one by one: edge rechecks, single-ray fallback
   // The packet as one interval ray (Boulos et al. 2006), for culling a node's children that no
   // lane can enter (cull_children): when every lane's direction has the same sign on each axis,
   // each reciprocal lies in [rdir_lo, rdir_hi] and the near plane of a box on axis a is bounds
@@ -375,9 +392,9 @@ struct Packet8 {
   float margin_hi;
 };
 
-struct PacketBest8 {
-  V8 t, u, v;
-  I8 primitive;  // starts at 0 with t = tmax (see Closest)
+struct PacketBest {
+  PV t, u, v;
+  PI primitive;  // starts at 0 with t = tmax (see Closest)
   unsigned found;
 };
 
@@ -389,16 +406,16 @@ constexpr int kSingleRayThreshold = 2;
 struct PacketStack {
   static constexpr int kEntries = 8 * 66;
   uint32_t ref[kEntries];
-  alignas(32) float near[kEntries][8];
+  alignas(64) float near[kEntries][kPacketLanes];
   int top = 0;
 };
 
 // Hands lane `lane` to the single-ray traversal of subtree `ref`, keeping its hit so far.
 template <bool kCount>
-void finish_lane(const WideBvhView& bvh, const Packet8& p, unsigned lane, uint32_t ref,
-                 PacketBest8& best, KernelCounters* counters) {
-  alignas(32) float t[8], u[8], v[8];
-  alignas(32) uint32_t prim[8];
+void finish_lane(const WideBvhView& bvh, const Packet& p, unsigned lane, uint32_t ref,
+                 PacketBest& best, KernelCounters* counters) {
+  alignas(64) float t[kPacketLanes], u[kPacketLanes], v[kPacketLanes];
+  alignas(64) uint32_t prim[kPacketLanes];
   store(t, best.t);
   store(u, best.u);
   store(v, best.v);
@@ -415,42 +432,42 @@ void finish_lane(const WideBvhView& bvh, const Packet8& p, unsigned lane, uint32
   u[lane] = c.best.u;
   v[lane] = c.best.v;
   prim[lane] = c.best.primitive;
-  best.t = V8::load(t);
-  best.u = V8::load(u);
-  best.v = V8::load(v);
-  best.primitive = I8::load(prim);
+  best.t = PV::load(t);
+  best.u = PV::load(u);
+  best.v = PV::load(v);
+  best.primitive = PI::load(prim);
   best.found |= 1u << lane;
 }
 
 // Lanes `active` against triangle `lane` of block b: intersect_triangle_mt lane by lane (s and
 // q depend only on the shared origin, so they are computed once, in the same float operations).
-inline void intersect_triangle8(const TriangleBlock& b, unsigned j, const Packet8& p,
-                                unsigned active, PacketBest8& best) {
+inline void intersect_triangle_packet(const TriangleBlock& b, unsigned j, const Packet& p,
+                                      unsigned active, PacketBest& best) {
   const Vec3f e1 = column(b.e1, int(j)), e2 = column(b.e2, int(j));
-  const Vec3vf8 P = cross(p.d, Vec3vf8::splat(e2));
-  V8 det = dot(Vec3vf8::splat(e1), P);
+  const Vec3vP P = cross(p.d, Vec3vP::splat(e2));
+  PV det = dot(Vec3vP::splat(e1), P);
   const Vec3f s = p.o - column(b.v0, int(j));
   const Vec3f q = cross(s, e1);
-  V8 su = dot(Vec3vf8::splat(s), P);
-  V8 sv = dot(p.d, Vec3vf8::splat(q));
-  V8 sign = signbits(det);
-  V8 abs_det = abs(det);
-  V8 U = su ^ sign, V = sv ^ sign, UV = U + V;
-  V8 outer_lo = V8::splat(-kEdgeBand) * abs_det, outer_hi = V8::splat(1.0f + kEdgeBand) * abs_det;
-  M8 reject = (det == V8::splat(0.0f)) |
+  PV su = dot(Vec3vP::splat(s), P);
+  PV sv = dot(p.d, Vec3vP::splat(q));
+  PV sign = signbits(det);
+  PV abs_det = abs(det);
+  PV U = su ^ sign, V = sv ^ sign, UV = U + V;
+  PV outer_lo = PV::splat(-kEdgeBand) * abs_det, outer_hi = PV::splat(1.0f + kEdgeBand) * abs_det;
+  PM reject = (det == PV::splat(0.0f)) |
               (((U < outer_lo) | (U > outer_hi)) | ((V < outer_lo) | (UV > outer_hi)));
   unsigned keep = active & ~movemask(reject);
   if (!keep) return;
-  V8 band = V8::splat(kEdgeBand) * abs_det, inner_hi = V8::splat(1.0f - kEdgeBand) * abs_det;
+  PV band = PV::splat(kEdgeBand) * abs_det, inner_hi = PV::splat(1.0f - kEdgeBand) * abs_det;
   unsigned edge = keep & movemask(((U < band) | (V < band)) | (UV > inner_hi));
   unsigned inner = keep & ~edge;
-  const I8 prim = I8::splat(int32_t(b.primitive[j]));
+  const PI prim = PI::splat(int32_t(b.primitive[j]));
   if (inner) {
-    V8 inv = V8::splat(1.0f) / det;
-    V8 t = V8::splat(dot(e2, q)) * inv;
+    PV inv = PV::splat(1.0f) / det;
+    PV t = PV::splat(dot(e2, q)) * inv;
     // Primitive indices are below 2^31: the signed comparison orders them.
-    M8 better = (t < best.t) | ((t == best.t) & (prim < best.primitive));
-    M8 take = (M8::from_bits(inner) & (t > p.tmin)) & better;
+    PM better = (t < best.t) | ((t == best.t) & (prim < best.primitive));
+    PM take = (PM::from_bits(inner) & (t > p.tmin)) & better;
     unsigned taken = movemask(take);
     if (taken) {
       best.t = select(take, t, best.t);
@@ -463,14 +480,14 @@ inline void intersect_triangle8(const TriangleBlock& b, unsigned j, const Packet
   if (edge) {
     float tri[9];
     lane_triangle(b, j, tri);
-    alignas(32) float bt[8];
+    alignas(64) float bt[kPacketLanes];
     store(bt, best.t);
     for (; edge; edge &= edge - 1) {
       unsigned lane = lowest_bit(edge);
       KernelHit h;
       if (!recheck_triangle_near_edge(p.ray[lane], tri, bt[lane], h)) continue;
-      alignas(32) float t[8], u[8], v[8];
-      alignas(32) uint32_t pr[8];
+      alignas(64) float t[kPacketLanes], u[kPacketLanes], v[kPacketLanes];
+      alignas(64) uint32_t pr[kPacketLanes];
       store(t, best.t);
       store(u, best.u);
       store(v, best.v);
@@ -481,23 +498,18 @@ inline void intersect_triangle8(const TriangleBlock& b, unsigned j, const Packet
       v[lane] = h.v;
       pr[lane] = b.primitive[j];
       bt[lane] = h.t;
-      best.t = V8::load(t);
-      best.u = V8::load(u);
-      best.v = V8::load(v);
-      best.primitive = I8::load(pr);
+      best.t = PV::load(t);
+      best.u = PV::load(u);
+      best.v = PV::load(v);
+      best.primitive = PI::load(pr);
       best.found |= 1u << lane;
     }
   }
 }
 
-// The largest lane of a.
-inline float max_lane(V8 a) {
-  a = max(a, swap_lanes<4>(a));
-  a = max(a, swap_lanes<2>(a));
-  a = max(a, swap_lanes<1>(a));
-  alignas(32) float x[8];
-  store(x, a);
-  return x[0];
+// The largest lane of a (no lane is NaN).
+inline float max_lane(PV a) {
+  return reduce_max(a);
 }
 
 // The children of `node` (bit i: child slot i) that no lane of `active` can enter, found for all
@@ -510,12 +522,12 @@ inline float max_lane(V8 a) {
 // after margins wider than every rounding of either test (2^-18 of the planes' and origin's
 // magnitudes, against the per-lane test's few ulps), has no lane that enters it. Slots whose
 // bounds are infinite (empty) give NaN and are never culled here.
-inline unsigned cull_children(const WideNode& node, const Packet8& p, unsigned active,
-                              const PacketBest8& best) {
+inline unsigned cull_children(const WideNode& node, const Packet& p, unsigned active,
+                              const PacketBest& best) {
   const V8 slack = V8::splat(1.0f / 262144.0f);
-  V8 entry = p.tmin;  // the same in every lane
+  V8 entry = V8::splat(p.tmin1);
   V8 exit =
-      V8::splat(max_lane(select(M8::from_bits(active), best.t, V8::splat(-__builtin_inff()))));
+      V8::splat(max_lane(select(PM::from_bits(active), best.t, PV::splat(-__builtin_inff()))));
   for (int a = 0; a < 3; ++a) {
     const V8 o = V8::splat(p.o[a]);
     const V8 lo = V8::splat(p.rdir_lo[a]), hi = V8::splat(p.rdir_hi[a]);
@@ -534,19 +546,19 @@ inline unsigned cull_children(const WideNode& node, const Packet8& p, unsigned a
 }
 
 template <bool kCount>
-void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best,
+void traverse_packet(const WideBvhView& bvh, const Packet& p, PacketBest& best,
                      KernelCounters* counters) {
   PacketStack stack;
   stack.ref[0] = bvh.root;
   store(stack.near[0], p.tmin);
   stack.top = 1;
-  const V8 inf = V8::splat(__builtin_inff());
+  const PV inf = PV::splat(__builtin_inff());
   // Work per lane, counted in float lanes (exact up to 2^24 per ray) with one add per step.
-  V8 nodes = V8::splat(0.0f), tests = V8::splat(0.0f);
+  PV nodes = PV::splat(0.0f), tests = PV::splat(0.0f);
   while (stack.top > 0) {
     --stack.top;
     uint32_t ref = stack.ref[stack.top];
-    unsigned active = p.valid & movemask(V8::load(stack.near[stack.top]) <= best.t);
+    unsigned active = p.valid & movemask(PV::load(stack.near[stack.top]) <= best.t);
     if (!active) continue;
     if (__builtin_popcount(active) <= kSingleRayThreshold) {
       for (; active; active &= active - 1)
@@ -554,38 +566,35 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
       continue;
     }
     if (!(ref & kLeafFlag)) {
-      if (kCount) nodes = nodes + masked(M8::from_bits(active), V8::splat(1.0f));
+      if (kCount) nodes = nodes + masked(PM::from_bits(active), PV::splat(1.0f));
       const WideNode& node = bvh.nodes[ref];
-      const M8 act = M8::from_bits(active);
+      const PM act = PM::from_bits(active);
       const unsigned culled = p.coherent ? cull_children(node, p, active, best) : 0u;
       uint32_t refs[kWideBvhWidth];
       float keys[kWideBvhWidth];
-      alignas(32) float nears[kWideBvhWidth][8];
+      alignas(64) float nears[kWideBvhWidth][kPacketLanes];
       int n = 0;
       for (int i = 0; i < kWideBvhWidth && node.child[i] != kEmptyTree; ++i) {
         if ((culled >> i) & 1u) continue;
-        V8 tn[3], tf[3];
+        PV tn[3], tf[3];
         for (int a = 0; a < 3; ++a) {
-          V8 t_lo = mul_sub(V8::splat(node.bounds[2 * a][i]), p.rdir[a], p.org_rdir[a]);
-          V8 t_hi = mul_sub(V8::splat(node.bounds[2 * a + 1][i]), p.rdir[a], p.org_rdir[a]);
+          PV t_lo = mul_sub(PV::splat(node.bounds[2 * a][i]), p.rdir[a], p.org_rdir[a]);
+          PV t_hi = mul_sub(PV::splat(node.bounds[2 * a + 1][i]), p.rdir[a], p.org_rdir[a]);
           tn[a] = min(t_lo, t_hi);
           tf[a] = max(t_lo, t_hi);
         }
-        V8 t0 = max(tn[2], max(tn[1], max(tn[0], p.tmin))) - p.margin;
-        V8 t1 = (min(tf[2], min(tf[1], min(tf[0], best.t))) + p.margin) * V8::splat(kWiden);
-        M8 hit = act & (t0 <= t1);
+        PV t0 = max(tn[2], max(tn[1], max(tn[0], p.tmin))) - p.margin;
+        PV t1 = (min(tf[2], min(tf[1], min(tf[0], best.t))) + p.margin) * PV::splat(kWiden);
+        PM hit = act & (t0 <= t1);
         if (!movemask(hit)) continue;
         // The child's distance for ordering: its nearest entry among the lanes that hit it.
-        V8 d = select(hit, t0, inf);
-        alignas(32) float dd[8];
-        store(dd, d);
-        float key = dd[0];
-        for (int k = 1; k < 8; ++k) key = dd[k] < key ? dd[k] : key;
+        PV d = select(hit, t0, inf);
+        const float key = -max_lane(-d);
         int k = n++;
         for (; k > 0 && keys[k - 1] < key; --k) {  // descending: the nearest ends last
           keys[k] = keys[k - 1];
           refs[k] = refs[k - 1];
-          for (int l = 0; l < 8; ++l) nears[k][l] = nears[k - 1][l];
+          for (int l = 0; l < kPacketLanes; ++l) nears[k][l] = nears[k - 1][l];
         }
         keys[k] = key;
         refs[k] = node.child[i];
@@ -593,7 +602,7 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
       }
       for (int k = 0; k < n; ++k) {
         stack.ref[stack.top] = refs[k];
-        for (int l = 0; l < 8; ++l) stack.near[stack.top][l] = nears[k][l];
+        for (int l = 0; l < kPacketLanes; ++l) stack.near[stack.top][l] = nears[k][l];
         ++stack.top;
       }
       RVR_DCHECK(stack.top <= PacketStack::kEntries,
@@ -602,57 +611,58 @@ void traverse_packet(const WideBvhView& bvh, const Packet8& p, PacketBest8& best
     }
     const uint32_t first = (ref & ~kLeafFlag) >> kLeafCountBits;
     const uint32_t triangles = ref & ((1u << kLeafCountBits) - 1);
-    if (kCount) tests = tests + masked(M8::from_bits(active), V8::splat(float(triangles)));
+    if (kCount) tests = tests + masked(PM::from_bits(active), PV::splat(float(triangles)));
     for (uint32_t k = 0; k < triangles; ++k)
-      intersect_triangle8(bvh.blocks[first + k / kTriangleBlock], k % kTriangleBlock, p, active,
-                          best);
+      intersect_triangle_packet(bvh.blocks[first + k / kTriangleBlock], k % kTriangleBlock, p,
+                                active, best);
   }
   if (kCount) {
-    alignas(32) float n[8], t[8];
+    alignas(64) float n[kPacketLanes], t[kPacketLanes];
     store(n, nodes);
     store(t, tests);
-    for (int l = 0; l < 8; ++l) {
+    for (int l = 0; l < kPacketLanes; ++l) {
       counters[l].nodes += uint64_t(n[l]);
       counters[l].tests += uint64_t(t[l]);
     }
   }
 }
 
-// Sets up lanes [first, first + 8) of a tile; false when a direction has a zero component (such
-// rays take the robust single-ray path). Eight lanes at once: the reciprocal directions are one
-// vector division per axis, each lane rounding as the scalar 1 / d does.
-bool make_packet8(const RayPacket& packet, int first, Packet8& p) {
-  const int live = packet.count - first < 8 ? packet.count - first : 8;
+// Sets up lanes [first, first + kPacketLanes) of a tile; false when a direction has a zero
+// component (such rays take the robust single-ray path). All lanes at once: the reciprocal
+// directions are one vector division per axis, each lane rounding as the scalar 1 / d does.
+bool make_packet(const RayPacket& packet, int first, Packet& p) {
+  const int live = packet.count - first < kPacketLanes ? packet.count - first : kPacketLanes;
   p.valid = (1u << live) - 1u;
-  alignas(32) float d[3][8];
+  alignas(64) float d[3][kPacketLanes];
   for (int a = 0; a < 3; ++a)  // unused lanes copy a live one
-    for (int l = 0; l < 8; ++l) d[a][l] = packet.dir[a][l < live ? first + l : first];
-  V8 margin = V8::splat(0.0f);
+    for (int l = 0; l < kPacketLanes; ++l) d[a][l] = packet.dir[a][l < live ? first + l : first];
+  PV margin = PV::splat(0.0f);
   for (int a = 0; a < 3; ++a) {
-    const V8 da = V8::load(d[a]);
-    if (movemask(abs(da) < V8::splat(kTinyDirection)) != 0) return false;
-    const V8 rdir = V8::splat(1.0f) / da;
-    const V8 org_rdir = V8::splat(packet.origin[a]) * rdir;
+    const PV da = PV::load(d[a]);
+    if (movemask(abs(da) < PV::splat(kTinyDirection)) != 0) return false;
+    const PV rdir = PV::splat(1.0f) / da;
+    const PV org_rdir = PV::splat(packet.origin[a]) * rdir;
     // 2^-20: org * rdir's rounding, x16; the largest over the axes, as e > m ? e : m.
-    margin = max(abs(org_rdir) * V8::splat(1.0f / 1048576.0f), margin);
+    margin = max(abs(org_rdir) * PV::splat(1.0f / 1048576.0f), margin);
     p.d[a] = da;
     p.rdir[a] = rdir;
     p.org_rdir[a] = org_rdir;
     p.o[a] = packet.origin[a];
   }
   p.margin = margin;
-  p.tmin = V8::splat(packet.tmin);
+  p.tmin = PV::splat(packet.tmin);
+  p.tmin1 = packet.tmin;
   p.coherent = true;
   for (int a = 0; a < 3; ++a) {
-    const unsigned negative = movemask(p.rdir[a] < V8::splat(0.0f));
-    p.coherent = p.coherent && (negative == 0u || negative == 0xFFu);
+    const unsigned negative = movemask(p.rdir[a] < PV::splat(0.0f));
+    p.coherent = p.coherent && (negative == 0u || negative == kAllLanes);
     p.rdir_lo[a] = -max_lane(-p.rdir[a]);
     p.rdir_hi[a] = max_lane(p.rdir[a]);
     p.near_row[a] = 2 * a + (negative ? 1 : 0);
     p.far_row[a] = 2 * a + (negative ? 0 : 1);
   }
   p.margin_hi = max_lane(margin);
-  for (int l = 0; l < 8; ++l) {
+  for (int l = 0; l < kPacketLanes; ++l) {
     for (int a = 0; a < 3; ++a) {
       p.ray[l].origin[a] = packet.origin[a];
       p.ray[l].dir[a] = d[a][l];
@@ -666,11 +676,11 @@ bool make_packet8(const RayPacket& packet, int first, Packet8& p) {
 template <bool kCount>
 void closest_packet_impl(const WideBvhView& bvh, const RayPacket& packet, KernelHit* hits,
                          KernelCounters* counters) {
-  for (int first = 0; first < packet.count; first += 8) {
-    Packet8 p;
+  for (int first = 0; first < packet.count; first += kPacketLanes) {
+    Packet p;
     if (bvh.root == kEmptyTree) break;
-    if (!make_packet8(packet, first, p)) {
-      for (int i = first; i < first + 8 && i < packet.count; ++i) {
+    if (!make_packet(packet, first, p)) {
+      for (int i = first; i < first + kPacketLanes && i < packet.count; ++i) {
         KernelRay r{{packet.origin[0], packet.origin[1], packet.origin[2]},
                     {packet.dir[0][i], packet.dir[1][i], packet.dir[2][i]},
                     packet.tmin,
@@ -679,15 +689,15 @@ void closest_packet_impl(const WideBvhView& bvh, const RayPacket& packet, Kernel
       }
       continue;
     }
-    PacketBest8 best{V8::splat(packet.tmax), V8::splat(0.0f), V8::splat(0.0f), I8::splat(0), 0u};
+    PacketBest best{PV::splat(packet.tmax), PV::splat(0.0f), PV::splat(0.0f), PI::splat(0), 0u};
     traverse_packet<kCount>(bvh, p, best, kCount ? counters + first : nullptr);
-    alignas(32) float t[8], u[8], v[8];
-    alignas(32) uint32_t prim[8];
+    alignas(64) float t[kPacketLanes], u[kPacketLanes], v[kPacketLanes];
+    alignas(64) uint32_t prim[kPacketLanes];
     store(t, best.t);
     store(u, best.u);
     store(v, best.v);
     store(prim, best.primitive);
-    for (int l = 0; l < 8 && first + l < packet.count; ++l) {
+    for (int l = 0; l < kPacketLanes && first + l < packet.count; ++l) {
       if (!((best.found >> l) & 1)) continue;
       KernelHit& h = hits[first + l];
       h.t = t[l];

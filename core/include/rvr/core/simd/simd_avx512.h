@@ -101,6 +101,55 @@ inline unsigned movemask(vboolf16 m) {
 inline vfloat16 select(vboolf16 m, vfloat16 a, vfloat16 b) {  // m ? a : b
   return {_mm512_mask_blend_ps(m.v, b.v, a.v)};
 }
+// a in the lanes of m, +0 in the others.
+inline vfloat16 masked(vboolf16 m, vfloat16 a) {
+  return {_mm512_maskz_mov_ps(m.v, a.v)};
+}
+// Bitwise operations (AVX-512 DQ).
+inline vfloat16 operator&(vfloat16 a, vfloat16 b) {
+  return {_mm512_and_ps(a.v, b.v)};
+}
+inline vfloat16 operator|(vfloat16 a, vfloat16 b) {
+  return {_mm512_or_ps(a.v, b.v)};
+}
+inline vfloat16 operator^(vfloat16 a, vfloat16 b) {
+  return {_mm512_xor_ps(a.v, b.v)};
+}
+inline vfloat16 signbits(vfloat16 a) {
+  return a & vfloat16::splat(-0.0f);
+}
+inline vfloat16 abs(vfloat16 a) {
+  return {_mm512_andnot_ps(vfloat16::splat(-0.0f).v, a.v)};
+}
+
+// The largest lane of a, when no lane is NaN.
+inline float reduce_max(vfloat16 a) {
+  vfloat8 m = max(vfloat8{_mm512_maskz_extractf32x8_ps(__mmask8(0xFF), a.v, 0)},
+                  vfloat8{_mm512_maskz_extractf32x8_ps(__mmask8(0xFF), a.v, 1)});
+  m = max(m, swap_lanes<4>(m));
+  m = max(m, swap_lanes<2>(m));
+  m = max(m, swap_lanes<1>(m));
+  return _mm256_cvtss_f32(m.v);
+}
+
+// ------------------------------------------------ 16 int32 (lanes of floats' bits or indices)
+
+struct vint16 {
+  __m512i v;
+  static vint16 splat(int32_t x) { return {_mm512_set1_epi32(x)}; }
+  static vint16 load(const uint32_t* p) { return {_mm512_load_si512(p)}; }  // 64-byte aligned
+};
+
+inline void store(uint32_t* p, vint16 a) {  // 64-byte aligned
+  _mm512_store_si512(p, a.v);
+}
+// Signed comparison.
+inline vboolf16 operator<(vint16 a, vint16 b) {
+  return {_mm512_cmplt_epi32_mask(a.v, b.v)};
+}
+inline vint16 select(vboolf16 m, vint16 a, vint16 b) {  // m ? a : b
+  return {_mm512_mask_blend_epi32(m.v, b.v, a.v)};
+}
 
 // ------------------------------------------------- 8 doubles, 8 int64, 8-bit masks
 

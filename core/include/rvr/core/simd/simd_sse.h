@@ -19,6 +19,10 @@ struct vboolf4 {
   static vboolf4 load(const uint32_t* p) {
     return {_mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(p)))};
   }
+  static vboolf4 from_bits(unsigned m) {  // lane k set when bit k of m is
+    const __m128i bits = _mm_setr_epi32(1, 2, 4, 8);
+    return {_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(int(m)), bits), bits))};
+  }
 };
 
 struct vfloat4 {

@@ -19,10 +19,7 @@ namespace {
 struct vboolf8 {
   vboolf4 lo, hi;
   static vboolf8 from_bits(unsigned m) {  // lane k set when bit k of m is
-    const __m128i lo_bits = _mm_setr_epi32(1, 2, 4, 8), hi_bits = _mm_setr_epi32(16, 32, 64, 128);
-    const __m128i mm = _mm_set1_epi32(int(m));
-    return {{_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(mm, lo_bits), lo_bits))},
-            {_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(mm, hi_bits), hi_bits))}};
+    return {vboolf4::from_bits(m & 0xFu), vboolf4::from_bits((m >> 4) & 0xFu)};
   }
 };
 
