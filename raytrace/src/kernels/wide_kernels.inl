@@ -25,8 +25,9 @@ namespace rvr {
 namespace RVR_KERNEL_NS {
 namespace {
 
-// Eight lanes in every ISA (a wide node's children, a packet's rays): the SIMD layer's vfloat8,
-// native in AVX2 and AVX-512 units and two halves in SSE ones; triangle blocks take vfloat4.
+// Eight lanes in every ISA for a wide node's children (and the hybrid's named triangles): the
+// SIMD layer's vfloat8, native in AVX2 and AVX-512 units and two halves in SSE ones; triangle
+// blocks take vfloat4; ray packets take vfloat16 (PV, below).
 using namespace simd;
 using V8 = vfloat8;
 using M8 = vboolf8;
