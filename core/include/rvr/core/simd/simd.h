@@ -4,11 +4,11 @@
 // top-level CMakeLists.txt, which lists the ISAs in RVR_SIMD_ISAS):
 //
 //   simd_sse.h     vfloat4, vboolf4, vint4, vdouble2, vllong2            (every ISA)
-//   simd_sse8.h    vfloat8, vboolf8, vint8 as pairs of 128-bit halves     (SSE only)
 //   simd_avx2.h    vfloat8, vboolf8, vint8, vdouble4, vllong4             (AVX2, AVX-512)
 //   simd_avx512.h  vfloat16, vboolf16, vint16, vdouble8, vboold8, vllong8, masked loads and
 //                  stores
-//   simd_pair16.h  vfloat16, vboolf16, vint16 as pairs of 8-lane halves     (SSE and AVX2)
+//   simd_halves.h  the wider float, mask and int vectors as two halves:   (SSE, AVX2)
+//                  8 and 16 lanes in SSE units, 16 in AVX2 ones
 //
 // and the native widths below (vfloatx: 4, 8 or 16 floats; vdoublex: 2, 4 or 8 doubles). On top
 // of them, for every ISA, vec3v.h: Vec3v<V>, 3-vectors of these vectors (dot, cross, ...).
@@ -30,13 +30,8 @@
 
 #if defined(__AVX512F__)
 #include "rvr/core/simd/simd_avx512.h"
-#elif defined(__AVX2__)
-#include "rvr/core/simd/simd_avx2.h"
-#include "rvr/core/simd/simd_pair16.h"
 #else
-#include "rvr/core/simd/simd_pair16.h"
-#include "rvr/core/simd/simd_sse.h"
-#include "rvr/core/simd/simd_sse8.h"
+#include "rvr/core/simd/simd_halves.h"
 #endif
 
 namespace rvr::simd {

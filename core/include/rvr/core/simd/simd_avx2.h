@@ -148,6 +148,14 @@ inline vfloat8 swap_lanes(vfloat8 a) {
   if constexpr (J == 4) return {_mm256_permute2f128_ps(a.v, a.v, 1)};
 }
 
+// The largest lane of a, when no lane is NaN.
+inline float reduce_max(vfloat8 a) {
+  a = max(a, swap_lanes<4>(a));
+  a = max(a, swap_lanes<2>(a));
+  a = max(a, swap_lanes<1>(a));
+  return _mm256_cvtss_f32(a.v);
+}
+
 // ------------------------------------------------- 8 int32 (lanes of floats' bits or indices)
 
 struct vint8 {

@@ -124,12 +124,9 @@ inline vfloat16 abs(vfloat16 a) {
 
 // The largest lane of a, when no lane is NaN.
 inline float reduce_max(vfloat16 a) {
-  vfloat8 m = max(vfloat8{_mm512_maskz_extractf32x8_ps(__mmask8(0xFF), a.v, 0)},
-                  vfloat8{_mm512_maskz_extractf32x8_ps(__mmask8(0xFF), a.v, 1)});
-  m = max(m, swap_lanes<4>(m));
-  m = max(m, swap_lanes<2>(m));
-  m = max(m, swap_lanes<1>(m));
-  return _mm256_cvtss_f32(m.v);
+  const vfloat8 m = max(vfloat8{_mm512_maskz_extractf32x8_ps(__mmask8(0xFF), a.v, 0)},
+                        vfloat8{_mm512_maskz_extractf32x8_ps(__mmask8(0xFF), a.v, 1)});
+  return reduce_max(m);
 }
 
 // ------------------------------------------------ 16 int32 (lanes of floats' bits or indices)

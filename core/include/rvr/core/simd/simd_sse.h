@@ -140,7 +140,17 @@ struct vint4 {
   static vint4 setr(int32_t a, int32_t b, int32_t c, int32_t d) {
     return {_mm_setr_epi32(a, b, c, d)};
   }
+  static vint4 load(const uint32_t* p) {  // 16-byte aligned
+    return {_mm_load_si128(reinterpret_cast<const __m128i*>(p))};
+  }
 };
+
+inline void store(uint32_t* p, vint4 a) {  // 16-byte aligned
+  _mm_store_si128(reinterpret_cast<__m128i*>(p), a.v);
+}
+inline void storeu(uint32_t* p, vint4 a) {
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(p), a.v);
+}
 
 inline vint4 operator&(vint4 a, vint4 b) {
   return {_mm_and_si128(a.v, b.v)};
@@ -156,6 +166,24 @@ inline vboolf4 operator==(vint4 a, vint4 b) {
 inline vint4 select(vboolf4 m, vint4 a, vint4 b) {
   return {_mm_castps_si128(
       select(m, vfloat4{_mm_castsi128_ps(a.v)}, vfloat4{_mm_castsi128_ps(b.v)}).v)};
+}
+
+// Lane k takes lane k ^ J (J = 1 or 2).
+template <int J>
+inline vfloat4 swap_lanes(vfloat4 a) {
+  static_assert(J == 1 || J == 2);
+  if constexpr (J == 1) return {_mm_shuffle_ps(a.v, a.v, 0xB1)};
+  if constexpr (J == 2) return {_mm_shuffle_ps(a.v, a.v, 0x4E)};
+}
+template <int J>
+inline vint4 swap_lanes(vint4 a) {
+  return {_mm_castps_si128(swap_lanes<J>(vfloat4{_mm_castsi128_ps(a.v)}).v)};
+}
+// The largest lane of a, when no lane is NaN.
+inline float reduce_max(vfloat4 a) {
+  a = max(a, swap_lanes<2>(a));
+  a = max(a, swap_lanes<1>(a));
+  return _mm_cvtss_f32(a.v);
 }
 
 // ------------------------------------------------------------- 2 doubles, 2 int64
