@@ -22,214 +22,169 @@
 namespace rvr::simd {
 namespace {
 
-template <class B>
-struct vbool_halves {
-  B lo, hi;
-  static constexpr int kHalf = int(sizeof(B) / sizeof(float));  // lanes of a half
-  static vbool_halves from_bits(unsigned m) {                   // lane k set when bit k of m is
+// Two halves of V: a float, mask or int vector of twice V's lanes. The operations below are
+// templates over V, so each exists for the halves of the vectors that have it (arithmetic for
+// floats, from_bits and movemask for masks, ...).
+template <class V>
+struct vhalves {
+  V lo, hi;
+  static constexpr int kHalf = int(sizeof(V) / sizeof(float));  // lanes of a half
+  template <class T>
+  static vhalves load(const T* p) {  // aligned as V::load needs
+    return {V::load(p), V::load(p + kHalf)};
+  }
+  static vhalves loadu(const float* p) { return {V::loadu(p), V::loadu(p + kHalf)}; }
+  template <class T>
+  static vhalves splat(T x) {
+    return {V::splat(x), V::splat(x)};
+  }
+  static vhalves zero() { return {V::zero(), V::zero()}; }
+  static vhalves from_bits(unsigned m) {  // masks: lane k set when bit k of m is
     constexpr unsigned half_mask = (1u << kHalf) - 1u;
-    return {B::from_bits(m & half_mask), B::from_bits((m >> kHalf) & half_mask)};
+    return {V::from_bits(m & half_mask), V::from_bits((m >> kHalf) & half_mask)};
   }
 };
 
-template <class F>
-struct vfloat_halves {
-  F lo, hi;
-  static constexpr int kHalf = int(sizeof(F) / sizeof(float));
-  static vfloat_halves load(const float* p) { return {F::load(p), F::load(p + kHalf)}; }
-  static vfloat_halves loadu(const float* p) { return {F::loadu(p), F::loadu(p + kHalf)}; }
-  static vfloat_halves splat(float x) { return {F::splat(x), F::splat(x)}; }
-  static vfloat_halves zero() { return {F::zero(), F::zero()}; }
-};
-
-template <class I>
-struct vint_halves {
-  I lo, hi;
-  static constexpr int kHalf = int(sizeof(I) / sizeof(int32_t));
-  static vint_halves splat(int32_t x) { return {I::splat(x), I::splat(x)}; }
-  static vint_halves load(const uint32_t* p) { return {I::load(p), I::load(p + kHalf)}; }
-};
-
 #if defined(__AVX2__)
-using vboolf16 = vbool_halves<vboolf8>;
-using vfloat16 = vfloat_halves<vfloat8>;
-using vint16 = vint_halves<vint8>;
+using vboolf16 = vhalves<vboolf8>;
+using vfloat16 = vhalves<vfloat8>;
+using vint16 = vhalves<vint8>;
 #else
-using vboolf8 = vbool_halves<vboolf4>;
-using vfloat8 = vfloat_halves<vfloat4>;
-using vint8 = vint_halves<vint4>;
-using vboolf16 = vbool_halves<vboolf8>;
-using vfloat16 = vfloat_halves<vfloat8>;
-using vint16 = vint_halves<vint8>;
+using vboolf8 = vhalves<vboolf4>;
+using vfloat8 = vhalves<vfloat4>;
+using vint8 = vhalves<vint4>;
+using vboolf16 = vhalves<vboolf8>;
+using vfloat16 = vhalves<vfloat8>;
+using vint16 = vhalves<vint8>;
 #endif
 
-// The mask type of two halves of F.
-template <class F>
-using mask_of = vbool_halves<decltype(F{} < F{})>;
-
-template <class F>
-inline void store(float* p, vfloat_halves<F> a) {
+template <class T, class V>
+inline void store(T* p, vhalves<V> a) {
   store(p, a.lo);
-  store(p + vfloat_halves<F>::kHalf, a.hi);
+  store(p + vhalves<V>::kHalf, a.hi);
 }
-template <class F>
-inline void storeu(float* p, vfloat_halves<F> a) {
+template <class T, class V>
+inline void storeu(T* p, vhalves<V> a) {
   storeu(p, a.lo);
-  storeu(p + vfloat_halves<F>::kHalf, a.hi);
+  storeu(p + vhalves<V>::kHalf, a.hi);
 }
 
-template <class F>
-inline vfloat_halves<F> operator+(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline vhalves<V> operator+(vhalves<V> a, vhalves<V> b) {
   return {a.lo + b.lo, a.hi + b.hi};
 }
-template <class F>
-inline vfloat_halves<F> operator-(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline vhalves<V> operator-(vhalves<V> a, vhalves<V> b) {
   return {a.lo - b.lo, a.hi - b.hi};
 }
-template <class F>
-inline vfloat_halves<F> operator*(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline vhalves<V> operator*(vhalves<V> a, vhalves<V> b) {
   return {a.lo * b.lo, a.hi * b.hi};
 }
-template <class F>
-inline vfloat_halves<F> operator/(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline vhalves<V> operator/(vhalves<V> a, vhalves<V> b) {
   return {a.lo / b.lo, a.hi / b.hi};
 }
-template <class F>
-inline vfloat_halves<F> sqrt(vfloat_halves<F> a) {
+template <class V>
+inline vhalves<V> sqrt(vhalves<V> a) {
   return {sqrt(a.lo), sqrt(a.hi)};
 }
-template <class F>
-inline vfloat_halves<F> min(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline vhalves<V> min(vhalves<V> a, vhalves<V> b) {
   return {min(a.lo, b.lo), min(a.hi, b.hi)};
 }
-template <class F>
-inline vfloat_halves<F> max(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline vhalves<V> max(vhalves<V> a, vhalves<V> b) {
   return {max(a.lo, b.lo), max(a.hi, b.hi)};
 }
-template <class F>
-inline vfloat_halves<F> operator&(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline vhalves<V> operator&(vhalves<V> a, vhalves<V> b) {
   return {a.lo & b.lo, a.hi & b.hi};
 }
-template <class F>
-inline vfloat_halves<F> operator|(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline vhalves<V> operator|(vhalves<V> a, vhalves<V> b) {
   return {a.lo | b.lo, a.hi | b.hi};
 }
-template <class F>
-inline vfloat_halves<F> operator^(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline vhalves<V> operator^(vhalves<V> a, vhalves<V> b) {
   return {a.lo ^ b.lo, a.hi ^ b.hi};
 }
-template <class F>
-inline vfloat_halves<F> andnot(vfloat_halves<F> a, vfloat_halves<F> b) {  // ~a & b
+template <class V>
+inline vhalves<V> andnot(vhalves<V> a, vhalves<V> b) {  // ~a & b
   return {andnot(a.lo, b.lo), andnot(a.hi, b.hi)};
 }
-template <class F>
-inline vfloat_halves<F> operator-(vfloat_halves<F> a) {
+template <class V>
+inline vhalves<V> operator-(vhalves<V> a) {
   return {-a.lo, -a.hi};
 }
-template <class F>
-inline vfloat_halves<F> signbits(vfloat_halves<F> a) {
+template <class V>
+inline vhalves<V> signbits(vhalves<V> a) {
   return {signbits(a.lo), signbits(a.hi)};
 }
-template <class F>
-inline vfloat_halves<F> abs(vfloat_halves<F> a) {
+template <class V>
+inline vhalves<V> abs(vhalves<V> a) {
   return {abs(a.lo), abs(a.hi)};
 }
 
-template <class F>
-inline mask_of<F> operator<(vfloat_halves<F> a, vfloat_halves<F> b) {
+// Comparisons give the halves of the half's mask type (signed for ints).
+template <class V>
+using mask_of = vhalves<decltype(V{} < V{})>;
+template <class V>
+inline mask_of<V> operator<(vhalves<V> a, vhalves<V> b) {
   return {a.lo < b.lo, a.hi < b.hi};
 }
-template <class F>
-inline mask_of<F> operator<=(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline mask_of<V> operator<=(vhalves<V> a, vhalves<V> b) {
   return {a.lo <= b.lo, a.hi <= b.hi};
 }
-template <class F>
-inline mask_of<F> operator>(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline mask_of<V> operator>(vhalves<V> a, vhalves<V> b) {
   return {a.lo > b.lo, a.hi > b.hi};
 }
-template <class F>
-inline mask_of<F> operator>=(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline mask_of<V> operator>=(vhalves<V> a, vhalves<V> b) {
   return {a.lo >= b.lo, a.hi >= b.hi};
 }
-template <class F>
-inline mask_of<F> operator==(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline mask_of<V> operator==(vhalves<V> a, vhalves<V> b) {
   return {a.lo == b.lo, a.hi == b.hi};
 }
-template <class F>
-inline mask_of<F> operator!=(vfloat_halves<F> a, vfloat_halves<F> b) {
+template <class V>
+inline mask_of<V> operator!=(vhalves<V> a, vhalves<V> b) {
   return {a.lo != b.lo, a.hi != b.hi};
 }
 
 template <class B>
-inline vbool_halves<B> operator&(vbool_halves<B> a, vbool_halves<B> b) {
-  return {a.lo & b.lo, a.hi & b.hi};
+inline unsigned movemask(vhalves<B> m) {
+  return movemask(m.lo) | movemask(m.hi) << vhalves<B>::kHalf;
 }
-template <class B>
-inline vbool_halves<B> operator|(vbool_halves<B> a, vbool_halves<B> b) {
-  return {a.lo | b.lo, a.hi | b.hi};
-}
-template <class B>
-inline unsigned movemask(vbool_halves<B> m) {
-  return movemask(m.lo) | movemask(m.hi) << vbool_halves<B>::kHalf;
-}
-template <class F>
-inline unsigned le_bits(vfloat_halves<F> a, vfloat_halves<F> b) {  // movemask(a <= b)
+template <class V>
+inline unsigned le_bits(vhalves<V> a, vhalves<V> b) {  // movemask(a <= b)
   return movemask(a <= b);
 }
-template <class B, class F>
-inline vfloat_halves<F> select(vbool_halves<B> m, vfloat_halves<F> a, vfloat_halves<F> b) {
-  return {select(m.lo, a.lo, b.lo), select(m.hi, a.hi, b.hi)};  // m ? a : b
-}
-template <class B>
-inline vbool_halves<B> select(vbool_halves<B> m, vbool_halves<B> a, vbool_halves<B> b) {
+template <class B, class V>
+inline vhalves<V> select(vhalves<B> m, vhalves<V> a, vhalves<V> b) {  // m ? a : b
   return {select(m.lo, a.lo, b.lo), select(m.hi, a.hi, b.hi)};
 }
-template <class B, class F>
-inline vfloat_halves<F> masked(vbool_halves<B> m, vfloat_halves<F> a) {  // a in m, else +0
+template <class B, class V>
+inline vhalves<V> masked(vhalves<B> m, vhalves<V> a) {  // a in the lanes of m, +0 in the others
   return {masked(m.lo, a.lo), masked(m.hi, a.hi)};
 }
 
 // Lane k takes lane k ^ J (J a power of two below the width): the halves swap when J is a
 // half's width, and each half swaps its own lanes below it.
-template <int J, class F>
-inline vfloat_halves<F> swap_lanes(vfloat_halves<F> a) {
-  static_assert(J >= 1 && J <= vfloat_halves<F>::kHalf && (J & (J - 1)) == 0);
-  if constexpr (J == vfloat_halves<F>::kHalf)
+template <int J, class V>
+inline vhalves<V> swap_lanes(vhalves<V> a) {
+  static_assert(J >= 1 && J <= vhalves<V>::kHalf && (J & (J - 1)) == 0);
+  if constexpr (J == vhalves<V>::kHalf)
     return {a.hi, a.lo};
   else
     return {swap_lanes<J>(a.lo), swap_lanes<J>(a.hi)};
 }
 // The largest lane of a, when no lane is NaN.
-template <class F>
-inline float reduce_max(vfloat_halves<F> a) {
+template <class V>
+inline float reduce_max(vhalves<V> a) {
   return reduce_max(max(a.lo, a.hi));
-}
-
-template <class I>
-inline void store(uint32_t* p, vint_halves<I> a) {
-  store(p, a.lo);
-  store(p + vint_halves<I>::kHalf, a.hi);
-}
-template <class I>
-inline void storeu(uint32_t* p, vint_halves<I> a) {
-  storeu(p, a.lo);
-  storeu(p + vint_halves<I>::kHalf, a.hi);
-}
-template <class I>
-inline vbool_halves<decltype(I{} < I{})> operator<(vint_halves<I> a, vint_halves<I> b) {
-  return {a.lo < b.lo, a.hi < b.hi};  // signed
-}
-template <class B, class I>
-inline vint_halves<I> select(vbool_halves<B> m, vint_halves<I> a, vint_halves<I> b) {
-  return {select(m.lo, a.lo, b.lo), select(m.hi, a.hi, b.hi)};  // m ? a : b
-}
-template <int J, class I>
-inline vint_halves<I> swap_lanes(vint_halves<I> a) {
-  static_assert(J >= 1 && J <= vint_halves<I>::kHalf && (J & (J - 1)) == 0);
-  if constexpr (J == vint_halves<I>::kHalf)
-    return {a.hi, a.lo};
-  else
-    return {swap_lanes<J>(a.lo), swap_lanes<J>(a.hi)};
 }
 
 }  // namespace
