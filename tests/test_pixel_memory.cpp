@@ -4,8 +4,11 @@
 // poison) never reaches an image.
 #include <gtest/gtest.h>
 
+#include <cinttypes>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <initializer_list>
 #include <memory>
 #include <string>
@@ -67,6 +70,44 @@ TEST(PixelMemory, ThePoolNeverHoldsMoreThanItsLimit) {
     EXPECT_LE(recycled_pixel_bytes(), kRecycleLimitBytes);
   }
   EXPECT_GE(recycled_pixel_bytes(), 4 * bytes);  // the newest four are kept
+}
+
+namespace {
+
+// The VmFlags line of the mapping of /proc/self/smaps that holds address p ("" if none does).
+std::string vm_flags_at(const void* p) {
+  std::ifstream smaps("/proc/self/smaps");
+  const uintptr_t a = reinterpret_cast<uintptr_t>(p);
+  bool inside = false;
+  for (std::string line; std::getline(smaps, line);) {
+    uintptr_t begin = 0, end = 0;
+    if (std::sscanf(line.c_str(), "%" SCNxPTR "-%" SCNxPTR " ", &begin, &end) == 2 &&
+        line.find(':') > line.find(' ')) {  // a mapping's header, not a "Key: value" line
+      inside = a >= begin && a < end;
+      continue;
+    }
+    if (inside && line.rfind("VmFlags:", 0) == 0) return line;
+  }
+  return "";
+}
+
+}  // namespace
+
+// Frame memory is asked for transparent huge pages, for every renderer's buffers alike: the
+// whole 2 MiB pages inside a fresh block carry the kernel's "hg" flag (MADV_HUGEPAGE).
+TEST(PixelMemory, AFreshFrameBlockIsAskedForHugePages) {
+  if (!std::ifstream("/proc/self/smaps") ||
+      !std::ifstream("/sys/kernel/mm/transparent_hugepage/enabled"))
+    GTEST_SKIP() << "this system has no transparent huge pages to ask for";
+  const size_t bytes = size_t(9) << 20;
+  void* p = acquire_pixel_memory(bytes);
+  const uintptr_t huge = kHugePageBytes;
+  const void* inner =
+      reinterpret_cast<const void*>((reinterpret_cast<uintptr_t>(p) + huge - 1) & ~(huge - 1));
+  const std::string flags = vm_flags_at(inner);
+  EXPECT_NE(flags, "") << "no mapping holds the block";
+  EXPECT_NE((flags + " ").find(" hg "), std::string::npos) << flags;
+  release_pixel_memory(p, bytes);
 }
 
 namespace {

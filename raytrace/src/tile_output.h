@@ -1,15 +1,17 @@
 // One tile of the tracer's frame, staged before it goes to the frame buffers: the blocks of the
 // tile write their pixels here one by one, then the tile is copied out a buffer at a time and a
 // row at a time, so that each buffer receives runs of whole tile rows (the z-buffers write
-// theirs row by row too) instead of a few bytes to each of six buffers per pixel.
+// theirs row by row too) instead of a few bytes to each of six buffers per pixel. The runs go
+// with streaming stores (stream_copy.h), as softraster's rows do.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <glm/glm.hpp>
 #include <limits>
 
 #include "rvr/core/framebuffers.h"
+#include "rvr/core/stream_copy.h"
 
 namespace rvr {
 
@@ -44,6 +46,7 @@ class TileOutput {
     copy_rows(primitive_id, fb.primitive_id.data(), fb);
     copy_rows(cost, fb.cost.data(), fb);
     if (!fb.lod.empty()) copy_rows(lod, fb.lod.data(), fb);
+    stream_fence();
   }
 
   glm::vec3 colour[kMaxWidth * kMaxHeight];
@@ -60,7 +63,7 @@ class TileOutput {
   void copy_rows(const T* from, T* to, const FrameBuffers& fb) const {
     const size_t run = size_t(x1_ - x0_) * sizeof(T);
     for (int y = y0_; y < y1_; ++y)
-      std::memcpy(static_cast<void*>(to + fb.index(x0_, y)), from + index(x0_, y), run);
+      stream_copy(static_cast<void*>(to + fb.index(x0_, y)), from + index(x0_, y), run);
   }
 
   int x0_ = 0, y0_ = 0, x1_ = 0, y1_ = 0;

@@ -1,6 +1,5 @@
 #include "soft/deferred_shading.h"
 
-#include <sys/mman.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -14,6 +13,7 @@
 #include "rvr/core/prefetch.h"
 #include "rvr/core/shade_batch.h"
 #include "rvr/core/shapes/triangle_mesh.h"
+#include "rvr/core/stream_copy.h"
 #include "rvr/core/surface_colour.h"
 
 namespace rvr::soft {
@@ -29,18 +29,6 @@ struct ObjectShading {
   ShadeMaterial material{};
 };
 
-// Asks for transparent huge pages over a buffer not yet touched. The frame's buffers are fresh
-// memory every frame (the caller takes them away), tens of MB first touched here: one page
-// fault per 4 KiB, or, where the system grants huge pages on request, one per 2 MiB. Advice
-// only: no byte written changes, and a refusal (an error return) leaves the small pages.
-template <class T>
-void ask_for_huge_pages(PixelVector<T>& v) {
-  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-  const uintptr_t begin = (reinterpret_cast<uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
-  const uintptr_t end = reinterpret_cast<uintptr_t>(v.data() + v.size()) & ~(kHuge - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-}
-
 // v in p[0, n). std::fill stores a glm::vec3 a float at a time; four of them are 48 bytes,
 // three 16-byte stores of one repeating pattern.
 void fill_vec3(glm::vec3* p, size_t n, const glm::vec3& v) {
@@ -53,13 +41,7 @@ void fill_vec3(glm::vec3* p, size_t n, const glm::vec3& v) {
 
 // Sizes fb to w x h; its pixels are left for the caller to write, every one of them.
 void allocate_frame(int w, int h, FrameBuffers& fb) {
-  fb.allocate(w, h);
-  ask_for_huge_pages(fb.colour);
-  ask_for_huge_pages(fb.normal);
-  ask_for_huge_pages(fb.depth);
-  ask_for_huge_pages(fb.object_id);
-  ask_for_huge_pages(fb.primitive_id);
-  ask_for_huge_pages(fb.cost);
+  fb.allocate(w, h);  // frame memory: asked for huge pages (pixel_memory.h)
 }
 
 // The ids alone, sized and left undefined (every pixel is written); every other buffer empty.
@@ -69,8 +51,16 @@ void allocate_ids(int w, int h, FrameBuffers& fb) {
   fb.height = h;
   fb.object_id.resize(fb.pixel_count());
   fb.primitive_id.resize(fb.pixel_count());
-  ask_for_huge_pages(fb.object_id);
-  ask_for_huge_pages(fb.primitive_id);
+}
+
+// Calls f(x0, n, run) for the runs [x0, x0 + n) of a row `width` wide, with `run` room for n
+// values: each run is computed into it (in cache) and then streamed to its frame buffer
+// (stream_copy.h), as the tracer streams its tiles' rows.
+template <class T, class F>
+void for_each_run(int width, F&& f) {
+  constexpr int kRun = 256;
+  alignas(64) T run[kRun];
+  for (int x0 = 0; x0 < width; x0 += kRun) f(x0, std::min(kRun, width - x0), run);
 }
 
 // What visibility leaves per pixel, a row at a time: depth, object and primitive id, cost.
@@ -97,12 +87,14 @@ class VisibilityRows {
     // One buffer at a time.
     const uint32_t* __restrict row_object = target_.objects() + row;
     const double* __restrict row_depth = target_.depths() + row;
-    float* __restrict depth_out = fb.depth.data() + row;
-    // Loads before the selection, so that these loops vectorize (branch-free).
-    for (int k = 0; k < width; ++k) {
-      const float depth = float(row_depth[k]);
-      depth_out[k] = row_object[k] == kNoId ? std::numeric_limits<float>::infinity() : depth;
-    }
+    for_each_run<float>(width, [&](int x0, int n, float* __restrict run) {
+      // Loads before the selection, so that this loop vectorizes (branch-free).
+      for (int k = 0; k < n; ++k) {
+        const float depth = float(row_depth[x0 + k]);
+        run[k] = row_object[x0 + k] == kNoId ? std::numeric_limits<float>::infinity() : depth;
+      }
+      stream_copy(fb.depth.data() + row + size_t(x0), run, size_t(n) * sizeof(float));
+    });
     write_ids(y, fb);
   }
 
@@ -113,20 +105,23 @@ class VisibilityRows {
     const size_t row = fb.index(0, y);
     const uint32_t* __restrict row_object = target_.objects() + row;
     const uint32_t* __restrict row_primitive = target_.primitives() + row;
-    uint32_t* __restrict primitive_out = fb.primitive_id.data() + row;
-    std::memcpy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
-    if (every_primitive_id_) {
-      for (int k = 0; k < width; ++k) {
-        const uint32_t primitive = row_primitive[k];
-        primitive_out[k] = row_object[k] == kNoId ? kNoId : primitive;
+    stream_copy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
+    const uint8_t* use = use_primitive_id_.data();
+    const bool every = every_primitive_id_;
+    for_each_run<uint32_t>(width, [&](int x0, int n, uint32_t* __restrict run) {
+      const uint32_t* __restrict object = row_object + x0;
+      const uint32_t* __restrict primitive = row_primitive + x0;
+      if (every) {
+        for (int k = 0; k < n; ++k) {
+          const uint32_t p = primitive[k];
+          run[k] = object[k] == kNoId ? kNoId : p;
+        }
+      } else {
+        for (int k = 0; k < n; ++k)
+          run[k] = object[k] == kNoId ? kNoId : use[object[k]] != 0 ? primitive[k] : 0u;
       }
-    } else {
-      const uint8_t* use = use_primitive_id_.data();
-      for (int k = 0; k < width; ++k)
-        primitive_out[k] = row_object[k] == kNoId    ? kNoId
-                           : use[row_object[k]] != 0 ? row_primitive[k]
-                                                     : 0u;
-    }
+      stream_copy(fb.primitive_id.data() + row + size_t(x0), run, size_t(n) * sizeof(uint32_t));
+    });
   }
 
  private:
@@ -355,6 +350,7 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
                         RowShader shader(frame);
                         for (int y = r.begin(); y != r.end(); ++y) shader.shade_row(y);
                         shader.flush();
+                        stream_fence();  // the rows' streamed stores, before another thread reads
                         if (progress)
                           progress->advance(uint64_t(r.size()) * uint64_t(target.width()));
                       });
@@ -393,6 +389,7 @@ void write_visibility(const DrawList& list, const DepthTarget& target, const glm
                                                   fb.primitive_id[row + size_t(x)], x, y, planes);
         }
       }
+      stream_fence();  // the rows' streamed stores, before another thread reads
       if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));
     });
   });

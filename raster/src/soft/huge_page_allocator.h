@@ -13,10 +13,6 @@
 
 #include "rvr/core/pixel_memory.h"
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 namespace rvr::soft {
 
 template <class T>
@@ -37,13 +33,9 @@ struct HugePageAllocator : DefaultInitConstruct {  // SetupTriangle has no membe
   // chunks reuse these pages instead of faulting and clearing fresh huge pages.
   T* allocate(size_t n) {
     // sizeof(T) is a multiple of alignof(T), so bytes is one of the alignment as it must be.
+    // Frame memory of whole huge pages is asked for them (acquire_pixel_memory).
     const size_t align = huge(n) ? kPage : std::max<size_t>(alignof(T), 64);
-    void* p = acquire_pixel_memory(bytes_for(n), align);
-#if defined(MADV_HUGEPAGE)
-    if (huge(n))
-      madvise(p, bytes_for(n), MADV_HUGEPAGE);  // a hint: without huge pages it works as before
-#endif
-    return static_cast<T*>(p);
+    return static_cast<T*>(acquire_pixel_memory(bytes_for(n), align));
   }
   void deallocate(T* p, size_t n) noexcept {
     release_pixel_memory(p, bytes_for(n), huge(n) ? kPage : std::max<size_t>(alignof(T), 64));

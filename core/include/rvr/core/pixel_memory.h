@@ -15,6 +15,9 @@
 namespace rvr {
 
 constexpr size_t kRecycledBytes = size_t(1) << 20;
+// Blocks this large are asked for transparent huge pages (the whole such pages inside them), so
+// every renderer's frame buffers get the same pages.
+constexpr size_t kHugePageBytes = size_t(2) << 20;
 constexpr size_t kRecycleLimitBytes = size_t(256) << 20;
 
 // Aligned to `align` (a power of two, at least 64); throws std::bad_alloc when the system has no
