@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <cinttypes>
-#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
