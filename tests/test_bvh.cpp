@@ -604,6 +604,9 @@ TEST(Bvh, CountsFewerTestsThanBruteForce) {
   }
 }
 
+// A count no ray's traversal reaches: what a packet's counter slots hold before the query.
+constexpr uint64_t kStaleCount = uint64_t(1) << 60;
+
 // Packets of primary rays (one origin, up to 64 directions) find exactly the hits single rays
 // find, lane by lane, with every kernel and with Embree's rtcIntersect8/16; the per-ray counters
 // add up to some work for every ray. Tiles are full or partial, aim at the scene or past it, and
@@ -639,10 +642,17 @@ TEST(Packets, SameHitsAsSingleRays) {
         for (int a = 0; a < 3; ++a) p.dir[a][k] = d[a];
       }
       for (const Accelerated& a : accels) {
+        // closest_packet writes every slot and reads none: what the slots held before (here a
+        // hit and counts no ray could have) must not show through.
+        const HitRecord stale{-1.0f, 7u, 0.25f, 0.5f, 3u, true};
+        const TraversalCounters stale_work{kStaleCount, kStaleCount};
         HitRecord packet_hits[kPacketRays];
         TraversalCounters work[kPacketRays];
+        std::fill_n(packet_hits, kPacketRays, stale);
+        std::fill_n(work, kPacketRays, stale_work);
         a.geometry->closest_packet(p, packet_hits, work);
         HitRecord unused_hits[kPacketRays];
+        std::fill_n(unused_hits, kPacketRays, stale);
         a.geometry->closest_packet(p, unused_hits, nullptr);  // the uncounted variant
         for (int k = 0; k < p.count; ++k) {
           Ray ray{o, {p.dir[0][k], p.dir[1][k], p.dir[2][k]}, p.tmin, p.tmax};
@@ -653,7 +663,18 @@ TEST(Packets, SameHitsAsSingleRays) {
               a.label + " tile " + std::to_string(tile) + " ray " + std::to_string(k);
           ASSERT_EQ(h.primitive != kNoPrimitive, found) << what;
           ASSERT_EQ(unused_hits[k].primitive, h.primitive) << what;
-          if (!found) continue;
+          ASSERT_LT(work[k].nodes_visited, kStaleCount) << what;
+          ASSERT_LT(work[k].primitive_tests, kStaleCount) << what;
+          if (a.label == "embree") {  // Embree counts nothing
+            EXPECT_EQ(work[k].nodes_visited + work[k].primitive_tests, 0u) << what;
+          }
+          if (!found) {
+            const HitRecord none;
+            EXPECT_TRUE(same_bits(h.t, none.t) && h.csg_leaf == none.csg_leaf &&
+                        h.csg_flip == none.csg_flip)
+                << what;
+            continue;
+          }
           hits += a.label == "bvh2";
           if (a.label == "embree") {  // its own triangle test: same object, t to float precision
             EXPECT_EQ(a.geometry->surface(ray, h).object, brute.surface(ray, single).object)
@@ -666,6 +687,7 @@ TEST(Packets, SameHitsAsSingleRays) {
                       same_bits(h.v, single.v))
               << what;
           ASSERT_EQ(h.csg_leaf, single.csg_leaf) << what;
+          ASSERT_EQ(h.csg_flip, single.csg_flip) << what;
           EXPECT_GT(work[k].nodes_visited + work[k].primitive_tests, 0u) << what;
         }
       }

@@ -10,6 +10,7 @@
 
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/prefetch.h"
+#include "rvr/raytrace/packet_slots.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
 
@@ -174,9 +175,9 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
   if (n_traced >= kPacketFallbacks) {
     // Many to trace (an empty background): the whole block as one packet, as the tracer traces
     // it; its hits are closest()'s, so which way is taken changes no pixel.
-    HitRecord packet_hits[kPacketRays];
-    TraversalCounters packet_work[kPacketRays];
-    geometry_.closest_packet(packet, packet_hits, packet_work);
+    PacketSlots<HitRecord> packet_hits;
+    PacketSlots<TraversalCounters> packet_work;
+    geometry_.closest_packet(packet, packet_hits.data(), packet_work.data());
     for (int k = 0; k < n; ++k) {
       if (traced[k]) {
         hits[k] = packet_hits[k];

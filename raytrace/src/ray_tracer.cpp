@@ -37,6 +37,7 @@
 #include "rvr/core/timer.h"
 #include "rvr/raytrace/bvh.h"
 #include "rvr/raytrace/intersect.h"
+#include "rvr/raytrace/packet_slots.h"
 #include "rvr/raytrace/primary_hit_source.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/screen_bounds.h"
@@ -157,11 +158,11 @@ class FrameTracer {
   void render_block(int x0, int y0, int x1, int y1, TileOutput& out, RayCounters& counters) const {
     if (culled(x0, y0, x1, y1, out, counters)) return;
     const RayPacket packet = rays_.packet(x0, y0, x1 - x0, y1 - y0);
-    HitRecord hits[kPacketRays];
-    TraversalCounters work[kPacketRays];
-    geometry_.closest_packet(packet, hits, work);
+    PacketSlots<HitRecord> hits;
+    PacketSlots<TraversalCounters> work;
+    geometry_.closest_packet(packet, hits.data(), work.data());
     counters.primary += uint64_t(packet.count);
-    finish_block(x0, y0, x1 - x0, packet, hits, work, out, counters);
+    finish_block(x0, y0, x1 - x0, packet, hits.data(), work.data(), out, counters);
   }
 
   // The same pixels with their primary hits from `source`.
@@ -173,15 +174,16 @@ class FrameTracer {
       return;
     }
     const RayPacket packet = rays_.packet(x0, y0, x1 - x0, y1 - y0);
-    HitRecord hits[kPacketRays];
-    TraversalCounters work[kPacketRays];
+    PacketSlots<HitRecord> hits;
+    PacketSlots<TraversalCounters> work;
     float given_lod[kPacketRays];
     bool given[kPacketRays];
-    CentreBlock block{x0, y0, x1, y1, packet, hits, work, given_lod, given, 0, {}};
+    CentreBlock block{x0, y0, x1, y1, packet, hits.data(), work.data(), given_lod, given, 0, {}};
     source.centre_hits(block);
     counters.primary += block.rays;
     add_traversal(counters, block.unattributed);
-    finish_block(x0, y0, x1 - x0, packet, hits, work, out, counters, given_lod, given);
+    finish_block(x0, y0, x1 - x0, packet, hits.data(), work.data(), out, counters, given_lod,
+                 given);
   }
 
  private:

@@ -12,6 +12,7 @@
 #include "rvr/core/shapes/csg.h"
 #include "rvr/core/shapes/shape_geometry.h"
 #include "rvr/raytrace/bvh_packet.h"
+#include "rvr/raytrace/packet_slots.h"
 #include "rvr/raytrace/primary_rays.h"
 #include "rvr/raytrace/traversal_kernels.h"
 
@@ -382,35 +383,30 @@ void TraceGeometry::closest_packet(const RayPacket& packet, HitRecord* hits,
   };
   if (embree_) {
     embree_closest_packet(*embree_, packet, hits);
+    if (counters) std::fill_n(counters, packet.count, TraversalCounters{});
     return;
   }
   if (!kernels_) {
     TraversalCounters unused;
     for (int i = 0; i < packet.count; ++i) {
       hits[i] = HitRecord{};
+      if (counters) counters[i] = TraversalCounters{};
       closest(ray(i), hits[i], counters ? counters[i] : unused);
     }
     return;
   }
   KernelHit kh[kPacketRays];
-  KernelCounters kc[kPacketRays];
+  PacketSlots<KernelCounters> kc;  // the kernel adds to them: zeroed as far as the packet goes
   for (int i = 0; i < packet.count; ++i) kh[i].primitive = kUnusedLane;
-  if (!wide_.empty()) kernels_->closest_packet(wide_.view(), packet, kh, counters ? kc : nullptr);
+  if (counters) std::fill_n(kc.data(), packet.count, KernelCounters{});
+  if (!wide_.empty())
+    kernels_->closest_packet(wide_.view(), packet, kh, counters ? kc.data() : nullptr);
   for (int i = 0; i < packet.count; ++i) {
-    HitRecord& h = hits[i];
-    h = HitRecord{};
-    bool found = kh[i].primitive != kUnusedLane;
-    if (found) {
-      h.t = kh[i].t;
-      h.u = kh[i].u;
-      h.v = kh[i].v;
-      h.primitive = kh[i].primitive;
-    }
-    if (counters) {
-      counters[i].nodes_visited += kc[i].nodes;
-      counters[i].primitive_tests += kc[i].tests;
-    }
+    const KernelHit& k = kh[i];
+    hits[i] = k.primitive != kUnusedLane ? HitRecord{k.t, k.primitive, k.u, k.v} : HitRecord{};
   }
+  if (counters)
+    for (int i = 0; i < packet.count; ++i) counters[i] = {kc[i].nodes, kc[i].tests};
   if (!analytic_.empty()) closest_analytic_packet(packet, hits, counters);
 }
 

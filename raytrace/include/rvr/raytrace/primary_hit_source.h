@@ -17,6 +17,7 @@ namespace rvr {
 struct CentreBlock {
   int x0, y0, x1, y1;
   const RayPacket& packet;
+  // The source writes every ray's hits[k] and work[k]: they arrive unset (PacketSlots).
   HitRecord* hits;          // each ray's closest hit (primitive kNoPrimitive: none, background)
   TraversalCounters* work;  // each ray's traversal work: its pixel's cost AOV
   // Where given[k], the texture level of detail ray k's hit samples at instead of its own

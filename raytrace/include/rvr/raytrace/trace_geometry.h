@@ -100,7 +100,9 @@ class TraceGeometry {
   bool closest(const Ray& ray, HitRecord& hit) const;
   // Closest hits of a tile of rays from one origin (primary rays), hits[i] for ray i: with the
   // wide BVH a packet traversal, otherwise one ray at a time. Same hits as closest().
-  // counters[i] per ray, when not null.
+  // counters[i], when not null, is set to ray i's traversal work (none with Embree). Every
+  // hits[i] and counters[i] of the packet is written and none is read: they may be unset
+  // (PacketSlots).
   void closest_packet(const RayPacket& packet, HitRecord* hits, TraversalCounters* counters) const;
   // Any hit in (ray.tmin, ray.tmax): shadow rays.
   bool occluded(const Ray& ray, TraversalCounters& counters) const;
