@@ -381,8 +381,9 @@ struct Packet {
   PV tmin;
   float tmin1;  // tmin, the same in every lane
   Vec3f o;
+  float tmax1;  // tmax, the same in every lane
   unsigned valid;
-  KernelRay ray[kPacketLanes];  // the same rays one by one: edge rechecks, single-ray fallback
+  alignas(64) float dir[3][kPacketLanes];  // d lane by lane, for ray()
   // The packet as one interval ray (Boulos et al. 2006), for culling a node's children that no
   // lane can enter (cull_children): when every lane's direction has the same sign on each axis,
   // each reciprocal lies in [rdir_lo, rdir_hi] and the near plane of a box on axis a is bounds
@@ -391,6 +392,11 @@ struct Packet {
   float rdir_lo[3], rdir_hi[3];
   int near_row[3], far_row[3];
   float margin_hi;
+
+  // Lane `lane` as a single ray: edge rechecks, the single-ray fallback.
+  KernelRay ray(unsigned lane) const {
+    return {{o[0], o[1], o[2]}, {dir[0][lane], dir[1][lane], dir[2][lane]}, tmin1, tmax1};
+  }
 };
 
 struct PacketBest {
@@ -427,7 +433,7 @@ void finish_lane(const WideBvhView& bvh, const Packet& p, unsigned lane, uint32_
   c.best.v = v[lane];
   c.best.primitive = prim[lane];
   c.found = (best.found >> lane) & 1;
-  traverse_from<false, kCount, false>(bvh, p.ray[lane], ref, c, kCount ? &counters[lane] : nullptr);
+  traverse_from<false, kCount, false>(bvh, p.ray(lane), ref, c, kCount ? &counters[lane] : nullptr);
   if (!c.found) return;
   t[lane] = c.best.t;
   u[lane] = c.best.u;
@@ -486,7 +492,7 @@ inline void intersect_triangle_packet(const TriangleBlock& b, unsigned j, const 
     for (; edge; edge &= edge - 1) {
       unsigned lane = lowest_bit(edge);
       KernelHit h;
-      if (!recheck_triangle_near_edge(p.ray[lane], tri, bt[lane], h)) continue;
+      if (!recheck_triangle_near_edge(p.ray(lane), tri, bt[lane], h)) continue;
       alignas(64) float t[kPacketLanes], u[kPacketLanes], v[kPacketLanes];
       alignas(64) uint32_t pr[kPacketLanes];
       store(t, best.t);
@@ -634,12 +640,12 @@ void traverse_packet(const WideBvhView& bvh, const Packet& p, PacketBest& best,
 bool make_packet(const RayPacket& packet, int first, Packet& p) {
   const int live = packet.count - first < kPacketLanes ? packet.count - first : kPacketLanes;
   p.valid = (1u << live) - 1u;
-  alignas(64) float d[3][kPacketLanes];
   for (int a = 0; a < 3; ++a)  // unused lanes copy a live one
-    for (int l = 0; l < kPacketLanes; ++l) d[a][l] = packet.dir[a][l < live ? first + l : first];
+    for (int l = 0; l < kPacketLanes; ++l)
+      p.dir[a][l] = packet.dir[a][l < live ? first + l : first];
   PV margin = PV::splat(0.0f);
   for (int a = 0; a < 3; ++a) {
-    const PV da = PV::load(d[a]);
+    const PV da = PV::load(p.dir[a]);
     if (movemask(abs(da) < PV::splat(kTinyDirection)) != 0) return false;
     const PV rdir = PV::splat(1.0f) / da;
     const PV org_rdir = PV::splat(packet.origin[a]) * rdir;
@@ -663,14 +669,7 @@ bool make_packet(const RayPacket& packet, int first, Packet& p) {
     p.far_row[a] = 2 * a + (negative ? 0 : 1);
   }
   p.margin_hi = max_lane(margin);
-  for (int l = 0; l < kPacketLanes; ++l) {
-    for (int a = 0; a < 3; ++a) {
-      p.ray[l].origin[a] = packet.origin[a];
-      p.ray[l].dir[a] = d[a][l];
-    }
-    p.ray[l].tmin = packet.tmin;
-    p.ray[l].tmax = packet.tmax;
-  }
+  p.tmax1 = packet.tmax;
   return true;
 }
 
