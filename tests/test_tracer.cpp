@@ -83,6 +83,36 @@ TEST(Tracer, SameBytesWithOneAndTwoThreads) {
   EXPECT_EQ(one.stats.at("rays.shadow"), two.stats.at("rays.shadow"));
 }
 
+// The cost AOV gives each pixel the traversal work of every ray traced for it: its centre ray,
+// and in full mode its shadow, reflection and refraction rays and its further samples. Summed over
+// the image it is the frame's counted work, which the tracer adds up separately (per block, in
+// each thread's counters). Every count is far below 2^24, so each pixel's float is exact.
+TEST(Tracer, CostAovAddsUpToTheFramesTraversalWork) {
+  struct Case {
+    const char* scene;
+    RenderMode mode;
+    int samples;
+  };
+  for (const Case c : {Case{"cornell", RenderMode::Visibility, 1},
+                       Case{"cornell", RenderMode::Local, 1}, Case{"glass", RenderMode::Full, 1},
+                       Case{"cornell", RenderMode::Full, 4}, Case{"csg", RenderMode::Local, 1}}) {
+    Scene s = make_builtin_scene(c.scene).value();
+    s.image.width = 96;
+    s.image.height = 72;
+    s.image.samples_per_pixel = c.samples;
+    RenderOptions o;
+    o.mode = c.mode;
+    o.cost_aov = true;
+    const RenderOutput out = RayTracer().render(s, o).value();
+    double cost = 0.0;
+    for (float v : out.buffers.cost) cost += double(v);
+    const double counted = out.stats.at("bvh.nodes_visited") + out.stats.at("primitive_tests");
+    const std::string name = std::string(c.scene) + " " + to_string(c.mode);
+    EXPECT_GT(counted, 0.0) << name;
+    EXPECT_EQ(cost, counted) << name;
+  }
+}
+
 // A sphere over a plane, a point light: a plane point is in shadow exactly when the segment
 // to the light passes through the sphere. With no ambient light, shadowed plane pixels are 0.
 TEST(Tracer, HardShadowIsTheProjectedSphere) {

@@ -214,6 +214,11 @@ class FrameTracer {
     counters.traversal.primitive_tests += work.primitive_tests;
   }
 
+  // The traversal work counted so far: nodes visited and primitives tested.
+  static uint64_t traced_work(const RayCounters& counters) {
+    return counters.traversal.nodes_visited + counters.traversal.primitive_tests;
+  }
+
   // The pixels of one block once the closest hits of their centre rays are known: hits[k] (for
   // ray k of `packet`, row by row, w wide; primitive kNoPrimitive where it missed), found with
   // work[k]. Every buffer of every pixel is written into `out`: the AOVs from the centre hit; in
@@ -232,18 +237,21 @@ class FrameTracer {
     SurfaceBatch batch;
     for (int a = 0; a < 3; ++a) batch.origin[a] = packet.origin[a];
     size_t batch_pixel[kPacketRays];
-    bool mixed = false;  // the batch's pixels have more than one material
+    int batch_count = 0;  // kept out of `batch` so that it stays in a register
+    bool mixed = false;   // the batch's pixels have more than one material
     uint32_t batch_material = 0;
+    // The centre rays' traversal work, added to `counters` once for the block.
+    TraversalCounters centre_work;
     geometry_.fetch_surface_data(hits, packet.count, mode == RenderMode::Visibility);
     const int y1 = y0 + packet.count / w;
     for (int y = y0, k = 0; y < y1; ++y)
       for (int x = x0; x < x0 + w; ++x, ++k) {  // ray k is pixel (x, y)
         const size_t i = out.index(x, y);
         const HitRecord& hit = hits[k];
-        counters.traversal.nodes_visited += work[k].nodes_visited;
-        counters.traversal.primitive_tests += work[k].primitive_tests;
-        const uint64_t work_before =
-            counters.traversal.nodes_visited + counters.traversal.primitive_tests;
+        centre_work.nodes_visited += work[k].nodes_visited;
+        centre_work.primitive_tests += work[k].primitive_tests;
+        // The traversal work of the rays this pixel's shading traces (full mode, supersampling).
+        const uint64_t traced_before = traced_work(counters);
         if (textured_) out.lod[i] = kNoLod;
         if (hit.primitive == kNoPrimitive) {
           out.set_background(i, scene_.image.background);
@@ -262,7 +270,7 @@ class FrameTracer {
                                                               hit.t, primary_footprint_);
           }
         } else if (mode == RenderMode::Local) {
-          const int slot = batch.count++;
+          const int slot = batch_count++;
           batch_pixel[slot] = i;
           const uint32_t material = add_to_batch(batch, slot, packet, k, hit, out, i);
           const uint32_t object = out.object_id[i];
@@ -303,10 +311,11 @@ class FrameTracer {
         if (supersampled) out.colour[i] = supersample(x, y, counters);
         // Work for this pixel: its centre ray and every ray its shading traced.
         out.cost[i] = options_.cost_aov ? float(work[k].nodes_visited + work[k].primitive_tests +
-                                                counters.traversal.nodes_visited +
-                                                counters.traversal.primitive_tests - work_before)
+                                                traced_work(counters) - traced_before)
                                         : 0.0f;
       }
+    add_traversal(counters, centre_work);
+    batch.count = batch_count;
     if (batch.count > 0) {
       pad_batch(batch, mixed);
       batch.material = mixed ? nullptr : &materials_[batch_material];
