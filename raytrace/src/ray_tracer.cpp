@@ -219,116 +219,182 @@ class FrameTracer {
     return counters.traversal.nodes_visited + counters.traversal.primitive_tests;
   }
 
-  // The pixels of one block once the closest hits of their centre rays are known: hits[k] (for
-  // ray k of `packet`, row by row, w wide; primitive kNoPrimitive where it missed), found with
-  // work[k]. Every buffer of every pixel is written into `out`: the AOVs from the centre hit; in
-  // local mode the surface and colour computed by the shading kernels, the block's hits as one
-  // batch; in full mode (shadow, reflection and refraction rays) one pixel at a time.
-  // given_lod[k], where given[k] (both may be null: none), is the texture level of detail ray
-  // k's hit samples at instead of its own footprint's (a PrimaryHitSource's).
+  // A block's centre hits as finish_block receives them: hits[k] for ray k of `packet` (row by
+  // row, w wide, from pixel (x0, y0); primitive kNoPrimitive where it missed), found with
+  // work[k]; given_lod[k], where given[k] (both may be null: none), is the texture level of
+  // detail ray k's hit samples at instead of its own footprint's (a PrimaryHitSource's).
+  struct BlockHits {
+    int x0, y0, w;
+    const RayPacket& packet;
+    const HitRecord* hits;
+    const TraversalCounters* work;
+    const float* given_lod;
+    const bool* given;
+
+    const float* lod_given(int k) const { return given && given[k] ? &given_lod[k] : nullptr; }
+    glm::vec3 direction(int k) const {
+      return {packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]};
+    }
+    uint64_t centre_work(int k) const { return work[k].nodes_visited + work[k].primitive_tests; }
+    // f(k, x, y, i) for ray k, its pixel (x, y) and the pixel's index i in `out`.
+    template <class F>
+    void for_each_pixel(const TileOutput& out, F&& f) const {
+      const int y1 = y0 + packet.count / w;
+      for (int y = y0, k = 0; y < y1; ++y)
+        for (int x = x0; x < x0 + w; ++x, ++k) f(k, x, y, out.index(x, y));
+    }
+  };
+
+  // The pixels of one block once the closest hits of their centre rays are known. Every buffer
+  // of every pixel is written into `out`: the AOVs from the centre hit and, by mode, no colour
+  // (visibility), the surface and colour computed by the shading kernels for the block's hits as
+  // one batch (local), or each pixel's shadow, reflection and refraction rays traced (full).
   void finish_block(int x0, int y0, int w, const RayPacket& packet, const HitRecord* hits,
                     const TraversalCounters* work, TileOutput& out, RayCounters& counters,
                     const float* given_lod = nullptr, const bool* given = nullptr) const {
-    static_assert(kPacketRays <= kShadeBatch, "a block's hits fit one batch");
     const auto start = Clock::now();
-    const RenderMode mode = options_.mode;
-    const bool supersampled =
-        mode != RenderMode::Visibility && scene_.image.samples_per_pixel > 1 && !centre_only_;
+    const BlockHits block{x0, y0, w, packet, hits, work, given_lod, given};
+    geometry_.fetch_surface_data(hits, packet.count, options_.mode == RenderMode::Visibility);
+    switch (options_.mode) {
+      case RenderMode::Visibility:
+        finish_visibility(block, out);
+        break;
+      case RenderMode::Local:
+        finish_local(block, out, counters);
+        break;
+      case RenderMode::Full:
+        finish_full(block, out, counters);
+        break;
+    }
+    TraversalCounters centre;
+    for (int k = 0; k < packet.count; ++k) {
+      centre.nodes_visited += work[k].nodes_visited;
+      centre.primitive_tests += work[k].primitive_tests;
+    }
+    add_traversal(counters, centre);
+    counters.shade_seconds += seconds_since(start);
+  }
+
+  // Whether a pixel's colour is the mean of its samples, traced one by one, rather than its
+  // centre ray's (shading modes only).
+  bool supersampled() const { return scene_.image.samples_per_pixel > 1 && !centre_only_; }
+
+  // A pixel's cost AOV: the traversal work of every ray traced for it.
+  float pixel_cost(uint64_t work) const { return options_.cost_aov ? float(work) : 0.0f; }
+
+  // Visibility is the hit's distance and ids: no surface, no shading.
+  void finish_visibility(const BlockHits& b, TileOutput& out) const {
+    b.for_each_pixel(out, [&](int k, int, int, size_t i) {
+      const HitRecord& hit = b.hits[k];
+      if (textured_) out.lod[i] = kNoLod;
+      if (hit.primitive == kNoPrimitive) {
+        out.set_background(i, scene_.image.background);
+      } else {
+        const auto [object, primitive] = geometry_.hit_ids(hit);
+        out.colour[i] = scene_.image.background;
+        out.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
+        out.object_id[i] = object;
+        out.primitive_id[i] = primitive;
+        out.normal[i] = glm::vec3(0.0f);
+        if (textured_ && object_textured_[object])
+          out.lod[i] = b.given && b.given[k]
+                           ? b.given_lod[k]
+                           : textured_hit_lod(scene_.objects[object], primitive, b.direction(k),
+                                              hit.t, primary_footprint_);
+      }
+      out.cost[i] = pixel_cost(b.centre_work(k));
+    });
+  }
+
+  // Local shading: the block's hits put into one batch, whose surfaces and colours the shading
+  // kernels compute together. A batch of one material shades with it; a mixed one carries each
+  // slot's.
+  void finish_local(const BlockHits& b, TileOutput& out, RayCounters& counters) const {
+    static_assert(kPacketRays <= kShadeBatch, "a block's hits fit one batch");
+    const bool supersampled = this->supersampled();
     SurfaceBatch batch;
-    for (int a = 0; a < 3; ++a) batch.origin[a] = packet.origin[a];
+    for (int a = 0; a < 3; ++a) batch.origin[a] = b.packet.origin[a];
     size_t batch_pixel[kPacketRays];
     int batch_count = 0;  // kept out of `batch` so that it stays in a register
     bool mixed = false;   // the batch's pixels have more than one material
     uint32_t batch_material = 0;
-    // The centre rays' traversal work, added to `counters` once for the block.
-    TraversalCounters centre_work;
-    geometry_.fetch_surface_data(hits, packet.count, mode == RenderMode::Visibility);
-    const int y1 = y0 + packet.count / w;
-    for (int y = y0, k = 0; y < y1; ++y)
-      for (int x = x0; x < x0 + w; ++x, ++k) {  // ray k is pixel (x, y)
-        const size_t i = out.index(x, y);
-        const HitRecord& hit = hits[k];
-        centre_work.nodes_visited += work[k].nodes_visited;
-        centre_work.primitive_tests += work[k].primitive_tests;
-        // The traversal work of the rays this pixel's shading traces (full mode, supersampling).
-        const uint64_t traced_before = traced_work(counters);
-        if (textured_) out.lod[i] = kNoLod;
-        if (hit.primitive == kNoPrimitive) {
-          out.set_background(i, scene_.image.background);
-        } else if (mode == RenderMode::Visibility) {
-          // Visibility is the hit's distance and ids: no surface, no shading.
-          const auto [object, primitive] = geometry_.hit_ids(hit);
-          out.colour[i] = scene_.image.background;
-          out.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
-          out.object_id[i] = object;
-          out.primitive_id[i] = primitive;
-          out.normal[i] = glm::vec3(0.0f);
-          if (textured_ && object_textured_[object]) {
-            const glm::vec3 D(packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]);
-            out.lod[i] = given && given[k] ? given_lod[k]
-                                           : textured_hit_lod(scene_.objects[object], primitive, D,
-                                                              hit.t, primary_footprint_);
+    b.for_each_pixel(out, [&](int k, int x, int y, size_t i) {
+      const HitRecord& hit = b.hits[k];
+      if (textured_) out.lod[i] = kNoLod;
+      if (hit.primitive == kNoPrimitive) {
+        out.set_background(i, scene_.image.background);
+      } else {
+        const int slot = batch_count++;
+        batch_pixel[slot] = i;
+        const uint32_t material = add_to_batch(batch, slot, b.packet, k, hit, out, i);
+        const uint32_t object = out.object_id[i];
+        if (varies_ && object_varies_[object]) {
+          // Its own material: the diffuse replaced by the base colour at the hit.
+          const Material& m = scene_.materials[material];
+          const glm::vec3 base = varying_base_colour(
+              scene_.objects[object], out.primitive_id[i], hit.u, hit.v, b.direction(k), hit.t,
+              &primary_footprint_, out.lod[i], b.lod_given(k));
+          if (!mixed) {
+            mixed = true;
+            for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
           }
-        } else if (mode == RenderMode::Local) {
-          const int slot = batch_count++;
-          batch_pixel[slot] = i;
-          const uint32_t material = add_to_batch(batch, slot, packet, k, hit, out, i);
-          const uint32_t object = out.object_id[i];
-          if (varies_ && object_varies_[object]) {
-            // Its own material: the diffuse replaced by the base colour at the hit.
-            const glm::vec3 D(packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]);
-            const Material& m = scene_.materials[material];
-            const glm::vec3 base = varying_base_colour(
-                scene_.objects[object], out.primitive_id[i], hit.u, hit.v, D, hit.t,
-                &primary_footprint_, out.lod[i], given && given[k] ? &given_lod[k] : nullptr);
-            if (!mixed) {
-              mixed = true;
-              for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
-            }
-            put_material(batch, slot, shade_material(with_diffuse(m, base), scene_.ambient));
-          } else {
-            if (slot == 0) {
-              batch_material = material;
-            } else if (!mixed && material != batch_material) {
-              mixed = true;  // from now on each slot carries its material
-              for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
-            }
-            if (mixed) put_material(batch, slot, materials_[material]);
-          }
+          put_material(batch, slot, shade_material(with_diffuse(m, base), scene_.ambient));
         } else {
-          const Ray ray = PrimaryRays::ray_of(packet, k);
-          const SurfaceHit s = geometry_.surface(ray, hit);
-          const glm::vec3 V = -glm::normalize(ray.dir);
-          const glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
-          out.depth[i] = s.t;
-          out.object_id[i] = s.object;
-          out.primitive_id[i] = s.primitive;
-          out.normal[i] = N;
-          out.colour[i] =
-              shade(ray, s, N, V, 0, counters, nullptr, textured_footprint(),
-                    textured_ ? &out.lod[i] : nullptr, given && given[k] ? &given_lod[k] : nullptr);
+          if (slot == 0) {
+            batch_material = material;
+          } else if (!mixed && material != batch_material) {
+            mixed = true;  // from now on each slot carries its material
+            for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
+          }
+          if (mixed) put_material(batch, slot, materials_[material]);
         }
-        if (supersampled) out.colour[i] = supersample(x, y, counters);
-        // Work for this pixel: its centre ray and every ray its shading traced.
-        out.cost[i] = options_.cost_aov ? float(work[k].nodes_visited + work[k].primitive_tests +
-                                                traced_work(counters) - traced_before)
-                                        : 0.0f;
       }
-    add_traversal(counters, centre_work);
+      uint64_t sample_work = 0;
+      if (supersampled) {
+        const uint64_t before = traced_work(counters);
+        out.colour[i] = supersample(x, y, counters);
+        sample_work = traced_work(counters) - before;
+      }
+      out.cost[i] = pixel_cost(b.centre_work(k) + sample_work);
+    });
+    if (batch_count == 0) return;
     batch.count = batch_count;
-    if (batch.count > 0) {
-      pad_batch(batch, mixed);
-      batch.material = mixed ? nullptr : &materials_[batch_material];
-      kernels_.shade_surfaces(batch, light_arrays_.lights());
-      for (int slot = 0; slot < batch.count; ++slot) {
-        const size_t i = batch_pixel[slot];
-        out.normal[i] = {batch.shading_normal[0][slot], batch.shading_normal[1][slot],
-                         batch.shading_normal[2][slot]};
-        if (!supersampled)
-          out.colour[i] = {batch.colour[0][slot], batch.colour[1][slot], batch.colour[2][slot]};
-      }
+    pad_batch(batch, mixed);
+    batch.material = mixed ? nullptr : &materials_[batch_material];
+    kernels_.shade_surfaces(batch, light_arrays_.lights());
+    for (int slot = 0; slot < batch.count; ++slot) {
+      const size_t i = batch_pixel[slot];
+      out.normal[i] = {batch.shading_normal[0][slot], batch.shading_normal[1][slot],
+                       batch.shading_normal[2][slot]};
+      if (!supersampled)
+        out.colour[i] = {batch.colour[0][slot], batch.colour[1][slot], batch.colour[2][slot]};
     }
-    counters.shade_seconds += seconds_since(start);
+  }
+
+  // Full shading, one pixel at a time: each hit's shadow, reflection and refraction rays traced.
+  void finish_full(const BlockHits& b, TileOutput& out, RayCounters& counters) const {
+    const bool supersampled = this->supersampled();
+    b.for_each_pixel(out, [&](int k, int x, int y, size_t i) {
+      const HitRecord& hit = b.hits[k];
+      const uint64_t before = traced_work(counters);
+      if (textured_) out.lod[i] = kNoLod;
+      if (hit.primitive == kNoPrimitive) {
+        out.set_background(i, scene_.image.background);
+      } else {
+        const Ray ray = PrimaryRays::ray_of(b.packet, k);
+        const SurfaceHit s = geometry_.surface(ray, hit);
+        const glm::vec3 V = -glm::normalize(ray.dir);
+        const glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
+        out.depth[i] = s.t;
+        out.object_id[i] = s.object;
+        out.primitive_id[i] = s.primitive;
+        out.normal[i] = N;
+        out.colour[i] = shade(ray, s, N, V, 0, counters, nullptr, textured_footprint(),
+                              textured_ ? &out.lod[i] : nullptr, b.lod_given(k));
+      }
+      if (supersampled) out.colour[i] = supersample(x, y, counters);
+      out.cost[i] = pixel_cost(b.centre_work(k) + traced_work(counters) - before);
+    });
   }
 
   // Puts ray k's hit into slot `slot` of the batch, for the kernel to compute its surface, and
