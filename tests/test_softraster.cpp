@@ -437,6 +437,42 @@ TEST(SoftRasterizer, DrawsCsgObjectsLeafByLeafWithoutWarnings) {
   EXPECT_EQ(r.name(), "softraster");
 }
 
+// pixels.covered is counted from the blocks' counts of empty pixels, not read pixel by pixel:
+// it must equal the pixels with an id in the frame written, whatever drew them (the fill
+// kernels of every instruction set, with and without hi-z, and the CSG pass's surfaces).
+TEST(SoftRasterizer, PixelsCoveredIsThePixelsWithAnId) {
+  std::vector<std::pair<std::string, Scene>> scenes;
+  for (const char* name : {"tessphere:2000", "occluders:8", "soup:3000", "cornell", "csg"}) {
+    Expected<Scene> scene = make_builtin_scene(name);
+    ASSERT_TRUE(scene.ok());
+    scenes.emplace_back(name, *scene);
+  }
+  // The CSG solids alone: their surfaces land on empty pixels, not on a wall drawn before.
+  Scene solids = scenes.back().second;
+  std::erase_if(solids.objects, [](const Object& o) { return o.type != ObjectType::Csg; });
+  scenes.emplace_back("csg solids alone", solids);
+  for (auto& [name, scene] : scenes) {
+    scene.image.width = 203;  // blocks cut by the frame's right and bottom edges
+    scene.image.height = 117;
+    for (Isa isa : kAllIsas) {
+      if (!cpu_supports(isa)) continue;
+      for (bool hiz : {true, false}) {
+        SoftRasterizer r;
+        RenderOptions options;
+        options.hiz = hiz;
+        options.isa = isa;
+        Expected<RenderOutput> out = r.render(scene, options);
+        ASSERT_TRUE(out.ok()) << out.error().message;
+        size_t with_id = 0;
+        for (uint32_t id : out->buffers.object_id) with_id += id != kNoId;
+        EXPECT_GT(with_id, 0u) << name;
+        EXPECT_EQ(out->stats.at("pixels.covered"), double(with_id))
+            << name << " " << to_string(isa) << " hiz " << hiz;
+      }
+    }
+  }
+}
+
 // RenderOptions::zbuffer_left_out (the hybrids' z-buffer pass): both z-buffers draw the scene as
 // if the objects left out had no triangles, and every other object keeps its id. The expected ids
 // come from the same scene with those objects emptied (a mesh with no triangles, same index);

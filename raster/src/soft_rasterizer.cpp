@@ -279,10 +279,9 @@ Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSamp
 
 // The camera pass's counts: triangles, fragments, covered pixels, blocks, memory.
 void record_draw_stats(const DrawResult& drawn, const DepthTarget& target, size_t submitted,
-                       bool shaded, const FrameBuffers& fb, RenderOutput& out) {
+                       bool shaded, RenderOutput& out) {
   const soft::TileCounters& sum = drawn.counters;
-  uint64_t covered = 0;
-  for (size_t i = 0; i < fb.pixel_count(); ++i) covered += target.covered(i) ? 1 : 0;
+  const size_t covered = target.covered_pixels();
   out.stats["triangles.submitted"] = double(submitted);
   out.stats["triangles.clipped"] = double(drawn.clipped);
   out.stats["triangles.setup"] = double(drawn.set_up);
@@ -542,7 +541,7 @@ Expected<RenderOutput> render_impl(const Scene& scene, const RenderOptions& opti
   RVR_TRY(draw_view(setup, camera, camera_frame(setup, camera.reflection), out, drawn));
   out.stats["time.setup"] += prepare_seconds;
   out.stats["time.visibility"] += prepare_seconds;
-  record_draw_stats(drawn, *kept, draws.list.triangles(), shade, out.buffers, out);
+  record_draw_stats(drawn, *kept, draws.list.triangles(), shade, out);
 
   std::vector<EnvironmentMapped> mapped;
   std::vector<std::string> left_out;  // transparent planar mirrors

@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <limits>
 
@@ -87,6 +88,19 @@ size_t DepthTarget::bytes() const {
          (object_.size() + primitive_.size() + fragments_.size()) * sizeof(uint32_t) +
          bary_.size() * sizeof(float) + block_max_.size() * sizeof(double) +
          block_rejects_.size() * sizeof(uint32_t);
+}
+
+size_t DepthTarget::covered_pixels() const {
+  size_t empty = 0;
+  for (uint16_t n : block_empty_) empty += n;
+  return size_t(width_) * size_t(height_) - empty;
+}
+
+void DepthTarget::leave_empty_count(size_t i) {
+  const int x = int(i % size_t(width_)), y = int(i / size_t(width_));
+  // Atomic: the rows of one 8-row band of blocks may be set by different threads.
+  std::atomic_ref<uint16_t>(block_empty_[block_index(x, y)])
+      .fetch_sub(1, std::memory_order_relaxed);
 }
 
 void DepthTarget::update_block_max(int bx, int by) {

@@ -71,6 +71,9 @@ class DepthTarget {
     return depth_only_ ? depth_[i] != std::numeric_limits<double>::infinity()
                        : object_[i] != 0xFFFFFFFFu;
   }
+  // How many pixels are covered: the frame less its blocks' counts of empty pixels, which every
+  // draw keeps (a pixel leaves its block's count when first drawn), so no pixel is read.
+  size_t covered_pixels() const;
   double depth(size_t i) const { return depth_[i]; }
   uint32_t object(size_t i) const { return object_[i]; }
   uint32_t primitive(size_t i) const { return primitive_[i]; }
@@ -97,9 +100,11 @@ class DepthTarget {
   }
   // A surface found after every draw into the target (a CSG solid's, csg_pass.h) written at
   // pixel i over what was drawn there (a depth-only target: its depth alone). The blocks' hi-z
-  // bounds are not updated: nothing is drawn into the target after it.
+  // bounds are not updated: nothing is drawn into the target after it. Pixels of one block may be
+  // set from different threads.
   void set_surface(size_t i, double depth, uint32_t object, uint32_t primitive,
                    const glm::vec3& barycentric) {
+    if (depth_[i] == std::numeric_limits<double>::infinity()) leave_empty_count(i);
     depth_[i] = depth;
     if (depth_only_) return;
     object_[i] = object;
@@ -128,6 +133,8 @@ class DepthTarget {
     return size_t(y / kBlock) * size_t(blocks_x_) + size_t(x / kBlock);
   }
   void update_block_max(int bx, int by);
+  // Pixel i, drawn for the first time outside the kernels, leaves its block's empty count.
+  void leave_empty_count(size_t i);
 
   int width_, height_, tiles_x_, tiles_y_, blocks_x_, blocks_y_;
   double near_, far_;
