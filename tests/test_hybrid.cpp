@@ -29,6 +29,7 @@
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/scene_loader.h"
 #include "same_bytes.h"
+#include "scene_builders.h"
 
 using namespace rvr;
 
@@ -198,6 +199,44 @@ TEST(Hybrid, TracesCsgWhereTheZBufferDrawsNothing) {
     for (const std::string& w : out.warnings) noted |= w.find("csg") != std::string::npos;
     EXPECT_TRUE(noted) << hybrid;
   }
+}
+
+// Where the z-buffer draws nothing next to a pixel it drew, a silhouette or shared edge may fall
+// either way at the pixel's centre: the hybrid traces those pixels. A triangle whose right edge
+// runs through a column of pixel centres shows it: the fill rule leaves that column empty, the
+// ray test (edges included) may hit there. The hybrid's ids are the tracer's on every pixel the
+// z-buffer left empty; leaving those pixels background would lose the edge.
+TEST(Hybrid, TracesEmptyPixelsNextToWhatTheZBufferDrew) {
+  Scene scene = test::empty_scene(64, 64, {0, 0, 0}, {0, 0, -1}, 90.0f);
+  const uint32_t m = test::emissive(scene, {1, 1, 1});
+  // At z = -1 with a 90 degree field of view, screen x = 32 + 32 * world x (y flipped): the
+  // right edge lies on the centres of column 47, the diagonal on the centres of (x, x).
+  const float lo = -15.5f / 32.0f, hi = 15.5f / 32.0f;
+  Object o;
+  o.type = ObjectType::Triangles;
+  o.material = m;
+  o.mesh.positions = {{lo, -lo, -1}, {hi, -lo, -1}, {hi, -hi, -1}};
+  o.mesh.triangles = {{0, 1, 2}};
+  scene.objects.push_back(o);
+  RenderOptions options;
+  options.mode = RenderMode::Visibility;
+  auto render = [&](const char* name) {
+    auto r = make_renderer(name, GlBackend::OsMesa);
+    EXPECT_TRUE(r.ok()) << name;
+    Expected<RenderOutput> out = r.value()->render(scene, options);
+    EXPECT_TRUE(out.ok()) << name << ": " << (out.ok() ? "" : out.error().message);
+    return std::move(out).value().buffers;
+  };
+  const FrameBuffers traced = render("raytrace"), zbuffer = render("softraster"),
+                     hybrid = render("hybrid_soft");
+  size_t edge_pixels = 0;  // empty to the z-buffer, the triangle to the tracer
+  for (size_t i = 0; i < traced.pixel_count(); ++i) {
+    if (zbuffer.object_id[i] != kNoId) continue;
+    edge_pixels += traced.object_id[i] != kNoId;
+    EXPECT_EQ(hybrid.object_id[i], traced.object_id[i]) << "pixel " << i;
+  }
+  EXPECT_GT(edge_pixels, 0u) << "the scene has no pixel the fill rule and the ray test decide "
+                                "differently: it tests nothing";
 }
 
 // Deterministic: the same bytes on one thread as on every core.

@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "rvr/core/check.h"
 #include "rvr/core/framebuffers.h"
 #include "rvr/core/prefetch.h"
 #include "rvr/raytrace/packet_slots.h"
@@ -98,6 +99,30 @@ void ZBufferHits::fetch_next_block(const CentreBlock& block) const {
   }
 }
 
+// For each row of the block, bit x - x0 set where pixel (x, y) or one of its eight neighbours
+// was drawn: next_to_drawn for a whole row at once, each id of the block's border read once.
+void ZBufferHits::drawn_nearby(const CentreBlock& block, uint32_t* rows) const {
+  RVR_DCHECK(block.x1 - block.x0 <= kPacketSide && block.y1 - block.y0 <= kPacketSide,
+             "a block of at most kPacketSide pixels on a side");
+  const int nx0 = std::max(block.x0 - 1, 0), nx1 = std::min(block.x1 + 1, visible_.width);
+  auto drawn_row = [&](int y) {  // bit x - x0 + 1 set where (x, y) was drawn, x in [x0 - 1, x1]
+    uint32_t m = 0;
+    if (y < 0 || y >= visible_.height) return m;
+    const uint32_t* ids = visible_.object_id.data() + size_t(y) * size_t(visible_.width);
+    for (int x = nx0; x < nx1; ++x) m |= uint32_t(ids[x] != kNoId) << (x - block.x0 + 1);
+    return m;
+  };
+  uint32_t above = drawn_row(block.y0 - 1), here = drawn_row(block.y0);
+  for (int y = block.y0; y < block.y1; ++y) {
+    const uint32_t below = drawn_row(y + 1);
+    const uint32_t column = above | here | below;
+    // Bit x - x0 of the result: columns x - 1, x and x + 1, bits x - x0 .. x - x0 + 2.
+    rows[y - block.y0] = column | column >> 1 | column >> 2;
+    above = here;
+    here = below;
+  }
+}
+
 void ZBufferHits::centre_hits(CentreBlock& block) const {
   HybridCounters& counters = counters_.local();
   const RayPacket& packet = block.packet;
@@ -107,6 +132,8 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
   bool traced[kPacketRays];
   int n_traced = 0;
   uint64_t background = 0;
+  uint32_t near_drawn[kPacketSide];
+  drawn_nearby(block, near_drawn);
   // The ids the z-buffer drew, and which pixels need a ray at all.
   uint32_t object[kPacketRays], primitive[kPacketRays];
   bool drawn[kPacketRays], rebuilt[kPacketRays], approximate[kPacketRays];
@@ -119,13 +146,20 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
       primitive[k] = visible_.primitive_id[i];
       drawn[k] = object[k] != kNoId;
       approximate[k] = approximated_at(i);
-      hits[k] = HitRecord{};
       work[k] = TraversalCounters{};
-      traced[k] = !drawn[k] && next_to_drawn(x, y);
+      // A drawn pixel's hit is rebuilt or traced, below; an empty one's starts as a miss.
+      if (drawn[k]) {
+        traced[k] = false;
+        continue;
+      }
+      hits[k] = HitRecord{};
+      // Empty next to a pixel the z-buffer covered: a silhouette or shared edge may fall either
+      // way at its centre, so the tracer may see any surface there.
+      traced[k] = (near_drawn[y - block.y0] >> (x - block.x0)) & 1;
       // Otherwise, empty, background to the z-buffer away from every edge it drew: background
       // to the tracer too, without a ray, unless a shape the z-buffer draws approximately may
       // appear there (below).
-      if (!drawn[k] && !traced[k] && !approximate[k]) background++;
+      if (!traced[k] && !approximate[k]) background++;
     }
   fetch_next_block(block);
   geometry_.intersect_named_packet(packet, object, primitive, drawn, hits, rebuilt, work);
@@ -135,9 +169,10 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
   uint64_t ask_shapes = 0;
   for (int k = 0; k < n; ++k)
     if (approximate[k] && (drawn[k] ? rebuilt[k] : !traced[k])) ask_shapes |= uint64_t(1) << k;
-  HitRecord shape[kPacketRays];
+  PacketSlots<HitRecord> shape;  // written where found
   const uint64_t shape_found =
-      ask_shapes ? geometry_.closest_approximated_packet(packet, ask_shapes, shape, work) : 0;
+      ask_shapes ? geometry_.closest_approximated_packet(packet, ask_shapes, shape.data(), work)
+                 : 0;
   for (int k = 0; k < n; ++k) {
     const bool has_shape = (shape_found >> k) & 1;
     if (!drawn[k]) {

@@ -40,6 +40,7 @@ class ZBufferHits : public PrimaryHitSource {
 
  private:
   bool next_to_drawn(int x, int y) const;
+  void drawn_nearby(const CentreBlock& block, uint32_t* rows) const;
   void fetch_next_block(const CentreBlock& block) const;
   // Pixel i lies where a shape the z-buffer draws approximately may appear.
   bool approximated_at(size_t i) const { return !approximated_.empty() && approximated_[i]; }

@@ -52,9 +52,6 @@ namespace {
 // Tiles run in parallel, each staged in a TileOutput: wide and short, so that each writes long
 // runs of every buffer's rows.
 constexpr int kTileWidth = TileOutput::kMaxWidth, kTileHeight = TileOutput::kMaxHeight;
-// Primary rays go as packets of kPacketSide x kPacketSide pixel-centre rays (kPacketRays).
-constexpr int kPacketSide = 8;
-static_assert(kPacketSide * kPacketSide == kPacketRays);
 
 using Clock = std::chrono::steady_clock;
 

@@ -1,5 +1,5 @@
 // Primary hits found by the caller instead of the tracer's own centre rays: the tracer asks a
-// PrimaryHitSource for them one block of pixels at a time (at most kPacketRays pixels, from the
+// PrimaryHitSource for them one block of pixels at a time (at most kPacketSide on a side, from the
 // tiles' threads in parallel), then shades them exactly as it shades its own. The hybrid's
 // z-buffer answers this way (hybrid/src/zbuffer_hits.h); the tracer knows nothing of how.
 #pragma once

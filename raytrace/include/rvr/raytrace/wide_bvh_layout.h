@@ -71,6 +71,9 @@ struct KernelCounters {
 // A tile of primary rays sharing one origin (a pinhole camera): up to kPacketRays directions in
 // SoA, the same tmin and tmax for all.
 constexpr int kPacketRays = 64;
+// Primary rays go as packets of kPacketSide x kPacketSide pixel-centre rays.
+constexpr int kPacketSide = 8;
+static_assert(kPacketSide * kPacketSide == kPacketRays);
 struct alignas(32) RayPacket {
   float origin[3];
   float tmin, tmax;
