@@ -697,9 +697,10 @@ TEST(Packets, SameHitsAsSingleRays) {
 }
 
 // The hybrid's rebuild, a packet at a time: every ray names an object and primitive (the triangle
-// it hits, a neighbour, one far away, a tessellated sphere, an analytic shape, ids out of range),
-// and intersect_named_packet finds what intersect_named finds ray by ray, to the bit, with
-// the same counted tests, whichever kernel tests the named triangles eight at a time.
+// it hits, a neighbour, one far away, a tessellated sphere, an analytic shape, ids out of range;
+// in some packets every ray names one triangle), and intersect_named_packet finds what
+// intersect_named finds ray by ray, to the bit, with the same counted tests, whichever kernel tests
+// the named triangles eight at a time.
 TEST(Packets, RebuiltHitsAreIntersectVisiblesOwn) {
   int hits = 0, misses = 0;
   for (Scene scene :
@@ -746,6 +747,12 @@ TEST(Packets, RebuiltHitsAreIntersectVisiblesOwn) {
           }
           wanted[k] = object[k] != kNoId || k % 5 == 0;  // some unwanted, some naming nothing
         }
+        if (tile % 8 == 5)  // every ray names what the middle one hits: groups of one triangle
+          for (int k = 0; k < p.count; ++k) {
+            object[k] = object[p.count / 2];
+            primitive[k] = primitive[p.count / 2];
+            wanted[k] = true;
+          }
         HitRecord packet_hits[kPacketRays];
         bool found[kPacketRays];
         TraversalCounters work[kPacketRays];

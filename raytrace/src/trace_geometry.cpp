@@ -625,13 +625,15 @@ void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32
                packet.tmin,
                packet.tmax};
   };
+  static_assert(sizeof(TrianglePrecomputed) == 9 * sizeof(float), "v0, e1, e2: 9 floats");
   const bool simd = kernels_ && triangle_test_ == TriangleTest::MollerTrumbore;
   NamedTriangles named;
-  int lane_ray[kPacketRays];
-  uint32_t lane_triangle[kPacketRays];
+  named.triangles = reinterpret_cast<const float*>(triangles_.data());
   uint64_t analytic_rays = 0;  // the rays naming a shape traced analytically
+  uint32_t previous = 0;       // the triangle the last ray tested by the kernel named
   for (int k = 0; k < packet.count; ++k) {
     found[k] = false;
+    named.index[k] = previous;
     if (!wanted[k]) continue;
     const uint32_t o = object[k];
     // One named triangle of a mesh, read from flat per-object tables (no pointer to follow).
@@ -644,43 +646,31 @@ void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32
         found[k] = intersect_named(ray_of(k), o, primitive[k], hits[k], counters[k]);
       continue;
     }
-    const int lane = named.count++;
-    const uint32_t p = object_first_triangle_[o] + primitive[k];
-    const TrianglePrecomputed& tri = triangles_[p];
-    lane_ray[lane] = k;
-    lane_triangle[lane] = p;
-    for (int a = 0; a < 3; ++a) {
-      named.dir[a][lane] = packet.dir[a][k];
-      named.v0[a][lane] = tri.v0[a];
-      named.e1[a][lane] = tri.e1[a];
-      named.e2[a][lane] = tri.e2[a];
-    }
+    previous = named.index[k] = object_first_triangle_[o] + primitive[k];
+    named.rays |= uint64_t(1) << k;
   }
   intersect_named_shapes(packet, object, analytic_rays, hits, found, counters);
-  if (named.count == 0) return;
-  for (int lane = named.count; lane % 8 != 0; ++lane)  // the kernel's last group: repeat a lane
-    for (int a = 0; a < 3; ++a) {
-      named.dir[a][lane] = named.dir[a][0];
-      named.v0[a][lane] = named.v0[a][0];
-      named.e1[a][lane] = named.e1[a][0];
-      named.e2[a][lane] = named.e2[a][0];
-    }
-  KernelHit kernel_hits[kPacketRays];
+  if (named.rays == 0) return;
+  // The rays before the first the kernel tests name its triangle, as the rest name their
+  // predecessor's.
+  const int lead = __builtin_ctzll(named.rays);
+  for (int k = 0; k < lead; ++k) named.index[k] = named.index[lead];
+  PacketSlots<KernelHit> kernel_hits;  // written where the outcome is Hit
   NamedOutcome outcome[kPacketRays];
-  kernels_->intersect_named(packet, named, kernel_hits, outcome);
-  for (int lane = 0; lane < named.count; ++lane) {
-    const int k = lane_ray[lane];
-    if (outcome[lane] == NamedOutcome::NearEdge) {  // decided in double, as intersect_named does
+  kernels_->intersect_named(packet, named, kernel_hits.data(), outcome);
+  for (uint64_t m = named.rays; m != 0; m &= m - 1) {
+    const int k = __builtin_ctzll(m);
+    if (outcome[k] == NamedOutcome::NearEdge) {  // decided in double, as intersect_named does
       found[k] = intersect_named(ray_of(k), object[k], primitive[k], hits[k], counters[k]);
       continue;
     }
     counters[k].primitive_tests++;
     hits[k] = HitRecord{};
-    if (outcome[lane] == NamedOutcome::Miss) continue;
-    hits[k].t = kernel_hits[lane].t;
-    hits[k].u = kernel_hits[lane].u;
-    hits[k].v = kernel_hits[lane].v;
-    hits[k].primitive = lane_triangle[lane];
+    if (outcome[k] == NamedOutcome::Miss) continue;
+    hits[k].t = kernel_hits[k].t;
+    hits[k].u = kernel_hits[k].u;
+    hits[k].v = kernel_hits[k].v;
+    hits[k].primitive = named.index[k];
     found[k] = true;
   }
 }

@@ -716,18 +716,57 @@ void closest_packet(const WideBvhView& bvh, const RayPacket& packet, KernelHit* 
     closest_packet_impl<false>(bvh, packet, hits, nullptr);
 }
 
+// The triangles rays [first, first + 8) of `named` are tested against, lanes past the packet's
+// `live` rays repeating the first: one triangle's vectors splatted when every ray names it (a
+// z-buffer's pixels mostly name what their neighbours name), else gathered lane by lane.
+void named_triangles(const NamedTriangles& named, int first, int live, Vec3vf8& v0, Vec3vf8& e1,
+                     Vec3vf8& e2) {
+  const uint32_t* index = named.index + first;
+  bool one = true;
+  for (int l = 1; l < live; ++l) one &= index[l] == index[0];
+  if (one) {
+    const float* t = named.triangles + 9 * size_t(index[0]);
+    v0 = Vec3vf8::splat(t[0], t[1], t[2]);
+    e1 = Vec3vf8::splat(t[3], t[4], t[5]);
+    e2 = Vec3vf8::splat(t[6], t[7], t[8]);
+    return;
+  }
+  alignas(32) float lanes[3][3][8];  // v0, e1, e2 by axis and lane
+  for (int l = 0; l < 8; ++l) {
+    const float* t = named.triangles + 9 * size_t(index[l < live ? l : 0]);
+    for (int v = 0; v < 3; ++v)
+      for (int a = 0; a < 3; ++a) lanes[v][a][l] = t[3 * v + a];
+  }
+  v0 = Vec3vf8::load(lanes[0]);
+  e1 = Vec3vf8::load(lanes[1]);
+  e2 = Vec3vf8::load(lanes[2]);
+}
+
 // intersect_triangle_mt's float pass, lane by lane with its operations in its order (glm's
 // cross and dot), eight rays each against its own triangle.
 void intersect_named(const RayPacket& packet, const NamedTriangles& named, KernelHit* hits,
                      NamedOutcome* outcome) {
   const V8 tmin = V8::splat(packet.tmin), tmax = V8::splat(packet.tmax);
-  for (int first = 0; first < named.count; first += 8) {
-    const Vec3vf8 D = Vec3vf8::load(named.dir, first);
-    const Vec3vf8 E1 = Vec3vf8::load(named.e1, first), E2 = Vec3vf8::load(named.e2, first);
+  for (int first = 0; first < packet.count; first += 8) {
+    const unsigned rays = unsigned(named.rays >> first) & 0xFFu;
+    if (rays == 0) continue;
+    const int live = packet.count - first < 8 ? packet.count - first : 8;
+    Vec3vf8 D;
+    if (live == 8) {  // the packet's rows lie 24 bytes into it: unaligned
+      D = {V8::loadu(packet.dir[0] + first), V8::loadu(packet.dir[1] + first),
+           V8::loadu(packet.dir[2] + first)};
+    } else {  // the packet's lanes past its count are unset: a live one repeated
+      alignas(32) float dir[3][8];
+      for (int a = 0; a < 3; ++a)
+        for (int l = 0; l < 8; ++l) dir[a][l] = packet.dir[a][first + (l < live ? l : 0)];
+      D = Vec3vf8::load(dir);
+    }
+    Vec3vf8 V0, E1, E2;
+    named_triangles(named, first, live, V0, E1, E2);
     const Vec3vf8 P = cross(D, E2);
     const V8 det = dot(E1, P);
     // U, V: su, sv times sign(det)
-    const Vec3vf8 S = Vec3vf8::splat(packet.origin) - Vec3vf8::load(named.v0, first);
+    const Vec3vf8 S = Vec3vf8::splat(packet.origin) - V0;
     const V8 su = dot(S, P);
     const Vec3vf8 Q = cross(S, E1);
     const V8 sv = dot(D, Q);
@@ -749,7 +788,8 @@ void intersect_named(const RayPacket& packet, const NamedTriangles& named, Kerne
     store(ts, t);
     store(us, su * inv_det);
     store(vs, sv * inv_det);
-    for (int l = 0; l < 8 && first + l < named.count; ++l) {
+    for (unsigned m = rays; m != 0; m &= m - 1) {
+      const int l = __builtin_ctz(m);
       const unsigned bit = 1u << l;
       outcome[first + l] = (near_edge & bit) ? NamedOutcome::NearEdge
                            : (hit & bit)     ? NamedOutcome::Hit

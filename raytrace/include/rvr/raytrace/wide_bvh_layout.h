@@ -82,14 +82,14 @@ struct alignas(32) RayPacket {
 };
 
 // Rays of one packet, each with the one triangle it is to be tested against (the hybrid's
-// rebuild of a z-buffer's hits): lane i is ray dir[.][i] from the packet's origin against the
-// triangle v0, e1, e2 [.][i]. Lanes [count, padded to 8) repeat a live lane.
+// rebuild of a z-buffer's hits): ray k of the packet, for each bit k of `rays`, against triangle
+// index[k] of `triangles` (9 floats each: v0, e1, e2). Every other ray below the packet's count
+// names a triangle too (a neighbour's, so that groups of rays naming one triangle stay whole);
+// its outcome is not written.
 struct NamedTriangles {
-  int count = 0;
-  alignas(32) float dir[3][kPacketRays];
-  alignas(32) float v0[3][kPacketRays];
-  alignas(32) float e1[3][kPacketRays];
-  alignas(32) float e2[3][kPacketRays];
+  const float* triangles;
+  uint64_t rays = 0;
+  uint32_t index[kPacketRays];
 };
 // What the test found for a lane: nothing, a hit (t, u, v), or a hit within intersect_triangle_mt's
 // edge band, which the caller decides in double precision as that function does.
@@ -106,8 +106,8 @@ struct TraversalKernels {
   // hits[i] for ray i of the packet; counters[i] per ray (may be null).
   void (*closest_packet)(const WideBvhView&, const RayPacket&, KernelHit* hits,
                          KernelCounters* counters);
-  // intersect_triangle_mt's float pass for each lane of `named`, eight lanes at a time, with the
-  // packet's origin, tmin and tmax: outcome[i], and hits[i] where it is Hit.
+  // intersect_triangle_mt's float pass for each ray of `named`, eight rays at a time, with the
+  // packet's origin, tmin and tmax: outcome[k], and hits[k] where it is Hit.
   void (*intersect_named)(const RayPacket& packet, const NamedTriangles& named, KernelHit* hits,
                           NamedOutcome* outcome);
 };
