@@ -379,6 +379,16 @@ TEST(SoftRasterizer, VisibilityModeWritesIdsDepthAndCostOnly) {
           << label;
       EXPECT_EQ(no_cost.stats.at("fragments.generated"), local.stats.at("fragments.generated"))
           << label;
+      // The target keeps what the pass reads: no barycentrics (3 floats a pixel) without
+      // shading, no fragment counts (a uint32_t a pixel) without the cost AOV.
+      const double pixels = double(scene.image.width) * double(scene.image.height);
+      EXPECT_EQ(local.stats.at("memory.raster_bytes") - visibility.stats.at("memory.raster_bytes"),
+                12.0 * pixels)
+          << label;
+      EXPECT_EQ(
+          visibility.stats.at("memory.raster_bytes") - no_cost.stats.at("memory.raster_bytes"),
+          4.0 * pixels)
+          << label;
     }
   }
 }

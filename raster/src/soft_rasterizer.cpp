@@ -110,11 +110,15 @@ glm::dmat4 camera_view_projection(const Scene& scene, const RenderOptions& optio
 DepthTarget& camera_target(const RenderOptions& options, int w, int h, float near, float far,
                            const soft::FillKernels& kernels, tbb::task_arena& arena,
                            std::optional<DepthTarget>& kept) {
+  // Barycentrics for shading, fragment counts for the cost AOV: a visibility pass without it
+  // (the hybrids') writes depth and ids alone.
+  const soft::TargetArrays arrays{/*ids=*/true, options.mode != RenderMode::Visibility,
+                                  options.cost_aov};
   arena.execute([&] {
-    if (kept && kept->same_setup(w, h, near, far, options.hiz, kernels))
+    if (kept && kept->same_setup(w, h, near, far, options.hiz, kernels, arrays))
       kept->clear();
     else
-      kept.emplace(w, h, near, far, options.hiz, kernels);
+      kept.emplace(w, h, near, far, options.hiz, kernels, arrays);
   });
   kept->set_depth_format(!options.depth_format                        ? soft::kDepthExact
                          : *options.depth_format == DepthFormat::D24  ? soft::kDepthD24
@@ -228,7 +232,7 @@ Status add_shadowed_light(const VisibleFrame& frame, const std::vector<LightSamp
   if (!reuse)
     arena.execute([&] {
       scratch_built.emplace(settings.size, settings.size, near_plane, far_plane, options.hiz,
-                            kernels, /*depth_only=*/true);
+                            kernels, soft::kDepthOnly);
     });
   std::vector<soft::ShadowCube> own_cubes;
   std::vector<soft::ShadowCube>& cubes = keep ? kept->cubes : own_cubes;

@@ -40,8 +40,10 @@ struct FillTarget {
   int width;
   int blocks_x;
   double near_plane, far_plane;
-  bool depth_only;
-  int depth_format;  // kDepthExact, kDepthD24, ...
+  bool depth_only;         // no ids, barycentrics or fragment counts
+  bool keep_barycentrics;  // bary written
+  bool count_fragments;    // fragments counted
+  int depth_format;        // kDepthExact, kDepthD24, ...
 };
 
 struct FillResult {

@@ -15,7 +15,7 @@
 namespace rvr::soft {
 
 DepthTarget::DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz,
-                         const FillKernels& kernels, bool depth_only)
+                         const FillKernels& kernels, TargetArrays arrays)
     : width_(width),
       height_(height),
       tiles_x_((width + kTile - 1) / kTile),
@@ -25,7 +25,7 @@ DepthTarget::DepthTarget(int width, int height, double near_plane, double far_pl
       near_(near_plane),
       far_(far_plane),
       hiz_(hiz),
-      depth_only_(depth_only),
+      arrays_{arrays.ids, arrays.ids && arrays.barycentrics, arrays.ids && arrays.fragments},
       kernels_(&kernels) {
   RVR_CHECK(width > 0 && height > 0 && width <= kMaxImageSide && height <= kMaxImageSide,
             "the renderer refuses frames outside 1..kMaxImageSide: ", width, "x", height);
@@ -51,32 +51,43 @@ void DepthTarget::clear() {
   // Sized without a serial fill (tens of MB at 1024x768: a serial fill would be a serial share
   // of every frame), then filled in parallel slices.
   depth_.resize(n);
-  if (!depth_only_) {
+  if (arrays_.ids) {
     object_.resize(n);
     primitive_.resize(n);
-    fragments_.resize(n);
-    bary_.resize(3 * n);
   }
+  if (arrays_.fragments) fragments_.resize(n);
+  if (arrays_.barycentrics) bary_.resize(3 * n);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 14),
                     [&](const tbb::blocked_range<size_t>& r) {
                       std::fill(depth_.begin() + std::ptrdiff_t(r.begin()),
                                 depth_.begin() + std::ptrdiff_t(r.end()),
                                 std::numeric_limits<double>::infinity());
-                      if (depth_only_) return;
-                      std::fill(object_.begin() + std::ptrdiff_t(r.begin()),
-                                object_.begin() + std::ptrdiff_t(r.end()), 0xFFFFFFFFu);
+                      if (arrays_.ids)
+                        std::fill(object_.begin() + std::ptrdiff_t(r.begin()),
+                                  object_.begin() + std::ptrdiff_t(r.end()), 0xFFFFFFFFu);
                       // Primitive ids and barycentrics are read only where an object was
                       // drawn, and written with it: not cleared.
-                      std::fill(fragments_.begin() + std::ptrdiff_t(r.begin()),
-                                fragments_.begin() + std::ptrdiff_t(r.end()), 0u);
+                      if (arrays_.fragments)
+                        std::fill(fragments_.begin() + std::ptrdiff_t(r.begin()),
+                                  fragments_.begin() + std::ptrdiff_t(r.end()), 0u);
                     });
   block_max_.assign(size_t(blocks_x_) * size_t(blocks_y_), std::numeric_limits<double>::infinity());
   block_rejects_.assign(block_max_.size(), 0);
   block_empty_.resize(block_max_.size());
-  fill_target_ = {depth_.data(), object_.data(),    primitive_.data(),
-                  bary_.data(),  fragments_.data(), block_empty_.data(),
-                  width_,        blocks_x_,         near_,
-                  far_,          depth_only_,       depth_format_};
+  fill_target_ = {depth_.data(),
+                  object_.data(),
+                  primitive_.data(),
+                  bary_.data(),
+                  fragments_.data(),
+                  block_empty_.data(),
+                  width_,
+                  blocks_x_,
+                  near_,
+                  far_,
+                  !arrays_.ids,
+                  arrays_.barycentrics,
+                  arrays_.fragments,
+                  depth_format_};
   for (int by = 0; by < blocks_y_; ++by)
     for (int bx = 0; bx < blocks_x_; ++bx)
       block_empty_[size_t(by) * size_t(blocks_x_) + size_t(bx)] = uint16_t(
@@ -148,7 +159,7 @@ void DepthTarget::draw_tile(int tx, int ty, const SetupTriangles* sub_chunks, co
     for (int y = py; y <= py1; ++y) {
       const size_t i = size_t(y) * size_t(width_) + size_t(px);
       __builtin_prefetch(&depth_[i], 1);
-      if (!depth_only_) __builtin_prefetch(&fragments_[i], 1);
+      if (arrays_.fragments) __builtin_prefetch(&fragments_[i], 1);
     }
   };
   for (size_t k = 0; k < std::min(count, kHotAhead); ++k) __builtin_prefetch(&triangle(k));

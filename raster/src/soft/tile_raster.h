@@ -13,6 +13,7 @@
 #include <limits>
 #include <vector>
 
+#include "rvr/core/check.h"
 #include "rvr/core/framebuffers.h"
 #include "soft/fill_kernel.h"
 #include "soft/setup_triangle.h"
@@ -29,12 +30,22 @@ struct TileCounters {
   uint64_t blocks_full = 0;         // blocks drawn without edge tests
 };
 
+// What a target keeps per pixel besides its depth: what the passes that read it need, no more
+// written per fragment.
+struct TargetArrays {
+  bool ids = true;           // object and primitive ids (false: depth alone, a shadow map)
+  bool barycentrics = true;  // the visible triangle's, for shading
+  bool fragments = true;     // fragments generated per pixel, for the cost AOV
+  bool operator==(const TargetArrays&) const = default;
+};
+inline constexpr TargetArrays kDepthOnly{false, false, false};
+
 class DepthTarget {
  public:
-  // depth_only: keeps depths alone (shadow maps), no ids, barycentrics or per-pixel cost.
+  // `arrays`: what it keeps besides depth (barycentrics and fragments only with ids).
   // `kernels`: the per-pixel loop of the instruction set chosen for this render.
   DepthTarget(int width, int height, double near_plane, double far_plane, bool hiz,
-              const FillKernels& kernels, bool depth_only = false);
+              const FillKernels& kernels, TargetArrays arrays = {});
   // Back to nothing drawn, for the next pass through the same target.
   void clear();
   // Re-dimensioned to width x height (the same planes, hi-z and kernels) and cleared, keeping
@@ -47,10 +58,11 @@ class DepthTarget {
   }
   // Whether this target was made with these arguments (and can be cleared instead of rebuilt).
   bool same_setup(int width, int height, double near_plane, double far_plane, bool hiz,
-                  const FillKernels& kernels) const {
+                  const FillKernels& kernels, TargetArrays arrays) const {
     return width == width_ && height == height_ && near_plane == near_ && far_plane == far_ &&
-           hiz == hiz_ && &kernels == kernels_ && !depth_only_;
+           hiz == hiz_ && &kernels == kernels_ && arrays == arrays_;
   }
+  const TargetArrays& arrays() const { return arrays_; }
 
   int width() const { return width_; }
   int height() const { return height_; }
@@ -68,8 +80,8 @@ class DepthTarget {
 
   // What the frame ended with, per pixel.
   bool covered(size_t i) const {
-    return depth_only_ ? depth_[i] != std::numeric_limits<double>::infinity()
-                       : object_[i] != 0xFFFFFFFFu;
+    return !arrays_.ids ? depth_[i] != std::numeric_limits<double>::infinity()
+                        : object_[i] != 0xFFFFFFFFu;
   }
   // How many pixels are covered: the frame less its blocks' counts of empty pixels, which every
   // draw keeps (a pixel leaves its block's count when first drawn), so no pixel is read.
@@ -77,18 +89,22 @@ class DepthTarget {
   double depth(size_t i) const { return depth_[i]; }
   uint32_t object(size_t i) const { return object_[i]; }
   uint32_t primitive(size_t i) const { return primitive_[i]; }
-  // Perspective-correct barycentrics of the visible triangle at the pixel centre.
+  // Perspective-correct barycentrics of the visible triangle at the pixel centre (kept).
   glm::vec3 barycentric(size_t i) const {
+    RVR_DCHECK(arrays_.barycentrics, "a target without barycentrics");
     return {bary_[3 * i], bary_[3 * i + 1], bary_[3 * i + 2]};
   }
-  // Work at pixel (x, y): fragments generated, plus each hi-z rejection of its block as 1/64.
+  // Work at pixel (x, y): fragments generated, plus each hi-z rejection of its block as 1/64
+  // (fragments kept).
   float cost(int x, int y) const {
+    RVR_DCHECK(arrays_.fragments, "a target without fragment counts");
     return float(fragments_[size_t(y) * size_t(width_) + size_t(x)]) +
            float(block_rejects_[block_index(x, y)]) / float(kBlock * kBlock);
   }
   // cost(x, y) of the whole row y into out[0, width): the same floats, the block's rejection
   // term computed once per block instead of once per pixel.
   void cost_row(int y, float* out) const {
+    RVR_DCHECK(arrays_.fragments, "a target without fragment counts");
     const uint32_t* fragments = fragments_.data() + size_t(y) * size_t(width_);
     const uint32_t* rejects = block_rejects_.data() + size_t(y / kBlock) * size_t(blocks_x_);
     for (int x0 = 0; x0 < width_; x0 += kBlock) {
@@ -106,9 +122,10 @@ class DepthTarget {
                    const glm::vec3& barycentric) {
     if (depth_[i] == std::numeric_limits<double>::infinity()) leave_empty_count(i);
     depth_[i] = depth;
-    if (depth_only_) return;
+    if (!arrays_.ids) return;
     object_[i] = object;
     primitive_[i] = primitive;
+    if (!arrays_.barycentrics) return;
     bary_[3 * i] = barycentric.x;
     bary_[3 * i + 1] = barycentric.y;
     bary_[3 * i + 2] = barycentric.z;
@@ -116,7 +133,7 @@ class DepthTarget {
   // Fragments drawn at pixel i outside this target (a CSG solid's leaf passes), counted in its
   // cost.
   void add_fragments(size_t i, uint32_t fragments) {
-    if (!depth_only_) fragments_[i] += fragments;
+    if (arrays_.fragments) fragments_[i] += fragments;
   }
   double near_plane() const { return near_; }
   double far_plane() const { return far_; }
@@ -138,7 +155,8 @@ class DepthTarget {
 
   int width_, height_, tiles_x_, tiles_y_, blocks_x_, blocks_y_;
   double near_, far_;
-  bool hiz_, depth_only_;
+  bool hiz_;
+  TargetArrays arrays_;
   int depth_format_ = kDepthExact;
   const FillKernels* kernels_;
   FillTarget fill_target_;     // pointers into the arrays below, for the kernels

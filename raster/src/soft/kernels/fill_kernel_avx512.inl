@@ -86,7 +86,7 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
         const vdouble8 depth = one / s;
         result.generated += unsigned(__builtin_popcount(movemask(mask)));
         const size_t i = row_start + size_t(x);
-        if (!target.depth_only) {
+        if (target.count_fragments) {
           uint32_t* fragments = target.fragments + i;
           storeu(mask, fragments, loadu(mask, fragments) + one_fragment);
         }
@@ -125,6 +125,8 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
           if (!target.depth_only) {
             storeu(passed, target.object + i, object);
             storeu(passed, target.primitive + i, primitive);
+          }
+          if (target.keep_barycentrics) {
             // The barycentrics (q / s, rounded to float as the scalar cast does), interleaved
             // with AVX-512's two-source permutes and 16-lane masked stores.
             const vfloat8 b0 = to_float(q[0] / s);

@@ -77,7 +77,7 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
         for (unsigned m = mask; m; m &= m - 1) {
           const int k = int(lowest_bit(m));
           const size_t i = size_t(y) * size_t(target.width) + size_t(x + k);
-          if (!target.depth_only) ++target.fragments[i];
+          if (target.count_fragments) ++target.fragments[i];
           const double depth = depth_lane[k];
           // The depth range clips what lies beyond far (and rounding just inside near).
           if (passes_depth_test(depth, target.depth[i], target) && depth >= target.near_plane &&
@@ -86,7 +86,7 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
         }
         if (passed) {
           result.drawn = true;
-          if (!target.depth_only)
+          if (target.keep_barycentrics)
             for (int j = 0; j < 3; ++j) storeu(q_lane[j], q[j] / s);
         }
         for (; passed; passed &= passed - 1) {
@@ -99,7 +99,8 @@ void fill(const FillTriangle& t, const FillTarget& target, int x0, int y0, int x
           if (!target.depth_only) {
             target.object[i] = t.object;
             target.primitive[i] = t.primitive;
-            for (int j = 0; j < 3; ++j) target.bary[3 * i + size_t(j)] = float(q_lane[j][k]);
+            if (target.keep_barycentrics)
+              for (int j = 0; j < 3; ++j) target.bary[3 * i + size_t(j)] = float(q_lane[j][k]);
           }
         }
       }
