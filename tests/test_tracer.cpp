@@ -113,6 +113,32 @@ TEST(Tracer, CostAovAddsUpToTheFramesTraversalWork) {
   }
 }
 
+// The frame's time divides into visibility (until the primary hits are known) and shading, in
+// the shares the threads' time divides (counted in time-stamp ticks): the two add up to the
+// render time, and full shading with 4 samples a pixel, each traced with its shadow rays, takes
+// a larger share than writing the AOVs of visibility mode. The margin is wide: visibility mode's
+// share is its AOV writes beside the traversal, full mode's nearly all of the frame.
+TEST(Tracer, RenderTimeSplitsIntoVisibilityAndShading) {
+  Scene s = make_builtin_scene("cornell").value();
+  s.image.width = 160;
+  s.image.height = 120;
+  auto share = [&](RenderMode mode, int samples) {
+    s.image.samples_per_pixel = samples;
+    RenderOptions o;
+    o.mode = mode;
+    const RenderOutput out = RayTracer().render(s, o).value();
+    const double visibility = out.stats.at("time.visibility"), shade = out.stats.at("time.shade");
+    EXPECT_GE(visibility, 0.0);
+    EXPECT_GE(shade, 0.0);
+    EXPECT_NEAR(visibility + shade, out.stats.at("time.render"), 1e-12);
+    return shade / out.stats.at("time.render");
+  };
+  const double visibility_share = share(RenderMode::Visibility, 1);
+  const double full_share = share(RenderMode::Full, 4);
+  EXPECT_GT(full_share, 0.5);
+  EXPECT_GT(full_share, visibility_share + 0.2);
+}
+
 // A sphere over a plane, a point light: a plane point is in shadow exactly when the segment
 // to the light passes through the sphere. With no ambient light, shadowed plane pixels are 0.
 TEST(Tracer, HardShadowIsTheProjectedSphere) {

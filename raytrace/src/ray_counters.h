@@ -36,8 +36,8 @@ struct RayCounters {
 #undef RVR_DECLARE_COUNT
   TraversalCounters traversal;
   // Thread time spent on tiles, and of it after the primary hits were known (surfaces, AOVs,
-  // shading): how a frame's time divides between visibility and shading.
-  double busy_seconds = 0, shade_seconds = 0;
+  // shading), in cycle_ticks: how a frame's time divides between visibility and shading.
+  uint64_t busy_ticks = 0, shade_ticks = 0;
 
   uint64_t rays() const {
     return primary + shadow + reflection + refraction;
@@ -50,8 +50,8 @@ struct RayCounters {
 #define RVR_ADD_TRAVERSAL_COUNT(field, stat, reported_in) traversal.field += o.traversal.field;
     RVR_TRAVERSAL_COUNTS(RVR_ADD_TRAVERSAL_COUNT)
 #undef RVR_ADD_TRAVERSAL_COUNT
-    busy_seconds += o.busy_seconds;
-    shade_seconds += o.shade_seconds;
+    busy_ticks += o.busy_ticks;
+    shade_ticks += o.shade_ticks;
   }
 
   // Writes every counter the frame reports into `stats` under its stat's name: `own_traversal`

@@ -249,7 +249,7 @@ class FrameTracer {
   void finish_block(int x0, int y0, int w, const RayPacket& packet, const HitRecord* hits,
                     const TraversalCounters* work, TileOutput& out, RayCounters& counters,
                     const float* given_lod = nullptr, const bool* given = nullptr) const {
-    const auto start = Clock::now();
+    const uint64_t start = cycle_ticks();
     const BlockHits block{x0, y0, w, packet, hits, work, given_lod, given};
     geometry_.fetch_surface_data(hits, packet.count, options_.mode == RenderMode::Visibility);
     switch (options_.mode) {
@@ -269,7 +269,7 @@ class FrameTracer {
       centre.primitive_tests += work[k].primitive_tests;
     }
     add_traversal(counters, centre);
-    counters.shade_seconds += seconds_since(start);
+    counters.shade_ticks += cycle_ticks() - start;
   }
 
   // Whether a pixel's colour is the mean of its samples, traced one by one, rather than its
@@ -739,7 +739,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   const RayCounters total =
       for_each_tile(w, h, options.threads, [&](int x0, int y0, int x1, int y1, RayCounters& local) {
         if (is_cancelled(progress)) return;  // the tiles left are skipped
-        const auto t_tile = Clock::now();
+        const uint64_t t_tile = cycle_ticks();
         const uint64_t rays_before = local.rays();
         TileOutput tile;
         tile.begin(x0, y0, x1, y1);
@@ -754,7 +754,7 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
         tile.write_to(out.buffers);
         if (progress)
           progress->advance(uint64_t(x1 - x0) * uint64_t(y1 - y0), local.rays() - rays_before);
-        local.busy_seconds += seconds_since(t_tile);
+        local.busy_ticks += cycle_ticks() - t_tile;
       });
   if (is_cancelled(progress)) return cancelled_error();
   const double render_seconds = seconds_since(t_render);
@@ -762,7 +762,8 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
   // The frame's time divided as the threads' time divides: until the primary hits are known
   // (rays generated and traced, or found by the PrimaryHitSource) and after (surfaces, AOVs,
   // shading and every ray after the primary hit).
-  const double shade_share = total.busy_seconds > 0 ? total.shade_seconds / total.busy_seconds : 0;
+  const double shade_share =
+      total.busy_ticks > 0 ? double(total.shade_ticks) / double(total.busy_ticks) : 0;
   out.stats["time.shade"] = render_seconds * shade_share;
   out.stats["time.visibility"] = render_seconds - out.stats["time.shade"];
   out.info["shade_kernel"] = shade_kernels(*isa).isa;
