@@ -395,15 +395,17 @@ void TraceGeometry::closest_packet(const RayPacket& packet, HitRecord* hits,
     }
     return;
   }
-  KernelHit kh[kPacketRays];
+  PacketSlots<KernelHit> kh;       // the kernel writes every ray's, a miss included
   PacketSlots<KernelCounters> kc;  // the kernel adds to them: zeroed as far as the packet goes
-  for (int i = 0; i < packet.count; ++i) kh[i].primitive = kUnusedLane;
   if (counters) std::fill_n(kc.data(), packet.count, KernelCounters{});
-  if (!wide_.empty())
-    kernels_->closest_packet(wide_.view(), packet, kh, counters ? kc.data() : nullptr);
-  for (int i = 0; i < packet.count; ++i) {
-    const KernelHit& k = kh[i];
-    hits[i] = k.primitive != kUnusedLane ? HitRecord{k.t, k.primitive, k.u, k.v} : HitRecord{};
+  if (wide_.empty()) {
+    for (int i = 0; i < packet.count; ++i) hits[i] = HitRecord{};
+  } else {
+    kernels_->closest_packet(wide_.view(), packet, kh.data(), counters ? kc.data() : nullptr);
+    for (int i = 0; i < packet.count; ++i) {
+      const KernelHit& k = kh[i];
+      hits[i] = k.primitive != kUnusedLane ? HitRecord{k.t, k.primitive, k.u, k.v} : HitRecord{};
+    }
   }
   if (counters)
     for (int i = 0; i < packet.count; ++i) counters[i] = {kc[i].nodes, kc[i].tests};

@@ -640,9 +640,13 @@ void traverse_packet(const WideBvhView& bvh, const Packet& p, PacketBest& best,
 bool make_packet(const RayPacket& packet, int first, Packet& p) {
   const int live = packet.count - first < kPacketLanes ? packet.count - first : kPacketLanes;
   p.valid = (1u << live) - 1u;
-  for (int a = 0; a < 3; ++a)  // unused lanes copy a live one
-    for (int l = 0; l < kPacketLanes; ++l)
-      p.dir[a][l] = packet.dir[a][l < live ? first + l : first];
+  if (live == kPacketLanes) {
+    for (int a = 0; a < 3; ++a) store(p.dir[a], PV::loadu(packet.dir[a] + first));
+  } else {
+    for (int a = 0; a < 3; ++a)  // unused lanes copy a live one
+      for (int l = 0; l < kPacketLanes; ++l)
+        p.dir[a][l] = packet.dir[a][l < live ? first + l : first];
+  }
   PV margin = PV::splat(0.0f);
   for (int a = 0; a < 3; ++a) {
     const PV da = PV::load(p.dir[a]);
@@ -676,15 +680,19 @@ bool make_packet(const RayPacket& packet, int first, Packet& p) {
 template <bool kCount>
 void closest_packet_impl(const WideBvhView& bvh, const RayPacket& packet, KernelHit* hits,
                          KernelCounters* counters) {
+  if (bvh.root == kEmptyTree) {
+    for (int i = 0; i < packet.count; ++i) hits[i].primitive = kUnusedLane;
+    return;
+  }
   for (int first = 0; first < packet.count; first += kPacketLanes) {
     Packet p;
-    if (bvh.root == kEmptyTree) break;
     if (!make_packet(packet, first, p)) {
       for (int i = first; i < first + kPacketLanes && i < packet.count; ++i) {
         KernelRay r{{packet.origin[0], packet.origin[1], packet.origin[2]},
                     {packet.dir[0][i], packet.dir[1][i], packet.dir[2][i]},
                     packet.tmin,
                     packet.tmax};
+        hits[i].primitive = kUnusedLane;  // unless it hits
         trace<false, kCount>(bvh, r, &hits[i], kCount ? &counters[i] : nullptr);
       }
       continue;
@@ -698,8 +706,11 @@ void closest_packet_impl(const WideBvhView& bvh, const RayPacket& packet, Kernel
     store(v, best.v);
     store(prim, best.primitive);
     for (int l = 0; l < kPacketLanes && first + l < packet.count; ++l) {
-      if (!((best.found >> l) & 1)) continue;
       KernelHit& h = hits[first + l];
+      if (!((best.found >> l) & 1)) {
+        h.primitive = kUnusedLane;
+        continue;
+      }
       h.t = t[l];
       h.u = u[l];
       h.v = v[l];

@@ -103,7 +103,8 @@ struct TraversalKernels {
   bool (*closest_counted)(const WideBvhView&, const KernelRay&, KernelHit&, KernelCounters&);
   bool (*occluded)(const WideBvhView&, const KernelRay&);
   bool (*occluded_counted)(const WideBvhView&, const KernelRay&, KernelCounters&);
-  // hits[i] for ray i of the packet; counters[i] per ray (may be null).
+  // hits[i] for ray i of the packet, primitive kUnusedLane where it hits nothing; counters[i]
+  // per ray, added to (may be null).
   void (*closest_packet)(const WideBvhView&, const RayPacket&, KernelHit* hits,
                          KernelCounters* counters);
   // intersect_triangle_mt's float pass for each ray of `named`, eight rays at a time, with the

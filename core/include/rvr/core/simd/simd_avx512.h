@@ -35,6 +35,7 @@ struct vboolf16 {
 struct vfloat16 {
   __m512 v;
   static vfloat16 load(const float* p) { return {_mm512_load_ps(p)}; }  // 64-byte aligned
+  static vfloat16 loadu(const float* p) { return {_mm512_loadu_ps(p)}; }
   static vfloat16 splat(float x) { return {_mm512_set1_ps(x)}; }
   static vfloat16 zero() { return {_mm512_setzero_ps()}; }
 };
