@@ -2,6 +2,7 @@
 // the tracer, in full mode on every built-in scene: the image must be the tracer's except where
 // the z-buffer's silhouettes and shared edges fall the other way.
 #include <gtest/gtest.h>
+#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
@@ -25,6 +26,7 @@
 #include "rvr/core/gl_backend.h"
 #include "rvr/core/renderer.h"
 #include "rvr/core/scene.h"
+#include "rvr/core/shapes/triangle_mesh.h"
 #include "rvr/core/texture.h"
 #include "rvr/renderers/registry.h"
 #include "rvr/scene_io/scene_loader.h"
