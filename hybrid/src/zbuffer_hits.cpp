@@ -132,8 +132,10 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
   bool traced[kPacketRays];
   int n_traced = 0;
   uint64_t background = 0;
+  // Which pixels lie next to a drawn one: asked of the block's rows once its first empty pixel
+  // needs it (a block the z-buffer covered whole needs none).
   uint32_t near_drawn[kPacketSide];
-  drawn_nearby(block, near_drawn);
+  bool near_known = false;
   // The ids the z-buffer drew, and which pixels need a ray at all.
   uint32_t object[kPacketRays], primitive[kPacketRays];
   bool drawn[kPacketRays], rebuilt[kPacketRays], approximate[kPacketRays];
@@ -153,6 +155,10 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
         continue;
       }
       hits[k] = HitRecord{};
+      if (!near_known) {
+        drawn_nearby(block, near_drawn);
+        near_known = true;
+      }
       // Empty next to a pixel the z-buffer covered: a silhouette or shared edge may fall either
       // way at its centre, so the tracer may see any surface there.
       traced[k] = (near_drawn[y - block.y0] >> (x - block.x0)) & 1;

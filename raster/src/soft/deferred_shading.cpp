@@ -53,6 +53,12 @@ void allocate_ids(int w, int h, FrameBuffers& fb) {
   fb.primitive_id.resize(fb.pixel_count());
 }
 
+// Copies with ordinary stores, which leave the lines in the cache: for ids the next pass reads
+// at once (the hybrids' tracer rebuilds every hit from them).
+void cached_copy(void* to, const void* from, size_t bytes) {
+  std::memcpy(to, from, bytes);
+}
+
 // Calls f(x0, n, run) for the runs [x0, x0 + n) of a row `width` wide, with `run` room for n
 // values: each run is computed into it (in cache) and then streamed to its frame buffer
 // (stream_copy.h), as the tracer streams its tiles' rows.
@@ -95,17 +101,18 @@ class VisibilityRows {
       }
       stream_copy(fb.depth.data() + row + size_t(x0), run, size_t(n) * sizeof(float));
     });
-    write_ids(y, fb);
+    write_ids(y, fb, stream_copy);
   }
 
-  // Row y of fb's object and primitive ids alone.
-  void write_ids(int y, FrameBuffers& fb) const {
+  // Row y of fb's object and primitive ids alone, each run stored by `copy`.
+  template <class Copy>
+  void write_ids(int y, FrameBuffers& fb, Copy copy) const {
     static_assert(kNoId == 0xFFFFFFFFu);
     const int width = target_.width();  // a local: stores through uint32_t* could alias a member
     const size_t row = fb.index(0, y);
     const uint32_t* __restrict row_object = target_.objects() + row;
     const uint32_t* __restrict row_primitive = target_.primitives() + row;
-    stream_copy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
+    copy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
     const uint8_t* use = use_primitive_id_.data();
     const bool every = every_primitive_id_;
     for_each_run<uint32_t>(width, [&](int x0, int n, uint32_t* __restrict run) {
@@ -120,7 +127,7 @@ class VisibilityRows {
         for (int k = 0; k < n; ++k)
           run[k] = object[k] == kNoId ? kNoId : use[object[k]] != 0 ? primitive[k] : 0u;
       }
-      stream_copy(fb.primitive_id.data() + row + size_t(x0), run, size_t(n) * sizeof(uint32_t));
+      copy(fb.primitive_id.data() + row + size_t(x0), run, size_t(n) * sizeof(uint32_t));
     });
   }
 
@@ -373,7 +380,7 @@ void write_visibility(const DrawList& list, const DepthTarget& target, const glm
       for (int y = r.begin(); y != r.end(); ++y) {
         const size_t row = fb.index(0, y);
         if (ids_only) {
-          visibility.write_ids(y, fb);
+          visibility.write_ids(y, fb, cached_copy);
         } else {
           visibility.write(y, fb);
           fill_vec3(fb.colour.data() + row, size_t(w), background);
