@@ -138,9 +138,8 @@ TEST(MemoryEstimate, ComposesThePartsInTheOrderASessionTakesThem) {
   // Through two probes the line gives each probe back, and any N between and beyond them the
   // parts' own composition (they are linear here).
   const MemoryModel m = fit_memory_model({made_probe(3e4), made_probe(3e5)});
-  // (A session also holds what the frame-memory pool keeps of other image sizes.)
   for (double n : {3e4, 3e5, 1e6, 3e7}) {
-    const double expected = composed_peak(made_probe(n)) + kStalePixelBytes;
+    const double expected = composed_peak(made_probe(n));
     EXPECT_NEAR(estimate_peak(m, n), expected, 1e-6 * expected) << n;
   }
   EXPECT_NEAR(m.retained[1].per_n, 110, 1e-9);
@@ -154,8 +153,8 @@ TEST(MemoryEstimate, ComposesThePartsInTheOrderASessionTakesThem) {
 }
 
 // The plan trimmed: made_probe's session peaks at 1.9×10^8 + 238 bytes per N above 2.5×10^5
-// (the second renderer's build), plus the 2^28 bytes of stale frame blocks, and with 2×10^9
-// bytes available a session may take 1.6×10^9: N up to 1.14×10^9 / 238 = 4.8×10^6 fit.
+// (the second renderer's build), and with 1.8×10^9 bytes available a session may take
+// 1.44×10^9: N up to 1.25×10^9 / 238 = 5.25×10^6 fit.
 TEST(MemoryEstimate, DropsThePlannedNThatDoNotFitWithANote) {
   const Family soup = *find_family("soup");
   std::vector<size_t> probed;
@@ -164,12 +163,12 @@ TEST(MemoryEstimate, DropsThePlannedNThatDoNotFitWithANote) {
     return made_probe(double(n));
   };
   Expected<FamilyMemory> m =
-      check_family_memory(soup, {"softraster", "raytrace"}, 1024, probe, 2e9);
+      check_family_memory(soup, {"softraster", "raytrace"}, 1024, probe, 1.8e9);
   ASSERT_TRUE(m.ok()) << m.error().message;
   EXPECT_EQ(probed, memory_probe_ns(soup));
-  EXPECT_DOUBLE_EQ(m->usable_bytes, kMemoryUsableShare * 2e9);
+  EXPECT_DOUBLE_EQ(m->usable_bytes, kMemoryUsableShare * 1.8e9);
   // At large N the second renderer's build decides: 1.2e8 + 48 N + 7e7 + 190 N.
-  const double largest = (kMemoryUsableShare * 2e9 - 1.2e8 - 7e7 - kStalePixelBytes) / (48 + 190);
+  const double largest = (kMemoryUsableShare * 1.8e9 - 1.2e8 - 7e7) / (48 + 190);
   std::vector<size_t> dropped;
   for (size_t n : sweep_ns(soup))
     if (double(n) > largest) dropped.push_back(n);
@@ -180,7 +179,7 @@ TEST(MemoryEstimate, DropsThePlannedNThatDoNotFitWithANote) {
   EXPECT_NE(note.find("soup: N = 5.6×10^6, 1.0×10^7, 1.8×10^7, 3.2×10^7 dropped from the plan"),
             std::string::npos)
       << note;
-  EXPECT_NE(note.find("more than the 1.5 GiB a session may take (80% of the 1.9 GiB available"),
+  EXPECT_NE(note.find("more than the 1.3 GiB a session may take (80% of the 1.7 GiB available"),
             std::string::npos)
       << note;
 }
@@ -243,7 +242,7 @@ TEST(MemoryEstimate, AStudyNeverPreparesADroppedPoint) {
   hooks.probe_memory = [](const Family&, size_t n, int) -> Expected<MemoryProbe> {
     return made_probe(double(n));
   };
-  hooks.available_memory = [] { return 2e9; };
+  hooks.available_memory = [] { return 1.8e9; };
   Expected<StudyResult> r = run_study(request, hooks);
   ASSERT_TRUE(r.ok()) << r.error().message;
   ASSERT_FALSE(prepared.empty());

@@ -2,6 +2,7 @@
 #include "study_processes.h"
 
 #include <fmt/format.h>
+#include <malloc.h>
 #include <poll.h>
 #include <signal.h>
 #include <spawn.h>
@@ -326,6 +327,10 @@ json answer(const json& request, const std::vector<std::string>& renderers, Rend
   if (it == prepared.end()) return error_json(internal_error(fmt::format("no scene {}", id)));
   if (op == "release") {
     prepared.erase(it);
+    // What the point freed goes back to the system: malloc would otherwise keep a varying share
+    // of it in its per-thread arenas, which the next point's peak would carry (the memory
+    // estimate's probes do the same, memory_estimate.h).
+    malloc_trim(0);
     return json::object();
   }
   if (op == "frame") {

@@ -160,8 +160,7 @@ double estimate_peak(const MemoryModel& m, double n) {
     frame_peak.push_back(m.frame_peak[k].at(n));
   }
   return compose(m.baseline.at(n), m.scene.at(n), m.scene_peak.at(n), retained, prepare_peak,
-                 frame_peak) +
-         kStalePixelBytes;
+                 frame_peak);
 }
 
 double composed_peak(const MemoryProbe& p) {
@@ -198,6 +197,15 @@ Expected<MemoryProbe> probe_memory_here(const std::vector<std::string>& renderer
   mallopt(M_MMAP_THRESHOLD, 1 << 20);
   // What every session holds beside its point.
   RVR_TRY_ASSIGN(reference, prepare_frames(renderers, mode, family, family.low, width));
+  // What the pixel sweep leaves: the frame-memory pool (pixel_memory.h) keeps its narrower frames'
+  // blocks, which no full-size frame takes again. A session's first measures those points before
+  // its larger N; a later one takes them in random order among the others. Their blocks are the
+  // same at every N, so they are made at the family's smallest.
+  for (int narrower : pixel_sweep_widths(width)) {
+    RVR_TRY_ASSIGN(swept, prepare_frames(renderers, mode, family, family.low, narrower));
+    for (size_t k = 0; k < renderers.size(); ++k)
+      if (Expected<FrameTime> t = (*swept)->time_frame(k); !t) return t.error();
+  }
   // What a session leaves behind from the point it measured before (the planned N below: the
   // first session goes up in N), still resident when the next is prepared.
   Family all = family;
@@ -210,6 +218,9 @@ Expected<MemoryProbe> probe_memory_here(const std::vector<std::string>& renderer
     for (size_t k = 0; k < renderers.size(); ++k)
       if (Expected<FrameTime> t = (*earlier)->time_frame(k); !t) return t.error();
   }
+  // What the points before freed goes back to the system, as a session's worker returns it when
+  // it releases a point (malloc_trim), so that what they leave is the frame-memory pool's blocks.
+  malloc_trim(0);
   MemoryProbe p;
   p.n = double(n);
   bool reset_ok = true;

@@ -20,21 +20,22 @@
 #include <vector>
 
 #include "rvr/core/expected.h"
-#include "rvr/core/pixel_memory.h"
 #include "rvr/core/renderer.h"
 #include "rvr/study/sweep_plan.h"
 
 namespace rvr::study {
 
 // A session's resident memory at one point, measured in a fresh process that does what a
-// session does: the family's reference point prepared first, the planned N below the point
+// session does: the family's reference point prepared first, the pixel sweep's narrower widths
+// prepared, rendered and released (at the family's smallest N), the planned N below the point
 // prepared, rendered and released (the first session goes up in N), then the point's scene
 // built, each renderer prepared and its first frame rendered (in the study's order of
 // renderers), then one more frame of each renderer with all of them prepared. Bytes.
 struct MemoryProbe {
   double n = 0;  // the point's scene N
-  // Resident before its scene: the program, its libraries, the reference point, and what the
-  // point before left resident.
+  // Resident before its scene: the program, its libraries, the reference point, the pixel
+  // sweep's frame blocks the frame-memory pool keeps (pixel_memory.h), and what the point before
+  // left resident.
   double baseline_bytes = 0;
   double scene_bytes = 0;       // resident growth while the scene was built
   double scene_peak_bytes = 0;  // the most resident while it was built, above the baseline
@@ -71,18 +72,11 @@ MemoryModel fit_memory_model(const std::vector<MemoryProbe>& probes);
 
 // The session's peak resident memory at N: baseline plus the largest of the scene's peak while
 // it is built and the scene plus the largest of, for each renderer k, what the renderers before
-// it retain plus k's preparation peak, and what all retain plus any renderer's frame peak; plus
-// kStalePixelBytes. Through two probes it gives each probe's composed_peak back, plus that.
+// it retain plus k's preparation peak, and what all retain plus any renderer's frame peak.
+// Through two probes it gives each probe's composed_peak back.
 double estimate_peak(const MemoryModel& model, double n);
 // The same sum over a probe's measured parts.
 double composed_peak(const MemoryProbe& probe);
-
-// What a session holds that no probe does: a session measures the pixel sweep's narrower images
-// too, in random order in its later sessions, and the frame-memory pool (pixel_memory.h) keeps
-// released frame blocks of those sizes, up to kRecycleLimitBytes, while a larger point's
-// full-size frames are allocated afresh. The probe's own pool holds full-size blocks the
-// point's frames take again.
-constexpr double kStalePixelBytes = double(kRecycleLimitBytes);
 
 // What a session may hold: this share of the memory available (MemAvailable) when the study
 // starts. The rest covers the estimate's error (see kMemoryProbeMaxN) and what other processes
@@ -93,8 +87,8 @@ constexpr double kMemoryUsableShare = 0.8;
 // grows with N to outweigh what does not, and the smaller one must sit well below the larger:
 // softraster's buffers stop growing at a chunk of 262,144 triangles, and between neighbouring
 // N the BVH's bytes per triangle vary by ±10% with its vectors' capacities. Probes at 10^5 and
-// 10^6 (a few seconds on two cores) give the peaks measured at 3×10^6 and 10^7 within 2%
-// (tests/test_study_plan.cpp holds them to 10%).
+// 10^6 (a few seconds on two cores) give the peaks measured at 3×10^6 and 10^7 within 6%, below
+// them (tests/test_study_plan.cpp holds them to 10%).
 constexpr size_t kMemoryProbeMaxN = 1'000'000;
 
 // The N a family's memory is probed at: the largest planned N (full width) up to
