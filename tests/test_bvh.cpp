@@ -721,7 +721,9 @@ TEST(Packets, RebuiltHitsAreIntersectVisiblesOwn) {
         p.count = tile % 4 == 3 ? 1 + tile % 37 : kPacketRays;
         const glm::vec3 centre = scene.camera.target + 0.5f * glm::vec3(U(rng), U(rng), U(rng)) - o;
         uint32_t object[kPacketRays], primitive[kPacketRays];
-        bool wanted[kPacketRays];
+        // Every third tile wants every ray, with the bits past the count set too: the packet's
+        // count bounds the rays tested.
+        uint64_t wanted = tile % 3 == 0 ? ~uint64_t(0) : 0;
         for (int k = 0; k < p.count; ++k) {
           const glm::vec3 d =
               centre + 0.02f * glm::length(centre) *
@@ -745,23 +747,26 @@ TEST(Packets, RebuiltHitsAreIntersectVisiblesOwn) {
             default:
               break;
           }
-          wanted[k] = object[k] != kNoId || k % 5 == 0;  // some unwanted, some naming nothing
+          // Some unwanted, some naming nothing.
+          if (object[k] != kNoId || k % 5 == 0) wanted |= uint64_t(1) << k;
         }
-        if (tile % 8 == 5)  // every ray names what the middle one hits: groups of one triangle
+        if (tile % 8 == 5) {  // every ray names what the middle one hits: groups of one triangle
+          wanted = p.all();
           for (int k = 0; k < p.count; ++k) {
             object[k] = object[p.count / 2];
             primitive[k] = primitive[p.count / 2];
-            wanted[k] = true;
           }
+        }
         HitRecord packet_hits[kPacketRays];
-        bool found[kPacketRays];
         TraversalCounters work[kPacketRays];
-        geometry.intersect_named_packet(p, object, primitive, wanted, packet_hits, found, work);
+        const uint64_t found =
+            geometry.intersect_named_packet(p, object, primitive, wanted, packet_hits, work);
+        EXPECT_EQ(found & ~p.all(), 0u) << "a ray past the packet's count";
         for (int k = 0; k < p.count; ++k) {
           const std::string what = std::string(to_string(isa)) + " tile " + std::to_string(tile) +
                                    " ray " + std::to_string(k);
-          if (!wanted[k]) {
-            EXPECT_FALSE(found[k]) << what;
+          if (!((wanted >> k) & 1)) {
+            EXPECT_FALSE((found >> k) & 1) << what;
             continue;
           }
           HitRecord single;
@@ -769,7 +774,7 @@ TEST(Packets, RebuiltHitsAreIntersectVisiblesOwn) {
           const Ray ray{o, {p.dir[0][k], p.dir[1][k], p.dir[2][k]}, p.tmin, p.tmax};
           const bool want =
               geometry.intersect_named(ray, object[k], primitive[k], single, single_work);
-          ASSERT_EQ(found[k], want) << what;
+          ASSERT_EQ(bool((found >> k) & 1), want) << what;
           EXPECT_EQ(work[k].primitive_tests, single_work.primitive_tests) << what;
           (want ? hits : misses)++;
           if (!want) continue;

@@ -3,6 +3,8 @@
 #include <stddef.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstring>
 #include <initializer_list>
 #include <memory>
 #include <utility>
@@ -27,6 +29,24 @@ bool take_if_nearer(const HitRecord& other, HitRecord& hit) {
   if (!(other.t < hit.t || (other.t == hit.t && other.primitive < hit.primitive))) return false;
   hit = other;
   return true;
+}
+
+// The first w of `row` into `to`: a whole block's row (the usual case) by a copy of constant
+// size, which the compiler inlines.
+template <class T>
+void copy_row(const T* row, int w, T* to) {
+  if (w == kPacketSide)
+    std::memcpy(to, row, kPacketSide * sizeof(T));
+  else
+    std::copy_n(row, w, to);
+}
+
+// Bit x set where is(row[x]), for the first w of `row`.
+template <class T, class Is>
+uint64_t row_bits(const T* row, int w, Is is) {
+  uint64_t bits = 0;
+  for (int x = 0; x < w; ++x) bits |= uint64_t(is(row[x])) << x;
+  return bits;
 }
 
 }  // namespace
@@ -126,92 +146,80 @@ void ZBufferHits::drawn_nearby(const CentreBlock& block, uint32_t* rows) const {
 void ZBufferHits::centre_hits(CentreBlock& block) const {
   HybridCounters& counters = counters_.local();
   const RayPacket& packet = block.packet;
-  const int n = packet.count;
+  const int n = packet.count, w = block.x1 - block.x0;
   HitRecord* hits = block.hits;
   TraversalCounters* work = block.work;
-  bool traced[kPacketRays];
-  int n_traced = 0;
-  uint64_t background = 0;
-  // Which pixels lie next to a drawn one: asked of the block's rows once its first empty pixel
-  // needs it (a block the z-buffer covered whole needs none).
-  uint32_t near_drawn[kPacketSide];
-  bool near_known = false;
-  // The ids the z-buffer drew, and which pixels need a ray at all.
+  // The ids the z-buffer drew, and as masks of the block's rays (bit k: ray k, pixel
+  // (x0 + k % w, y0 + k / w)) which it drew and where a shape it draws approximately or not at
+  // all may appear.
   uint32_t object[kPacketRays], primitive[kPacketRays];
-  bool drawn[kPacketRays], rebuilt[kPacketRays], approximate[kPacketRays];
-  for (int y = block.y0, k = 0; y < block.y1; ++y)
-    for (int x = block.x0; x < block.x1; ++x, ++k) {  // ray k is pixel (x, y)
-      const size_t i = size_t(y) * size_t(visible_.width) + size_t(x);
-      block.given[k] = false;
-      if (!visible_.lod.empty()) block.given_lod[k] = visible_.lod[i];
-      object[k] = visible_.object_id[i];
-      primitive[k] = visible_.primitive_id[i];
-      drawn[k] = object[k] != kNoId;
-      approximate[k] = approximated_at(i);
-      work[k] = TraversalCounters{};
-      // A drawn pixel's hit is rebuilt or traced, below; an empty one's starts as a miss.
-      if (drawn[k]) {
-        traced[k] = false;
-        continue;
-      }
-      hits[k] = HitRecord{};
-      if (!near_known) {
-        drawn_nearby(block, near_drawn);
-        near_known = true;
-      }
-      // Empty next to a pixel the z-buffer covered: a silhouette or shared edge may fall either
-      // way at its centre, so the tracer may see any surface there.
-      traced[k] = (near_drawn[y - block.y0] >> (x - block.x0)) & 1;
-      // Otherwise, empty, background to the z-buffer away from every edge it drew: background
-      // to the tracer too, without a ray, unless a shape the z-buffer draws approximately may
-      // appear there (below).
-      if (!traced[k] && !approximate[k]) background++;
-    }
+  uint64_t drawn = 0, approximate = 0;
+  for (int y = block.y0, k = 0; y < block.y1; ++y, k += w) {
+    const size_t i = size_t(y) * size_t(visible_.width) + size_t(block.x0);
+    copy_row(visible_.object_id.data() + i, w, object + k);
+    copy_row(visible_.primitive_id.data() + i, w, primitive + k);
+    if (!visible_.lod.empty()) copy_row(visible_.lod.data() + i, w, block.given_lod + k);
+    drawn |= row_bits(object + k, w, [](uint32_t id) { return id != kNoId; }) << k;
+    if (!approximated_.empty())
+      approximate |= row_bits(approximated_.data() + i, w, [](uint8_t a) { return a != 0; }) << k;
+  }
+  std::fill_n(block.given, n, false);
+  std::fill_n(work, n, TraversalCounters{});
   fetch_next_block(block);
-  geometry_.intersect_named_packet(packet, object, primitive, drawn, hits, rebuilt, work);
-  // Where a shape the z-buffer draws approximately or not at all may appear, the nearest of
-  // those shapes, for the block's rays at once: asked of the empty pixels away from every edge,
-  // and of the rebuilt ones.
-  uint64_t ask_shapes = 0;
-  for (int k = 0; k < n; ++k)
-    if (approximate[k] && (drawn[k] ? rebuilt[k] : !traced[k])) ask_shapes |= uint64_t(1) << k;
+  // An empty pixel's hit starts as a miss. Empty next to a pixel the z-buffer covered, it is
+  // traced: a silhouette or shared edge may fall either way at its centre, so the tracer may see
+  // any surface there. (A block the z-buffer covered whole asks nothing of its neighbours.)
+  const uint64_t empty = ~drawn & packet.all();
+  uint64_t traced = 0;
+  if (empty != 0) {
+    uint32_t near_drawn[kPacketSide];
+    drawn_nearby(block, near_drawn);
+    const uint32_t row = (uint32_t(1) << w) - 1;
+    for (int r = 0; r < block.y1 - block.y0; ++r)
+      traced |= uint64_t(near_drawn[r] & row) << (r * w);
+    traced &= empty;
+    for (uint64_t m = empty; m != 0; m &= m - 1) hits[__builtin_ctzll(m)] = HitRecord{};
+  }
+  // Otherwise empty, background to the z-buffer away from every edge it drew: background to the
+  // tracer too, without a ray, unless a shape the z-buffer draws approximately may appear there.
+  const uint64_t away = empty & ~traced;
+  const uint64_t background = away & ~approximate;
+  const uint64_t rebuilt =
+      geometry_.intersect_named_packet(packet, object, primitive, drawn, hits, work);
+  // Where such a shape may appear, the nearest of those shapes, for the block's rays at once:
+  // asked of the empty pixels away from every edge, and of the rebuilt ones.
+  const uint64_t ask_shapes = approximate & (rebuilt | away);
   PacketSlots<HitRecord> shape;  // written where found
   const uint64_t shape_found =
       ask_shapes ? geometry_.closest_approximated_packet(packet, ask_shapes, shape.data(), work)
                  : 0;
-  for (int k = 0; k < n; ++k) {
-    const bool has_shape = (shape_found >> k) & 1;
-    if (!drawn[k]) {
-      n_traced += traced[k];
-      // Empty, away from every edge, where a shape the z-buffer draws approximately or not at
-      // all may appear: no triangle lies under the centre, so the nearest of those shapes is
-      // the hit, or the background.
-      if (!traced[k] && approximate[k]) {
-        counters.fallback_traced++;
-        counters.approximated_pixels += has_shape;
-        if (has_shape) hits[k] = shape[k];
-      }
-      continue;
-    }
-    if (!rebuilt[k]) {
-      // The z-buffer's polygon covers the centre where the exact surface does not
-      // (silhouettes, shared edges): the tracer decides, below.
-      traced[k] = true;
-      n_traced++;
-      counters.fallback_missed++;
-      continue;
-    }
-    counters.rebuilt++;
-    // A hit rebuilt from the z-buffer samples its texture at the z-buffer's level.
-    block.given[k] = !visible_.lod.empty();
-    // Where a shape the z-buffer draws approximately may appear, that shape may lie in front
-    // of what it drew (a sphere's rim outside its inscribed polygon): checked as sample_hits
-    // checks every sample.
-    if (has_shape && take_if_nearer(shape[k], hits[k])) {
-      block.given[k] = false;
-      counters.approximated_pixels++;
-    }
+  // Empty, away from every edge, where such a shape may appear: no triangle lies under the
+  // centre, so the nearest of those shapes is the hit, or the background.
+  const uint64_t shape_only = away & approximate;
+  counters.fallback_traced += uint64_t(std::popcount(shape_only));
+  counters.approximated_pixels += uint64_t(std::popcount(shape_only & shape_found));
+  for (uint64_t m = shape_only & shape_found; m != 0; m &= m - 1) {
+    const int k = __builtin_ctzll(m);
+    hits[k] = shape[k];
   }
+  // The z-buffer's polygon covers the centre where the exact surface does not (silhouettes,
+  // shared edges): the tracer decides, below.
+  const uint64_t missed = drawn & ~rebuilt;
+  counters.fallback_missed += uint64_t(std::popcount(missed));
+  traced |= missed;
+  counters.rebuilt += uint64_t(std::popcount(rebuilt));
+  // A hit rebuilt from the z-buffer samples its texture at the z-buffer's level.
+  if (!visible_.lod.empty())
+    for (uint64_t m = rebuilt; m != 0; m &= m - 1) block.given[__builtin_ctzll(m)] = true;
+  // A shape the z-buffer draws approximately may lie in front of what it drew (a sphere's rim
+  // outside its inscribed polygon): checked as sample_hits checks every sample.
+  for (uint64_t m = rebuilt & shape_found; m != 0; m &= m - 1) {
+    const int k = __builtin_ctzll(m);
+    if (!take_if_nearer(shape[k], hits[k])) continue;
+    block.given[k] = false;
+    counters.approximated_pixels++;
+  }
+  const int n_traced = std::popcount(traced);
   counters.fallback_traced += uint64_t(n_traced);
   if (n_traced >= kPacketFallbacks) {
     // Many to trace (an empty background): the whole block as one packet, as the tracer traces
@@ -220,7 +228,7 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
     PacketSlots<TraversalCounters> packet_work;
     geometry_.closest_packet(packet, packet_hits.data(), packet_work.data());
     for (int k = 0; k < n; ++k) {
-      if (traced[k]) {
+      if ((traced >> k) & 1) {
         hits[k] = packet_hits[k];
         work[k] = packet_work[k];
       } else {  // traversed for nothing, but traversed: counted, not charged to the pixel
@@ -228,17 +236,18 @@ void ZBufferHits::centre_hits(CentreBlock& block) const {
         block.unattributed.primitive_tests += packet_work[k].primitive_tests;
       }
     }
-  } else if (n_traced > 0) {
-    for (int k = 0; k < n; ++k) {
-      if (!traced[k]) continue;
+  } else {
+    for (uint64_t m = traced; m != 0; m &= m - 1) {
+      const int k = __builtin_ctzll(m);
       hits[k] = HitRecord{};
       geometry_.closest(PrimaryRays::ray_of(packet, k), hits[k], work[k]);
     }
   }
   if (geometry_.has_csg())
     for (int k = 0; k < n; ++k) counters.csg_pixels += csg_hit(hits[k]);
-  counters.background += background;
-  block.rays = uint64_t(n) - background;
+  const int n_background = std::popcount(background);
+  counters.background += uint64_t(n_background);
+  block.rays = uint64_t(n - n_background);
 }
 
 void ZBufferHits::sample_hits(SampleBlock& block) const {

@@ -593,11 +593,13 @@ bool TraceGeometry::intersect_named(const Ray& ray, uint32_t object, uint32_t pr
 }
 
 // intersect_named for the rays of `rays` (bit k: ray k), each naming an object traced
-// analytically: shape by shape, its kind dispatched once for the rays that name it.
-void TraceGeometry::intersect_named_shapes(const RayPacket& packet, const uint32_t* object,
-                                           uint64_t rays, HitRecord* hits, bool* found,
-                                           TraversalCounters* counters) const {
+// analytically: shape by shape, its kind dispatched once for the rays that name it. Returns the
+// rays that hit.
+uint64_t TraceGeometry::intersect_named_shapes(const RayPacket& packet, const uint32_t* object,
+                                               uint64_t rays, HitRecord* hits,
+                                               TraversalCounters* counters) const {
   const uint32_t n_triangles = uint32_t(triangles_.size());
+  uint64_t found = 0;
   while (rays != 0) {
     const uint32_t a = object_analytic_[object[__builtin_ctzll(rays)]];
     std::visit(
@@ -609,61 +611,66 @@ void TraceGeometry::intersect_named_shapes(const RayPacket& packet, const uint32
             counters[k].primitive_tests++;
             hits[k] = HitRecord{};
             ShapeHit h;
-            found[k] = shape.intersect(PrimaryRays::ray_of(packet, k), h);
-            if (found[k]) hits[k] = shape_hit_record(h, n_triangles + a);
+            if (!shape.intersect(PrimaryRays::ray_of(packet, k), h)) continue;
+            hits[k] = shape_hit_record(h, n_triangles + a);
+            found |= uint64_t(1) << k;
           }
         },
         analytic_[a].shape);
   }
+  return found;
 }
 
-void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32_t* object,
-                                           const uint32_t* primitive, const bool* wanted,
-                                           HitRecord* hits, bool* found,
-                                           TraversalCounters* counters) const {
-  auto ray_of = [&](int k) {
-    return Ray{{packet.origin[0], packet.origin[1], packet.origin[2]},
-               {packet.dir[0][k], packet.dir[1][k], packet.dir[2][k]},
-               packet.tmin,
-               packet.tmax};
-  };
+uint64_t TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32_t* object,
+                                               const uint32_t* primitive, uint64_t wanted,
+                                               HitRecord* hits, TraversalCounters* counters) const {
   static_assert(sizeof(TrianglePrecomputed) == 9 * sizeof(float), "v0, e1, e2: 9 floats");
   const bool simd = kernels_ && triangle_test_ == TriangleTest::MollerTrumbore;
   NamedTriangles named;
   named.triangles = reinterpret_cast<const float*>(triangles_.data());
-  uint64_t analytic_rays = 0;  // the rays naming a shape traced analytically
-  uint32_t previous = 0;       // the triangle the last ray tested by the kernel named
-  for (int k = 0; k < packet.count; ++k) {
-    found[k] = false;
-    named.index[k] = previous;
-    if (!wanted[k]) continue;
+  uint64_t found = 0;
+  uint64_t named_rays = 0;         // the rays naming one triangle of a mesh, for the kernel
+  uint64_t analytic_rays = 0;      // the rays naming a shape traced analytically
+  auto named_alone = [&](int k) {  // intersect_named itself, for ray k
+    if (intersect_named(PrimaryRays::ray_of(packet, k), object[k], primitive[k], hits[k],
+                        counters[k]))
+      found |= uint64_t(1) << k;
+  };
+  // One named triangle of a mesh, read from flat per-object tables (no pointer to follow).
+  const uint32_t n_objects = simd ? uint32_t(object_triangle_count_.size()) : 0;
+  const uint32_t* triangle_count = object_triangle_count_.data();
+  const uint32_t* first_triangle = object_first_triangle_.data();
+  for (uint64_t m = wanted & packet.all(); m != 0; m &= m - 1) {
+    const int k = __builtin_ctzll(m);
     const uint32_t o = object[k];
-    // One named triangle of a mesh, read from flat per-object tables (no pointer to follow).
-    const bool one_triangle =
-        simd && o < object_triangle_count_.size() && primitive[k] < object_triangle_count_[o];
-    if (!one_triangle) {
-      if (o < object_analytic_.size() && object_analytic_[o] != kNoPrimitive)
-        analytic_rays |= uint64_t(1) << k;  // below, shape by shape
-      else
-        found[k] = intersect_named(ray_of(k), o, primitive[k], hits[k], counters[k]);
-      continue;
+    if (o < n_objects && primitive[k] < triangle_count[o]) {
+      named.index[k] = first_triangle[o] + primitive[k];
+      named_rays |= uint64_t(1) << k;
+    } else if (o < object_analytic_.size() && object_analytic_[o] != kNoPrimitive) {
+      analytic_rays |= uint64_t(1) << k;  // below, shape by shape
+    } else {
+      named_alone(k);
     }
-    previous = named.index[k] = object_first_triangle_[o] + primitive[k];
-    named.rays |= uint64_t(1) << k;
   }
-  intersect_named_shapes(packet, object, analytic_rays, hits, found, counters);
-  if (named.rays == 0) return;
-  // The rays before the first the kernel tests name its triangle, as the rest name their
-  // predecessor's.
-  const int lead = __builtin_ctzll(named.rays);
-  for (int k = 0; k < lead; ++k) named.index[k] = named.index[lead];
+  found |= intersect_named_shapes(packet, object, analytic_rays, hits, counters);
+  if (named_rays == 0) return found;
+  named.rays = named_rays;
+  // Every ray the kernel does not test names the triangle of the nearest tested ray before it
+  // (the first tested ray's, before that one), so a group of eight naming one triangle stays one.
+  uint32_t previous = named.index[__builtin_ctzll(named_rays)];
+  for (int k = 0; k < packet.count; ++k) {
+    if ((named_rays >> k) & 1)
+      previous = named.index[k];
+    else
+      named.index[k] = previous;
+  }
   PacketSlots<KernelHit> kernel_hits;  // written where the outcome is Hit
   NamedOutcome outcome[kPacketRays];
   kernels_->intersect_named(packet, named, kernel_hits.data(), outcome);
-  for (uint64_t m = named.rays; m != 0; m &= m - 1) {
+  for (uint64_t m = named_rays; m != 0; m &= m - 1) {
     const int k = __builtin_ctzll(m);
     if (outcome[k] == NamedOutcome::NearEdge) {  // decided in double, as intersect_named does
-      found[k] = intersect_named(ray_of(k), object[k], primitive[k], hits[k], counters[k]);
+      named_alone(k);
       continue;
     }
     counters[k].primitive_tests++;
@@ -673,8 +680,9 @@ void TraceGeometry::intersect_named_packet(const RayPacket& packet, const uint32
     hits[k].u = kernel_hits[k].u;
     hits[k].v = kernel_hits[k].v;
     hits[k].primitive = named.index[k];
-    found[k] = true;
+    found |= uint64_t(1) << k;
   }
+  return found;
 }
 
 bool TraceGeometry::closest_approximated(const Ray& ray, HitRecord& hit,

@@ -133,14 +133,14 @@ class TraceGeometry {
   std::vector<Aabb> approximated_bounds() const;
   // The scene objects those shapes are, ascending.
   std::vector<uint32_t> approximated_objects() const;
-  // intersect_named for the rays of a packet at once: for each ray k with wanted[k], the
-  // object[k] and primitive[k] a visibility buffer named; found[k] and hits[k] as
-  // intersect_named gives them, counters[k] its tests. With the wide BVH's kernels, the rays
-  // naming one triangle each are tested eight at a time by the same operations (near an edge,
-  // by intersect_named itself).
-  void intersect_named_packet(const RayPacket& packet, const uint32_t* object,
-                              const uint32_t* primitive, const bool* wanted, HitRecord* hits,
-                              bool* found, TraversalCounters* counters) const;
+  // intersect_named for the rays of a packet at once: for each ray k of `wanted` (bit k), the
+  // object[k] and primitive[k] a visibility buffer named; hits[k] as intersect_named gives it,
+  // counters[k] its tests. Returns the rays that hit (bit k where intersect_named would return
+  // true). With the wide BVH's kernels, the rays naming one triangle each are tested eight at a
+  // time by the same operations (near an edge, by intersect_named itself).
+  uint64_t intersect_named_packet(const RayPacket& packet, const uint32_t* object,
+                                  const uint32_t* primitive, uint64_t wanted, HitRecord* hits,
+                                  TraversalCounters* counters) const;
   // True when the scene holds CSG objects (which no z-buffer draws).
   bool has_csg() const { return !csg_primitives_.empty(); }
   // True when the scene holds shapes a z-buffer draws approximately or not at all (those of
@@ -187,9 +187,10 @@ class TraceGeometry {
   template <bool kAnyHit>
   bool query_analytic(const Ray& ray, float t_max, HitRecord& hit,
                       TraversalCounters* counters) const;
-  // intersect_named_packet's rays (bit k of `rays`: ray k) that name a shape traced analytically.
-  void intersect_named_shapes(const RayPacket& packet, const uint32_t* object, uint64_t rays,
-                              HitRecord* hits, bool* found, TraversalCounters* counters) const;
+  // intersect_named_packet's rays (bit k of `rays`: ray k) that name a shape traced analytically;
+  // returns those that hit.
+  uint64_t intersect_named_shapes(const RayPacket& packet, const uint32_t* object, uint64_t rays,
+                                  HitRecord* hits, TraversalCounters* counters) const;
   void nearest_shape_hits(const RayPacket& packet, uint64_t rays, uint32_t analytic, float* t_max,
                           uint64_t& found, HitRecord* hits) const;
   // The analytic shapes' part of closest_packet: hits[k] holds ray k's triangle hit, if any.

@@ -79,6 +79,8 @@ struct alignas(32) RayPacket {
   float tmin, tmax;
   int count;
   float dir[3][kPacketRays];
+  // Bit k set for each ray k < count.
+  uint64_t all() const { return count == kPacketRays ? ~uint64_t(0) : (uint64_t(1) << count) - 1; }
 };
 
 // Rays of one packet, each with the one triangle it is to be tested against (the hybrid's
