@@ -312,6 +312,7 @@ class FrameTracer {
     SurfaceBatch batch;
     for (int a = 0; a < 3; ++a) batch.origin[a] = b.packet.origin[a];
     size_t batch_pixel[kPacketRays];
+    LastTriangle last;
     int batch_count = 0;  // kept out of `batch` so that it stays in a register
     bool mixed = false;   // the batch's pixels have more than one material
     uint32_t batch_material = 0;
@@ -323,7 +324,7 @@ class FrameTracer {
       } else {
         const int slot = batch_count++;
         batch_pixel[slot] = i;
-        const uint32_t material = add_to_batch(batch, slot, b.packet, k, hit, out, i);
+        const uint32_t material = add_to_batch(batch, slot, b.packet, k, hit, out, i, last);
         const uint32_t object = out.object_id[i];
         if (varies_ && object_varies_[object]) {
           // Its own material: the diffuse replaced by the base colour at the hit.
@@ -394,17 +395,29 @@ class FrameTracer {
     });
   }
 
+  // The surface data of the triangle the last hit put into a batch was on: neighbouring pixels
+  // mostly show one triangle, whose data is then read once (as softraster's shading keeps the
+  // last triangle it gathered).
+  struct LastTriangle {
+    uint32_t primitive = kNoPrimitive;
+    TriangleSurfaceData data;
+  };
+
   // Puts ray k's hit into slot `slot` of the batch, for the kernel to compute its surface, and
   // its depth and ids into pixel i of `out`; returns its material. Every input of the slot is
   // written (zeros where the kernel selects it away), so no lane reads undefined memory.
   uint32_t add_to_batch(SurfaceBatch& batch, int slot, const RayPacket& packet, int k,
-                        const HitRecord& hit, TileOutput& out, size_t i) const {
+                        const HitRecord& hit, TileOutput& out, size_t i, LastTriangle& last) const {
     const glm::vec3 zero(0.0f);
     batch.t[slot] = hit.t;
     for (int a = 0; a < 3; ++a) batch.direction[a][slot] = packet.dir[a][k];
     out.depth[i] = hit.t;  // the direction's forward component is 1: t is view depth
     if (hit.primitive < geometry_.triangle_count()) {
-      const TriangleSurfaceData d = geometry_.triangle_surface_data(hit.primitive);
+      if (hit.primitive != last.primitive) {
+        last.primitive = hit.primitive;
+        last.data = geometry_.triangle_surface_data(hit.primitive);
+      }
+      const TriangleSurfaceData& d = last.data;
       batch.u[slot] = hit.u;
       batch.v[slot] = hit.v;
       put_vec3(batch.edge1, slot, d.triangle->e1);
