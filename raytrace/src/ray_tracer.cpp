@@ -316,45 +316,55 @@ class FrameTracer {
     int batch_count = 0;  // kept out of `batch` so that it stays in a register
     bool mixed = false;   // the batch's pixels have more than one material
     uint32_t batch_material = 0;
-    b.for_each_pixel(out, [&](int k, int x, int y, size_t i) {
-      const HitRecord& hit = b.hits[k];
+    // Each pixel's level of detail, cost and, where its ray missed, background; which rays hit.
+    size_t pixel[kPacketRays];
+    uint64_t hit_rays = 0;
+    b.for_each_pixel(out, [&](int k, int, int, size_t i) {
+      pixel[k] = i;
       if (textured_) out.lod[i] = kNoLod;
-      if (hit.primitive == kNoPrimitive) {
+      if (b.hits[k].primitive == kNoPrimitive)
         out.set_background(i, scene_.image.background);
-      } else {
-        const int slot = batch_count++;
-        batch_pixel[slot] = i;
-        const uint32_t material = add_to_batch(batch, slot, b.packet, k, hit, out, i, last);
-        const uint32_t object = out.object_id[i];
-        if (varies_ && object_varies_[object]) {
-          // Its own material: the diffuse replaced by the base colour at the hit.
-          const Material& m = scene_.materials[material];
-          const glm::vec3 base = varying_base_colour(
-              scene_.objects[object], out.primitive_id[i], hit.u, hit.v, b.direction(k), hit.t,
-              &primary_footprint_, out.lod[i], b.lod_given(k));
-          if (!mixed) {
-            mixed = true;
-            for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
-          }
-          put_material(batch, slot, shade_material(with_diffuse(m, base), scene_.ambient));
-        } else {
-          if (slot == 0) {
-            batch_material = material;
-          } else if (!mixed && material != batch_material) {
-            mixed = true;  // from now on each slot carries its material
-            for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
-          }
-          if (mixed) put_material(batch, slot, materials_[material]);
+      else
+        hit_rays |= uint64_t(1) << k;
+      out.cost[i] = pixel_cost(b.centre_work(k));  // after set_background's zero
+    });
+    // The hits into the batch, in ray order.
+    for (uint64_t m = hit_rays; m != 0; m &= m - 1) {
+      const int k = __builtin_ctzll(m);
+      const size_t i = pixel[k];
+      const HitRecord& hit = b.hits[k];
+      const int slot = batch_count++;
+      batch_pixel[slot] = i;
+      const uint32_t material = add_to_batch(batch, slot, b.packet, k, hit, out, i, last);
+      const uint32_t object = out.object_id[i];
+      if (varies_ && object_varies_[object]) {
+        // Its own material: the diffuse replaced by the base colour at the hit.
+        const Material& m = scene_.materials[material];
+        const glm::vec3 base = varying_base_colour(scene_.objects[object], out.primitive_id[i],
+                                                   hit.u, hit.v, b.direction(k), hit.t,
+                                                   &primary_footprint_, out.lod[i], b.lod_given(k));
+        if (!mixed) {
+          mixed = true;
+          for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
         }
+        put_material(batch, slot, shade_material(with_diffuse(m, base), scene_.ambient));
+      } else {
+        if (slot == 0) {
+          batch_material = material;
+        } else if (!mixed && material != batch_material) {
+          mixed = true;  // from now on each slot carries its material
+          for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
+        }
+        if (mixed) put_material(batch, slot, materials_[material]);
       }
-      uint64_t sample_work = 0;
-      if (supersampled) {
+    }
+    // A supersampled pixel's colour is its samples' mean, its cost theirs too.
+    if (supersampled)
+      b.for_each_pixel(out, [&](int k, int x, int y, size_t i) {
         const uint64_t before = traced_work(counters);
         out.colour[i] = supersample(x, y, counters);
-        sample_work = traced_work(counters) - before;
-      }
-      out.cost[i] = pixel_cost(b.centre_work(k) + sample_work);
-    });
+        out.cost[i] = pixel_cost(b.centre_work(k) + traced_work(counters) - before);
+      });
     if (batch_count == 0) return;
     batch.count = batch_count;
     pad_batch(batch, mixed);
