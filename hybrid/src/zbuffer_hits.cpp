@@ -49,6 +49,19 @@ uint64_t row_bits(const T* row, int w, Is is) {
   return bits;
 }
 
+// Whether any of the n bytes at p is non-zero: eight at a time.
+bool any_set(const uint8_t* p, int n) {
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    uint64_t word;
+    std::memcpy(&word, p + i, sizeof(word));
+    if (word != 0) return true;
+  }
+  for (; i < n; ++i)
+    if (p[i] != 0) return true;
+  return false;
+}
+
 }  // namespace
 
 ZBufferHits::ZBufferHits(const Scene& scene, const TraceGeometry& geometry,
@@ -67,11 +80,8 @@ HybridCounters ZBufferHits::counters() const {
 bool ZBufferHits::only_background(int x0, int y0, int x1, int y1) const {
   const size_t width = size_t(visible_.width);
   if (!approximated_.empty())
-    for (int y = y0; y < y1; ++y) {
-      const uint8_t* row = approximated_.data() + size_t(y) * width;
-      for (int x = x0; x < x1; ++x)
-        if (row[x]) return false;
-    }
+    for (int y = y0; y < y1; ++y)
+      if (any_set(approximated_.data() + size_t(y) * width + size_t(x0), x1 - x0)) return false;
   const int nx0 = std::max(x0 - 1, 0), nx1 = std::min(x1 + 1, visible_.width);
   for (int y = std::max(y0 - 1, 0); y < std::min(y1 + 1, visible_.height); ++y) {
     const uint32_t* row = visible_.object_id.data() + size_t(y) * width;
