@@ -655,34 +655,21 @@ uint64_t TraceGeometry::intersect_named_packet(const RayPacket& packet, const ui
   found |= intersect_named_shapes(packet, object, analytic_rays, hits, counters);
   if (named_rays == 0) return found;
   named.rays = named_rays;
-  // Every ray the kernel does not test names the triangle of the nearest tested ray before it
-  // (the first tested ray's, before that one), so a group of eight naming one triangle stays one.
-  uint32_t previous = named.index[__builtin_ctzll(named_rays)];
-  for (int k = 0; k < packet.count; ++k) {
-    if ((named_rays >> k) & 1)
-      previous = named.index[k];
-    else
-      named.index[k] = previous;
-  }
-  PacketSlots<KernelHit> kernel_hits;  // written where the outcome is Hit
-  NamedOutcome outcome[kPacketRays];
-  kernels_->intersect_named(packet, named, kernel_hits.data(), outcome);
-  for (uint64_t m = named_rays; m != 0; m &= m - 1) {
+  NamedHits kernel_hits;
+  kernels_->intersect_named(packet, named, kernel_hits);
+  // Near an edge: decided in double, as intersect_named does.
+  for (uint64_t m = kernel_hits.near_edge; m != 0; m &= m - 1) named_alone(__builtin_ctzll(m));
+  for (uint64_t m = named_rays & ~kernel_hits.near_edge; m != 0; m &= m - 1) {
     const int k = __builtin_ctzll(m);
-    if (outcome[k] == NamedOutcome::NearEdge) {  // decided in double, as intersect_named does
-      named_alone(k);
-      continue;
-    }
     counters[k].primitive_tests++;
     hits[k] = HitRecord{};
-    if (outcome[k] == NamedOutcome::Miss) continue;
-    hits[k].t = kernel_hits[k].t;
-    hits[k].u = kernel_hits[k].u;
-    hits[k].v = kernel_hits[k].v;
+    if (!((kernel_hits.hit >> k) & 1)) continue;
+    hits[k].t = kernel_hits.t[k];
+    hits[k].u = kernel_hits.u[k];
+    hits[k].v = kernel_hits.v[k];
     hits[k].primitive = named.index[k];
-    found |= uint64_t(1) << k;
   }
-  return found;
+  return found | kernel_hits.hit;
 }
 
 bool TraceGeometry::closest_approximated(const Ray& ray, HitRecord& hit,

@@ -727,16 +727,18 @@ void closest_packet(const WideBvhView& bvh, const RayPacket& packet, KernelHit* 
     closest_packet_impl<false>(bvh, packet, hits, nullptr);
 }
 
-// The triangles rays [first, first + 8) of `named` are tested against, lanes past the packet's
-// `live` rays repeating the first: one triangle's vectors splatted when every ray names it (a
-// z-buffer's pixels mostly name what their neighbours name), else gathered lane by lane.
-void named_triangles(const NamedTriangles& named, int first, int live, Vec3vf8& v0, Vec3vf8& e1,
-                     Vec3vf8& e2) {
+// The triangles rays [first, first + 8) of `named` are tested against, for the lanes of `rays`
+// (bit l: ray first + l, at least one), the others repeating the lowest's: one triangle's
+// vectors splatted when every ray names it (a z-buffer's pixels mostly name what their
+// neighbours name), else gathered lane by lane.
+void named_triangles(const NamedTriangles& named, int first, unsigned rays, Vec3vf8& v0,
+                     Vec3vf8& e1, Vec3vf8& e2) {
   const uint32_t* index = named.index + first;
+  const uint32_t lowest = index[lowest_bit(rays)];
   bool one = true;
-  for (int l = 1; l < live; ++l) one &= index[l] == index[0];
+  for (unsigned m = rays & (rays - 1); m != 0; m &= m - 1) one &= index[lowest_bit(m)] == lowest;
   if (one) {
-    const float* t = named.triangles + 9 * size_t(index[0]);
+    const float* t = named.triangles + 9 * size_t(lowest);
     v0 = Vec3vf8::splat(t[0], t[1], t[2]);
     e1 = Vec3vf8::splat(t[3], t[4], t[5]);
     e2 = Vec3vf8::splat(t[6], t[7], t[8]);
@@ -744,7 +746,7 @@ void named_triangles(const NamedTriangles& named, int first, int live, Vec3vf8& 
   }
   alignas(32) float lanes[3][3][8];  // v0, e1, e2 by axis and lane
   for (int l = 0; l < 8; ++l) {
-    const float* t = named.triangles + 9 * size_t(index[l < live ? l : 0]);
+    const float* t = named.triangles + 9 * size_t((rays >> l) & 1u ? index[l] : lowest);
     for (int v = 0; v < 3; ++v)
       for (int a = 0; a < 3; ++a) lanes[v][a][l] = t[3 * v + a];
   }
@@ -755,9 +757,10 @@ void named_triangles(const NamedTriangles& named, int first, int live, Vec3vf8& 
 
 // intersect_triangle_mt's float pass, lane by lane with its operations in its order (glm's
 // cross and dot), eight rays each against its own triangle.
-void intersect_named(const RayPacket& packet, const NamedTriangles& named, KernelHit* hits,
-                     NamedOutcome* outcome) {
+void intersect_named(const RayPacket& packet, const NamedTriangles& named, NamedHits& out) {
   const V8 tmin = V8::splat(packet.tmin), tmax = V8::splat(packet.tmax);
+  out.hit = 0;
+  out.near_edge = 0;
   for (int first = 0; first < packet.count; first += 8) {
     const unsigned rays = unsigned(named.rays >> first) & 0xFFu;
     if (rays == 0) continue;
@@ -773,7 +776,7 @@ void intersect_named(const RayPacket& packet, const NamedTriangles& named, Kerne
       D = Vec3vf8::load(dir);
     }
     Vec3vf8 V0, E1, E2;
-    named_triangles(named, first, live, V0, E1, E2);
+    named_triangles(named, first, rays, V0, E1, E2);
     const Vec3vf8 P = cross(D, E2);
     const V8 det = dot(E1, P);
     // U, V: su, sv times sign(det)
@@ -791,22 +794,16 @@ void intersect_named(const RayPacket& packet, const NamedTriangles& named, Kerne
     const unsigned rejected = movemask((det == V8::splat(0.0f)) | (U < outer_lo) | (U > outer_hi) |
                                        (V < outer_lo) | (UV > outer_hi));
     const unsigned near_edge =
-        ~rejected & movemask(((U < inner_lo) | (V < inner_lo)) | (UV > inner_hi));
+        rays & ~rejected & movemask(((U < inner_lo) | (V < inner_lo)) | (UV > inner_hi));
     const V8 inv_det = V8::splat(1.0f) / det;
     const V8 t = dot(E2, Q) * inv_det;
-    const unsigned hit = ~rejected & ~near_edge & movemask((t > tmin) & (t < tmax));
-    alignas(32) float ts[8], us[8], vs[8];
-    store(ts, t);
-    store(us, su * inv_det);
-    store(vs, sv * inv_det);
-    for (unsigned m = rays; m != 0; m &= m - 1) {
-      const int l = __builtin_ctz(m);
-      const unsigned bit = 1u << l;
-      outcome[first + l] = (near_edge & bit) ? NamedOutcome::NearEdge
-                           : (hit & bit)     ? NamedOutcome::Hit
-                                             : NamedOutcome::Miss;
-      if (hit & bit) hits[first + l] = {ts[l], us[l], vs[l], 0u};
-    }
+    const unsigned hit = rays & ~rejected & ~near_edge & movemask((t > tmin) & (t < tmax));
+    // Whole vectors into the 64 slots (first + 8 <= kPacketRays): read only where hit.
+    store(out.t + first, t);
+    store(out.u + first, su * inv_det);
+    store(out.v + first, sv * inv_det);
+    out.hit |= uint64_t(hit) << first;
+    out.near_edge |= uint64_t(near_edge) << first;
   }
 }
 

@@ -85,17 +85,22 @@ struct alignas(32) RayPacket {
 
 // Rays of one packet, each with the one triangle it is to be tested against (the hybrid's
 // rebuild of a z-buffer's hits): ray k of the packet, for each bit k of `rays`, against triangle
-// index[k] of `triangles` (9 floats each: v0, e1, e2). Every other ray below the packet's count
-// names a triangle too (a neighbour's, so that groups of rays naming one triangle stay whole);
-// its outcome is not written.
+// index[k] of `triangles` (9 floats each: v0, e1, e2). index[k] is read only for those rays.
 struct NamedTriangles {
   const float* triangles;
   uint64_t rays = 0;
   uint32_t index[kPacketRays];
 };
-// What the test found for a lane: nothing, a hit (t, u, v), or a hit within intersect_triangle_mt's
-// edge band, which the caller decides in double precision as that function does.
-enum class NamedOutcome : uint8_t { Miss, Hit, NearEdge };
+// What the test found for the rays of a NamedTriangles: the rays it hits (t, u, v in SoA, set
+// for those rays), and those whose hit lies within intersect_triangle_mt's edge band, which the
+// caller decides in double precision as that function does. Every other ray misses.
+struct NamedHits {
+  uint64_t hit = 0;
+  uint64_t near_edge = 0;
+  alignas(32) float t[kPacketRays];
+  alignas(32) float u[kPacketRays];
+  alignas(32) float v[kPacketRays];
+};
 
 // One instruction set's traversal functions. Counting variants fill KernelCounters (for the cost
 // AOV and statistics); the others count nothing, for benchmarks.
@@ -110,9 +115,8 @@ struct TraversalKernels {
   void (*closest_packet)(const WideBvhView&, const RayPacket&, KernelHit* hits,
                          KernelCounters* counters);
   // intersect_triangle_mt's float pass for each ray of `named`, eight rays at a time, with the
-  // packet's origin, tmin and tmax: outcome[k], and hits[k] where it is Hit.
-  void (*intersect_named)(const RayPacket& packet, const NamedTriangles& named, KernelHit* hits,
-                          NamedOutcome* outcome);
+  // packet's origin, tmin and tmax.
+  void (*intersect_named)(const RayPacket& packet, const NamedTriangles& named, NamedHits& hits);
 };
 
 // Defined in baseline code (wide_bvh.cpp): the double-precision recheck of a hit near a
