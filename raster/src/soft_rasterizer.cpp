@@ -418,9 +418,12 @@ Status draw_view(const RenderSetup& setup, const MirrorView& view, const ViewFra
   if (options.mode == RenderMode::Visibility) {
     t = Clock::now();
     if (progress) progress->begin("readback", uint64_t(w) * uint64_t(h), "pixels");
-    soft::write_visibility(list, target, scene.image.background, options.cost_aov,
-                           options.visibility_ids_only, surfaces ? &*surfaces : nullptr, arena,
-                           progress, fb);
+    const soft::SurfaceColours* lod_surfaces = surfaces ? &*surfaces : nullptr;
+    if (options.visibility_ids_only)
+      soft::give_visibility_ids(list, target, lod_surfaces, arena, progress, fb);
+    else
+      soft::write_visibility(list, target, scene.image.background, options.cost_aov, lod_surfaces,
+                             arena, progress, fb);
     out.stats["time.readback"] = seconds_since(t);
     return ok_status();
   }

@@ -44,21 +44,6 @@ void allocate_frame(int w, int h, FrameBuffers& fb) {
   fb.allocate(w, h);  // frame memory: asked for huge pages (pixel_memory.h)
 }
 
-// The ids alone, sized and left undefined (every pixel is written); every other buffer empty.
-void allocate_ids(int w, int h, FrameBuffers& fb) {
-  fb.allocate(0, 0);
-  fb.width = w;
-  fb.height = h;
-  fb.object_id.resize(fb.pixel_count());
-  fb.primitive_id.resize(fb.pixel_count());
-}
-
-// Copies with ordinary stores, which leave the lines in the cache: for ids the next pass reads
-// at once (the hybrids' tracer rebuilds every hit from them).
-void cached_copy(void* to, const void* from, size_t bytes) {
-  std::memcpy(to, from, bytes);
-}
-
 // Calls f(x0, n, run) for the runs [x0, x0 + n) of a row `width` wide, with `run` room for n
 // values: each run is computed into it (in cache) and then streamed to its frame buffer
 // (stream_copy.h), as the tracer streams its tiles' rows.
@@ -101,18 +86,17 @@ class VisibilityRows {
       }
       stream_copy(fb.depth.data() + row + size_t(x0), run, size_t(n) * sizeof(float));
     });
-    write_ids(y, fb, stream_copy);
+    write_ids(y, fb);
   }
 
-  // Row y of fb's object and primitive ids alone, each run stored by `copy`.
-  template <class Copy>
-  void write_ids(int y, FrameBuffers& fb, Copy copy) const {
+  // Row y of fb's object and primitive ids.
+  void write_ids(int y, FrameBuffers& fb) const {
     static_assert(kNoId == 0xFFFFFFFFu);
     const int width = target_.width();  // a local: stores through uint32_t* could alias a member
     const size_t row = fb.index(0, y);
     const uint32_t* __restrict row_object = target_.objects() + row;
     const uint32_t* __restrict row_primitive = target_.primitives() + row;
-    copy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
+    stream_copy(fb.object_id.data() + row, row_object, size_t(width) * sizeof(uint32_t));
     const uint8_t* use = use_primitive_id_.data();
     const bool every = every_primitive_id_;
     for_each_run<uint32_t>(width, [&](int x0, int n, uint32_t* __restrict run) {
@@ -127,7 +111,7 @@ class VisibilityRows {
         for (int k = 0; k < n; ++k)
           run[k] = object[k] == kNoId ? kNoId : use[object[k]] != 0 ? primitive[k] : 0u;
       }
-      copy(fb.primitive_id.data() + row + size_t(x0), run, size_t(n) * sizeof(uint32_t));
+      stream_copy(fb.primitive_id.data() + row + size_t(x0), run, size_t(n) * sizeof(uint32_t));
     });
   }
 
@@ -364,42 +348,61 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
   });
 }
 
-void write_visibility(const DrawList& list, const DepthTarget& target, const glm::vec3& background,
-                      bool cost, bool ids_only, const SurfaceColours* surfaces,
-                      tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb) {
-  const int w = target.width(), h = target.height();
-  if (ids_only)
-    allocate_ids(w, h, fb);
-  else
-    allocate_frame(w, h, fb);  // every pixel is written below
-  const VisibilityRows visibility(list, target, cost);
-  if (surfaces && surfaces->textured())
-    fb.lod.assign(fb.pixel_count(), std::numeric_limits<float>::quiet_NaN());
+// Each textured pixel's level of detail into fb.lod (NaN elsewhere), from fb's ids; primitive
+// ids read only where the object names its triangles (`use_primitive_id`), 0 elsewhere, as the
+// visibility buffer reports them.
+void write_lod(const DrawList& list, const SurfaceColours& surfaces, tbb::task_arena& arena,
+               FrameBuffers& fb) {
+  const int w = fb.width, h = fb.height;
+  fb.lod.assign(fb.pixel_count(), std::numeric_limits<float>::quiet_NaN());
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
       for (int y = r.begin(); y != r.end(); ++y) {
         const size_t row = fb.index(0, y);
-        if (ids_only) {
-          visibility.write_ids(y, fb, cached_copy);
-        } else {
-          visibility.write(y, fb);
-          fill_vec3(fb.colour.data() + row, size_t(w), background);
-          std::memset(static_cast<void*>(fb.normal.data() + row), 0,
-                      size_t(w) * sizeof(glm::vec3));  // +0.0f is all zero bits
-        }
-        if (fb.lod.empty()) continue;
         PlanesCache planes;
         for (int x = 0; x < w; ++x) {
           const uint32_t id = fb.object_id[row + size_t(x)];
           if (id == kNoId || !list.objects[id].material) continue;
-          fb.lod[row + size_t(x)] = surfaces->lod(id, *list.objects[id].material,
-                                                  fb.primitive_id[row + size_t(x)], x, y, planes);
+          const uint32_t primitive =
+              list.objects[id].use_primitive_id ? fb.primitive_id[row + size_t(x)] : 0u;
+          fb.lod[row + size_t(x)] =
+              surfaces.lod(id, *list.objects[id].material, primitive, x, y, planes);
         }
+      }
+    });
+  });
+}
+
+void write_visibility(const DrawList& list, const DepthTarget& target, const glm::vec3& background,
+                      bool cost, const SurfaceColours* surfaces, tbb::task_arena& arena,
+                      ProgressSink* progress, FrameBuffers& fb) {
+  const int w = target.width(), h = target.height();
+  allocate_frame(w, h, fb);  // every pixel is written below
+  const VisibilityRows visibility(list, target, cost);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& r) {
+      for (int y = r.begin(); y != r.end(); ++y) {
+        const size_t row = fb.index(0, y);
+        visibility.write(y, fb);
+        fill_vec3(fb.colour.data() + row, size_t(w), background);
+        std::memset(static_cast<void*>(fb.normal.data() + row), 0,
+                    size_t(w) * sizeof(glm::vec3));  // +0.0f is all zero bits
       }
       stream_fence();  // the rows' streamed stores, before another thread reads
       if (progress) progress->advance(uint64_t(r.size()) * uint64_t(w));
     });
   });
+  if (surfaces && surfaces->textured()) write_lod(list, *surfaces, arena, fb);
+}
+
+void give_visibility_ids(const DrawList& list, DepthTarget& target, const SurfaceColours* surfaces,
+                         tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb) {
+  fb.allocate(0, 0);
+  fb.width = target.width();
+  fb.height = target.height();
+  target.give_ids(fb.object_id, fb.primitive_id);
+  if (surfaces && surfaces->textured()) write_lod(list, *surfaces, arena, fb);
+  if (progress) progress->advance(uint64_t(fb.pixel_count()));
 }
 
 }  // namespace rvr::soft

@@ -44,11 +44,18 @@ void shade_pixels(const DrawList& list, const DepthTarget& target, const Deferre
 
 // Visibility mode: sizes fb to the target and writes every pixel of every buffer without
 // shading: depth, object and primitive id and cost (0 everywhere when !cost) as shade_pixels
-// writes them, colour the background, normal 0; with ids_only, the ids alone, the other
-// buffers left empty.
+// writes them, colour the background, normal 0.
 // `surfaces` not null and some object textured: fb.lod too (the hybrids' primary hits).
 void write_visibility(const DrawList& list, const DepthTarget& target, const glm::vec3& background,
-                      bool cost, bool ids_only, const SurfaceColours* surfaces,
-                      tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb);
+                      bool cost, const SurfaceColours* surfaces, tbb::task_arena& arena,
+                      ProgressSink* progress, FrameBuffers& fb);
+
+// Visibility mode, ids only (RenderOptions::visibility_ids_only): fb sized to the target with
+// the target's object and primitive ids, handed over rather than copied (DepthTarget::give_ids),
+// and lod as write_visibility writes it; no other buffer. The primitive ids are the target's:
+// the triangle's where an object was drawn (also for an object that does not name its
+// triangles), unset where none was.
+void give_visibility_ids(const DrawList& list, DepthTarget& target, const SurfaceColours* surfaces,
+                         tbb::task_arena& arena, ProgressSink* progress, FrameBuffers& fb);
 
 }  // namespace rvr::soft

@@ -94,6 +94,16 @@ void DepthTarget::clear() {
           (std::min(kBlock, width_ - bx * kBlock)) * (std::min(kBlock, height_ - by * kBlock)));
 }
 
+void DepthTarget::give_ids(PixelVector<uint32_t>& object, PixelVector<uint32_t>& primitive) {
+  RVR_CHECK(arrays_.ids, "a target without ids has none to give");
+  object.swap(object_);
+  primitive.swap(primitive_);
+  object_.clear();
+  primitive_.clear();
+  fill_target_.object = nullptr;
+  fill_target_.primitive = nullptr;
+}
+
 size_t DepthTarget::bytes() const {
   return depth_.size() * sizeof(double) +
          (object_.size() + primitive_.size() + fragments_.size()) * sizeof(uint32_t) +

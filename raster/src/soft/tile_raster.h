@@ -142,6 +142,10 @@ class DepthTarget {
   const uint32_t* objects() const { return object_.data(); }
   const uint32_t* primitives() const { return primitive_.data(); }
   const float* barycentrics() const { return bary_.data(); }
+  // This frame's object and primitive ids, swapped into `object` and `primitive` instead of
+  // copied, for a caller that reads them after the next draw: the target has none until its next
+  // clear(), which sizes its own again (from the recycled pixel memory).
+  void give_ids(PixelVector<uint32_t>& object, PixelVector<uint32_t>& primitive);
   size_t bytes() const;
 
  private:

@@ -86,7 +86,10 @@ struct RenderOptions {
   bool visibility_lod = false;
   // softraster in visibility mode: write object_id and primitive_id only (and lod with
   // visibility_lod), leaving depth, colour, normal and cost empty: the hybrids' z-buffer pass,
-  // whose tracer rebuilds every hit from the ids. raster reads its buffers back as before.
+  // whose tracer rebuilds every hit from the ids. The ids are its depth target's, handed over
+  // rather than copied, so primitive_id is defined only where an object was drawn, and there is
+  // the drawn triangle's index also for an object that does not name its triangles (where the
+  // full visibility buffer says 0). raster reads its buffers back as before.
   bool visibility_ids_only = false;
   // Z-buffers: scene objects (indices into Scene::objects) left out of every view they draw; the
   // others keep their ids. The hybrids leave out the shapes their tracer intersects wherever
