@@ -2,6 +2,7 @@
 
 #include <emmintrin.h>
 #include <stddef.h>
+#include <xmmintrin.h>
 
 #include <algorithm>
 #include <bit>
