@@ -56,6 +56,25 @@ Vec3vProbeInput random_input(std::mt19937& rng) {
   std::uniform_int_distribution<int> exponent(-12, 12);
   auto draw = [&] { return std::ldexp(mantissa(rng), exponent(rng)); };
   Vec3vProbeInput in;
+  // Ints on both sides of 2^31 (where a signed comparison errs) and of the table's end.
+  std::uniform_int_distribution<uint32_t> any;
+  auto draw_int = [&]() -> uint32_t {
+    switch (any(rng) % 4) {
+      case 0:
+        return any(rng) % kProbeTable;
+      case 1:
+        return kProbeTable + any(rng) % 4;
+      case 2:
+        return 0x80000000u + any(rng) % 4;
+      default:
+        return any(rng);
+    }
+  };
+  for (uint32_t t = 0; t < kProbeTable; ++t) in.table[t] = any(rng);
+  for (int k = 0; k < kProbeLanes; ++k) {
+    in.i[k] = draw_int();
+    in.j[k] = k % 5 == 0 ? in.i[k] : draw_int();
+  }
   for (int k = 0; k < kProbeLanes; ++k) {
     for (int a = 0; a < 3; ++a) {
       in.a[a][k] = k == 0 ? 0.0f : draw();
@@ -101,6 +120,14 @@ TEST(Vec3v, EveryLaneIsTheScalarOperationInEveryIsaAndWidth) {
         }
         if (width != ProbeWidth::Scalar) {
           EXPECT_EQ(out.less_bits, less_bits) << check.where;
+          unsigned below_bits = 0;
+          for (int k = 0; k < kProbeLanes; ++k) {
+            below_bits |= unsigned(in.i[k] < in.j[k]) << k;
+            const uint32_t i = in.i[k];
+            EXPECT_EQ(out.gathered[k], i < kProbeTable ? in.table[i] + i : i)
+                << check.where << " lane " << k << " gather";
+          }
+          EXPECT_EQ(out.below_bits, below_bits) << check.where;
         }
         if (width == ProbeWidth::Sixteen) check.same("reduce_max", 0, out.max_x, max_x);
         for (int k = 0; k < kProbeLanes; ++k) {

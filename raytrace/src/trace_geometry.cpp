@@ -636,21 +636,21 @@ uint64_t TraceGeometry::intersect_named_packet(const RayPacket& packet, const ui
                         counters[k]))
       found |= uint64_t(1) << k;
   };
-  // One named triangle of a mesh, read from flat per-object tables (no pointer to follow).
-  const uint32_t n_objects = simd ? uint32_t(object_triangle_count_.size()) : 0;
-  const uint32_t* triangle_count = object_triangle_count_.data();
-  const uint32_t* first_triangle = object_first_triangle_.data();
-  for (uint64_t m = wanted & packet.all(); m != 0; m &= m - 1) {
+  // The rays naming one triangle of a mesh, looked up in flat per-object tables eight at a time;
+  // the others one by one.
+  const uint64_t rays = wanted & packet.all();
+  if (simd)
+    named_rays = kernels_->name_triangles(
+        TriangleNames{object_first_triangle_.data(), object_triangle_count_.data(),
+                      uint32_t(object_triangle_count_.size())},
+        object, primitive, rays, named.index);
+  for (uint64_t m = rays & ~named_rays; m != 0; m &= m - 1) {
     const int k = __builtin_ctzll(m);
     const uint32_t o = object[k];
-    if (o < n_objects && primitive[k] < triangle_count[o]) {
-      named.index[k] = first_triangle[o] + primitive[k];
-      named_rays |= uint64_t(1) << k;
-    } else if (o < object_analytic_.size() && object_analytic_[o] != kNoPrimitive) {
+    if (o < object_analytic_.size() && object_analytic_[o] != kNoPrimitive)
       analytic_rays |= uint64_t(1) << k;  // below, shape by shape
-    } else {
+    else
       named_alone(k);
-    }
   }
   found |= intersect_named_shapes(packet, object, analytic_rays, hits, counters);
   if (named_rays == 0) return found;

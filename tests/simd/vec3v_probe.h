@@ -2,17 +2,23 @@
 // that test_vec3v can hold every operation of every ISA and vector width to the scalar
 // computation: each unit evaluates the operations on sixteen lanes of inputs. With them, the
 // lane operations of the vectors themselves that the packet kernels use (abs, sign bits, masks
-// and their bits, the largest lane).
+// and their bits, the largest lane), and the int vectors' unsigned comparison and masked gather.
 #pragma once
+
+#include <cstdint>
 
 namespace rvr {
 
 constexpr int kProbeLanes = 16;
+constexpr uint32_t kProbeTable = 64;
 
 struct Vec3vProbeInput {
   alignas(64) float a[3][kProbeLanes];
   alignas(64) float b[3][kProbeLanes];
   alignas(64) float s[kProbeLanes];  // the scalar factor and divisor
+  // The int vectors' lookups: i and j compared unsigned, and table entries gathered.
+  uint32_t i[kProbeLanes], j[kProbeLanes];
+  uint32_t table[kProbeTable];
 };
 
 // Lane k of every result from lane k of the inputs; select takes a where a.x < b.x.
@@ -35,6 +41,10 @@ struct Vec3vProbeOutput {
   alignas(64) float masked_x[kProbeLanes];
   unsigned less_bits;
   float max_x;  // 16 lanes only: reduce_max(a.x)
+  // Vector widths only: bit k of below_bits is lane k of less_unsigned(i, j); gathered[k] is
+  // table[i[k]] + i[k] where i[k] < kProbeTable (gather's mask), else i[k] (gather's 0 + i).
+  unsigned below_bits;
+  uint32_t gathered[kProbeLanes];
 };
 
 // The vector types Vec3v is instantiated with: float (one lane at a time; no normalize or

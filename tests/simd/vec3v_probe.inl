@@ -50,6 +50,35 @@ void store1(float (&row)[kProbeLanes], int i, V a) {
     store(row + i, a);
 }
 
+// The int vector of V's width.
+template <class V>
+struct IntOf;
+template <>
+struct IntOf<vfloat4> {
+  using type = vint4;
+};
+template <>
+struct IntOf<vfloat8> {
+  using type = vint8;
+};
+template <>
+struct IntOf<vfloat16> {
+  using type = vint16;
+};
+
+template <class V>
+void run_ints(const Vec3vProbeInput& in, Vec3vProbeOutput& out) {
+  using I = typename IntOf<V>::type;
+  constexpr int kLanes = int(sizeof(V) / sizeof(float));
+  out.below_bits = 0;
+  for (int k = 0; k < kProbeLanes; k += kLanes) {
+    const I i = I::loadu(in.i + k), j = I::loadu(in.j + k);
+    out.below_bits |= movemask(less_unsigned(i, j)) << k;
+    const auto in_table = less_unsigned(i, I::splat(int32_t(kProbeTable)));
+    storeu(out.gathered + k, gather(in.table, i, in_table) + i);
+  }
+}
+
 template <class V>
 void run_width(const Vec3vProbeInput& in, Vec3vProbeOutput& out) {
   constexpr int kLanes = int(sizeof(V) / sizeof(float));
@@ -75,6 +104,9 @@ void run_width(const Vec3vProbeInput& in, Vec3vProbeOutput& out) {
       store(out.masked_x + i, masked(M::from_bits(less), a.x));
     }
     if constexpr (std::is_same_v<V, vfloat16>) out.max_x = reduce_max(a.x);
+    if constexpr (!std::is_same_v<V, float>) {
+      if (i == 0) run_ints<V>(in, out);
+    }
     store1(out.dot, i, dot(a, b));
     store1(out.length_squared, i, length_squared(a));
   }

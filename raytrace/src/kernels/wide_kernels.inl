@@ -727,6 +727,23 @@ void closest_packet(const WideBvhView& bvh, const RayPacket& packet, KernelHit* 
     closest_packet_impl<false>(bvh, packet, hits, nullptr);
 }
 
+uint64_t name_triangles(const TriangleNames& names, const uint32_t* object,
+                        const uint32_t* primitive, uint64_t rays, uint32_t* index) {
+  const I8 objects = I8::splat(int32_t(names.objects));
+  uint64_t named = 0;
+  for (int first = 0; first < kPacketRays; first += 8) {
+    const unsigned lanes = unsigned(rays >> first) & 0xFFu;
+    if (lanes == 0) continue;
+    const I8 o = I8::loadu(object + first), p = I8::loadu(primitive + first);
+    // The table lookups only in lanes that name a known object: others are not read.
+    const M8 known = M8::from_bits(lanes) & less_unsigned(o, objects);
+    const M8 mesh = known & less_unsigned(p, gather(names.triangle_count, o, known));
+    storeu(index + first, gather(names.first_triangle, o, mesh) + p);
+    named |= uint64_t(movemask(mesh)) << first;
+  }
+  return named;
+}
+
 // The triangles rays [first, first + 8) of `named` are tested against, for the lanes of `rays`
 // (bit l: ray first + l, at least one), the others repeating the lowest's: one triangle's
 // vectors splatted when every ray names it (a z-buffer's pixels mostly name what their
@@ -811,7 +828,7 @@ void intersect_named(const RayPacket& packet, const NamedTriangles& named, Named
 
 extern const TraversalKernels kKernels = {RVR_KERNEL_NAME, closest,          closest_counted,
                                           occluded,        occluded_counted, closest_packet,
-                                          intersect_named};
+                                          name_triangles,  intersect_named};
 
 }  // namespace RVR_KERNEL_NS
 }  // namespace rvr

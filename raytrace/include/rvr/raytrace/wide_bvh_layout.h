@@ -83,6 +83,15 @@ struct alignas(32) RayPacket {
   uint64_t all() const { return count == kPacketRays ? ~uint64_t(0) : (uint64_t(1) << count) - 1; }
 };
 
+// Where the meshes' triangles lie in the triangle table a NamedTriangles indexes: object o's
+// triangle p is entry first_triangle[o] + p, for p < triangle_count[o] (0 for an object that is
+// not a mesh), o < objects.
+struct TriangleNames {
+  const uint32_t* first_triangle = nullptr;
+  const uint32_t* triangle_count = nullptr;
+  uint32_t objects = 0;
+};
+
 // Rays of one packet, each with the one triangle it is to be tested against (the hybrid's
 // rebuild of a z-buffer's hits): ray k of the packet, for each bit k of `rays`, against triangle
 // index[k] of `triangles` (9 floats each: v0, e1, e2). index[k] is read only for those rays.
@@ -114,6 +123,11 @@ struct TraversalKernels {
   // per ray, added to (may be null).
   void (*closest_packet)(const WideBvhView&, const RayPacket&, KernelHit* hits,
                          KernelCounters* counters);
+  // The rays k of `rays` whose (object[k], primitive[k]) names a triangle of a mesh in `names`,
+  // with that triangle's table entry in index[k] (left undefined for the others). object and
+  // primitive hold kPacketRays entries; each group of eight with a ray in `rays` is read whole.
+  uint64_t (*name_triangles)(const TriangleNames& names, const uint32_t* object,
+                             const uint32_t* primitive, uint64_t rays, uint32_t* index);
   // intersect_triangle_mt's float pass for each ray of `named`, eight rays at a time, with the
   // packet's origin, tmin and tmax.
   void (*intersect_named)(const RayPacket& packet, const NamedTriangles& named, NamedHits& hits);

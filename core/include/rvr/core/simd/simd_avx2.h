@@ -164,6 +164,9 @@ struct vint8 {
   static vint8 load(const uint32_t* p) {  // 32-byte aligned
     return {_mm256_castps_si256(_mm256_load_ps(reinterpret_cast<const float*>(p)))};
   }
+  static vint8 loadu(const uint32_t* p) {
+    return {_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p))};
+  }
 };
 
 inline void store(uint32_t* p, vint8 a) {  // 32-byte aligned
@@ -182,6 +185,17 @@ inline vboolf8 operator<(vint8 a, vint8 b) {
 inline vint8 select(vboolf8 m, vint8 a, vint8 b) {  // m ? a : b, through the float blend
   return {_mm256_castps_si256(
       _mm256_blendv_ps(_mm256_castsi256_ps(b.v), _mm256_castsi256_ps(a.v), m.v))};
+}
+// Unsigned a < b: the signed comparison with both sign bits flipped.
+inline vboolf8 less_unsigned(vint8 a, vint8 b) {
+  const __m256i sign = _mm256_set1_epi32(INT32_MIN);
+  return {_mm256_castsi256_ps(
+      _mm256_cmpgt_epi32(_mm256_xor_si256(b.v, sign), _mm256_xor_si256(a.v, sign)))};
+}
+// base[index] in the lanes of m, 0 in the others (whose index is not read).
+inline vint8 gather(const uint32_t* base, vint8 index, vboolf8 m) {
+  return {_mm256_mask_i32gather_epi32(_mm256_setzero_si256(), reinterpret_cast<const int*>(base),
+                                      index.v, _mm256_castps_si256(m.v), 4)};
 }
 template <int J>
 inline vint8 swap_lanes(vint8 a) {

@@ -136,10 +136,14 @@ struct vint16 {
   __m512i v;
   static vint16 splat(int32_t x) { return {_mm512_set1_epi32(x)}; }
   static vint16 load(const uint32_t* p) { return {_mm512_load_si512(p)}; }  // 64-byte aligned
+  static vint16 loadu(const uint32_t* p) { return {_mm512_loadu_si512(p)}; }
 };
 
 inline void store(uint32_t* p, vint16 a) {  // 64-byte aligned
   _mm512_store_si512(p, a.v);
+}
+inline void storeu(uint32_t* p, vint16 a) {
+  _mm512_storeu_si512(p, a.v);
 }
 // Signed comparison.
 inline vboolf16 operator<(vint16 a, vint16 b) {
@@ -147,6 +151,16 @@ inline vboolf16 operator<(vint16 a, vint16 b) {
 }
 inline vint16 select(vboolf16 m, vint16 a, vint16 b) {  // m ? a : b
   return {_mm512_mask_blend_epi32(m.v, b.v, a.v)};
+}
+inline vint16 operator+(vint16 a, vint16 b) {
+  return {_mm512_add_epi32(a.v, b.v)};
+}
+inline vboolf16 less_unsigned(vint16 a, vint16 b) {
+  return {_mm512_cmplt_epu32_mask(a.v, b.v)};
+}
+// base[index] in the lanes of m, 0 in the others (whose index is not read).
+inline vint16 gather(const uint32_t* base, vint16 index, vboolf16 m) {
+  return {_mm512_mask_i32gather_epi32(_mm512_setzero_si512(), m.v, index.v, base, 4)};
 }
 
 // ------------------------------------------------- 8 doubles, 8 int64, 8-bit masks

@@ -33,7 +33,10 @@ struct vhalves {
   static vhalves load(const T* p) {  // aligned as V::load needs
     return {V::load(p), V::load(p + kHalf)};
   }
-  static vhalves loadu(const float* p) { return {V::loadu(p), V::loadu(p + kHalf)}; }
+  template <class T>
+  static vhalves loadu(const T* p) {
+    return {V::loadu(p), V::loadu(p + kHalf)};
+  }
   template <class T>
   static vhalves splat(T x) {
     return {V::splat(x), V::splat(x)};
@@ -152,6 +155,16 @@ inline mask_of<V> operator==(vhalves<V> a, vhalves<V> b) {
 template <class V>
 inline mask_of<V> operator!=(vhalves<V> a, vhalves<V> b) {
   return {a.lo != b.lo, a.hi != b.hi};
+}
+
+template <class V>
+inline auto less_unsigned(vhalves<V> a, vhalves<V> b) {  // ints
+  return vhalves<decltype(less_unsigned(a.lo, b.lo))>{less_unsigned(a.lo, b.lo),
+                                                      less_unsigned(a.hi, b.hi)};
+}
+template <class V, class B>
+inline vhalves<V> gather(const uint32_t* base, vhalves<V> index, vhalves<B> m) {
+  return {gather(base, index.lo, m.lo), gather(base, index.hi, m.hi)};
 }
 
 template <class B>

@@ -143,6 +143,9 @@ struct vint4 {
   static vint4 load(const uint32_t* p) {  // 16-byte aligned
     return {_mm_load_si128(reinterpret_cast<const __m128i*>(p))};
   }
+  static vint4 loadu(const uint32_t* p) {
+    return {_mm_loadu_si128(reinterpret_cast<const __m128i*>(p))};
+  }
 };
 
 inline void store(uint32_t* p, vint4 a) {  // 16-byte aligned
@@ -166,6 +169,23 @@ inline vboolf4 operator==(vint4 a, vint4 b) {
 inline vint4 select(vboolf4 m, vint4 a, vint4 b) {
   return {_mm_castps_si128(
       select(m, vfloat4{_mm_castsi128_ps(a.v)}, vfloat4{_mm_castsi128_ps(b.v)}).v)};
+}
+inline vint4 operator+(vint4 a, vint4 b) {
+  return {_mm_add_epi32(a.v, b.v)};
+}
+// Unsigned a < b: the signed comparison with both sign bits flipped.
+inline vboolf4 less_unsigned(vint4 a, vint4 b) {
+  const __m128i sign = _mm_set1_epi32(INT32_MIN);
+  return {_mm_castsi128_ps(_mm_cmpgt_epi32(_mm_xor_si128(b.v, sign), _mm_xor_si128(a.v, sign)))};
+}
+// base[index] in the lanes of m, 0 in the others (whose index is not read); lane by lane, as
+// SSE has no gather.
+inline vint4 gather(const uint32_t* base, vint4 index, vboolf4 m) {
+  alignas(16) uint32_t i[4], out[4];
+  store(i, index);
+  const unsigned bits = unsigned(_mm_movemask_ps(m.v));
+  for (int l = 0; l < 4; ++l) out[l] = (bits >> l) & 1u ? base[i[l]] : 0u;
+  return vint4::load(out);
 }
 
 // Lane k takes lane k ^ J (J = 1 or 2).
