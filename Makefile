@@ -102,7 +102,12 @@ SANITIZE_PYTHON ?= python_|lazy_loading
 # session's peak resident set at 10^7 triangles: under ASan the shadow memory and quarantine
 # change that peak (the comparison means nothing there) and the session takes tens of minutes;
 # the study's memory code still runs under ASan in the other MemoryEstimate tests.
-SANITIZE_EXCLUDE ?= Conformance[.]AgreesWithTheOtherLoopOrder/raytrace_none_|python_wheel|MemoryEstimate[.]WithinTenPercentOfASessionsMeasuredPeak
+# Two tests repeat code the suite already runs under ASan, at more than a minute each there:
+# Bvh.MatchesBruteForceOnSpheresAsMeshes (the brute-force tracer over a scene of thousands of
+# triangles; the same comparison runs on the other Bvh.MatchesBruteForce* scenes) and
+# StudyFit.IntervalCoverageOverSeededReplicates (the same fit 1200 times to count how often its
+# intervals cover the truth, a statistical property; the fit runs in the other StudyFit tests).
+SANITIZE_EXCLUDE ?= Conformance[.]AgreesWithTheOtherLoopOrder/raytrace_none_|python_wheel|MemoryEstimate[.]WithinTenPercentOfASessionsMeasuredPeak|Bvh[.]MatchesBruteForceOnSpheresAsMeshes|StudyFit[.]IntervalCoverageOverSeededReplicates
 # LeakSanitizer's exit-time scan (gcc 12's libsanitizer) can crash ("Tracer caught signal 11")
 # on a garbage dynamic-TLS entry of a Mesa library opened with dlopen. RVR_LINK_OSMESA=ON loads
 # libOSMesa and LLVM at start-up (static TLS), which avoids it, but Mesa's EGL driver is still

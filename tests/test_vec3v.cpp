@@ -5,10 +5,10 @@
 // components span many magnitudes (so that a different association of a sum or a different
 // order of a difference changes the bits).
 #include <gtest/gtest.h>
-#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <glm/glm.hpp>
 #include <ios>
