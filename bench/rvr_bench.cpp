@@ -773,23 +773,22 @@ void BM_Build(benchmark::State& state, const std::string& accel) {
       state.SkipWithError(g.error().c_str());
       break;
     }
+    bytes = double(g.acceleration_bytes());
     if (accel == "bvh") {
       nodes = double(g.wide_bvh().stats().nodes);
       sah = g.wide_bvh().stats().binary_sah_cost;
-      bytes = double(g.acceleration_bytes());
     } else if (accel == "bvh2") {
       nodes = double(g.bvh().stats().nodes);
       sah = g.bvh().stats().sah_cost;
-      bytes = double(g.acceleration_bytes());
     }
     benchmark::DoNotOptimize(&g);
   }
   using C = benchmark::Counter;
   state.counters["prims/s"] = C(double(state.range(0)), C::kIsIterationInvariantRate);
+  state.counters["bytes/tri"] = bytes / double(state.range(0));
   if (accel_kind(accel) != AccelKind::Embree) {
     state.counters["nodes"] = nodes;
     state.counters["sah_cost"] = sah;
-    state.counters["bytes/tri"] = bytes / double(state.range(0));
   }
 }
 

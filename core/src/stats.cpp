@@ -159,8 +159,10 @@ constexpr std::array kStats = {
                     "share of the triangle blocks' slots used"},
     StatDeclaration{"bvh.sah_cost", kRatio, "cost", "raytrace_bvh2",
                     "the binary BVH's surface-area-heuristic cost"},
-    StatDeclaration{"bvh.bytes", kCount, "bytes", "raytrace, hybrids (a BVH)",
-                    "memory the acceleration structure holds"},
+    StatDeclaration{"bvh.bytes", kCount, "bytes", "raytrace, hybrids (a BVH), embree",
+                    "memory the acceleration structure holds (Embree's: what its build "
+                    "allocated and kept, by its memory monitor, without its copy of the "
+                    "geometry)"},
     // The hybrids' split of the work.
     StatDeclaration{"hybrid.rebuilt", kCount, "pixels", "hybrids",
                     "pixels whose primary hit is rebuilt from the z-buffer's ids, no ray"},

@@ -15,7 +15,7 @@
 #include "rvr/raytrace/trace_geometry.h"
 #include "rvr/raytrace/wide_bvh_layout.h"
 
-#define RVR_EMBREE_ABI_VERSION 1
+#define RVR_EMBREE_ABI_VERSION 2
 
 namespace rvr {
 
@@ -65,6 +65,9 @@ struct rvr_embree {
   int (*packet_width)(const rvr::EmbreeScene& scene);
   // The widest of Embree's kernels it runs on this CPU, e.g. "AVX2".
   const char* (*kernel_isa)();
+  // Bytes the scene's build added to the device and kept (its BVH and the triangle data of its
+  // leaves), as Embree's memory monitor reports them; the geometry buffers are not counted.
+  size_t (*build_bytes)(const rvr::EmbreeScene& scene);
 };
 
 // The table; the plugin's one exported symbol.

@@ -100,6 +100,10 @@ int embree_packet_width(const EmbreeBackend& backend) {
   return backend.api->packet_width(*backend.scene);
 }
 
+size_t embree_build_bytes(const EmbreeBackend& backend) {
+  return backend.api->build_bytes(*backend.scene);
+}
+
 std::string embree_kernel_isa() {
   const Expected<const rvr_embree*>& api = embree_api();
   return api ? (*api)->kernel_isa() : "unknown";

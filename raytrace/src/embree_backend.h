@@ -2,6 +2,7 @@
 // librvr_embree.so) opened on the first Embree scene: the tracer itself does not link Embree.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "rvr/core/ray.h"
@@ -19,5 +20,7 @@ bool embree_occluded(const EmbreeBackend& backend, const Ray& ray);
 // in consecutive groups of that many rays.
 void embree_closest_packet(const EmbreeBackend& backend, const RayPacket& packet, HitRecord* hits);
 int embree_packet_width(const EmbreeBackend& backend);
+// Bytes Embree's build of the scene holds (embree_abi.h, build_bytes).
+size_t embree_build_bytes(const EmbreeBackend& backend);
 
 }  // namespace rvr

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -35,11 +36,20 @@ struct EmbreeScene {
   size_t analytic_count = 0;
   std::vector<uint32_t> geometry_base;  // per geomID: unified index of its primitive 0
   int packet_width = 8;  // rtcIntersect8 or rtcIntersect16: the widest this device runs natively
+  // What the device holds, as its memory monitor reports allocations (+) and frees (-); and of
+  // it, what the scene's build added and kept: its BVH and the triangle data in its leaves.
+  std::atomic<int64_t> device_bytes{0};
+  size_t build_bytes = 0;
 
   static EmbreeScene* create(const EmbreeSceneInput& input, std::string& error);
   ~EmbreeScene() {
     if (scene) rtcReleaseScene(scene);
     if (device) rtcReleaseDevice(device);
+  }
+
+  static bool monitor(void* user, ssize_t bytes, bool /*post*/) {
+    static_cast<EmbreeScene*>(user)->device_bytes += int64_t(bytes);
+    return true;  // never refuse an allocation
   }
 
   // Embree's user-geometry callbacks: the analytic shapes through the tracer's callbacks.
@@ -159,6 +169,7 @@ EmbreeScene* EmbreeScene::create(const EmbreeSceneInput& input, std::string& err
             std::to_string(int(rtcGetDeviceError(nullptr))) + ")";
     return nullptr;
   }
+  rtcSetDeviceMemoryMonitorFunction(backend->device, &EmbreeScene::monitor, backend.get());
   backend->scene = rtcNewScene(backend->device);
   rtcSetSceneBuildQuality(backend->scene,
                           input.high_quality ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
@@ -198,7 +209,9 @@ EmbreeScene* EmbreeScene::create(const EmbreeSceneInput& input, std::string& err
     if (backend->geometry_base.size() <= id) backend->geometry_base.resize(id + 1, 0);
     backend->geometry_base[id] = input.first_analytic;
   }
+  const int64_t before_build = backend->device_bytes;
   rtcCommitScene(backend->scene);
+  backend->build_bytes = size_t(std::max<int64_t>(backend->device_bytes - before_build, 0));
   backend->packet_width =
       rtcGetDeviceProperty(backend->device, RTC_DEVICE_PROPERTY_NATIVE_RAY16_SUPPORTED) ? 16 : 8;
   if (RTCError e = rtcGetDeviceError(backend->device); e != RTC_ERROR_NONE) {
@@ -296,6 +309,10 @@ int packet_width(const EmbreeScene& backend) {
   return backend.packet_width;
 }
 
+size_t build_bytes(const EmbreeScene& backend) {
+  return backend.build_bytes;
+}
+
 const char* kernel_isa() {
   // Embree says which of its kernels it runs only in its verbose start-up report, on stdout:
   // capture it once in a temporary file.
@@ -345,8 +362,9 @@ EmbreeScene* create(const EmbreeSceneInput& input, std::string& error) {
 
 extern "C" __attribute__((visibility("default"))) const rvr_embree* rvr_embree_get() {
   static const rvr_embree table = {
-      RVR_EMBREE_ABI_VERSION, &rvr::create,         &rvr::destroy,      &rvr::closest,
-      &rvr::occluded,         &rvr::closest_packet, &rvr::packet_width, &rvr::kernel_isa,
+      RVR_EMBREE_ABI_VERSION, &rvr::create,     &rvr::destroy,
+      &rvr::closest,          &rvr::occluded,   &rvr::closest_packet,
+      &rvr::packet_width,     &rvr::kernel_isa, &rvr::build_bytes,
   };
   return &table;
 }

@@ -818,6 +818,8 @@ Expected<RenderOutput> RayTracer::render_frame(const Scene& scene, const RenderO
     out.stats["bvh.sah_cost"] = b.sah_cost;
     out.stats["bvh.bytes"] = double(geometry.acceleration_bytes());
     out.stats["time.bvh_build"] = b.seconds;
+  } else if (options.accel == AccelKind::Embree) {
+    out.stats["bvh.bytes"] = double(geometry.acceleration_bytes());
   }
   if (options.mode == RenderMode::Full && scene.camera.aperture_radius > 0.0f &&
       scene.image.samples_per_pixel == 1) {

@@ -172,6 +172,7 @@ int TraceGeometry::embree_packet_width() const {
 }
 
 size_t TraceGeometry::acceleration_bytes() const {
+  if (embree_) return embree_build_bytes(*embree_);
   return wide_.bytes() + bvh_.nodes().size() * sizeof(BvhNode) +
          slot_primitive_.size() * sizeof(uint32_t) +
          slot_triangles_.size() * sizeof(TrianglePrecomputed);

@@ -169,7 +169,8 @@ class TraceGeometry {
   // Embree's packet width (rtcIntersect8 or 16) when Embree answers; 0 otherwise.
   int embree_packet_width() const;
   // Bytes held for traversal: bvh: wide nodes + triangle blocks + the analytic shapes' tree;
-  // bvh2: nodes + leaf-ordered triangles + slot indices.
+  // bvh2: nodes + leaf-ordered triangles + slot indices; embree: what Embree's build of the
+  // scene allocated and kept, as its memory monitor reports it.
   size_t acceleration_bytes() const;
 
  private:
