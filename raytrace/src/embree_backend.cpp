@@ -1,7 +1,6 @@
 #include "embree_backend.h"
 
 #include <embree3/rtcore.h>  // RTC_VERSION_STRING only: Embree is not linked here
-#include <stddef.h>
 
 #include <cstdint>
 #include <memory>
