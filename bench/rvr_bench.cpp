@@ -126,10 +126,13 @@ class PhaseTimes {
     const char* stat;
     const char* counter;
   };
-  static constexpr std::array<Phase, 4> kPhases = {{{"time.visibility", "visibility_ms"},
+  static constexpr std::array<Phase, 7> kPhases = {{{"time.visibility", "visibility_ms"},
                                                     {"time.shade", "shade_ms"},
                                                     {"time.zbuffer", "zbuffer_ms"},
-                                                    {"time.trace", "trace_ms"}}};
+                                                    {"time.trace", "trace_ms"},
+                                                    {"time.setup", "setup_ms"},
+                                                    {"time.bin", "bin_ms"},
+                                                    {"time.raster", "raster_ms"}}};
   std::array<double, kPhases.size()> seconds_{};
   std::array<double, kPhases.size()> frames_{};
 };

@@ -29,10 +29,10 @@ using Clock = std::chrono::steady_clock;
 // a time in parallel, binned, and drawn into every tile before the next: memory holds one chunk,
 // whatever the triangle count. Each chunk's tile pass fetches again the frame-buffer lines its
 // triangles touch: scattered triangles (a soup) touch most of the frame in every chunk, so fewer,
-// larger chunks save that traffic; 262,144 set-up triangles are 48 MiB, well inside the memory
+// larger chunks save that traffic; 262,144 set-up triangles are 32 MiB, well inside the memory
 // target at 10^7.
 constexpr size_t kChunk = size_t(1) << 18;
-// 8192 set-up triangles are 1.5 MiB: one huge page each (HugePageAllocator).
+// 8192 set-up triangles are 1 MiB, in one huge page each (HugePageAllocator).
 constexpr size_t kSubChunk = 8192;
 
 // A sub-chunk whose vertex indices span at most this many vertices per triangle is projected as

@@ -157,15 +157,13 @@ void DepthTarget::draw_tile(int tx, int ty, const SetupTriangles* sub_chunks, co
   // A bin's triangles lie scattered over the chunk (megabytes, beyond L2), and so do the pixels
   // they touch in the frame's buffers: both are fetched ahead, so that the misses overlap
   // instead of stalling one by one. Triangle k + kHotAhead: its hot line. Triangle
-  // k + kColdAhead (whose hot line has arrived by then): its cold lines and the depth and
+  // k + kColdAhead (whose hot line has arrived by then): its cold line and the depth and
   // fragment-count lines of the first two rows of its box in this tile.
   constexpr size_t kHotAhead = 8, kColdAhead = 4;
   auto fetch_rest = [&](const SetupTriangle& t) {
-    const char* cold = reinterpret_cast<const char*>(&t) + 64;
-    __builtin_prefetch(cold);
-    __builtin_prefetch(cold + 64);
-    const int px = std::max(t.x0, ox), py = std::max(t.y0, oy);
-    const int py1 = std::min({t.y1, ey, py + 1});
+    __builtin_prefetch(reinterpret_cast<const char*>(&t) + 64);
+    const int px = std::max(int(t.x0), ox), py = std::max(int(t.y0), oy);
+    const int py1 = std::min({int(t.y1), ey, py + 1});
     for (int y = py; y <= py1; ++y) {
       const size_t i = size_t(y) * size_t(width_) + size_t(px);
       __builtin_prefetch(&depth_[i], 1);
@@ -178,8 +176,8 @@ void DepthTarget::draw_tile(int tx, int ty, const SetupTriangles* sub_chunks, co
     if (k + kHotAhead < count) __builtin_prefetch(&triangle(k + kHotAhead));
     if (k + kColdAhead < count) fetch_rest(triangle(k + kColdAhead));
     const SetupTriangle& t = triangle(k);
-    const int x0 = std::max(t.x0, ox), x1 = std::min(t.x1, ex);
-    const int y0 = std::max(t.y0, oy), y1 = std::min(t.y1, ey);
+    const int x0 = std::max(int(t.x0), ox), x1 = std::min(int(t.x1), ex);
+    const int y0 = std::max(int(t.y0), oy), y1 = std::min(int(t.y1), ey);
     if (x0 > x1 || y0 > y1) continue;
     if (hiz_) {
       // The whole triangle at once: behind the farthest depth of every block it overlaps.
@@ -228,8 +226,8 @@ void DepthTarget::draw(const SetupTriangle& t, int x0, int y0, int x1, int y1,
       f.qa[i] = t.qa[size_t(i)];
       f.qb[i] = t.qb[size_t(i)];
     }
-    f.ox = t.ox;
-    f.oy = t.oy;
+    f.ox = t.ox();
+    f.oy = t.oy();
     f.object = t.object;
     f.primitive = t.primitive;
     FillResult r;

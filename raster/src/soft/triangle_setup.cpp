@@ -204,10 +204,10 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
   // covered. Most triangles of a dense mesh hold none, and stop here.
   auto first_centre = [](int64_t lo) { return int((lo - kSub / 2 + kSub - 1) >> kSubBits); };
   auto last_centre = [](int64_t hi) { return int((hi - kSub / 2) >> kSubBits); };
-  t.x0 = std::max(0, first_centre(min_x));
-  t.y0 = std::max(0, first_centre(min_y));
-  t.x1 = std::min(width_ - 1, last_centre(max_x));
-  t.y1 = std::min(height_ - 1, last_centre(max_y));
+  t.x0 = int16_t(std::max(0, first_centre(min_x)));
+  t.y0 = int16_t(std::max(0, first_centre(min_y)));
+  t.x1 = int16_t(std::min(width_ - 1, last_centre(max_x)));
+  t.y1 = int16_t(std::min(height_ - 1, last_centre(max_y)));
   if (t.x0 > t.x1 || t.y0 > t.y1) return;
   RVR_DCHECK(t.x0 >= 0 && t.y0 >= 0 && t.x1 < width_ && t.y1 < height_,
              "a set-up triangle's pixel box lies on screen");
@@ -240,13 +240,12 @@ void TriangleSetup::emit(const double sx_in[3], const double sy_in[3], const int
   double dx1 = sx[1] - sx[0], dy1 = sy[1] - sy[0], dx2 = sx[2] - sx[0], dy2 = sy[2] - sy[0];
   double det = dx1 * dy2 - dx2 * dy1;
   if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return;
-  t.ox = sx[0];
-  t.oy = sy[0];
   for (int j = 0; j < 3; ++j) {
     double f0 = f_in[order[0]][j], f1 = f_in[order[1]][j], f2 = f_in[order[2]][j];
-    t.q0[j] = f0;
     t.qa[j] = ((f1 - f0) * dy2 - (f2 - f0) * dy1) / det;
     t.qb[j] = ((f2 - f0) * dx1 - (f1 - f0) * dx2) / det;
+    // The planes go through (sx[0], sy[0]) with value f0; stored at the snapped vertex 0.
+    t.q0[j] = plane_at_snapped_origin(f0, t.qa[j], t.qb[j], sx[0], sy[0], t.x[0], t.y[0]);
   }
   // Inside the unsnapped triangle depth is at least the nearest vertex's. A covered centre may
   // lie up to kSnapDistance outside it, where the clamped q_j sum to at most

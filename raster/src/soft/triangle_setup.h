@@ -20,6 +20,7 @@ namespace rvr::soft {
 // fixed point, so edge functions (products of 29-bit differences) never overflow int64.
 constexpr double kGuardPixels = double(1 << 16);
 constexpr int kMaxImageSide = 1 << 15;
+static_assert(kMaxImageSide - 1 <= INT16_MAX, "SetupTriangle's pixel box holds any pixel index");
 
 // A vertex in clip space, projected when it lies in front of the near plane.
 struct ProjectedVertex {

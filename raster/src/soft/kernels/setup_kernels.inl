@@ -102,7 +102,7 @@ struct BatchLanes {
   alignas(64) int index[B];
   alignas(64) double sx[3][B], sy[3][B], f[3][3][B], w_min[B];
   // Their perspective planes, hi-z bound and whether emit keeps them.
-  alignas(64) double qa[3][B], qb[3][B], min_depth[B];
+  alignas(64) double q0[3][B], qa[3][B], qb[3][B], min_depth[B];
   alignas(64) int64_t ok[B];
 };
 
@@ -200,21 +200,24 @@ int gather_survivors(const SetupBatch& in, BatchLanes& l) {
   return m;
 }
 
-// Survivors' perspective planes (the barycentrics over w as planes in screen space) and hi-z
-// bound; ok: emit keeps them.
+// Survivors' perspective planes (the barycentrics over w as planes in screen space, their values
+// taken at the snapped vertex 0) and hi-z bound; ok: emit keeps them.
 void planes_and_depth_bound(int m, BatchLanes& l) {
   for (int r = 0; r < m; ++r) {
+    const int32_t x0 = l.x[0][l.index[r]], y0 = l.y[0][l.index[r]];  // the planes' origin
     const double dx1 = l.sx[1][r] - l.sx[0][r], dy1 = l.sy[1][r] - l.sy[0][r];
     const double dx2 = l.sx[2][r] - l.sx[0][r], dy2 = l.sy[2][r] - l.sy[0][r];
     const double det = dx1 * dy2 - dx2 * dy1;
     const double abs_det = std::fabs(det);
     // emit drops !(|det| > 0) || !isfinite(det) (bitwise &: no branch in the vector loop).
     l.ok[r] = int64_t(abs_det > 0.0) & int64_t(abs_det <= DBL_MAX);
-#define RVR_PLANES(j)                                                     \
-  {                                                                       \
-    const double f0 = l.f[0][j][r], f1 = l.f[1][j][r], f2 = l.f[2][j][r]; \
-    l.qa[j][r] = ((f1 - f0) * dy2 - (f2 - f0) * dy1) / det;               \
-    l.qb[j][r] = ((f2 - f0) * dx1 - (f1 - f0) * dx2) / det;               \
+#define RVR_PLANES(j)                                                                        \
+  {                                                                                          \
+    const double f0 = l.f[0][j][r], f1 = l.f[1][j][r], f2 = l.f[2][j][r];                    \
+    l.qa[j][r] = ((f1 - f0) * dy2 - (f2 - f0) * dy1) / det;                                  \
+    l.qb[j][r] = ((f2 - f0) * dx1 - (f1 - f0) * dx2) / det;                                  \
+    l.q0[j][r] =                                                                             \
+        plane_at_snapped_origin(f0, l.qa[j][r], l.qb[j][r], l.sx[0][r], l.sy[0][r], x0, y0); \
   }
     RVR_PLANES(0)
     RVR_PLANES(1)
@@ -247,12 +250,10 @@ int write_survivors(const SetupBatch& in, int m, const BatchLanes& l, SetupTrian
       t.x[i] = l.x[i][k];
       t.y[i] = l.y[i][k];
       t.top_left[i] = l.top_left[i][k] != 0;
-      t.q0[i] = l.f[0][i][r];
+      t.q0[i] = l.q0[i][r];
       t.qa[i] = l.qa[i][r];
       t.qb[i] = l.qb[i][r];
     }
-    t.ox = l.sx[0][r];
-    t.oy = l.sy[0][r];
     t.x0 = l.bx0[k];
     t.y0 = l.by0[k];
     t.x1 = l.bx1[k];
