@@ -5,6 +5,7 @@
 // also set up every triangle exactly as its scalar setup does.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
