@@ -188,6 +188,44 @@ struct BatchVertices {
   }
 };
 
+// A width x height frame seen through a 0.9-radian perspective from the origin, looking down
+// -z, with softraster's setup for it, and the random draws the tests place triangles with.
+struct RandomFrame {
+  RandomFrame(int w, int h, unsigned seed, float nearest, float farthest)
+      : width(w),
+        height(h),
+        setup(w, h, glm::dmat4(glm::perspective(0.9f, float(w) / float(h), 0.1f, 500.0f))),
+        rng(seed),
+        log_depth(std::log(nearest), std::log(farthest)) {}
+  float unit() { return unit_draw(rng); }             // uniform in [-1, 1]
+  float depth() { return std::exp(log_depth(rng)); }  // log-uniform in [nearest, farthest]
+  int width, height;
+  soft::TriangleSetup setup;
+  std::mt19937 rng;
+  std::uniform_real_distribution<float> unit_draw{-1.0f, 1.0f};
+  std::uniform_real_distribution<float> log_depth;
+};
+
+// `count` random triangles, three vertices each as `setup` projects them: `corners(p)` places a
+// triangle's points; one that needs clipping, lies wholly outside the view or that `keep`
+// refuses is placed again.
+template <class Corners, class Keep>
+std::vector<soft::ProjectedVertex> projected_triangles(const soft::TriangleSetup& setup,
+                                                       size_t count, Corners&& corners,
+                                                       Keep&& keep) {
+  std::vector<soft::ProjectedVertex> vertices;
+  while (vertices.size() < 3 * count) {
+    glm::vec3 p[3];
+    corners(p);
+    const soft::ProjectedVertex v[3] = {setup.project(p[0]), setup.project(p[1]),
+                                        setup.project(p[2])};
+    if (v[0].clip_planes | v[1].clip_planes | v[2].clip_planes) continue;
+    if ((v[0].reject & v[1].reject & v[2].reject) || !keep(v)) continue;
+    vertices.insert(vertices.end(), v, v + 3);
+  }
+  return vertices;
+}
+
 }  // namespace
 
 // The batched setup kernels against TriangleSetup::add, the scalar setup (the oracle: the code
@@ -196,31 +234,27 @@ struct BatchVertices {
 // coverage test), large ones, slivers, degenerate ones (repeated or collinear vertices), both
 // windings, depths from 0.2 to 200.
 TEST(SoftrasterSetup, EveryKernelSetsUpTrianglesAsTheScalarSetupDoes) {
-  const int width = 101, height = 75;
-  const glm::dmat4 view_projection =
-      glm::dmat4(glm::perspective(0.9f, float(width) / float(height), 0.1f, 500.0f));
-  const soft::TriangleSetup scalar(width, height, view_projection);
-  std::mt19937 rng(12);
-  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  std::uniform_real_distribution<float> log_depth(std::log(0.2f), std::log(200.0f));
+  RandomFrame frame(101, 75, 12, 0.2f, 200.0f);
+  const int width = frame.width, height = frame.height;
+  const soft::TriangleSetup& scalar = frame.setup;
   std::uniform_int_distribution<int> kind(0, 5);
-  std::vector<soft::ProjectedVertex> vertices;
-  while (vertices.size() < 3 * 20000) {
-    const float z = -std::exp(log_depth(rng));
-    const glm::vec3 centre(unit(rng) * -z * 0.6f, unit(rng) * -z * 0.45f, z);
+  auto corners = [&](glm::vec3(&p)[3]) {
+    const float z = -frame.depth();
+    const float cx = frame.unit() * -z * 0.6f, cy = frame.unit() * -z * 0.45f;
+    const glm::vec3 centre(cx, cy, z);
     // Pixels are about |z| / 100 wide here.
     const float sizes[6] = {0.003f, 0.01f, 0.03f, 0.3f, 0.01f, 0.01f};
-    const int k = kind(rng);
+    const int k = kind(frame.rng);
     const float s = sizes[k] * -z;
-    glm::vec3 p[3];
-    for (glm::vec3& v : p) v = centre + s * glm::vec3(unit(rng), unit(rng), unit(rng) * 0.1f);
+    for (glm::vec3& v : p) {
+      const float dx = frame.unit(), dy = frame.unit(), dz = frame.unit();
+      v = centre + s * glm::vec3(dx, dy, dz * 0.1f);
+    }
     if (k == 4) p[2] = p[0];                          // two vertices the same
     if (k == 5) p[2] = p[0] + 0.37f * (p[1] - p[0]);  // collinear
-    soft::ProjectedVertex v[3] = {scalar.project(p[0]), scalar.project(p[1]), scalar.project(p[2])};
-    if (v[0].clip_planes | v[1].clip_planes | v[2].clip_planes) continue;
-    if (v[0].reject & v[1].reject & v[2].reject) continue;
-    vertices.insert(vertices.end(), v, v + 3);
-  }
+  };
+  const std::vector<soft::ProjectedVertex> vertices = projected_triangles(
+      scalar, 20000, corners, [](const soft::ProjectedVertex*) { return true; });
   const size_t count = vertices.size() / 3;
   soft::TriangleSetup reference_setup = scalar;
   soft::SetupTriangles expected;
@@ -268,32 +302,31 @@ TEST(SoftrasterSetup, EveryKernelSetsUpTrianglesAsTheScalarSetupDoes) {
 // stored at a point other than the one its origin is read from (a sub-pixel step, 1/8192 pixel)
 // is off by its slope over that step, 1e-7 of 1/w_k or more.
 TEST(SoftrasterSetup, PlanesAreBarycentricsOverDepthAtTheVertices) {
-  const int width = 160, height = 120;
-  const glm::dmat4 view_projection =
-      glm::dmat4(glm::perspective(0.9f, float(width) / float(height), 0.1f, 500.0f));
-  const soft::TriangleSetup scalar(width, height, view_projection);
-  std::mt19937 rng(31);
-  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-  std::uniform_real_distribution<float> log_depth(std::log(0.5f), std::log(50.0f));
+  RandomFrame frame(160, 120, 31, 0.5f, 50.0f);
+  const int width = frame.width, height = frame.height;
   std::uniform_real_distribution<float> log_size(std::log(0.01f), std::log(0.3f));
-  std::vector<soft::ProjectedVertex> vertices;
-  while (vertices.size() < 3 * 3000) {
-    const float z = -std::exp(log_depth(rng));
-    const glm::vec3 centre(unit(rng) * -z * 0.5f, unit(rng) * -z * 0.35f, z);
-    const float s = std::exp(log_size(rng)) * -z;  // pixels are about |z| / 160 wide
-    glm::vec3 p[3];
-    for (glm::vec3& v : p) v = centre + s * glm::vec3(unit(rng), unit(rng), unit(rng) * 0.5f);
-    soft::ProjectedVertex v[3] = {scalar.project(p[0]), scalar.project(p[1]), scalar.project(p[2])};
-    if (v[0].clip_planes | v[1].clip_planes | v[2].clip_planes) continue;
-    if (v[0].reject | v[1].reject | v[2].reject) continue;
-    // Well conditioned: the smallest altitude at least a tenth of the longest side.
+  auto corners = [&](glm::vec3(&p)[3]) {
+    const float z = -frame.depth();
+    const float cx = frame.unit() * -z * 0.5f, cy = frame.unit() * -z * 0.35f;
+    const glm::vec3 centre(cx, cy, z);
+    const float s = std::exp(log_size(frame.rng)) * -z;  // pixels are about |z| / 160 wide
+    for (glm::vec3& v : p) {
+      const float dx = frame.unit(), dy = frame.unit(), dz = frame.unit();
+      v = centre + s * glm::vec3(dx, dy, dz * 0.5f);
+    }
+  };
+  // Wholly on screen and well conditioned: the smallest altitude at least a tenth of the
+  // longest side.
+  auto well_conditioned = [](const soft::ProjectedVertex* v) {
+    if (v[0].reject | v[1].reject | v[2].reject) return false;
     const double ax = v[1].sx - v[0].sx, ay = v[1].sy - v[0].sy;
     const double bx = v[2].sx - v[0].sx, by = v[2].sy - v[0].sy;
     const double cx = v[2].sx - v[1].sx, cy = v[2].sy - v[1].sy;
     const double longest2 = std::max({ax * ax + ay * ay, bx * bx + by * by, cx * cx + cy * cy});
-    if (std::abs(ax * by - bx * ay) < 0.1 * longest2) continue;
-    vertices.insert(vertices.end(), v, v + 3);
-  }
+    return std::abs(ax * by - bx * ay) >= 0.1 * longest2;
+  };
+  const std::vector<soft::ProjectedVertex> vertices =
+      projected_triangles(frame.setup, 3000, corners, well_conditioned);
   const size_t count = vertices.size() / 3;
   auto check = [&](const soft::SetupTriangle& t, const std::string& who) {
     const size_t i = t.primitive;
@@ -307,7 +340,7 @@ TEST(SoftrasterSetup, PlanesAreBarycentricsOverDepthAtTheVertices) {
             << who << ": triangle " << i << ", plane " << j << " at vertex " << k;
       }
   };
-  soft::TriangleSetup reference_setup = scalar;
+  soft::TriangleSetup reference_setup = frame.setup;
   soft::SetupTriangles expected;
   size_t clipped = 0;
   for (size_t i = 0; i < count; ++i)
