@@ -389,11 +389,14 @@ void BM_Effects(benchmark::State& state, const std::string& effect) {
   effect_scene(effect, scene, options);
   RayTracer tracer;
   RenderOutput out = tracer.render(scene, options).value();
+  PhaseTimes phases;
   for (auto _ : state) {
     out = tracer.render(scene, options).value();
     benchmark::DoNotOptimize(out.buffers.colour.data());
+    phases.add(out);
   }
   add_counters(state, out, double(scene.image.width) * scene.image.height);
+  phases.report(state);
 }
 
 // What `rvr render builtin:cornell -r raytrace --aov depth,id,normal,cost` writes after its
