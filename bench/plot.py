@@ -190,6 +190,10 @@ def effects_table(rows, context, out):
     lines = [f"# What each technique costs and how far it is from the tracer ({subtitle(context)})", "",
              "cornell, 640x480, full mode (`primary`: local mode) (`BM_Effects`); PSNR against the tracer's frame, linear RGB, "
              "peak 1: inside the effect's mask where it has one, and over the whole image.", "",
+             "Shading: the tracer and the hybrids shade their hits on matt materials with the SIMD shading kernels, "
+             "a block at a time (shadow rays traced between the kernel's two passes); `softraster`'s shadow-map pass "
+             "still adds its light samples pixel by pixel (scalar), a small part of a frame that drawing its cube maps "
+             "dominates; `raster` shades in its GLSL fragment shader.", "",
              "| effect | renderer (technique) | ms | × tracer | PSNR in mask (dB) | PSNR image (dB) |",
              "|---|---|---|---|---|---|"]
     for effect in sorted(set(tracer) | set(techniques), key=lambda e: (effect_rank(e), e)):

@@ -236,8 +236,12 @@ const glm::vec3 kOrigin(0.25f, 0.5f, 2.75f);
 // The tracer's scalar code (TraceGeometry::surface and ray_tracer.cpp before the kernels):
 // P = o + t d, normalize(cross(e1, e2)), smooth normals interpolated and divided by their
 // length when it is above 0, V = -normalize(d), face_viewer, shade_local.
+// With `visibility` (full mode), vis_l is visibility[l], and the samples shade_local asks it
+// for are the bits of `asked`, the surface point is `position`.
 Shaded scalar_shade_surface(const SurfacePixel& p, const glm::vec3& ambient,
-                            const std::vector<LightSample>& lights) {
+                            const std::vector<LightSample>& lights,
+                            const float* visibility = nullptr, uint32_t* asked = nullptr,
+                            glm::vec3* position = nullptr) {
   const glm::vec3 P = kOrigin + p.t * p.direction;
   glm::vec3 geometric = p.geometric, shading = p.shading;
   if (!p.given) {
@@ -251,8 +255,22 @@ Shaded scalar_shade_surface(const SurfacePixel& p, const glm::vec3& ambient,
   }
   const glm::vec3 V = -glm::normalize(p.direction);
   const glm::vec3 N = face_viewer(shading, geometric, V);
-  return {N, shade_local(p.material, P, N, V, ambient, lights)};
+  if (!visibility) return {N, shade_local(p.material, P, N, V, ambient, lights)};
+  *asked = 0;
+  *position = P;
+  return {N, shade_local(p.material, P, N, V, ambient, lights,
+                         [&](size_t l, const glm::vec3&, const glm::vec3&) {
+                           *asked |= 1u << l;
+                           return visibility[l];
+                         })};
 }
+
+// What the kernels' full-mode path gives besides the colour: each pixel's point and the light
+// samples light_needs says need a shadow ray (bit l).
+struct NeedsOut {
+  std::vector<glm::vec3> position;
+  std::vector<uint32_t> needs;
+};
 
 // The deferred pass's pixels as hits: the same triangles and materials seen along rays from
 // kOrigin; every 9th an analytic shape (given normals), every 29th a smooth triangle whose
@@ -294,10 +312,15 @@ std::vector<SurfacePixel> random_surface_pixels() {
 // it once (the per-slot arrays then NaN), other batches carry it per slot; what the tracer does
 // not fill for a lane (vertex normals of flat triangles, triangle data of given lanes, given
 // normals of triangles) is NaN.
+// With `visibility` (vis of sample l at pixel p: visibility[p * lights.size() + l]), as the
+// tracer's full mode: light_needs (its points and needs into `needs_out`), then shade_surfaces
+// with the visibility.
 std::vector<Shaded> kernel_shade_surfaces(const ShadeKernels& kernels,
                                           const std::vector<SurfacePixel>& px,
                                           const glm::vec3& ambient,
-                                          const std::vector<LightSample>& lights) {
+                                          const std::vector<LightSample>& lights,
+                                          const std::vector<float>* visibility = nullptr,
+                                          NeedsOut* needs_out = nullptr) {
   const ShadeLightArrays soa(lights);
   auto batch = std::make_unique<SurfaceBatch>();
   std::vector<Shaded> out;
@@ -333,7 +356,25 @@ std::vector<Shaded> kernel_shade_surfaces(const ShadeKernels& kernels,
     }
     pad_batch(*batch, !one_material);
     batch->material = one_material ? &material : nullptr;
-    kernels.shade_surfaces(*batch, soa.lights());
+    if (!visibility) {
+      kernels.shade_surfaces(*batch, soa.lights(), nullptr);
+    } else {
+      LightNeeds needs;
+      kernels.light_needs(*batch, soa.lights(), needs);
+      auto vis = std::make_unique<LightVisibility>();
+      for (int i = 0; i < kShadeBatch; ++i)
+        for (size_t l = 0; l < lights.size(); ++l)
+          vis->vis[l][i] =
+              (*visibility)[std::min(first + size_t(i), px.size() - 1) * lights.size() + l];
+      for (int i = 0; i < n; ++i) {
+        needs_out->position.push_back(
+            {batch->position[0][i], batch->position[1][i], batch->position[2][i]});
+        uint32_t bits = 0;
+        for (size_t l = 0; l < lights.size(); ++l) bits |= uint32_t(needs.at(int(l), i)) << l;
+        needs_out->needs.push_back(bits);
+      }
+      kernels.shade_surfaces(*batch, soa.lights(), vis.get());
+    }
     for (int i = 0; i < n; ++i)
       out.push_back(
           {{batch->shading_normal[0][i], batch->shading_normal[1][i], batch->shading_normal[2][i]},
@@ -372,4 +413,42 @@ TEST(ShadeKernels, EveryKernelShadesTheTracersHitsAsTheScalarCodeBitForBit) {
   expect_surface_kernels_shade_as_scalar(pixels);
   for (size_t k = 0; k < pixels.size(); ++k) pixels[k].material = pixels[k / 150 * 150].material;
   expect_surface_kernels_shade_as_scalar(pixels);
+}
+
+// Full mode: every kernel asks for the visibility of the samples shade_local asks for, leaves
+// from the same point, and with the same answers (0, 1 and a fraction) gives the same bits.
+TEST(ShadeKernels, EveryKernelShadesTheTracersHitsWithTheirVisibilityAsTheScalarCode) {
+  const std::vector<SurfacePixel> pixels = random_surface_pixels();
+  std::mt19937 rng(5);
+  const float answers[] = {0.0f, 1.0f, 0.25f};
+  std::vector<float> visibility(pixels.size() * kLights.size());
+  for (float& v : visibility) v = answers[rng() % 3];
+  int tested = 0, asked_total = 0;
+  for (Isa isa : kAllIsas) {
+    if (!cpu_supports(isa)) continue;
+    ++tested;
+    NeedsOut needs;
+    const std::vector<Shaded> got =
+        kernel_shade_surfaces(shade_kernels(isa), pixels, kAmbient, kLights, &visibility, &needs);
+    ASSERT_EQ(got.size(), pixels.size());
+    int failures = 0;
+    for (size_t i = 0; i < pixels.size() && failures < 5; ++i) {
+      uint32_t asked = 0;
+      glm::vec3 P;
+      const Shaded want = scalar_shade_surface(pixels[i], kAmbient, kLights,
+                                               &visibility[i * kLights.size()], &asked, &P);
+      asked_total += __builtin_popcount(asked);
+      if (same_bits(got[i].normal, want.normal) && same_bits(got[i].colour, want.colour) &&
+          same_bits(needs.position[i], P) && needs.needs[i] == asked)
+        continue;
+      ++failures;
+      ADD_FAILURE() << to_string(isa) << " hit " << i << ": colour " << show(got[i].colour)
+                    << " point " << show(needs.position[i]) << " needs " << needs.needs[i]
+                    << ", scalar " << show(want.colour) << " " << show(P) << " " << asked;
+    }
+  }
+  EXPECT_GE(tested, 1);
+  // Both kinds of sample occur: asked for (in front) and skipped (behind, at the vertex).
+  EXPECT_GT(asked_total, 0);
+  EXPECT_LT(asked_total, tested * int(pixels.size() * kLights.size()));
 }

@@ -303,22 +303,30 @@ class FrameTracer {
     });
   }
 
-  // Local shading: the block's hits put into one batch, whose surfaces and colours the shading
-  // kernels compute together. A batch of one material shades with it; a mixed one carries each
-  // slot's.
-  void finish_local(const BlockHits& b, TileOutput& out, RayCounters& counters) const {
-    static_assert(kPacketRays <= kShadeBatch, "a block's hits fit one batch");
-    const bool supersampled = this->supersampled();
+  // A block's hits gathered into one SurfaceBatch for the shading kernels: slot j holds the hit
+  // of the pixel pixel[j] of `out`. A batch of one material shades with it; a mixed one carries
+  // each slot's.
+  struct GatheredHits {
     SurfaceBatch batch;
+    size_t pixel[kPacketRays];
+    int ray[kPacketRays];  // the slot's ray in the block
+  };
+
+  // Writes each pixel's level of detail, cost and, where its ray missed, background, and puts the
+  // hits whose material `batched(material)` accepts into g.batch, in ray order (their depth and
+  // ids into `out`), ready for the kernels. Returns the rays that hit but were not batched.
+  template <class Batched>
+  uint64_t gather_hits(const BlockHits& b, TileOutput& out, GatheredHits& g,
+                       Batched&& batched) const {
+    static_assert(kPacketRays <= kShadeBatch, "a block's hits fit one batch");
+    SurfaceBatch& batch = g.batch;
     for (int a = 0; a < 3; ++a) batch.origin[a] = b.packet.origin[a];
-    size_t batch_pixel[kPacketRays];
     LastTriangle last;
     int batch_count = 0;  // kept out of `batch` so that it stays in a register
     bool mixed = false;   // the batch's pixels have more than one material
     uint32_t batch_material = 0;
-    // Each pixel's level of detail, cost and, where its ray missed, background; which rays hit.
     size_t pixel[kPacketRays];
-    uint64_t hit_rays = 0;
+    uint64_t hit_rays = 0, unbatched = 0;
     b.for_each_pixel(out, [&](int k, int, int, size_t i) {
       pixel[k] = i;
       if (textured_) out.lod[i] = kNoLod;
@@ -328,18 +336,23 @@ class FrameTracer {
         hit_rays |= uint64_t(1) << k;
       out.cost[i] = pixel_cost(b.centre_work(k));  // after set_background's zero
     });
-    // The hits into the batch, in ray order.
     for (uint64_t m = hit_rays; m != 0; m &= m - 1) {
       const int k = __builtin_ctzll(m);
       const size_t i = pixel[k];
       const HitRecord& hit = b.hits[k];
-      const int slot = batch_count++;
-      batch_pixel[slot] = i;
+      const int slot = batch_count;
       const uint32_t material = add_to_batch(batch, slot, b.packet, k, hit, out, i, last);
+      if (!batched(material)) {
+        unbatched |= uint64_t(1) << k;
+        continue;  // the slot is taken by the next hit
+      }
+      ++batch_count;
+      g.pixel[slot] = i;
+      g.ray[slot] = k;
       const uint32_t object = out.object_id[i];
       if (varies_ && object_varies_[object]) {
         // Its own material: the diffuse replaced by the base colour at the hit.
-        const Material& m = scene_.materials[material];
+        const Material& mat = scene_.materials[material];
         const glm::vec3 base = varying_base_colour(scene_.objects[object], out.primitive_id[i],
                                                    hit.u, hit.v, b.direction(k), hit.t,
                                                    &primary_footprint_, out.lod[i], b.lod_given(k));
@@ -347,7 +360,7 @@ class FrameTracer {
           mixed = true;
           for (int j = 0; j < slot; ++j) put_material(batch, j, materials_[batch_material]);
         }
-        put_material(batch, slot, shade_material(with_diffuse(m, base), scene_.ambient));
+        put_material(batch, slot, shade_material(with_diffuse(mat, base), scene_.ambient));
       } else {
         if (slot == 0) {
           batch_material = material;
@@ -358,20 +371,32 @@ class FrameTracer {
         if (mixed) put_material(batch, slot, materials_[material]);
       }
     }
+    batch.count = batch_count;
+    if (batch_count > 0) {
+      pad_batch(batch, mixed);
+      batch.material = mixed ? nullptr : &materials_[batch_material];
+    }
+    return unbatched;
+  }
+
+  // Local shading: the block's hits put into one batch, whose surfaces and colours the shading
+  // kernels compute together.
+  void finish_local(const BlockHits& b, TileOutput& out, RayCounters& counters) const {
+    GatheredHits g;
+    gather_hits(b, out, g, [](uint32_t) { return true; });
     // A supersampled pixel's colour is its samples' mean, its cost theirs too.
+    const bool supersampled = this->supersampled();
     if (supersampled)
       b.for_each_pixel(out, [&](int k, int x, int y, size_t i) {
         const uint64_t before = traced_work(counters);
         out.colour[i] = supersample(x, y, counters);
         out.cost[i] = pixel_cost(b.centre_work(k) + traced_work(counters) - before);
       });
-    if (batch_count == 0) return;
-    batch.count = batch_count;
-    pad_batch(batch, mixed);
-    batch.material = mixed ? nullptr : &materials_[batch_material];
-    kernels_.shade_surfaces(batch, light_arrays_.lights());
+    const SurfaceBatch& batch = g.batch;
+    if (batch.count == 0) return;
+    kernels_.shade_surfaces(g.batch, light_arrays_.lights(), nullptr);
     for (int slot = 0; slot < batch.count; ++slot) {
-      const size_t i = batch_pixel[slot];
+      const size_t i = g.pixel[slot];
       out.normal[i] = {batch.shading_normal[0][slot], batch.shading_normal[1][slot],
                        batch.shading_normal[2][slot]};
       if (!supersampled)
@@ -379,30 +404,97 @@ class FrameTracer {
     }
   }
 
-  // Full shading, one pixel at a time: each hit's shadow, reflection and refraction rays traced.
+  // Whether full shading can take the block's hits as one batch: one sample per pixel (the
+  // light samples then fixed, without a pixel's random stream) and few enough light samples for
+  // the kernels' visibility arrays. Only a hit on a material that neither reflects nor
+  // transmits joins the batch (its colour is its local term: 1 - 0 - 0 is 1).
+  bool full_batches() const {
+    return !supersampled() && lights_.size() <= size_t(kShadeVisibleLights);
+  }
+  bool local_only(uint32_t material) const {
+    const Material& m = scene_.materials[material];
+    return m.mirror == 0.0f && m.transparency == 0.0f;
+  }
+
+  // Full shading with the hits on local-only materials as one batch: the kernels give each
+  // pixel's point and normal and which light samples need a shadow ray, the rays are traced
+  // pixel by pixel, and the kernels shade with their answers: every operation of shade() for
+  // such a hit, in its order. The other hits are shaded one at a time (shade_full_pixel).
   void finish_full(const BlockHits& b, TileOutput& out, RayCounters& counters) const {
-    const bool supersampled = this->supersampled();
-    b.for_each_pixel(out, [&](int k, int x, int y, size_t i) {
-      const HitRecord& hit = b.hits[k];
+    if (!full_batches()) {
+      b.for_each_pixel(out, [&](int k, int x, int y, size_t i) {
+        shade_full_pixel(b, k, x, y, i, out, counters);
+      });
+      return;
+    }
+    GatheredHits g;
+    const uint64_t unbatched =
+        gather_hits(b, out, g, [&](uint32_t material) { return local_only(material); });
+    if (unbatched != 0)
+      b.for_each_pixel(out, [&](int k, int x, int y, size_t i) {
+        if (unbatched >> k & 1) shade_full_pixel(b, k, x, y, i, out, counters);
+      });
+    SurfaceBatch& batch = g.batch;
+    if (batch.count == 0) return;
+    const ShadeLights lights = light_arrays_.lights();
+    LightNeeds needs;
+    kernels_.light_needs(batch, lights, needs);
+    // Every lane the kernel reads is set: 1 where no ray is traced (the kernel adds no term
+    // there), the padding lanes included.
+    LightVisibility visibility;
+    const int lanes = (batch.count + kShadeMaxLanes - 1) / kShadeMaxLanes * kShadeMaxLanes;
+    for (int l = 0; l < lights.count; ++l) std::fill_n(visibility.vis[l], lanes, 1.0f);
+    for (int slot = 0; slot < batch.count; ++slot) {
       const uint64_t before = traced_work(counters);
-      if (textured_) out.lod[i] = kNoLod;
-      if (hit.primitive == kNoPrimitive) {
-        out.set_background(i, scene_.image.background);
-      } else {
-        const Ray ray = PrimaryRays::ray_of(b.packet, k);
-        const SurfaceHit s = geometry_.surface(ray, hit);
-        const glm::vec3 V = -glm::normalize(ray.dir);
-        const glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
-        out.depth[i] = s.t;
-        out.object_id[i] = s.object;
-        out.primitive_id[i] = s.primitive;
-        out.normal[i] = N;
-        out.colour[i] = shade(ray, s, N, V, 0, counters, nullptr, textured_footprint(),
-                              textured_ ? &out.lod[i] : nullptr, b.lod_given(k));
-      }
-      if (supersampled) out.colour[i] = supersample(x, y, counters);
-      out.cost[i] = pixel_cost(b.centre_work(k) + traced_work(counters) - before);
-    });
+      const glm::vec3 P(batch.position[0][slot], batch.position[1][slot], batch.position[2][slot]);
+      const glm::vec3 N(batch.shading_normal[0][slot], batch.shading_normal[1][slot],
+                        batch.shading_normal[2][slot]);
+      const glm::vec3 above = P + ray_epsilon(P) * N;  // as shade() leaves the surface
+      for (int l = 0; l < lights.count; ++l)
+        if (needs.at(l, slot))
+          visibility.vis[l][slot] = shadow_visibility(above, lights_[size_t(l)].position, counters);
+      const size_t i = g.pixel[slot];
+      out.normal[i] = N;
+      out.cost[i] = pixel_cost(b.centre_work(g.ray[slot]) + traced_work(counters) - before);
+    }
+    kernels_.shade_surfaces(batch, lights, &visibility);
+    for (int slot = 0; slot < batch.count; ++slot)
+      out.colour[g.pixel[slot]] = {batch.colour[0][slot], batch.colour[1][slot],
+                                   batch.colour[2][slot]};
+  }
+
+  // Full shading of one pixel (ray k of the block, pixel (x, y), index i): its centre hit's
+  // shadow, reflection and refraction rays traced; with several samples, the samples' mean.
+  void shade_full_pixel(const BlockHits& b, int k, int x, int y, size_t i, TileOutput& out,
+                        RayCounters& counters) const {
+    const HitRecord& hit = b.hits[k];
+    const uint64_t before = traced_work(counters);
+    if (textured_) out.lod[i] = kNoLod;
+    if (hit.primitive == kNoPrimitive) {
+      out.set_background(i, scene_.image.background);
+    } else {
+      const Ray ray = PrimaryRays::ray_of(b.packet, k);
+      const SurfaceHit s = geometry_.surface(ray, hit);
+      const glm::vec3 V = -glm::normalize(ray.dir);
+      const glm::vec3 N = face_viewer(s.shading_normal, s.geometric_normal, V);
+      out.depth[i] = s.t;
+      out.object_id[i] = s.object;
+      out.primitive_id[i] = s.primitive;
+      out.normal[i] = N;
+      out.colour[i] = shade(ray, s, N, V, 0, counters, nullptr, textured_footprint(),
+                            textured_ ? &out.lod[i] : nullptr, b.lod_given(k));
+    }
+    if (supersampled()) out.colour[i] = supersample(x, y, counters);
+    out.cost[i] = pixel_cost(b.centre_work(k) + traced_work(counters) - before);
+  }
+
+  // vis of a light sample at `light` seen from `above` (a point just off the surface): 0 where
+  // the shadow ray meets anything before it, else 1.
+  float shadow_visibility(const glm::vec3& above, const glm::vec3& light,
+                          RayCounters& counters) const {
+    Ray shadow{above, light - above, 0.0f, 1.0f - 1e-4f};
+    counters.shadow++;
+    return geometry_.occluded(shadow, counters.traversal) ? 0.0f : 1.0f;
   }
 
   // The surface data of the triangle the last hit put into a batch was on: neighbouring pixels
@@ -571,9 +663,7 @@ class FrameTracer {
     float eps = ray_epsilon(s.position);
     glm::vec3 above = s.position + eps * N;  // on the viewer's side of the surface
     auto visibility = [&](size_t, const glm::vec3&, const glm::vec3& light) {
-      Ray shadow{above, light - above, 0.0f, 1.0f - 1e-4f};
-      counters.shadow++;
-      return geometry_.occluded(shadow, counters.traversal) ? 0.0f : 1.0f;
+      return shadow_visibility(above, light, counters);
     };
     glm::vec3 local = shade_local(
         m, s.position, N, V, scene_.ambient,

@@ -56,33 +56,58 @@ inline VF specular_power(VF x, VF s) {
   return load(r);
 }
 
-// shade_local from the base colour on: each light sample in order.
-V3 add_lights(const ShadeLanes& batch, int i, const V3& P, const V3& N, const V3& V,
-              const ShadeLights& lights) {
-  const VF zero = splat(0.0f);
+// The material terms of lanes [i, i + kLanes): the batch's one material, or each pixel's.
+struct MaterialLanes {
+  V3 diffuse, specular, base;
+  VF shininess;
+};
+inline MaterialLanes material_lanes(const ShadeLanes& batch, int i) {
   const ShadeMaterial* m = batch.material;
-  const V3 diffuse = m ? V3::splat(m->diffuse) : V3::load(batch.diffuse, i);
-  const V3 specular = m ? V3::splat(m->specular) : V3::load(batch.specular, i);
-  const VF shininess = m ? splat(m->shininess) : load(batch.shininess + i);
-  V3 colour = m ? V3::splat(m->base) : V3::load(batch.base, i);
+  if (m)
+    return {V3::splat(m->diffuse), V3::splat(m->specular), V3::splat(m->base), splat(m->shininess)};
+  return {V3::load(batch.diffuse, i), V3::load(batch.specular, i), V3::load(batch.base, i),
+          load(batch.shininess + i)};
+}
+
+// Light sample l at the lanes' points: its brdf and squared distance, and where it adds a term
+// (add_light_samples skips a sample at distance 0 and one whose brdf is 0: 0 * inf could be
+// NaN). Returns false, the rest unset, where no lane has the light at a distance above 0.
+struct LightSampleLanes {
+  M lit;
+  V3 brdf;
+  VF dist2;
+};
+inline bool light_sample(const MaterialLanes& m, const V3& P, const V3& N, const V3& V,
+                         const ShadeLights& lights, int l, LightSampleLanes& out) {
+  const VF zero = splat(0.0f);
+  const V3 to_light = V3::splat(column(lights.position, l)) - P;
+  const VF dist2 = length_squared(to_light);
+  const M far = dist2 > zero;  // !(dist2 > 0): the sample adds nothing
+  if (movemask(far) == 0) return false;
+  const V3 Ld = to_light / sqrt(dist2);
+  const VF n_dot_l = clamp0(dot(N, Ld));
+  const V3 H = normalize(Ld + V);
+  const VF n_dot_h = clamp0(dot(N, H));
+  const VF power = specular_power(n_dot_h, m.shininess);
+  out.brdf = m.diffuse * n_dot_l + m.specular * power;
+  out.lit = far & (((out.brdf.x != zero) | (out.brdf.y != zero)) | (out.brdf.z != zero));
+  out.dist2 = dist2;
+  return true;
+}
+
+// shade_local from the base colour on: each light sample in order, vis * brdf * I / dist2 with
+// vis from `visibility` (null: 1, and 1 * brdf is brdf, bit for bit).
+V3 add_lights(const ShadeLanes& batch, int i, const V3& P, const V3& N, const V3& V,
+              const ShadeLights& lights, const LightVisibility* visibility) {
+  const MaterialLanes m = material_lanes(batch, i);
+  V3 colour = m.base;
   for (int l = 0; l < lights.count; ++l) {
-    const V3 position = V3::splat(column(lights.position, l));
+    LightSampleLanes sample;
+    if (!light_sample(m, P, N, V, lights, l, sample)) continue;
     const V3 intensity = V3::splat(column(lights.intensity, l));
-    const V3 to_light = position - P;
-    const VF dist2 = length_squared(to_light);
-    M lit = dist2 > zero;  // !(dist2 > 0): the sample adds nothing
-    if (movemask(lit) == 0) continue;
-    const V3 Ld = to_light / sqrt(dist2);
-    const VF n_dot_l = clamp0(dot(N, Ld));
-    const V3 H = normalize(Ld + V);
-    const VF n_dot_h = clamp0(dot(N, H));
-    const VF power = specular_power(n_dot_h, shininess);
-    const V3 brdf = diffuse * n_dot_l + specular * power;
-    // brdf == vec3(0) skips the sample (its term could be NaN: 0 * inf).
-    lit = lit & (((brdf.x != zero) | (brdf.y != zero)) | (brdf.z != zero));
-    // vis * brdf * I / dist2 with vis = 1: 1 * brdf is brdf, bit for bit.
-    const V3 term = (brdf * intensity) / dist2;
-    colour = select(lit, colour + term, colour);
+    const V3 brdf = visibility ? sample.brdf * load(visibility->vis[l] + i) : sample.brdf;
+    const V3 term = (brdf * intensity) / sample.dist2;
+    colour = select(sample.lit, colour + term, colour);
   }
   return colour;
 }
@@ -111,38 +136,63 @@ void shade(ShadeBatch& batch, const float eye_position[3], const ShadeLights& li
     const V3 V = normalize(eye - P);
     const V3 N = face_viewer(shading, geometric, V);
     store(batch.shading_normal, i, N);
-    store(batch.colour, i, add_lights(batch, i, P, N, V, lights));
+    store(batch.colour, i, add_lights(batch, i, P, N, V, lights, nullptr));
   }
 }
 
-void shade_surfaces(SurfaceBatch& batch, const ShadeLights& lights) {
+// TraceGeometry::surface at lanes [i, i + kLanes): P = o + t d, then the triangle's normals;
+// the shading normal facing the viewer V = -normalize(d).
+struct SurfaceLanes {
+  V3 P, N, V;
+};
+inline SurfaceLanes surface_lanes(const SurfaceBatch& batch, const V3& origin, int i) {
+  const V3 direction = V3::load(batch.direction, i);
+  const V3 P = origin + direction * load(batch.t + i);
+  const M given = M::load(batch.given + i);
+  const M smooth = M::load(batch.smooth + i);
+  V3 geometric = V3::load(batch.geometric, i), shading = V3::load(batch.shading, i);
+  if (movemask(given) != kAllLanes) {
+    const V3 triangle = normalize(cross(V3::load(batch.edge1, i), V3::load(batch.edge2, i)));
+    V3 interpolated = triangle;
+    if (movemask(smooth) != 0) {
+      const VF u = load(batch.u + i), v = load(batch.v + i);
+      const VF w[3] = {splat(1.0f) - u - v, u, v};
+      const V3 n = interpolate(w, batch.vertex_normal, i);
+      const VF length = sqrt(length_squared(n));
+      interpolated = select(smooth & (length > splat(0.0f)), n / length, triangle);
+    }
+    geometric = select(given, geometric, triangle);
+    shading = select(given, shading, interpolated);
+  }
+  // -normalize(direction): the negation is exact.
+  const V3 V = -normalize(direction);
+  return {P, face_viewer(shading, geometric, V), V};
+}
+
+void shade_surfaces(SurfaceBatch& batch, const ShadeLights& lights,
+                    const LightVisibility* visibility) {
   const V3 origin = V3::splat(batch.origin);
   for (int i = 0; i < batch.count; i += kLanes) {
-    // TraceGeometry::surface: P = o + t d, then the triangle's normals.
-    const V3 direction = V3::load(batch.direction, i);
-    const V3 P = origin + direction * load(batch.t + i);
-    const M given = M::load(batch.given + i);
-    const M smooth = M::load(batch.smooth + i);
-    V3 geometric = V3::load(batch.geometric, i), shading = V3::load(batch.shading, i);
-    if (movemask(given) != kAllLanes) {
-      const V3 triangle = normalize(cross(V3::load(batch.edge1, i), V3::load(batch.edge2, i)));
-      V3 interpolated = triangle;
-      if (movemask(smooth) != 0) {
-        const VF u = load(batch.u + i), v = load(batch.v + i);
-        const VF w[3] = {splat(1.0f) - u - v, u, v};
-        const V3 n = interpolate(w, batch.vertex_normal, i);
-        const VF length = sqrt(length_squared(n));
-        interpolated = select(smooth & (length > splat(0.0f)), n / length, triangle);
-      }
-      geometric = select(given, geometric, triangle);
-      shading = select(given, shading, interpolated);
+    const SurfaceLanes s = surface_lanes(batch, origin, i);
+    store(batch.shading_normal, i, s.N);
+    store(batch.colour, i, add_lights(batch, i, s.P, s.N, s.V, lights, visibility));
+  }
+}
+
+void light_needs(SurfaceBatch& batch, const ShadeLights& lights, LightNeeds& needs) {
+  static_assert(64 % kLanes == 0 && 2 * 64 == kShadeBatch, "a group's bits lie in one word");
+  for (int l = 0; l < lights.count; ++l) needs.bits[l][0] = needs.bits[l][1] = 0;
+  const V3 origin = V3::splat(batch.origin);
+  for (int i = 0; i < batch.count; i += kLanes) {
+    const SurfaceLanes s = surface_lanes(batch, origin, i);
+    store(batch.position, i, s.P);
+    store(batch.shading_normal, i, s.N);
+    const MaterialLanes m = material_lanes(batch, i);
+    for (int l = 0; l < lights.count; ++l) {
+      LightSampleLanes sample;
+      if (!light_sample(m, s.P, s.N, s.V, lights, l, sample)) continue;
+      needs.bits[l][i / 64] |= uint64_t(movemask(sample.lit)) << (i % 64);
     }
-    // -normalize(direction): the negation is exact.
-    const V3 unit = normalize(direction);
-    const V3 V = -unit;
-    const V3 N = face_viewer(shading, geometric, V);
-    store(batch.shading_normal, i, N);
-    store(batch.colour, i, add_lights(batch, i, P, N, V, lights));
   }
 }
 

@@ -8,7 +8,7 @@
 namespace rvr {
 namespace RVR_KERNEL_NS {
 
-extern const ShadeKernels kShadeKernels = {RVR_KERNEL_NAME, shade, shade_surfaces};
+extern const ShadeKernels kShadeKernels = {RVR_KERNEL_NAME, shade, shade_surfaces, light_needs};
 
 }  // namespace RVR_KERNEL_NS
 }  // namespace rvr

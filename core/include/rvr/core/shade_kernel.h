@@ -71,6 +71,23 @@ struct SurfaceBatch : ShadeLanes {
   alignas(64) uint32_t given[kShadeBatch];      // ~0u: the normals are geometric and shading
   alignas(64) float geometric[3][kShadeBatch];  // unit, as modelled; read where given
   alignas(64) float shading[3][kShadeBatch];    // unit; read where given
+  // Output of light_needs: the surface point o + t d.
+  alignas(64) float position[3][kShadeBatch];
+};
+
+// At most this many light samples per batch when their visibility is given (full mode's shadow
+// rays): the visibility of each sample at each pixel, and which samples need it.
+constexpr int kShadeVisibleLights = 16;
+// bits[l]: bit i (of the 128, two words) set where light sample l adds a term at pixel i (its
+// distance above 0 and its brdf not 0, as add_light_samples skips the others): where
+// shade_local would call its visibility.
+struct LightNeeds {
+  uint64_t bits[kShadeVisibleLights][2];
+  bool at(int l, int i) const { return (bits[l][i / 64] >> (i % 64) & 1) != 0; }
+};
+// vis[l][i]: vis_l at pixel i (used where the light sample's bit in LightNeeds is set).
+struct LightVisibility {
+  alignas(64) float vis[kShadeVisibleLights][kShadeBatch];
 };
 
 // The light samples, structure of arrays, in the order they are summed.
@@ -84,7 +101,14 @@ struct ShadeKernels {
   const char* isa;
   // Fill batch.shading_normal and batch.colour for pixels [0, count) (and the padding).
   void (*shade)(ShadeBatch& batch, const float eye[3], const ShadeLights& lights);
-  void (*shade_surfaces)(SurfaceBatch& batch, const ShadeLights& lights);
+  // Each light sample's visibility 1 when `visibility` is null (local mode), else
+  // visibility->vis[l][i] (lights.count <= kShadeVisibleLights).
+  void (*shade_surfaces)(SurfaceBatch& batch, const ShadeLights& lights,
+                         const LightVisibility* visibility);
+  // Fill batch.position, batch.shading_normal and `needs` (cleared first) for pixels [0, count),
+  // lights.count <= kShadeVisibleLights: the points and normals a tracer's shadow rays leave from,
+  // and which it traces, before shade_surfaces takes their visibility.
+  void (*light_needs)(SurfaceBatch& batch, const ShadeLights& lights, LightNeeds& needs);
 };
 
 // The kernels of one instruction set; the caller must have checked cpu_supports(isa).
