@@ -4,10 +4,10 @@
 // cases, so an image cannot depend on the kernel, and softraster and the tracer compute the same
 // colour for the same surface point.
 #include <gtest/gtest.h>
-#include <stdint.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <glm/glm.hpp>
